@@ -1,0 +1,21 @@
+//! Bakes an rpath to the MuJoCo library folder into every executable of this package
+//! (binary, tests, doctests, benches), so they run without LD_LIBRARY_PATH.
+//! The folder comes from `MUJOCO_DYNAMIC_LINK_DIR`, which `.cargo/config.toml` sets to
+//! `third_party/mujoco/lib` (filled by `tools/bootstrap`).
+
+fn main() {
+    println!("cargo:rerun-if-env-changed=MUJOCO_DYNAMIC_LINK_DIR");
+    match std::env::var("MUJOCO_DYNAMIC_LINK_DIR") {
+        Ok(dir) => {
+            if !std::path::Path::new(&dir).join("libmujoco.so").exists() {
+                println!(
+                    "cargo:warning=libmujoco.so not found in {dir}: run tools/bootstrap first"
+                );
+            }
+            println!("cargo:rustc-link-arg=-Wl,-rpath,{dir}");
+        }
+        Err(_) => println!(
+            "cargo:warning=MUJOCO_DYNAMIC_LINK_DIR is not set: run cargo from the repository root (it reads .cargo/config.toml)"
+        ),
+    }
+}

@@ -1,0 +1,28 @@
+//! # macrotree
+//!
+//! Behavior trees written in YAML that drive a MuJoCo simulation of a Universal Robots UR5e
+//! arm with a Robotiq 2F-85 gripper through pick-and-place macro actions.
+//!
+//! The crate is layered the way the data flows:
+//!
+//! | layer | module | depends on MuJoCo? |
+//! |---|---|---|
+//! | YAML tree → typed spec (with source spans) | [`spec`] | no |
+//! | spec → validated, compiled plan (a bonsai `Behavior`) | [`plan`] | no |
+//! | plan → running tree (ticks, halts, trace events) | [`runtime`] | no |
+//! | typed world snapshot and condition leaves | [`world`] | no |
+//! | kinematics, IK, trajectories, gripper calibration | [`motion`] | no |
+//! | MuJoCo scene, stepping, world extraction | [`sim`] | yes |
+//! | macro-action leaves (reach, grasp, carry, …) | [`actions`] | through [`sim`] |
+//! | command-line interface | [`cli`] | yes |
+//!
+//! Units everywhere: metres, radians, seconds, unless a name says otherwise.
+
+pub mod actions;
+pub mod cli;
+pub mod motion;
+pub mod plan;
+pub mod runtime;
+pub mod sim;
+pub mod spec;
+pub mod world;
