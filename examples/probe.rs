@@ -1,45 +1,9 @@
-use macrotree::sim::{Scene, Sim};
+use macrotree::sim::{Scene, Sim, HOME_Q};
 fn main() {
-    let t = std::time::Instant::now();
     let scene = Scene::load().unwrap();
-    println!("load {:?}", t.elapsed());
-    let m = &scene.model;
-    println!(
-        "nq {} nv {} nu {} nbody {} ngeom {}",
-        m.ffi().nq,
-        m.ffi().nv,
-        m.ffi().nu,
-        m.ffi().nbody,
-        m.ffi().ngeom
-    );
+    println!("gains {:?}", scene.arm_gains);
     let mut sim = Sim::new(&scene);
+    for _ in 0..1000 { sim.command_arm(&HOME_Q, &[0.0; 6]); sim.step(); }
     let w = sim.observe();
-    println!(
-        "pinch {:?}\nrot {:?}\nwidth {}",
-        w.pinch_pos, w.pinch_rot, w.gripper_width
-    );
-    for _ in 0..500 {
-        sim.step();
-    }
-    let w = sim.observe();
-    println!(
-        "after 1s: pinch {:?} cube {:?} q {:?} width {}",
-        w.pinch_pos, w.cube_pos, w.arm_q, w.gripper_width
-    );
-    for u in [0.0, 50.0, 100.0, 150.0, 200.0, 230.0, 255.0] {
-        sim.set_gripper_ctrl(u);
-        for _ in 0..1000 {
-            sim.step();
-        }
-        let w = sim.observe();
-        println!(
-            "ctrl {u}: width {:.5} speed {:.4}",
-            w.gripper_width, w.gripper_speed
-        );
-    }
-    let t = std::time::Instant::now();
-    for _ in 0..10000 {
-        sim.step();
-    }
-    println!("10k steps {:?}", t.elapsed());
+    println!("after 2s with ff: pinch {:?} err {:?}", w.pinch_pos, macrotree::world::conditions::home_error(&w));
 }

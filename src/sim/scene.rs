@@ -87,6 +87,10 @@ pub struct Scene {
     pub model: Arc<MjModel>,
     /// Ids looked up once at load time.
     pub ids: SceneIds,
+    /// Position-servo gains (kp in N·m/rad, kv in N·m·s/rad) of each arm actuator.
+    pub arm_gains: [(f64, f64); 6],
+    /// Control range of each arm actuator, radians.
+    pub arm_ctrlrange: [[f64; 2]; 6],
 }
 
 impl std::fmt::Debug for Scene {
@@ -138,10 +142,12 @@ impl Scene {
             .map_err(|e| spec_err("attaching the 2F-85", e))?;
         let model = scene.compile().map_err(|e| spec_err("compiling the scene", e))?;
         let ids = SceneIds::lookup(&model)?;
-        Ok(Self {
-            model: Arc::new(model),
-            ids,
-        })
+        let gain = model.actuator_gainprm();
+        let bias = model.actuator_biasprm();
+        let range = model.actuator_ctrlrange();
+        let arm_gains = ids.arm_act.map(|a| (gain[a][0], -bias[a][2]));
+        let arm_ctrlrange = ids.arm_act.map(|a| range[a]);
+        Ok(Self { model: Arc::new(model), ids, arm_gains, arm_ctrlrange })
     }
 }
 

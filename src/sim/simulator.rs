@@ -89,6 +89,27 @@ impl Sim {
         }
     }
 
+    /// Commands the arm to track joint angles `q` (radians) moving at `qd` (rad/s), with feedforward.
+    ///
+    /// Menagerie's UR5e servos are plain PD position actuators, `τ = kp (ctrl − q) − kv q̇`, with
+    /// no gravity compensation: holding a pose they sag by about 0.6° (≈1 cm at the tool), and
+    /// tracking a moving target they lag by `kv/kp · q̇`. This command shifts the servo set point
+    /// so that `τ = kp (q − q_meas) + kv (qd − q̇_meas) + bias`, where `bias` is MuJoCo's
+    /// gravity + Coriolis torque at the current state (`qfrc_bias`) — the feedforward a real UR
+    /// controller applies. Call it before every physics step while tracking.
+    pub fn command_arm(&mut self, q: &[f64; 6], qd: &[f64; 6]) {
+        let ids = &self.scene.ids;
+        let bias = self.data.qfrc_bias();
+        let mut set = [0.0; 6];
+        for i in 0..6 {
+            let (kp, kv) = self.scene.arm_gains[i];
+            let u = q[i] + (kv * qd[i] + bias[ids.arm_dof[i]]) / kp;
+            let [lo, hi] = self.scene.arm_ctrlrange[i];
+            set[i] = u.clamp(lo, hi);
+        }
+        self.set_arm_ctrl(&set);
+    }
+
     /// Commands the gripper actuator (0 = open … 255 = closed).
     pub fn set_gripper_ctrl(&mut self, u: f64) {
         let a = self.scene.ids.gripper_act;
