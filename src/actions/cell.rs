@@ -16,11 +16,14 @@ enum ArmPlan {
     Track { trajectory: Box<dyn Trajectory>, t0: f64 },
 }
 
-/// Receives every physics step's actuator command (for replays and benchmarks).
-pub trait StepObserver {
+/// Sees every physics step and every macro action that starts: fault injection acts on the
+/// physics through it, benchmarks record the controls.
+pub trait StepObserver: Send {
     /// Called after the controls for the coming physics step are set; may act on the physics
     /// (fault injection) or record the controls.
     fn before_step(&mut self, sim: &mut Sim);
+    /// A macro action of `kind` (`"reach"`, `"grasp"`, `"carry"`, …) starts now.
+    fn on_action_start(&mut self, _kind: &str, _world: &World) {}
 }
 
 /// The simulated cell: simulation, arm tracker, gripper command and the latest world snapshot.
@@ -30,8 +33,8 @@ pub struct Cell {
     arm: ArmPlan,
     gripper_ctrl: f64,
     steps_per_tick: u32,
-    /// Optional per-step hook (fault injection, control recording).
-    pub observer: Option<Box<dyn StepObserver + Send>>,
+    /// Per-step hooks (fault injection, control recording), called in order.
+    pub observers: Vec<Box<dyn StepObserver>>,
 }
 
 impl Cell {
@@ -47,7 +50,7 @@ impl Cell {
             arm: ArmPlan::Hold(crate::sim::HOME_Q),
             gripper_ctrl: 0.0,
             steps_per_tick,
-            observer: None,
+            observers: Vec::new(),
         };
         cell.reset(layout);
         cell
@@ -59,6 +62,13 @@ impl Cell {
         self.arm = ArmPlan::Hold(crate::sim::HOME_Q);
         self.gripper_ctrl = 0.0;
         self.world = self.sim.observe();
+    }
+
+    /// Tells the observers that a macro action of `kind` starts.
+    pub fn notify_action_start(&mut self, kind: &str) {
+        for obs in &mut self.observers {
+            obs.on_action_start(kind, &self.world);
+        }
     }
 
     /// The control period, seconds.
@@ -133,7 +143,7 @@ impl Cell {
             };
             self.sim.command_arm(&q, &qd);
             self.sim.set_gripper_ctrl(self.gripper_ctrl);
-            if let Some(obs) = self.observer.as_mut() {
+            for obs in &mut self.observers {
                 obs.before_step(&mut self.sim);
             }
             self.sim.step();
