@@ -13,7 +13,7 @@ use super::reach::Reach;
 use super::release::Release;
 use crate::plan::LeafId;
 use crate::runtime::{LeafDriver, LeafOutcome};
-use crate::spec::Leaf;
+use crate::spec::{ActionLeaf, ConditionLeaf, Leaf};
 use crate::world::conditions as cond;
 
 /// A running macro action and when it must be done by.
@@ -42,12 +42,14 @@ pub struct MacroDriver<'a> {
     pub checks: ChecksRecorder,
     /// Leaf counters.
     pub counters: LeafCounters,
+    /// The reason of the last action that failed.
+    pub last_failure: Option<String>,
 }
 
 impl<'a> MacroDriver<'a> {
     /// A driver acting on `cell`.
     pub fn new(cell: &'a mut Cell) -> Self {
-        Self { cell, active: HashMap::new(), checks: ChecksRecorder::default(), counters: LeafCounters::default() }
+        Self { cell, active: HashMap::new(), checks: ChecksRecorder::default(), counters: LeafCounters::default(), last_failure: None }
     }
 
     /// The cell.
@@ -62,72 +64,78 @@ impl<'a> MacroDriver<'a> {
         self.checks.on_tick(self.cell.world(), closed);
     }
 
-    fn start_action(&mut self, leaf: &Leaf) -> Option<(Box<dyn MacroAction>, f64)> {
-        Some(match leaf {
-            Leaf::Reach(s) => (Box::new(Reach::new(s.clone())) as Box<dyn MacroAction>, s.timeout),
-            Leaf::MoveJoints(s) => (Box::new(MoveJoints::new(s.joints)), s.timeout),
-            Leaf::Home(s) => (Box::new(MoveJoints::home()), s.timeout),
-            Leaf::Grasp(s) => {
+    fn start_action(&mut self, leaf: &ActionLeaf) -> Box<dyn MacroAction> {
+        match leaf {
+            ActionLeaf::Reach(s) => Box::new(Reach::new(s.clone())),
+            ActionLeaf::MoveJoints(s) => Box::new(MoveJoints::new(s.joints)),
+            ActionLeaf::Home(_) => Box::new(MoveJoints::home()),
+            ActionLeaf::Grasp(s) => {
                 self.counters.grasp_attempts += 1;
-                (Box::new(Grasp::new(s.clone())), s.timeout)
+                Box::new(Grasp::new(s.clone()))
             }
-            Leaf::Carry(s) => {
+            ActionLeaf::Carry(s) => {
                 self.counters.carries += 1;
-                (Box::new(Carry::new(s.clone())), s.timeout)
+                Box::new(Carry::new(s.clone()))
             }
-            Leaf::Release(s) => {
+            ActionLeaf::Release(s) => {
                 self.checks.on_open();
-                (Box::new(Release::new(s.clone())), s.timeout)
+                Box::new(Release::new(s.clone()))
             }
-            _ => return None,
-        })
+        }
     }
 
-    fn condition(&self, leaf: &Leaf) -> Option<bool> {
+    fn condition(&self, leaf: &ConditionLeaf) -> bool {
         let w = self.cell.world();
-        Some(match leaf {
-            Leaf::CubeGrasped(_) => cond::cube_grasped(w, cond::Tolerances::GRASP_OFF_AXIS),
-            Leaf::CubeLifted(c) => cond::cube_lifted(w, c.min_height),
-            Leaf::CubeInBowl(_) => cond::cube_in_bowl(w, cond::Tolerances::REST_SPEED),
-            Leaf::CubeOnTable(_) => {
-                cond::cube_on_table(w, cond::Tolerances::ON_TABLE_HEIGHT, cond::Tolerances::REST_SPEED)
-            }
-            Leaf::GripperOpen(c) => cond::gripper_open(w, c.min_width),
-            Leaf::AtHome(c) => cond::at_home(w, c.tolerance),
-            _ => return None,
-        })
+        match leaf {
+            ConditionLeaf::CubeGrasped(_) => cond::cube_grasped(w, cond::Tolerances::GRASP_OFF_AXIS),
+            ConditionLeaf::CubeLifted(c) => cond::cube_lifted(w, c.min_height),
+            ConditionLeaf::CubeInBowl(_) => cond::cube_in_bowl(w, cond::Tolerances::REST_SPEED),
+            ConditionLeaf::CubeOnTable(c) => cond::cube_on_table(w, c.tolerance, cond::Tolerances::REST_SPEED),
+            ConditionLeaf::GripperOpen(c) => cond::gripper_open(w, c.min_width),
+            ConditionLeaf::AtHome(c) => cond::at_home(w, c.tolerance),
+        }
     }
 
     fn finish(&mut self, id: LeafId, leaf: &Leaf, progress: Progress) -> LeafOutcome {
         if !matches!(progress, Progress::Running) {
             self.active.remove(&id);
-            if matches!(leaf, Leaf::Grasp(_)) {
+            if matches!(leaf, Leaf::Action(ActionLeaf::Grasp(_))) {
                 self.checks.after_grasp(self.cell.world());
             }
         }
         match progress {
             Progress::Running => LeafOutcome::Running,
             Progress::Done => LeafOutcome::Success,
-            Progress::Failed(reason) => LeafOutcome::Failure(reason),
+            Progress::Failed(reason) => {
+                self.last_failure = Some(reason.clone());
+                LeafOutcome::Failure(reason)
+            }
         }
     }
 }
 
 impl LeafDriver for MacroDriver<'_> {
     fn tick(&mut self, id: LeafId, leaf: &Leaf, first: bool) -> LeafOutcome {
-        if let Some(ok) = self.condition(leaf) {
-            return if ok { LeafOutcome::Success } else { LeafOutcome::Failure(format!("{} is false", leaf.kind())) };
-        }
+        let action = match leaf {
+            Leaf::Condition(c) => {
+                return if self.condition(c) {
+                    LeafOutcome::Success
+                } else {
+                    LeafOutcome::Failure(format!("{} is false", c.kind()))
+                };
+            }
+            Leaf::Action(a) => a,
+            Leaf::Wait(_) => return LeafOutcome::Failure("wait is handled by the runtime, not the driver".into()),
+        };
         if first || !self.active.contains_key(&id) {
-            let Some((mut action, timeout)) = self.start_action(leaf) else {
-                return LeafOutcome::Failure(format!("{} is not an action this driver executes", leaf.kind()));
-            };
-            self.cell.notify_action_start(leaf.kind());
-            if let Err(reason) = action.start(self.cell) {
+            let mut controller = self.start_action(action);
+            self.cell.notify_action_start(action.kind());
+            if let Err(reason) = controller.start(self.cell) {
                 return self.finish(id, leaf, Progress::Failed(reason));
             }
             let now = self.cell.world().time;
-            self.active.insert(id, Active { action, deadline: now + timeout, timeout });
+            let timeout = action.timeout();
+            self.active.insert(id, Active { action: controller, deadline: now + timeout, timeout });
             return LeafOutcome::Running;
         }
         let now = self.cell.world().time;

@@ -89,6 +89,7 @@ pub fn run_in_cell(
     }
     let checks = driver.checks.clone();
     let counters = driver.counters;
+    let last_failure = driver.last_failure.clone();
     let world = cell.world().clone();
-    EpisodeReport::new(status, timed_out, config, &world, checks.finish(&world), counters, cell.sim().steps(), wall.elapsed().as_secs_f64(), runner.failure_reason())
+    EpisodeReport::new(status, timed_out, config, &world, checks.finish(&world), counters, cell.sim().steps(), wall.elapsed().as_secs_f64(), last_failure)
 }

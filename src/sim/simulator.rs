@@ -10,15 +10,7 @@ use super::layout::Layout;
 use super::scene::Scene;
 use crate::world::{BowlGeometry, World};
 
-/// Home joint angles of the UR5e (Menagerie keyframe `home`), radians.
-pub const HOME_Q: [f64; 6] = [
-    -std::f64::consts::FRAC_PI_2,
-    -std::f64::consts::FRAC_PI_2,
-    std::f64::consts::FRAC_PI_2,
-    -std::f64::consts::FRAC_PI_2,
-    -std::f64::consts::FRAC_PI_2,
-    0.0,
-];
+pub use crate::motion::HOME_Q;
 
 /// Half-thickness of a 2F-85 pad box across the grip (Menagerie `pad_box1/2` size y), metres.
 pub const PAD_HALF_THICKNESS: f64 = 0.004;
