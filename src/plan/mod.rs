@@ -1,1 +1,201 @@
-//! (under construction)
+//! Spec → validated, compiled plan: a bonsai [`Behavior<LeafId>`](bonsai_bt::Behavior) plus
+//! tables describing every node and leaf.
+//!
+//! # How node kinds map onto bonsai 0.14
+//!
+//! Every non-leaf node `X` is compiled to `B(X)` and wrapped in a *probe* so that the runtime
+//! learns exactly how bonsai finished it (bonsai itself reports only leaf calls):
+//!
+//! ```text
+//! W(X) = Select([ Sequence([ B(X), ok_probe(X) ]), fail_probe(X) ])
+//! ```
+//!
+//! Probes are internal leaves ([`Internal::Probe`]) that record the outcome and pass the whole
+//! remaining `dt` on, so they cost no simulated time. `B(X)` is:
+//!
+//! | YAML | bonsai |
+//! |---|---|
+//! | `sequence` / `fallback` | `Sequence` / `Select` (with memory) |
+//! | `parallel` | `WhenAll` |
+//! | `race` | `Race` |
+//! | `reactive_sequence [c.., x]` / `guard {c, x}` | `Race([check(c).., W(x)])`, a check reports Running while its condition holds and Failure otherwise |
+//! | `reactive_fallback [c.., x]` | `Race([check(c).., W(x)])`, a check reports Running while its condition fails and Success otherwise |
+//! | `retry N` | `Select([W(x), Sequence([yield₂, W(x)]), …, Sequence([yield_N, W(x)])])` |
+//! | `repeat N` | `Sequence([W(x), yield₂, W(x), …, yield_N, W(x)])` |
+//! | `timeout S` | `Timeout(S, W(x))` |
+//! | `inverter` / `force_success` / `force_failure` | `Invert` / `AlwaysSucceed` / `Invert(AlwaysSucceed)` |
+//! | `subtree` | `W(body)` |
+//! | leaf | `Action(LeafId)` |
+//!
+//! A *yield* ([`Internal::Yield`]) is Running on the tick it is reached and Success on the next
+//! one, so each retry attempt / repeat iteration after the first starts on a fresh tick, after
+//! the world has been stepped and re-read. See `docs/tick_semantics.md`.
+
+mod compile;
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::spec::{self, Diagnostic, Leaf};
+
+pub use compile::compile_spec;
+
+/// Index of a leaf: `plan.leaves[id.index()]` for ordinary leaves; internal leaves (probes and
+/// yields, see [`Internal`]) have the top bit set and index `plan.internal`.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+pub struct LeafId(pub u32);
+
+impl LeafId {
+    /// The bit that marks internal leaves.
+    pub const INTERNAL: u32 = 1 << 31;
+
+    /// True for probes and yields.
+    pub fn is_internal(self) -> bool {
+        self.0 & Self::INTERNAL != 0
+    }
+
+    /// Index into `plan.leaves` (or `plan.internal` for internal leaves).
+    pub fn index(self) -> usize {
+        (self.0 & !Self::INTERNAL) as usize
+    }
+}
+
+/// How a condition leaf that is re-checked every tick (by a `guard` or a reactive composite)
+/// reports to bonsai.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Check {
+    /// `inverter` nodes between the check's owner and the condition leaf, outermost first; the
+    /// condition's result is flipped once per inverter.
+    pub inverters: Vec<usize>,
+    /// The (inverted) result that lets the guarded child run: `true` (Success) for `guard` and
+    /// `reactive_sequence`, `false` (Failure) for `reactive_fallback`. That result is reported
+    /// to bonsai as Running; the other one is reported as is.
+    pub continue_on: bool,
+}
+
+/// One leaf of the plan (an action, a condition or a `wait`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LeafInfo {
+    /// The node path, e.g. `main/sequence/retry/sequence[pick]/reach#2`.
+    pub path: String,
+    /// The leaf with all parameters resolved.
+    pub kind: Leaf,
+    /// Index of the leaf's node in `plan.nodes`.
+    pub node: usize,
+    /// Set when the leaf is a re-checked condition of a guard / reactive composite.
+    pub check: Option<Check>,
+}
+
+/// One node of the plan (composite, decorator, subtree call or leaf), in preorder.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NodeInfo {
+    /// Stable, unique, readable path: `main/<segment>/…` where a segment is the node kind,
+    /// `[name]` if the node has a `name:` (for subtree calls, the subtree's name), and `#k`
+    /// (1-based) when siblings would otherwise share the segment.
+    pub path: String,
+    /// The YAML node kind (`sequence`, `retry`, `reach`, …).
+    pub kind: &'static str,
+    /// The `name:` given in YAML (for a subtree call without a name: the subtree's name).
+    pub name: Option<String>,
+    /// Parent node index (`None` for the root).
+    pub parent: Option<usize>,
+    /// Child node indices, in tick order (a guard's condition first).
+    pub children: Vec<usize>,
+    /// The leaf, for leaf nodes.
+    pub leaf: Option<LeafId>,
+    /// Short human-readable summary with the key parameters, e.g. `retry ×3`,
+    /// `reach cube +[0, 0, 0.15]`.
+    pub label: String,
+    /// Where the node is written, `file:line:column`.
+    pub source: String,
+}
+
+/// Runtime-internal leaves inserted by the compiler; they never reach a driver.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub enum Internal {
+    /// Records that `node` finished with Success (`success == true`) or Failure, and returns that
+    /// status with the whole remaining `dt`.
+    Probe {
+        /// The node whose outcome this probe records.
+        node: usize,
+        /// Which outcome.
+        success: bool,
+    },
+    /// Running on the tick it is first reached, Success (passing `dt` on) on the next tick:
+    /// starts iteration `iteration` (2-based) of the `retry`/`repeat` node `node` on a fresh tick.
+    Yield {
+        /// The retry / repeat node.
+        node: usize,
+        /// The attempt / iteration that starts after the yield (2, 3, …).
+        iteration: u32,
+        /// Total attempts / iterations of that node.
+        of: u32,
+    },
+}
+
+/// A validated, compiled tree, ready to be run by [`crate::runtime::TreeRunner`].
+#[derive(Clone, Debug)]
+pub struct Plan {
+    /// The bonsai behavior; actions are [`LeafId`]s.
+    pub behavior: bonsai_bt::Behavior<LeafId>,
+    /// Ordinary leaves, indexed by [`LeafId::index`].
+    pub leaves: Vec<LeafInfo>,
+    /// Every node in preorder; index 0 is the root.
+    pub nodes: Vec<NodeInfo>,
+    /// Internal leaves (probes, yields), indexed by [`LeafId::index`] of internal ids.
+    pub internal: Vec<Internal>,
+    /// The main file's name.
+    pub file: String,
+}
+
+impl Plan {
+    /// The ordinary leaf with this id (`None` for internal ids).
+    pub fn leaf(&self, id: LeafId) -> Option<&LeafInfo> {
+        if id.is_internal() {
+            None
+        } else {
+            self.leaves.get(id.index())
+        }
+    }
+
+    /// The internal leaf with this id (`None` for ordinary ids).
+    pub fn internal(&self, id: LeafId) -> Option<&Internal> {
+        if id.is_internal() {
+            self.internal.get(id.index())
+        } else {
+            None
+        }
+    }
+
+    /// Index of the node with this path.
+    pub fn node_by_path(&self, path: &str) -> Option<usize> {
+        self.nodes.iter().position(|n| n.path == path)
+    }
+
+    /// The leaf whose node path is `path`.
+    pub fn leaf_by_path(&self, path: &str) -> Option<LeafId> {
+        self.leaves
+            .iter()
+            .position(|l| l.path == path)
+            .map(|i| LeafId(i as u32))
+    }
+
+    /// Number of bonsai behavior nodes (a measure of the compiled size).
+    pub fn behavior_size(&self) -> usize {
+        compile::behavior_size(&self.behavior)
+    }
+}
+
+/// Read, validate and compile a tree file (following its `include:`s).
+pub fn load_plan(path: &Path) -> Result<Plan, Vec<Diagnostic>> {
+    let spec = spec::load_file(path)?;
+    compile_spec(&spec)
+}
+
+/// Read, validate and compile a tree from text. `file_name` appears in diagnostics, and its
+/// folder (if any) is the base for relative `include:` paths.
+pub fn compile_str(src: &str, file_name: &str) -> Result<Plan, Vec<Diagnostic>> {
+    let spec = spec::load_str(src, file_name)?;
+    compile_spec(&spec)
+}

@@ -1,1 +1,28 @@
-//! (under construction)
+//! YAML → typed, spanned spec.
+//!
+//! The pipeline is: text → [`value::Value`] (generic YAML with a location on every node, read by
+//! serde-saphyr under resource limits) → [`file::TreeFile`] (`include:`, `subtrees:`, `main:`)
+//! → [`node::Node`] (typed tree, subtrees expanded with their arguments, every node located).
+//! Every problem is an [`Issue`] turned into a [`Diagnostic`] with file:line:column.
+//!
+//! The format itself is documented in `docs/tree_format.md`.
+
+pub mod de;
+pub mod diag;
+pub mod expand;
+pub mod file;
+pub mod leaves;
+pub mod load;
+pub mod node;
+pub mod suggest;
+pub mod units;
+pub mod value;
+
+pub use diag::{Diagnostic, Issue, Loc, Sources};
+pub use leaves::{
+    ActionLeaf, AtHome, Carry, ConditionLeaf, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable,
+    Grasp, GripperOpen, Home, Leaf, MoveJoints, Reach, Release, Wait,
+};
+pub use load::{Spec, load_file, load_str};
+pub use node::{Node, NodeKind};
+pub use units::{PathKind, Target, Yaw};

@@ -1,0 +1,592 @@
+//! [`TreeRunner`]: bonsai `BT` + leaf lifecycle + per-node statuses.
+
+use std::sync::Arc;
+
+use bonsai_bt::{BT, Event, Status, UpdateArgs};
+use tracing::Level;
+
+use super::{LeafDriver, LeafOutcome, NodeStatus, Transition, TreeStatus};
+use crate::plan::{Internal, LeafId, Plan};
+use crate::spec::Leaf;
+
+/// Pending transitions kept when nobody drains them; older ones are dropped (and counted).
+const MAX_PENDING_TRANSITIONS: usize = 100_000;
+
+/// Runs a [`Plan`] on simulated time.
+///
+/// Each [`tick`](Self::tick) ticks the bonsai tree once with the given `dt`, calls the driver
+/// for the leaves bonsai reaches, then detects preempted nodes (see `docs/tick_semantics.md`),
+/// calls [`LeafDriver::halt`] for preempted running leaves, and records status transitions.
+pub struct TreeRunner {
+    plan: Arc<Plan>,
+    bt: BT<LeafId, ()>,
+    st: RunState,
+}
+
+#[derive(Default)]
+struct LeafRt {
+    /// The last call returned Running (the leaf is mid-execution).
+    running: bool,
+    /// Tick of the last call.
+    last_tick: u64,
+    /// `wait` leaves: simulated seconds accumulated in the current execution.
+    elapsed: f64,
+    /// Open while the leaf runs.
+    span: Option<tracing::Span>,
+}
+
+struct RunState {
+    statuses: Vec<NodeStatus>,
+    reasons: Vec<Option<String>>,
+    touched: Vec<u64>,
+    /// Root-first ancestors of each node, excluding the node itself.
+    ancestors: Vec<Vec<usize>>,
+    enclosing_retry: Vec<Option<usize>>,
+    attempts: Vec<u32>,
+    leaves: Vec<LeafRt>,
+    yield_pending: Vec<bool>,
+    pending_yields: Vec<(usize, u64)>,
+    last_failure: Option<String>,
+    transitions: Vec<Transition>,
+    dropped: u64,
+    tick: u64,
+    sim_time: f64,
+    finished: Option<TreeStatus>,
+}
+
+impl RunState {
+    fn new(plan: &Plan) -> Self {
+        let n = plan.nodes.len();
+        let mut ancestors = vec![Vec::new(); n];
+        let mut enclosing_retry = vec![None; n];
+        for i in 0..n {
+            if let Some(p) = plan.nodes[i].parent {
+                let mut a = ancestors[p].clone();
+                a.push(p);
+                ancestors[i] = a;
+                enclosing_retry[i] = if plan.nodes[p].kind == "retry" {
+                    Some(p)
+                } else {
+                    enclosing_retry[p]
+                };
+            }
+            if plan.nodes[i].kind == "retry" {
+                enclosing_retry[i] = Some(i);
+            }
+        }
+        Self {
+            statuses: vec![NodeStatus::Idle; n],
+            reasons: vec![None; n],
+            touched: vec![0; n],
+            ancestors,
+            enclosing_retry,
+            attempts: vec![0; n],
+            leaves: (0..plan.leaves.len()).map(|_| LeafRt::default()).collect(),
+            yield_pending: vec![false; plan.internal.len()],
+            pending_yields: Vec::new(),
+            last_failure: None,
+            transitions: Vec::new(),
+            dropped: 0,
+            tick: 0,
+            sim_time: 0.0,
+            finished: None,
+        }
+    }
+
+    fn level(plan: &Plan, node: usize) -> Level {
+        let info = &plan.nodes[node];
+        if info.leaf.is_some()
+            || info.parent.is_none()
+            || matches!(
+                info.kind,
+                "retry" | "guard" | "timeout" | "reactive_sequence" | "reactive_fallback"
+            )
+        {
+            Level::INFO
+        } else {
+            Level::DEBUG
+        }
+    }
+
+    /// Set a node's status; log a transition if it changed.
+    fn set(&mut self, plan: &Plan, node: usize, to: NodeStatus, reason: Option<String>) {
+        let from = self.statuses[node];
+        if to == NodeStatus::Failure || to == NodeStatus::Halted {
+            self.reasons[node] = reason.clone();
+        }
+        if from == to {
+            return;
+        }
+        self.statuses[node] = to;
+        let info = &plan.nodes[node];
+        let t = Transition {
+            tick: self.tick,
+            sim_time: self.sim_time,
+            node,
+            path: info.path.clone(),
+            kind: info.kind,
+            from,
+            to,
+            reason: if matches!(to, NodeStatus::Failure | NodeStatus::Halted) {
+                reason
+            } else {
+                None
+            },
+            attempt: self.enclosing_retry[node].map(|r| self.attempts[r].max(1)),
+        };
+        macro_rules! emit {
+            ($mac:ident) => {
+                tracing::$mac!(
+                    target: "macrotree::tree",
+                    tick = t.tick,
+                    sim_time = t.sim_time,
+                    path = %t.path,
+                    kind = t.kind,
+                    from = t.from.as_str(),
+                    to = t.to.as_str(),
+                    reason = t.reason.as_deref(),
+                    attempt = t.attempt,
+                    "{} {} -> {}",
+                    t.path,
+                    t.from,
+                    t.to
+                )
+            };
+        }
+        if Self::level(plan, node) == Level::INFO {
+            emit!(info);
+        } else {
+            emit!(debug);
+        }
+        if self.transitions.len() >= MAX_PENDING_TRANSITIONS {
+            self.transitions.remove(0);
+            self.dropped += 1;
+        }
+        self.transitions.push(t);
+    }
+
+    /// A leaf below `node` is being ticked: every ancestor that is not running starts running.
+    fn touch(&mut self, plan: &Plan, node: usize) {
+        let tick = self.tick;
+        for k in 0..self.ancestors[node].len() {
+            let a = self.ancestors[node][k];
+            if self.touched[a] == tick && self.statuses[a] == NodeStatus::Running {
+                continue;
+            }
+            self.touched[a] = tick;
+            if self.statuses[a] != NodeStatus::Running {
+                if matches!(plan.nodes[a].kind, "retry" | "repeat") {
+                    self.attempts[a] = 1;
+                }
+                self.set(plan, a, NodeStatus::Running, None);
+            }
+        }
+        self.touched[node] = tick;
+    }
+
+    fn on_leaf(
+        &mut self,
+        plan: &Plan,
+        driver: &mut dyn LeafDriver,
+        id: LeafId,
+        dt: f64,
+    ) -> (Status, f64) {
+        if let Some(internal) = plan.internal(id) {
+            return self.on_internal(plan, id, internal, dt);
+        }
+        let Some(info) = plan.leaf(id) else {
+            return (Status::Failure, dt);
+        };
+        let node = info.node;
+        self.touch(plan, node);
+        let rt = &mut self.leaves[id.index()];
+        let first = !rt.running;
+        rt.last_tick = self.tick;
+        if first {
+            rt.elapsed = 0.0;
+            rt.span = Some(
+                tracing::info_span!(target: "macrotree::tree", "leaf", path = %info.path, kind = info.kind.kind()),
+            );
+        }
+        let (outcome, leftover) = match &info.kind {
+            Leaf::Wait(w) => {
+                rt.elapsed += dt;
+                if rt.elapsed >= w.seconds {
+                    (LeafOutcome::Success, rt.elapsed - w.seconds)
+                } else {
+                    (LeafOutcome::Running, 0.0)
+                }
+            }
+            leaf => {
+                let span = rt.span.clone().unwrap_or_else(tracing::Span::none);
+                let out = span.in_scope(|| driver.tick(id, leaf, first));
+                let out = match (leaf, out) {
+                    (Leaf::Condition(c), LeafOutcome::Running) => {
+                        tracing::warn!(target: "macrotree::tree", path = %info.path, "condition `{}` answered Running; conditions must answer at once, treating it as Failure", c.kind());
+                        LeafOutcome::Failure(format!("condition `{}` answered Running", c.kind()))
+                    }
+                    (_, o) => o,
+                };
+                (out, dt)
+            }
+        };
+        let rt = &mut self.leaves[id.index()];
+        let raw = match outcome {
+            LeafOutcome::Running => {
+                rt.running = true;
+                self.set(plan, node, NodeStatus::Running, None);
+                return (Status::Running, 0.0);
+            }
+            LeafOutcome::Success => {
+                rt.running = false;
+                rt.span = None;
+                self.set(plan, node, NodeStatus::Success, None);
+                true
+            }
+            LeafOutcome::Failure(reason) => {
+                rt.running = false;
+                rt.span = None;
+                let reason = format!("{}: {reason}", info.kind.kind());
+                self.last_failure = Some(reason.clone());
+                self.set(plan, node, NodeStatus::Failure, Some(reason));
+                false
+            }
+        };
+        let Some(check) = &info.check else {
+            return (
+                if raw {
+                    Status::Success
+                } else {
+                    Status::Failure
+                },
+                leftover,
+            );
+        };
+        // A re-checked condition: apply inverters (innermost first), then decide.
+        let mut effective = raw;
+        for &inv in check.inverters.iter().rev() {
+            effective = !effective;
+            self.touched[inv] = self.tick;
+            let (st, reason) = if effective {
+                (NodeStatus::Success, None)
+            } else {
+                (
+                    NodeStatus::Failure,
+                    Some(format!("inverted: `{}` succeeded", info.kind.kind())),
+                )
+            };
+            if !effective {
+                self.last_failure = reason.clone();
+            }
+            self.set(plan, inv, st, reason);
+        }
+        if effective == check.continue_on {
+            (Status::Running, 0.0)
+        } else if effective {
+            (Status::Success, leftover)
+        } else {
+            (Status::Failure, leftover)
+        }
+    }
+
+    fn on_internal(
+        &mut self,
+        plan: &Plan,
+        id: LeafId,
+        internal: &Internal,
+        dt: f64,
+    ) -> (Status, f64) {
+        match *internal {
+            Internal::Probe { node, success } => {
+                if success {
+                    self.set(plan, node, NodeStatus::Success, None);
+                    (Status::Success, dt)
+                } else {
+                    let reason = self.failure_reason(plan, node);
+                    self.last_failure = Some(reason.clone());
+                    self.set(plan, node, NodeStatus::Failure, Some(reason));
+                    (Status::Failure, dt)
+                }
+            }
+            Internal::Yield {
+                node,
+                iteration,
+                of,
+            } => {
+                let i = id.index();
+                self.touch(plan, node);
+                if self.yield_pending[i] {
+                    self.yield_pending[i] = false;
+                    self.pending_yields.retain(|(y, _)| *y != i);
+                    (Status::Success, dt)
+                } else {
+                    self.yield_pending[i] = true;
+                    self.pending_yields.push((i, self.tick));
+                    self.attempts[node] = iteration;
+                    let info = &plan.nodes[node];
+                    if info.kind == "retry" {
+                        tracing::info!(
+                            target: "macrotree::tree",
+                            tick = self.tick,
+                            sim_time = self.sim_time,
+                            path = %info.path,
+                            kind = info.kind,
+                            attempt = iteration,
+                            reason = self.last_failure.as_deref(),
+                            "{}: attempt {} of {} starts next tick",
+                            info.path,
+                            iteration,
+                            of
+                        );
+                    } else {
+                        tracing::debug!(
+                            target: "macrotree::tree",
+                            tick = self.tick,
+                            sim_time = self.sim_time,
+                            path = %info.path,
+                            kind = info.kind,
+                            iteration,
+                            "{}: iteration {} of {} starts next tick",
+                            info.path,
+                            iteration,
+                            of
+                        );
+                    }
+                    (Status::Running, 0.0)
+                }
+            }
+        }
+    }
+
+    /// Why node `node` failed, from its kind and its children's statuses.
+    fn failure_reason(&self, plan: &Plan, node: usize) -> String {
+        let info = &plan.nodes[node];
+        let last = self
+            .last_failure
+            .clone()
+            .unwrap_or_else(|| "a child failed".into());
+        match info.kind {
+            "timeout" => {
+                let child_failed = info.children.first().is_some_and(|&c| {
+                    self.statuses[c] == NodeStatus::Failure && self.touched[c] == self.tick
+                });
+                if child_failed {
+                    last
+                } else {
+                    format!("{} expired", info.label)
+                }
+            }
+            "retry" => format!(
+                "all {} attempts failed; last: {last}",
+                self.attempts[node].max(1)
+            ),
+            "inverter" | "force_failure" => format!("{}: child succeeded", info.kind),
+            "guard" | "reactive_sequence" => {
+                let cond_failed = info
+                    .children
+                    .iter()
+                    .take(info.children.len().saturating_sub(1))
+                    .any(|&c| {
+                        self.touched[c] == self.tick && self.statuses[c] == NodeStatus::Failure
+                    });
+                if cond_failed {
+                    format!("condition failed: {last}")
+                } else {
+                    last
+                }
+            }
+            _ => last,
+        }
+    }
+
+    /// After bonsai's tick: halt running nodes that were not ticked, or whose parent is no
+    /// longer running. Preorder, so a halted parent halts its running children.
+    fn detect_halts(&mut self, plan: &Plan, driver: &mut dyn LeafDriver) {
+        for i in 0..plan.nodes.len() {
+            if self.statuses[i] != NodeStatus::Running {
+                continue;
+            }
+            let parent = plan.nodes[i].parent;
+            let parent_running = parent.is_none_or(|p| self.statuses[p] == NodeStatus::Running);
+            if self.touched[i] == self.tick && parent_running {
+                continue;
+            }
+            let reason = match parent {
+                Some(_) if !parent_running => {
+                    // The nearest ancestor that stopped running is the one that preempted us.
+                    let stopped = self.ancestors[i]
+                        .iter()
+                        .rev()
+                        .take_while(|&&a| self.statuses[a] != NodeStatus::Running)
+                        .last()
+                        .copied()
+                        .unwrap_or(i);
+                    format!(
+                        "preempted: `{}` {}",
+                        plan.nodes[stopped].path,
+                        match self.statuses[stopped] {
+                            NodeStatus::Halted => "was halted",
+                            NodeStatus::Success => "succeeded",
+                            _ => "failed",
+                        }
+                    )
+                }
+                _ => "preempted: no longer ticked by its parent".to_string(),
+            };
+            if let Some(id) = plan.nodes[i].leaf {
+                self.halt_leaf(plan, driver, id);
+            }
+            self.set(plan, i, NodeStatus::Halted, Some(reason));
+        }
+        // Yields reached but not completed are reset when not ticked any more.
+        let tick = self.tick;
+        let yp = &mut self.yield_pending;
+        self.pending_yields.retain(|&(y, t)| {
+            if t != tick {
+                yp[y] = false;
+            }
+            t == tick
+        });
+    }
+
+    fn halt_leaf(&mut self, plan: &Plan, driver: &mut dyn LeafDriver, id: LeafId) {
+        let Some(info) = plan.leaf(id) else { return };
+        let rt = &mut self.leaves[id.index()];
+        if !rt.running {
+            return;
+        }
+        rt.running = false;
+        let span = rt.span.take().unwrap_or_else(tracing::Span::none);
+        if !matches!(info.kind, Leaf::Wait(_)) {
+            span.in_scope(|| driver.halt(id, &info.kind));
+        }
+    }
+}
+
+impl TreeRunner {
+    /// A runner for `plan`, all nodes Idle.
+    pub fn new(plan: Arc<Plan>) -> Self {
+        let bt = BT::new(plan.behavior.clone(), ());
+        let st = RunState::new(&plan);
+        Self { plan, bt, st }
+    }
+
+    /// The plan being run.
+    pub fn plan(&self) -> &Arc<Plan> {
+        &self.plan
+    }
+
+    /// One control tick of `dt` simulated seconds at time `sim_time` (seconds, the time at the
+    /// start of the tick; used for logs). Returns the status of the whole tree.
+    ///
+    /// A non-finite or negative `dt` is treated as 0 (and logged). Once the tree has finished,
+    /// further ticks do nothing and return the final status until [`reset`](Self::reset).
+    pub fn tick(&mut self, sim_time: f64, dt: f64, driver: &mut dyn LeafDriver) -> TreeStatus {
+        if let Some(done) = self.st.finished {
+            return done;
+        }
+        let dt = if dt.is_finite() && dt >= 0.0 {
+            dt
+        } else {
+            tracing::warn!(target: "macrotree::tree", dt, "invalid tick dt; using 0");
+            0.0
+        };
+        let st = &mut self.st;
+        st.tick += 1;
+        st.sim_time = sim_time;
+        let plan: &Plan = &self.plan;
+        let event: Event = UpdateArgs { dt }.into();
+        let result = self.bt.tick(&event, &mut |args, _bb: &mut ()| {
+            st.on_leaf(plan, driver, *args.action, args.dt)
+        });
+        let status = match result {
+            Some((Status::Success, _)) => TreeStatus::Success,
+            Some((Status::Failure, _)) => TreeStatus::Failure,
+            Some((Status::Running, _)) => TreeStatus::Running,
+            None => TreeStatus::Failure, // bonsai says finished; cannot happen (we stop ticking first)
+        };
+        if status != TreeStatus::Running {
+            st.finished = Some(status);
+        }
+        st.detect_halts(plan, driver);
+        status
+    }
+
+    /// Status of every node (same indices as `plan.nodes`).
+    pub fn node_statuses(&self) -> &[NodeStatus] {
+        &self.st.statuses
+    }
+
+    /// The last failure / halt reason of every node (same indices as `plan.nodes`).
+    pub fn node_reasons(&self) -> &[Option<String>] {
+        &self.st.reasons
+    }
+
+    /// Status of the node at `path` (`None` if there is no such node).
+    pub fn status_of(&self, path: &str) -> Option<NodeStatus> {
+        self.plan.node_by_path(path).map(|i| self.st.statuses[i])
+    }
+
+    /// Status transitions since the last drain, in the order they happened.
+    pub fn drain_transitions(&mut self) -> Vec<Transition> {
+        std::mem::take(&mut self.st.transitions)
+    }
+
+    /// Transitions dropped because nobody drained them (more than 100 000 pending).
+    pub fn dropped_transitions(&self) -> u64 {
+        self.st.dropped
+    }
+
+    /// Leaves running now (mid-execution).
+    pub fn running_leaves(&self) -> Vec<LeafId> {
+        (0..self.st.leaves.len())
+            .filter(|&i| self.st.leaves[i].running)
+            .map(|i| LeafId(i as u32))
+            .collect()
+    }
+
+    /// Number of ticks that ticked the tree since the last reset.
+    pub fn tick_count(&self) -> u64 {
+        self.st.tick
+    }
+
+    /// The final status, once the tree has finished.
+    pub fn finished(&self) -> Option<TreeStatus> {
+        self.st.finished
+    }
+
+    /// Attempt (retry) or iteration (repeat) number of the node at index `node`: 0 before its
+    /// first run, then 1, 2, …
+    pub fn attempt(&self, node: usize) -> u32 {
+        self.st.attempts.get(node).copied().unwrap_or(0)
+    }
+
+    /// Stop the tree now: halt every running leaf (calling [`LeafDriver::halt`]) and mark every
+    /// running node Halted. The tree is then finished (Failure) until [`reset`](Self::reset).
+    pub fn halt_all(&mut self, driver: &mut dyn LeafDriver) {
+        let plan: &Plan = &self.plan;
+        let st = &mut self.st;
+        for i in 0..plan.nodes.len() {
+            if st.statuses[i] == NodeStatus::Running {
+                if let Some(id) = plan.nodes[i].leaf {
+                    st.halt_leaf(plan, driver, id);
+                }
+                st.set(
+                    plan,
+                    i,
+                    NodeStatus::Halted,
+                    Some("preempted: the tree was stopped".into()),
+                );
+            }
+        }
+        st.finished.get_or_insert(TreeStatus::Failure);
+    }
+
+    /// Start over: fresh bonsai state, all nodes Idle, counters and pending transitions cleared.
+    /// Running leaves are *not* halted here (no driver); call [`halt_all`](Self::halt_all) first
+    /// if the tree may be running.
+    pub fn reset(&mut self) {
+        self.bt.reset_bt();
+        self.st = RunState::new(&self.plan);
+    }
+}

@@ -1,0 +1,309 @@
+//! Source locations and user-facing diagnostics.
+//!
+//! Every problem found in a tree file becomes a [`Diagnostic`] that carries the file, the
+//! 1-based line and column (in characters), what was expected and what to do about it. Its
+//! [`Display`](std::fmt::Display) looks like rustc's:
+//!
+//! ```text
+//! error: unknown field `targt` in `reach`
+//!  --> trees/pick.yaml:7:20
+//!   |
+//! 7 |           - reach: {targt: cube}
+//!   |                     ^^^^^ expected one of `target`, `offset`, `yaw`, `path`, `speed`, `timeout`, `name`
+//!   = help: did you mean `target`?
+//! ```
+
+use std::fmt;
+use std::sync::Arc;
+
+/// Index of a source file in a [`Sources`] table.
+pub type FileId = u32;
+
+/// A position in a source file: 1-based line and column (counted in characters, not bytes) and
+/// the length in characters of the thing pointed at (at least 1 when rendered).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, Default)]
+pub struct Loc {
+    /// Which file ([`Sources`] index).
+    pub file: FileId,
+    /// 1-based line; 0 means "unknown".
+    pub line: u32,
+    /// 1-based column in characters; 0 means "unknown".
+    pub col: u32,
+    /// Length in characters of the spanned text (0 = unknown).
+    pub len: u32,
+}
+
+impl Loc {
+    /// A location in `file` whose line and column are unknown (e.g. the file as a whole).
+    pub fn file_start(file: FileId) -> Self {
+        Self {
+            file,
+            line: 1,
+            col: 1,
+            len: 0,
+        }
+    }
+}
+
+/// One problem in a tree file, located and explained.
+///
+/// Diagnostics are plain data so that tests can assert on `line`/`column`, and the CLI can
+/// print them with `{}` (rustc-like layout, see the module docs).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Diagnostic {
+    /// File name as given to the loader (e.g. `trees/pick.yaml`).
+    pub file: String,
+    /// 1-based line (0 if unknown).
+    pub line: u32,
+    /// 1-based column in characters (0 if unknown).
+    pub column: u32,
+    /// What is wrong, one line, lower case (e.g. "unknown node kind `sequnce`").
+    pub message: String,
+    /// Short text under the caret: what was expected there.
+    pub label: Option<String>,
+    /// What to do about it (e.g. "did you mean `sequence`?").
+    pub help: Option<String>,
+    /// Extra context (e.g. where a `$param` value came from).
+    pub note: Option<String>,
+    /// The source line the error points into, if known (without the line break).
+    pub source_line: Option<String>,
+    /// Width of the caret underline in characters (at least 1).
+    pub width: u32,
+}
+
+impl Diagnostic {
+    /// `file:line:column`, the way editors and terminals make it clickable.
+    pub fn location(&self) -> String {
+        format!("{}:{}:{}", self.file, self.line, self.column)
+    }
+}
+
+impl fmt::Display for Diagnostic {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "error: {}", self.message)?;
+        let gutter = self.line.to_string().len();
+        let pad = " ".repeat(gutter);
+        write!(f, "{pad}--> {}", self.location())?;
+        if let Some(src) = &self.source_line {
+            // Replace tabs so the caret lines up.
+            let shown: String = src
+                .chars()
+                .map(|c| if c == '\t' { ' ' } else { c })
+                .collect();
+            writeln!(f)?;
+            writeln!(f, "{pad} |")?;
+            writeln!(f, "{} | {}", self.line, shown.trim_end())?;
+            let before = " ".repeat(self.column.saturating_sub(1) as usize);
+            let carets = "^".repeat(self.width.max(1) as usize);
+            write!(f, "{pad} | {before}{carets}")?;
+            if let Some(label) = &self.label {
+                write!(f, " {label}")?;
+            }
+        } else if let Some(label) = &self.label {
+            writeln!(f)?;
+            write!(f, "{pad} = expected: {label}")?;
+        }
+        if let Some(note) = &self.note {
+            writeln!(f)?;
+            write!(f, "{pad} = note: {note}")?;
+        }
+        if let Some(help) = &self.help {
+            writeln!(f)?;
+            write!(f, "{pad} = help: {help}")?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for Diagnostic {}
+
+/// A problem found while reading a tree, before it is turned into a [`Diagnostic`] (which needs
+/// the file name and text from [`Sources`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Issue {
+    /// Where.
+    pub loc: Loc,
+    /// What is wrong.
+    pub message: String,
+    /// What was expected at that spot.
+    pub label: Option<String>,
+    /// What to do.
+    pub help: Option<String>,
+    /// Extra context.
+    pub note: Option<String>,
+}
+
+impl Issue {
+    /// A new issue at `loc` with `message`.
+    pub fn new(loc: Loc, message: impl Into<String>) -> Self {
+        Self {
+            loc,
+            message: message.into(),
+            label: None,
+            help: None,
+            note: None,
+        }
+    }
+
+    /// Set the caret label (what was expected).
+    #[must_use]
+    pub fn label(mut self, label: impl Into<String>) -> Self {
+        self.label = Some(label.into());
+        self
+    }
+
+    /// Set the help text (what to do).
+    #[must_use]
+    pub fn help(mut self, help: impl Into<String>) -> Self {
+        self.help = Some(help.into());
+        self
+    }
+
+    /// Set the help text if there is one.
+    #[must_use]
+    pub fn maybe_help(mut self, help: Option<String>) -> Self {
+        if help.is_some() {
+            self.help = help;
+        }
+        self
+    }
+
+    /// Set the note.
+    #[must_use]
+    pub fn note(mut self, note: impl Into<String>) -> Self {
+        self.note = Some(note.into());
+        self
+    }
+}
+
+/// One loaded source file.
+#[derive(Clone, Debug)]
+pub struct SourceFile {
+    /// Display name (path as given, or a test name).
+    pub name: String,
+    /// Full text (may be empty when the file could not be read).
+    pub text: Arc<str>,
+}
+
+/// The table of source files a tree was read from, for turning [`Issue`]s into
+/// [`Diagnostic`]s.
+#[derive(Clone, Debug, Default)]
+pub struct Sources {
+    files: Vec<SourceFile>,
+}
+
+impl Sources {
+    /// An empty table.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Register a file and get its id.
+    pub fn add(&mut self, name: impl Into<String>, text: impl Into<Arc<str>>) -> FileId {
+        self.files.push(SourceFile {
+            name: name.into(),
+            text: text.into(),
+        });
+        u32::try_from(self.files.len() - 1).unwrap_or(u32::MAX)
+    }
+
+    /// The file with id `id`.
+    pub fn get(&self, id: FileId) -> Option<&SourceFile> {
+        self.files.get(id as usize)
+    }
+
+    /// Number of files.
+    pub fn len(&self) -> usize {
+        self.files.len()
+    }
+
+    /// True if no file was registered.
+    pub fn is_empty(&self) -> bool {
+        self.files.is_empty()
+    }
+
+    /// Display name of file `id` (or `<unknown>`).
+    pub fn name(&self, id: FileId) -> &str {
+        self.get(id).map_or("<unknown>", |f| f.name.as_str())
+    }
+
+    /// Render `loc` as `file:line:col`.
+    pub fn describe(&self, loc: Loc) -> String {
+        format!("{}:{}:{}", self.name(loc.file), loc.line, loc.col)
+    }
+
+    /// Turn an issue into a self-contained diagnostic.
+    pub fn diagnostic(&self, issue: &Issue) -> Diagnostic {
+        let file = self.get(issue.loc.file);
+        let source_line = file.and_then(|f| {
+            if issue.loc.line == 0 {
+                return None;
+            }
+            f.text
+                .lines()
+                .nth(issue.loc.line as usize - 1)
+                .map(|l| l.chars().take(300).collect::<String>())
+        });
+        let width = match &source_line {
+            Some(l) => {
+                let avail = (l.chars().count() as u32 + 1).saturating_sub(issue.loc.col.max(1));
+                issue.loc.len.clamp(1, avail.max(1))
+            }
+            None => 1,
+        };
+        Diagnostic {
+            file: file.map_or_else(|| "<unknown>".to_string(), |f| f.name.clone()),
+            line: issue.loc.line,
+            column: issue.loc.col,
+            message: issue.message.clone(),
+            label: issue.label.clone(),
+            help: issue.help.clone(),
+            note: issue.note.clone(),
+            source_line,
+            width,
+        }
+    }
+
+    /// Turn many issues into diagnostics, sorted by file, line and column, without duplicates.
+    pub fn diagnostics(&self, issues: &[Issue]) -> Vec<Diagnostic> {
+        let mut out: Vec<Diagnostic> = Vec::with_capacity(issues.len());
+        let mut sorted: Vec<&Issue> = issues.iter().collect();
+        sorted.sort_by_key(|i| (i.loc.file, i.loc.line, i.loc.col));
+        for issue in sorted {
+            let d = self.diagnostic(issue);
+            if !out.contains(&d) {
+                out.push(d);
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn display_is_rustc_like() {
+        let mut s = Sources::new();
+        let f = s.add("t.yaml", "main:\n  sequnce: {}\n");
+        let d = s.diagnostic(
+            &Issue::new(
+                Loc {
+                    file: f,
+                    line: 2,
+                    col: 3,
+                    len: 7,
+                },
+                "unknown node kind `sequnce`",
+            )
+            .label("expected a node kind")
+            .help("did you mean `sequence`?"),
+        );
+        let text = d.to_string();
+        assert_eq!(
+            text,
+            "error: unknown node kind `sequnce`\n --> t.yaml:2:3\n  |\n2 |   sequnce: {}\n  |   ^^^^^^^ expected a node kind\n  = help: did you mean `sequence`?"
+        );
+    }
+}

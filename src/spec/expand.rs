@@ -1,0 +1,795 @@
+//! Spanned YAML values → typed [`Node`]s, expanding subtree calls with their arguments.
+//!
+//! Subtree bodies are kept as spanned [`Value`]s; a call substitutes `$param` scalars on a copy
+//! of the body (each substituted value keeps the location of the argument, and remembers the
+//! `$param` use it replaced) and then reads the copy as typed nodes. Errors therefore point at
+//! the file:line:column of whatever is wrong, argument or body.
+
+use std::collections::HashMap;
+
+use super::diag::{Issue, Loc, Sources};
+use super::file::{SubtreeDef, param_ref};
+use super::leaves::{ACTION_KINDS, CONDITION_KINDS, parse_leaf};
+use super::node::{COMPOSITE_KINDS, DECORATOR_KINDS, Node, NodeKind};
+use super::suggest::did_you_mean;
+use super::value::{Value, ValueKind};
+
+/// Deepest node nesting accepted after subtree expansion.
+pub const MAX_TREE_DEPTH: usize = 64;
+/// Most nodes accepted after subtree expansion.
+pub const MAX_TREE_NODES: usize = 5_000;
+/// Largest `attempts` / `times`.
+pub const MAX_COUNT: u32 = 1_000;
+
+/// All node kinds (composites, decorators, leaves), for suggestions.
+pub fn all_kinds() -> impl Iterator<Item = &'static str> {
+    COMPOSITE_KINDS
+        .iter()
+        .chain(DECORATOR_KINDS)
+        .chain(ACTION_KINDS)
+        .chain(CONDITION_KINDS)
+        .chain(&["wait"])
+        .copied()
+}
+
+/// Expands nodes; collects issues.
+pub struct Expander<'a> {
+    subtrees: &'a HashMap<String, SubtreeDef>,
+    sources: &'a Sources,
+    /// Problems found so far.
+    pub issues: Vec<Issue>,
+    stack: Vec<String>,
+    nodes: usize,
+    too_many_reported: bool,
+    /// How many times each subtree was called.
+    pub calls: HashMap<String, usize>,
+}
+
+impl<'a> Expander<'a> {
+    /// A new expander over the given subtree definitions.
+    pub fn new(subtrees: &'a HashMap<String, SubtreeDef>, sources: &'a Sources) -> Self {
+        Self {
+            subtrees,
+            sources,
+            issues: Vec::new(),
+            stack: Vec::new(),
+            nodes: 0,
+            too_many_reported: false,
+            calls: HashMap::new(),
+        }
+    }
+
+    fn err(&mut self, issue: Issue) {
+        self.issues.push(issue);
+    }
+
+    /// Read one node (and its descendants). `None` when it is too broken to build; the
+    /// problems are in [`Self::issues`].
+    pub fn node(&mut self, v: &Value, depth: usize) -> Option<Node> {
+        if depth > MAX_TREE_DEPTH {
+            self.err(
+                Issue::new(
+                    v.loc,
+                    format!("the tree is nested more than {MAX_TREE_DEPTH} levels deep"),
+                )
+                .help("flatten the tree or split it into subtrees"),
+            );
+            return None;
+        }
+        self.nodes += 1;
+        if self.nodes > MAX_TREE_NODES {
+            if !self.too_many_reported {
+                self.too_many_reported = true;
+                self.err(
+                    Issue::new(
+                        v.loc,
+                        format!(
+                            "the tree has more than {MAX_TREE_NODES} nodes after subtree expansion"
+                        ),
+                    )
+                    .help("check for subtrees that call each other many times"),
+                );
+            }
+            return None;
+        }
+        let (key, body) = match &v.kind {
+            ValueKind::Map(entries) if entries.len() == 1 => (&entries[0].0, &entries[0].1),
+            ValueKind::Map(entries) if entries.is_empty() => {
+                self.err(
+                    Issue::new(v.loc, "empty node `{}`")
+                        .label("expected a node like `sequence: {children: [...]}` or `home: {}`"),
+                );
+                return None;
+            }
+            ValueKind::Map(entries) => {
+                let keys: Vec<String> = entries
+                    .iter()
+                    .map(|(k, _)| format!("`{}`", k.as_str().unwrap_or("?")))
+                    .collect();
+                let has_name = entries.iter().any(|(k, _)| k.as_str() == Some("name"));
+                let help = if has_name {
+                    "put `name:` inside the node's mapping, e.g. `sequence: {name: pick, children: [...]}`"
+                } else {
+                    "a node is a mapping with exactly one key, its kind; start a new list item (`- `) for each node"
+                };
+                self.err(
+                    Issue::new(
+                        v.loc,
+                        format!(
+                            "a node must have exactly one kind, found {}",
+                            keys.join(", ")
+                        ),
+                    )
+                    .label("expected one key such as `sequence:` or `reach:`")
+                    .help(help),
+                );
+                return None;
+            }
+            ValueKind::Str(s) => {
+                let mut issue = Issue::new(
+                    v.loc,
+                    format!("a node must be a mapping, found {}", v.describe()),
+                )
+                .label("expected `kind: {parameters}`");
+                if let Some(r) = param_ref(s) {
+                    issue = issue.help(format!(
+                        "`${r}` stands for a value, not a node; pass nodes as subtrees"
+                    ));
+                } else if all_kinds().any(|k| k == s) {
+                    issue = issue.help(format!("write `{s}: {{}}`"));
+                } else if let Some(h) = did_you_mean(s, all_kinds()) {
+                    issue = issue.help(h);
+                }
+                self.err(issue);
+                return None;
+            }
+            _ => {
+                self.err(
+                    Issue::new(
+                        v.loc,
+                        format!("a node must be a mapping, found {}", v.describe()),
+                    )
+                    .label("expected `kind: {parameters}`, e.g. `home: {}`"),
+                );
+                return None;
+            }
+        };
+        let Some(kind) = key.as_str() else {
+            self.err(
+                Issue::new(key.loc, "a node kind must be a name").label("expected e.g. `sequence`"),
+            );
+            return None;
+        };
+        let kind = kind.to_string();
+        // Node bodies: a mapping, or nothing (`home:` = `home: {}`).
+        let empty;
+        let body = match &body.kind {
+            ValueKind::Map(_) => body,
+            ValueKind::Null => {
+                empty = Value::new(ValueKind::Map(vec![]), body.loc);
+                &empty
+            }
+            _ => {
+                let mut issue = Issue::new(
+                    body.loc,
+                    format!(
+                        "the body of `{kind}` must be a mapping, found {}",
+                        body.describe()
+                    ),
+                )
+                .label("expected `{...}`");
+                if COMPOSITE_KINDS.contains(&kind.as_str()) && body.as_seq().is_some() {
+                    issue = issue.help(format!("write `{kind}: {{children: [...]}}`"));
+                } else {
+                    issue = issue.help(format!(
+                        "write `{kind}: {{}}` for defaults, or `{kind}: {{param: value}}`"
+                    ));
+                }
+                self.err(issue);
+                return None;
+            }
+        };
+        let name = self.take_name(body);
+        let loc = key.loc;
+        let k = kind.as_str();
+        let node_kind = if COMPOSITE_KINDS.contains(&k) {
+            self.composite(k, loc, body, depth)?
+        } else if DECORATOR_KINDS.contains(&k) {
+            self.decorator(k, loc, body, depth)?
+        } else if let Some(parsed) = parse_leaf(k, &without_name(body)) {
+            match parsed {
+                Ok(leaf) => NodeKind::Leaf(leaf),
+                Err(e) => {
+                    let mut issue = e.into_issue(body.loc, |l| self.sources.describe(l));
+                    issue.message = format!("{} in `{k}`", issue.message);
+                    self.err(issue);
+                    return None;
+                }
+            }
+        } else {
+            let mut issue = Issue::new(key.loc, format!("unknown node kind `{k}`"))
+                .label("expected a node kind");
+            if self.subtrees.contains_key(k) {
+                issue = issue.help(format!(
+                    "`{k}` is a subtree: call it with `subtree: {{ref: {k}}}`"
+                ));
+            } else if let Some(h) = did_you_mean(k, all_kinds()) {
+                issue = issue.help(h);
+            } else {
+                issue =
+                    issue.help("see docs/tree_format.md (or `macrotree nodes`) for the node kinds");
+            }
+            self.err(issue);
+            return None;
+        };
+        Some(Node {
+            kind: node_kind,
+            name,
+            loc,
+        })
+    }
+
+    fn take_name(&mut self, body: &Value) -> Option<String> {
+        let v = body.get("name")?;
+        match v.as_str() {
+            Some(s) if valid_name(s) => Some(s.to_string()),
+            Some(s) => {
+                self.err(
+                    Issue::new(v.loc, format!("invalid node name `{s}`"))
+                        .label("expected 1–80 characters without `/`, `[`, `]`, `#` or line breaks")
+                        .help("names appear in node paths like `main/sequence[pick]/reach`; keep them simple"),
+                );
+                None
+            }
+            None => {
+                self.err(
+                    Issue::new(
+                        v.loc,
+                        format!("`name` must be text, found {}", v.describe()),
+                    )
+                    .label("expected a short label"),
+                );
+                None
+            }
+        }
+    }
+
+    /// Check that `body` has only `allowed` keys (plus `name`); return them.
+    fn fields<'v>(
+        &mut self,
+        kind: &str,
+        body: &'v Value,
+        allowed: &[&str],
+    ) -> HashMap<String, &'v Value> {
+        let mut out = HashMap::new();
+        for (k, v) in body.as_map().unwrap_or(&[]) {
+            match k.as_str() {
+                Some("name") => {}
+                Some(key) if allowed.contains(&key) => {
+                    out.insert(key.to_string(), v);
+                }
+                Some(key) => {
+                    let expected: Vec<String> = allowed
+                        .iter()
+                        .chain(&["name"])
+                        .map(|a| format!("`{a}`"))
+                        .collect();
+                    let mut issue =
+                        Issue::new(k.loc, format!("unknown parameter `{key}` in `{kind}`"))
+                            .label(format!("expected one of {}", expected.join(", ")));
+                    issue = issue
+                        .maybe_help(did_you_mean(key, allowed.iter().copied().chain(["name"])));
+                    if issue.help.is_none() && key == "children" {
+                        issue = issue.help(format!("`{kind}` takes a single `child:`"));
+                    } else if issue.help.is_none() && key == "child" {
+                        issue = issue.help(format!("`{kind}` takes a list: `children: [...]`"));
+                    }
+                    self.err(issue);
+                }
+                None => self.err(Issue::new(k.loc, "parameter names must be text")),
+            }
+        }
+        out
+    }
+
+    fn composite(&mut self, kind: &str, loc: Loc, body: &Value, depth: usize) -> Option<NodeKind> {
+        let f = self.fields(kind, body, &["children"]);
+        let Some(children_v) = f.get("children") else {
+            self.err(
+                Issue::new(loc, format!("`{kind}` needs `children:`"))
+                    .label("expected `children: [...]` with at least one node")
+                    .help(format!(
+                        "write `{kind}: {{children: [{{home: {{}}}}, ...]}}`"
+                    )),
+            );
+            return None;
+        };
+        let Some(items) = children_v.as_seq() else {
+            self.err(
+                Issue::new(
+                    children_v.loc,
+                    format!(
+                        "`children` must be a list of nodes, found {}",
+                        children_v.describe()
+                    ),
+                )
+                .label("expected `[...]` or a `- ` list"),
+            );
+            return None;
+        };
+        if items.is_empty() {
+            self.err(
+                Issue::new(children_v.loc, format!("`{kind}` has no children"))
+                    .label("expected at least one node")
+                    .help(format!("add a child node, or remove the empty `{kind}`")),
+            );
+            return None;
+        }
+        let mut children = Vec::with_capacity(items.len());
+        let mut ok = true;
+        for item in items {
+            match self.node(item, depth + 1) {
+                Some(n) => children.push(n),
+                None => ok = false,
+            }
+        }
+        if !ok {
+            return None;
+        }
+        if kind == "reactive_sequence" || kind == "reactive_fallback" {
+            let last = children.len() - 1;
+            for c in &children[..last] {
+                if c.as_check().is_none() {
+                    let what = if kind == "reactive_sequence" {
+                        "holds"
+                    } else {
+                        "fails"
+                    };
+                    self.err(
+                        Issue::new(c.loc, format!("in `{kind}`, only the last child may be `{}`", c.kind.kind_name()))
+                            .label("expected a condition leaf (or an `inverter` of one), re-checked every tick")
+                            .help(format!(
+                                "the children before the last are conditions re-checked every tick while the last one runs \
+                                 (as long as each {what}); use `sequence`/`fallback` for steps that run one after another"
+                            )),
+                    );
+                    ok = false;
+                }
+            }
+            if !ok {
+                return None;
+            }
+        }
+        Some(match kind {
+            "sequence" => NodeKind::Sequence(children),
+            "fallback" => NodeKind::Fallback(children),
+            "reactive_sequence" => NodeKind::ReactiveSequence(children),
+            "reactive_fallback" => NodeKind::ReactiveFallback(children),
+            "parallel" => NodeKind::Parallel(children),
+            _ => NodeKind::Race(children),
+        })
+    }
+
+    fn child(
+        &mut self,
+        kind: &str,
+        loc: Loc,
+        f: &HashMap<String, &Value>,
+        key: &str,
+        depth: usize,
+    ) -> Option<Box<Node>> {
+        match f.get(key) {
+            Some(v) => self.node(v, depth + 1).map(Box::new),
+            None => {
+                self.err(
+                    Issue::new(loc, format!("`{kind}` needs `{key}:`"))
+                        .label(format!("expected `{key}: <node>`"))
+                        .help(format!(
+                            "e.g. `{kind}: {{{}{key}: {{home: {{}}}}}}`",
+                            extra_example(kind)
+                        )),
+                );
+                None
+            }
+        }
+    }
+
+    fn count(
+        &mut self,
+        kind: &str,
+        loc: Loc,
+        f: &HashMap<String, &Value>,
+        key: &str,
+    ) -> Option<u32> {
+        let Some(v) = f.get(key) else {
+            self.err(
+                Issue::new(loc, format!("`{kind}` needs `{key}:`"))
+                    .label(format!("expected `{key}: N` (an integer ≥ 1)")),
+            );
+            return None;
+        };
+        match v.kind {
+            ValueKind::Int(n) if (1..=i64::from(MAX_COUNT)).contains(&n) => Some(n as u32),
+            ValueKind::Int(n) => {
+                self.err(
+                    Issue::new(
+                        v.loc,
+                        format!("`{key}` must be between 1 and {MAX_COUNT}, found {n}"),
+                    )
+                    .label("expected an integer ≥ 1")
+                    .with_via(v, self.sources),
+                );
+                None
+            }
+            _ => {
+                self.err(
+                    Issue::new(
+                        v.loc,
+                        format!("`{key}` must be an integer, found {}", v.describe()),
+                    )
+                    .label("expected an integer ≥ 1")
+                    .with_via(v, self.sources),
+                );
+                None
+            }
+        }
+    }
+
+    fn decorator(&mut self, kind: &str, loc: Loc, body: &Value, depth: usize) -> Option<NodeKind> {
+        match kind {
+            "guard" => {
+                let f = self.fields(kind, body, &["condition", "child"]);
+                let condition = self.child(kind, loc, &f, "condition", depth);
+                let child = self.child(kind, loc, &f, "child", depth);
+                let condition = condition?;
+                if condition.as_check().is_none() {
+                    self.err(
+                        Issue::new(condition.loc, format!("a guard's condition must be a condition leaf, found `{}`", condition.kind.kind_name()))
+                            .label(format!("expected one of {}", CONDITION_KINDS.join(", ")))
+                            .help("conditions are checked every tick and never run; put actions in `child:`"),
+                    );
+                    return None;
+                }
+                Some(NodeKind::Guard {
+                    condition,
+                    child: child?,
+                })
+            }
+            "retry" => {
+                let f = self.fields(kind, body, &["attempts", "child"]);
+                let attempts = self.count(kind, loc, &f, "attempts");
+                let child = self.child(kind, loc, &f, "child", depth);
+                Some(NodeKind::Retry {
+                    attempts: attempts?,
+                    child: child?,
+                })
+            }
+            "repeat" => {
+                let f = self.fields(kind, body, &["times", "child"]);
+                let times = self.count(kind, loc, &f, "times");
+                let child = self.child(kind, loc, &f, "child", depth);
+                Some(NodeKind::Repeat {
+                    times: times?,
+                    child: child?,
+                })
+            }
+            "timeout" => {
+                let f = self.fields(kind, body, &["seconds", "child"]);
+                let seconds = match f.get("seconds") {
+                    None => {
+                        self.err(
+                            Issue::new(loc, "`timeout` needs `seconds:`")
+                                .label("expected `seconds: S` (simulated seconds > 0)"),
+                        );
+                        None
+                    }
+                    Some(v) => match super::de::from_value::<Secs>(v) {
+                        Ok(s) => Some(s.0),
+                        Err(e) => {
+                            let issue = e.into_issue(v.loc, |l| self.sources.describe(l));
+                            self.err(issue);
+                            None
+                        }
+                    },
+                };
+                let child = self.child(kind, loc, &f, "child", depth);
+                Some(NodeKind::Timeout {
+                    seconds: seconds?,
+                    child: child?,
+                })
+            }
+            "inverter" | "force_success" | "force_failure" => {
+                let f = self.fields(kind, body, &["child"]);
+                let child = self.child(kind, loc, &f, "child", depth)?;
+                Some(match kind {
+                    "inverter" => NodeKind::Inverter(child),
+                    "force_success" => NodeKind::ForceSuccess(child),
+                    _ => NodeKind::ForceFailure(child),
+                })
+            }
+            _ => self.subtree_call(loc, body, depth),
+        }
+    }
+
+    fn subtree_call(&mut self, loc: Loc, body: &Value, depth: usize) -> Option<NodeKind> {
+        let f = self.fields("subtree", body, &["ref", "args"]);
+        let Some(rv) = f.get("ref") else {
+            self.err(
+                Issue::new(loc, "`subtree` needs `ref:`")
+                    .label("expected `ref: NAME` (a subtree defined under `subtrees:`)"),
+            );
+            return None;
+        };
+        let Some(reference) = rv.as_str() else {
+            self.err(
+                Issue::new(
+                    rv.loc,
+                    format!("`ref` must be a subtree name, found {}", rv.describe()),
+                )
+                .label("expected a name defined under `subtrees:`"),
+            );
+            return None;
+        };
+        let Some(def) = self.subtrees.get(reference) else {
+            let mut names: Vec<&str> = self.subtrees.keys().map(String::as_str).collect();
+            names.sort_unstable();
+            let label = if names.is_empty() {
+                "no subtrees are defined (add `subtrees:` or `include:` a library)".to_string()
+            } else {
+                format!(
+                    "expected one of {}",
+                    names
+                        .iter()
+                        .map(|n| format!("`{n}`"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            };
+            self.err(
+                Issue::new(rv.loc, format!("undefined subtree `{reference}`"))
+                    .label(label)
+                    .maybe_help(did_you_mean(reference, names.iter().copied()))
+                    .help_or("define it under `subtrees:` or include the file that defines it"),
+            );
+            return None;
+        };
+        if self.stack.iter().any(|s| s == reference) {
+            let mut chain = self.stack.clone();
+            chain.push(reference.to_string());
+            let start = chain.iter().position(|s| s == reference).unwrap_or(0);
+            self.err(
+                Issue::new(rv.loc, format!("recursive subtree: {}", chain[start..].join(" → ")))
+                    .label("this call leads back to itself")
+                    .help("subtrees are expanded in place, so they cannot call themselves; use `retry`/`repeat` for loops"),
+            );
+            return None;
+        }
+        // Arguments.
+        let mut env: HashMap<String, Value> = HashMap::new();
+        let mut arg_texts = Vec::new();
+        let mut ok = true;
+        if let Some(av) = f.get("args") {
+            match &av.kind {
+                ValueKind::Null => {}
+                ValueKind::Map(entries) => {
+                    for (k, v) in entries {
+                        let Some(pname) = k.as_str() else {
+                            self.err(Issue::new(k.loc, "argument names must be text"));
+                            ok = false;
+                            continue;
+                        };
+                        let pname = pname.strip_prefix('$').unwrap_or(pname);
+                        if def.params.iter().any(|p| p.name == pname) {
+                            env.insert(pname.to_string(), v.clone());
+                            arg_texts.push((pname.to_string(), render_value(v)));
+                        } else {
+                            let params: Vec<String> =
+                                def.params.iter().map(|p| format!("`{}`", p.name)).collect();
+                            let label = if params.is_empty() {
+                                format!("subtree `{reference}` takes no parameters")
+                            } else {
+                                format!("expected one of {}", params.join(", "))
+                            };
+                            self.err(
+                                Issue::new(k.loc, format!("unknown argument `{pname}` for subtree `{reference}`"))
+                                    .label(label)
+                                    .maybe_help(did_you_mean(pname, def.params.iter().map(|p| p.name.as_str())))
+                                    .help_or(format!(
+                                        "declare it in `subtrees: {{{reference}: {{params: {{{pname}: <default>}}}}}}` or remove it"
+                                    )),
+                            );
+                            ok = false;
+                        }
+                    }
+                }
+                _ => {
+                    self.err(
+                        Issue::new(
+                            av.loc,
+                            format!("`args` must be a mapping, found {}", av.describe()),
+                        )
+                        .label("expected `{param: value, ...}`"),
+                    );
+                    ok = false;
+                }
+            }
+        }
+        for p in &def.params {
+            if env.contains_key(&p.name) {
+                continue;
+            }
+            match &p.default {
+                Some(d) => {
+                    env.insert(p.name.clone(), d.clone());
+                }
+                None => {
+                    self.err(
+                        Issue::new(
+                            loc,
+                            format!("missing argument `{}` for subtree `{reference}`", p.name),
+                        )
+                        .label(format!(
+                            "`{}` is required (declared at {})",
+                            p.name,
+                            self.sources.describe(p.loc)
+                        ))
+                        .help(format!("add `args: {{{}: <value>}}`", p.name)),
+                    );
+                    ok = false;
+                }
+            }
+        }
+        if !ok {
+            return None;
+        }
+        let body_v = substitute(&def.root, &env);
+        let reference = reference.to_string();
+        *self.calls.entry(reference.clone()).or_default() += 1;
+        self.stack.push(reference.clone());
+        let body = self.node(&body_v, depth + 1);
+        self.stack.pop();
+        Some(NodeKind::Subtree {
+            reference,
+            args: arg_texts,
+            body: Box::new(body?),
+        })
+    }
+}
+
+/// Seconds for `timeout: {seconds}`.
+struct Secs(f64);
+
+impl<'de> serde::Deserialize<'de> for Secs {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        super::units::time_limit(d).map(Secs)
+    }
+}
+
+impl Issue {
+    fn with_via(mut self, v: &Value, sources: &Sources) -> Self {
+        if let Some(via) = v.via {
+            self.note = Some(format!(
+                "this value is a subtree argument, used at {}",
+                sources.describe(via)
+            ));
+        }
+        self
+    }
+}
+
+fn extra_example(kind: &str) -> &'static str {
+    match kind {
+        "retry" => "attempts: 3, ",
+        "repeat" => "times: 2, ",
+        "timeout" => "seconds: 10, ",
+        "guard" => "condition: {cube_grasped: {}}, ",
+        _ => "",
+    }
+}
+
+fn valid_name(s: &str) -> bool {
+    !s.trim().is_empty() && s.chars().count() <= 80 && !s.contains(['/', '[', ']', '#', '\n', '\r'])
+}
+
+fn without_name(body: &Value) -> Value {
+    match &body.kind {
+        ValueKind::Map(m) => Value {
+            kind: ValueKind::Map(
+                m.iter()
+                    .filter(|(k, _)| k.as_str() != Some("name"))
+                    .cloned()
+                    .collect(),
+            ),
+            loc: body.loc,
+            via: body.via,
+        },
+        _ => body.clone(),
+    }
+}
+
+/// Replace every `$param` scalar in `v` by its value from `env` (unknown ones are left as they
+/// are; they are reported separately by [`undefined_params`]).
+pub fn substitute(v: &Value, env: &HashMap<String, Value>) -> Value {
+    match &v.kind {
+        ValueKind::Str(s) => match param_ref(s).and_then(|p| env.get(p)) {
+            Some(arg) => {
+                let mut out = arg.clone();
+                mark_via(&mut out, v.loc);
+                out
+            }
+            None => v.clone(),
+        },
+        ValueKind::Seq(items) => Value {
+            kind: ValueKind::Seq(items.iter().map(|i| substitute(i, env)).collect()),
+            loc: v.loc,
+            via: v.via,
+        },
+        ValueKind::Map(entries) => Value {
+            kind: ValueKind::Map(
+                entries
+                    .iter()
+                    .map(|(k, x)| (k.clone(), substitute(x, env)))
+                    .collect(),
+            ),
+            loc: v.loc,
+            via: v.via,
+        },
+        _ => v.clone(),
+    }
+}
+
+fn mark_via(v: &mut Value, use_loc: Loc) {
+    if v.via.is_none() {
+        v.via = Some(use_loc);
+    }
+    match &mut v.kind {
+        ValueKind::Seq(items) => items.iter_mut().for_each(|i| mark_via(i, use_loc)),
+        ValueKind::Map(entries) => entries.iter_mut().for_each(|(_, x)| mark_via(x, use_loc)),
+        _ => {}
+    }
+}
+
+/// Every `$name` scalar in `v` whose name is not in `params`, with its location.
+pub fn undefined_params<'v>(v: &'v Value, params: &[&str], out: &mut Vec<(&'v str, Loc)>) {
+    match &v.kind {
+        ValueKind::Str(s) => {
+            if let Some(p) = param_ref(s)
+                && !params.contains(&p)
+            {
+                out.push((p, v.loc));
+            }
+        }
+        ValueKind::Seq(items) => items.iter().for_each(|i| undefined_params(i, params, out)),
+        ValueKind::Map(entries) => entries
+            .iter()
+            .for_each(|(_, x)| undefined_params(x, params, out)),
+        _ => {}
+    }
+}
+
+/// Compact flow-style text of a value (for display of subtree arguments).
+pub fn render_value(v: &Value) -> String {
+    match &v.kind {
+        ValueKind::Null => "~".into(),
+        ValueKind::Bool(b) => b.to_string(),
+        ValueKind::Int(i) => i.to_string(),
+        ValueKind::Float(x) => format!("{x}"),
+        ValueKind::Str(s) => s.clone(),
+        ValueKind::Seq(items) => format!(
+            "[{}]",
+            items
+                .iter()
+                .map(render_value)
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+        ValueKind::Map(entries) => format!(
+            "{{{}}}",
+            entries
+                .iter()
+                .map(|(k, x)| format!("{}: {}", render_value(k), render_value(x)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}

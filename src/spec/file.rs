@@ -1,0 +1,280 @@
+//! The top level of a tree file: `include:`, `subtrees:` and `main:`.
+
+use super::diag::{Issue, Loc};
+use super::suggest::did_you_mean;
+use super::value::{Value, ValueKind};
+
+/// Keys allowed at the top level of a tree file.
+pub const TOP_LEVEL_KEYS: &[&str] = &["include", "subtrees", "main"];
+/// Keys allowed in a subtree definition.
+pub const SUBTREE_KEYS: &[&str] = &["params", "root", "description"];
+
+/// One `include:` entry.
+#[derive(Clone, Debug)]
+pub struct IncludeRef {
+    /// The path as written (relative to the including file's folder).
+    pub path: String,
+    /// Where it is written.
+    pub loc: Loc,
+}
+
+/// One parameter of a subtree.
+#[derive(Clone, Debug)]
+pub struct ParamDef {
+    /// Name without the `$`.
+    pub name: String,
+    /// Default value; `None` when the parameter is required (written `~`).
+    pub default: Option<Value>,
+    /// Where the parameter name is written.
+    pub loc: Loc,
+}
+
+/// A reusable subtree with parameters.
+#[derive(Clone, Debug)]
+pub struct SubtreeDef {
+    /// The name used in `subtree: {ref: NAME}`.
+    pub name: String,
+    /// Where the name is written.
+    pub loc: Loc,
+    /// Optional one-line description.
+    pub description: Option<String>,
+    /// Parameters in written order.
+    pub params: Vec<ParamDef>,
+    /// The body, unsubstituted.
+    pub root: Value,
+}
+
+/// A parsed tree file, before subtree expansion.
+#[derive(Clone, Debug, Default)]
+pub struct TreeFile {
+    /// `include:` entries.
+    pub includes: Vec<IncludeRef>,
+    /// `subtrees:` definitions.
+    pub subtrees: Vec<SubtreeDef>,
+    /// `main:` (the root node), if present.
+    pub main: Option<Value>,
+    /// Where `main:` is written.
+    pub main_key: Option<Loc>,
+}
+
+/// True for names usable as subtree and parameter names: `[A-Za-z_][A-Za-z0-9_]*`.
+pub fn is_identifier(s: &str) -> bool {
+    let mut chars = s.chars();
+    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+        && s.len() <= 64
+}
+
+/// If `s` is a parameter reference `$name`, return `name`.
+pub fn param_ref(s: &str) -> Option<&str> {
+    s.strip_prefix('$').filter(|n| is_identifier(n))
+}
+
+/// Read the top level of a tree file. Problems are pushed to `issues`; what could be read is
+/// returned.
+pub fn parse_tree_file(v: &Value, issues: &mut Vec<Issue>) -> TreeFile {
+    let mut out = TreeFile::default();
+    let Some(entries) = v.as_map() else {
+        issues.push(
+            Issue::new(
+                v.loc,
+                format!("a tree file must be a mapping, found {}", v.describe()),
+            )
+            .label("expected `main:` (and optionally `include:` and `subtrees:`)")
+            .help("start the file with `main:` followed by the root node"),
+        );
+        return out;
+    };
+    for (k, val) in entries {
+        match k.as_str() {
+            Some("include") => parse_includes(val, &mut out.includes, issues),
+            Some("subtrees") => parse_subtrees(val, &mut out.subtrees, issues),
+            Some("main") => {
+                out.main = Some(val.clone());
+                out.main_key = Some(k.loc);
+            }
+            Some(other) => issues.push(
+                Issue::new(k.loc, format!("unknown top-level key `{other}`"))
+                    .label("expected `include`, `subtrees` or `main`")
+                    .maybe_help(did_you_mean(other, TOP_LEVEL_KEYS.iter().copied()))
+                    .help_or("remove it; a tree file has only `include:`, `subtrees:` and `main:`"),
+            ),
+            None => issues.push(
+                Issue::new(
+                    k.loc,
+                    format!("top-level keys must be names, found {}", k.describe()),
+                )
+                .label("expected `include`, `subtrees` or `main`"),
+            ),
+        }
+    }
+    out
+}
+
+impl Issue {
+    /// Set help text unless one is already set.
+    #[must_use]
+    pub fn help_or(mut self, help: impl Into<String>) -> Self {
+        if self.help.is_none() {
+            self.help = Some(help.into());
+        }
+        self
+    }
+}
+
+fn parse_includes(v: &Value, out: &mut Vec<IncludeRef>, issues: &mut Vec<Issue>) {
+    let items: Vec<&Value> = match &v.kind {
+        ValueKind::Seq(s) => s.iter().collect(),
+        ValueKind::Str(_) => vec![v],
+        ValueKind::Null => vec![],
+        _ => {
+            issues.push(
+                Issue::new(
+                    v.loc,
+                    format!(
+                        "`include` must be a list of file paths, found {}",
+                        v.describe()
+                    ),
+                )
+                .label("expected e.g. `[lib/pick_place.yaml]`"),
+            );
+            return;
+        }
+    };
+    for item in items {
+        match item.as_str() {
+            Some(p) if !p.trim().is_empty() => out.push(IncludeRef {
+                path: p.to_string(),
+                loc: item.loc,
+            }),
+            _ => issues.push(
+                Issue::new(
+                    item.loc,
+                    format!("an include must be a file path, found {}", item.describe()),
+                )
+                .label("expected a path relative to this file, e.g. `lib/pick_place.yaml`"),
+            ),
+        }
+    }
+}
+
+fn parse_subtrees(v: &Value, out: &mut Vec<SubtreeDef>, issues: &mut Vec<Issue>) {
+    let entries = match &v.kind {
+        ValueKind::Map(m) => m,
+        ValueKind::Null => return,
+        _ => {
+            issues.push(
+                Issue::new(
+                    v.loc,
+                    format!(
+                        "`subtrees` must be a mapping of names to subtrees, found {}",
+                        v.describe()
+                    ),
+                )
+                .label("expected `NAME: {params: {...}, root: <node>}`"),
+            );
+            return;
+        }
+    };
+    for (k, def) in entries {
+        let Some(name) = k.as_str().filter(|n| is_identifier(n)) else {
+            issues.push(
+                Issue::new(k.loc, format!("invalid subtree name {}", k.describe()))
+                    .label("expected a name made of letters, digits and `_`"),
+            );
+            continue;
+        };
+        if let Some(d) = parse_subtree_def(name, k.loc, def, issues) {
+            out.push(d);
+        }
+    }
+}
+
+fn parse_subtree_def(
+    name: &str,
+    loc: Loc,
+    v: &Value,
+    issues: &mut Vec<Issue>,
+) -> Option<SubtreeDef> {
+    let Some(entries) = v.as_map() else {
+        issues.push(
+            Issue::new(
+                v.loc,
+                format!("subtree `{name}` must be a mapping, found {}", v.describe()),
+            )
+            .label("expected `{params: {...}, root: <node>}`"),
+        );
+        return None;
+    };
+    let mut def = SubtreeDef {
+        name: name.to_string(),
+        loc,
+        description: None,
+        params: Vec::new(),
+        root: Value::new(ValueKind::Null, v.loc),
+    };
+    let mut has_root = false;
+    for (k, val) in entries {
+        match k.as_str() {
+            Some("root") => {
+                def.root = val.clone();
+                has_root = true;
+            }
+            Some("description") => match val.as_str() {
+                Some(s) => def.description = Some(s.to_string()),
+                None => issues.push(
+                    Issue::new(
+                        val.loc,
+                        format!("`description` must be text, found {}", val.describe()),
+                    )
+                    .label("expected a one-line description"),
+                ),
+            },
+            Some("params") => match &val.kind {
+                ValueKind::Null => {}
+                ValueKind::Map(ps) => {
+                    for (pk, pv) in ps {
+                        match pk.as_str().filter(|n| is_identifier(n)) {
+                            Some(pname) => def.params.push(ParamDef {
+                                name: pname.to_string(),
+                                default: (pv.kind != ValueKind::Null).then(|| pv.clone()),
+                                loc: pk.loc,
+                            }),
+                            None => issues.push(
+                                Issue::new(pk.loc, format!("invalid parameter name {}", pk.describe()))
+                                    .label("expected a name made of letters, digits and `_` (used as `$name`)")
+                                    .help("write parameters without the `$`, e.g. `params: {approach: 0.15}`"),
+                            ),
+                        }
+                    }
+                }
+                _ => issues.push(
+                    Issue::new(
+                        val.loc,
+                        format!("`params` must be a mapping, found {}", val.describe()),
+                    )
+                    .label("expected `{name: default, other: ~}` (`~` = required)"),
+                ),
+            },
+            Some(other) => issues.push(
+                Issue::new(k.loc, format!("unknown key `{other}` in subtree `{name}`"))
+                    .label("expected `params`, `root` or `description`")
+                    .maybe_help(did_you_mean(other, SUBTREE_KEYS.iter().copied()))
+                    .help_or(
+                        "a subtree has `params:` (optional), `root:` and `description:` (optional)",
+                    ),
+            ),
+            None => issues
+                .push(Issue::new(k.loc, "keys must be names").label("expected `params` or `root`")),
+        }
+    }
+    if !has_root {
+        issues.push(
+            Issue::new(loc, format!("subtree `{name}` has no `root:`"))
+                .label("expected `root: <node>`")
+                .help("add `root:` with the subtree's top node, e.g. `root: {sequence: {children: [...]}}`"),
+        );
+        return None;
+    }
+    Some(def)
+}

@@ -1,0 +1,493 @@
+//! Leaf nodes: macro actions (executed by a [`crate::runtime::LeafDriver`]), condition checks
+//! (instantaneous, also answered by the driver) and `wait` (handled by the runtime itself).
+//!
+//! Every parameter struct rejects unknown fields, has documented units and defaults, and is
+//! written in YAML as a single-key mapping, e.g. `reach: {target: cube, offset: [0, 0, 0.15]}`.
+//! All leaves also accept `name:` (handled by the tree parser, not stored here).
+
+use serde::{Deserialize, Serialize};
+
+use schemars::JsonSchema;
+
+use super::units::{self, PathKind, Target, Yaw};
+
+fn d_zero3() -> [f64; 3] {
+    [0.0, 0.0, 0.0]
+}
+fn d_speed() -> f64 {
+    0.5
+}
+fn d_5() -> f64 {
+    5.0
+}
+fn d_6() -> f64 {
+    6.0
+}
+fn d_2() -> f64 {
+    2.0
+}
+fn d_3() -> f64 {
+    3.0
+}
+fn d_10() -> f64 {
+    10.0
+}
+fn d_bowl() -> Target {
+    Target::Bowl
+}
+fn d_lift() -> f64 {
+    0.20
+}
+fn d_place_height() -> f64 {
+    0.03
+}
+fn d_retreat() -> f64 {
+    0.10
+}
+fn d_min_height() -> f64 {
+    0.03
+}
+fn d_min_width() -> f64 {
+    0.08
+}
+fn d_home_tol() -> f64 {
+    0.04
+}
+fn d_table_tol() -> f64 {
+    0.01
+}
+
+/// Move the tool to a target (plus an offset), e.g. above the cube (pre-grasp) or down onto it.
+///
+/// Succeeds when the tool is at the goal pose; fails if the goal is unreachable (IK) or the
+/// leaf's `timeout` expires. Halt: the driver stops the arm where it is (holds position).
+///
+/// ```yaml
+/// - reach: {target: cube, offset: [0, 0, 0.15]}                  # pre-grasp, 15 cm above
+/// - reach: {target: cube, offset: [0, 0, 0.0], path: cartesian}  # straight down onto it
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Reach {
+    /// What to reach: `cube`, `bowl` or `[x, y, z]` (world metres).
+    pub target: Target,
+    /// Offset of the tool centre point from the target, world frame, metres. Default `[0, 0, 0]`.
+    #[serde(default = "d_zero3", deserialize_with = "units::vec3")]
+    pub offset: [f64; 3],
+    /// Final tool yaw: `object` (default: match the target object's yaw so the fingers straddle
+    /// two faces), `keep`, or an angle (radians or `deg(..)`).
+    #[serde(default)]
+    pub yaw: Yaw,
+    /// `joint` (default, joint-space interpolation) or `cartesian` (straight tool path).
+    #[serde(default)]
+    pub path: PathKind,
+    /// Tool speed, m/s (> 0). Default 0.5.
+    #[serde(default = "d_speed", deserialize_with = "units::speed")]
+    #[schemars(range(min = 0.0))]
+    pub speed: f64,
+    /// Give up (Failure) after this many simulated seconds (> 0). Default 5.
+    #[serde(default = "d_5", deserialize_with = "units::time_limit")]
+    #[schemars(range(min = 0.0))]
+    pub timeout: f64,
+}
+
+/// Move the arm to six joint angles (radians, or `deg(..)`), shoulder pan first.
+///
+/// Halt: the driver stops the arm where it is.
+///
+/// ```yaml
+/// - move_joints: {joints: [0, deg(-90), deg(90), deg(-90), deg(-90), 0]}
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct MoveJoints {
+    /// Six joint angles, radians (numbers or `deg(..)`/`rad(..)`).
+    #[serde(deserialize_with = "units::joints6")]
+    #[schemars(with = "[units::Angle; 6]")]
+    pub joints: [f64; 6],
+    /// Give up after this many simulated seconds (> 0). Default 6.
+    #[serde(default = "d_6", deserialize_with = "units::time_limit")]
+    #[schemars(range(min = 0.0))]
+    pub timeout: f64,
+}
+
+/// Move the arm to its named home pose (joint space).
+///
+/// Halt: the driver stops the arm where it is.
+///
+/// ```yaml
+/// - home: {}
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Home {
+    /// Give up after this many simulated seconds (> 0). Default 6.
+    #[serde(default = "d_6", deserialize_with = "units::time_limit")]
+    #[schemars(range(min = 0.0))]
+    pub timeout: f64,
+}
+
+impl Default for Home {
+    fn default() -> Self {
+        Self { timeout: 6.0 }
+    }
+}
+
+/// Close the gripper. Succeeds when it has closed to `width` or stalled on contact; whether the
+/// cube is actually held is a separate check (`cube_grasped`).
+///
+/// Halt: the driver stops closing the fingers (keeps the current opening).
+///
+/// ```yaml
+/// - grasp: {}              # close until contact/stall
+/// - grasp: {width: 0.045}  # close to 45 mm pad-to-pad
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Grasp {
+    /// Close to this pad-to-pad width, metres (≥ 0). Absent: close until contact/stall.
+    #[serde(default, deserialize_with = "units::opt_distance")]
+    #[schemars(range(min = 0.0))]
+    pub width: Option<f64>,
+    /// Give up after this many simulated seconds (> 0). Default 2.
+    #[serde(default = "d_2", deserialize_with = "units::time_limit")]
+    #[schemars(range(min = 0.0))]
+    pub timeout: f64,
+}
+
+impl Default for Grasp {
+    fn default() -> Self {
+        Self {
+            width: None,
+            timeout: 2.0,
+        }
+    }
+}
+
+/// Carry the held cube: lift it, transfer it above `to`, and lower it until its bottom is
+/// `place_height` above the target (without opening the gripper).
+///
+/// Put it under `guard: {condition: {cube_grasped: {}}, ...}` so a slip aborts the carry.
+/// Halt: the driver stops the arm where it is (the gripper stays closed).
+///
+/// ```yaml
+/// - carry: {to: bowl, lift: 0.2, place_height: 0.03}
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Carry {
+    /// Where to: `cube`, `bowl` or `[x, y, z]` (world metres). Default `bowl`.
+    #[serde(default = "d_bowl")]
+    pub to: Target,
+    /// Height of the cube's bottom above the table during the transfer, metres (≥ 0). Default 0.20.
+    #[serde(default = "d_lift", deserialize_with = "units::distance")]
+    #[schemars(range(min = 0.0))]
+    pub lift: f64,
+    /// Height of the cube's bottom above the target when the carry ends, metres (≥ 0). Default 0.03.
+    #[serde(default = "d_place_height", deserialize_with = "units::distance")]
+    #[schemars(range(min = 0.0))]
+    pub place_height: f64,
+    /// Tool speed, m/s (> 0). Default 0.5.
+    #[serde(default = "d_speed", deserialize_with = "units::speed")]
+    #[schemars(range(min = 0.0))]
+    pub speed: f64,
+    /// Give up after this many simulated seconds (> 0). Default 10.
+    #[serde(default = "d_10", deserialize_with = "units::time_limit")]
+    #[schemars(range(min = 0.0))]
+    pub timeout: f64,
+}
+
+/// Open the gripper, then retreat straight up by `retreat`.
+///
+/// Halt: the driver stops the arm; the gripper keeps its current opening.
+///
+/// ```yaml
+/// - release: {retreat: 0.1}
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Release {
+    /// Vertical retreat after opening, metres (≥ 0). Default 0.10.
+    #[serde(default = "d_retreat", deserialize_with = "units::distance")]
+    #[schemars(range(min = 0.0))]
+    pub retreat: f64,
+    /// Give up after this many simulated seconds (> 0). Default 3.
+    #[serde(default = "d_3", deserialize_with = "units::time_limit")]
+    #[schemars(range(min = 0.0))]
+    pub timeout: f64,
+}
+
+/// Wait for a number of simulated seconds. Handled by the runtime (never reaches the driver):
+/// Running until the accumulated `dt` reaches `seconds`, then Success, passing the unused part of
+/// the tick on (bonsai's leftover-dt rule).
+///
+/// Halt: nothing to do (the elapsed time restarts at 0 on the next execution).
+///
+/// ```yaml
+/// - wait: {seconds: 0.5}
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Wait {
+    /// Simulated seconds (≥ 0).
+    #[serde(deserialize_with = "units::duration")]
+    #[schemars(range(min = 0.0))]
+    pub seconds: f64,
+}
+
+/// Condition: both finger pads touch the cube (it is held). Success or Failure, never Running.
+///
+/// ```yaml
+/// - cube_grasped: {}
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema, Default)]
+#[serde(deny_unknown_fields)]
+pub struct CubeGrasped {}
+
+/// Condition: the cube's bottom is at least `min_height` above the table.
+///
+/// ```yaml
+/// - cube_lifted: {min_height: 0.05}
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct CubeLifted {
+    /// Metres above the table (≥ 0). Default 0.03.
+    #[serde(default = "d_min_height", deserialize_with = "units::distance")]
+    #[schemars(range(min = 0.0))]
+    pub min_height: f64,
+}
+
+impl Default for CubeLifted {
+    fn default() -> Self {
+        Self { min_height: 0.03 }
+    }
+}
+
+/// Condition: the cube rests inside the bowl (inside its rim, not held).
+///
+/// ```yaml
+/// - cube_in_bowl: {}
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema, Default)]
+#[serde(deny_unknown_fields)]
+pub struct CubeInBowl {}
+
+/// Condition: the cube rests on the table (its bottom within `tolerance` of the table top).
+///
+/// ```yaml
+/// - cube_on_table: {}
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct CubeOnTable {
+    /// Allowed height of the cube's bottom above the table top, metres (≥ 0). Default 0.01.
+    #[serde(default = "d_table_tol", deserialize_with = "units::distance")]
+    #[schemars(range(min = 0.0))]
+    pub tolerance: f64,
+}
+
+impl Default for CubeOnTable {
+    fn default() -> Self {
+        Self { tolerance: 0.01 }
+    }
+}
+
+/// Condition: the gripper is open at least `min_width` (pad-to-pad).
+///
+/// ```yaml
+/// - gripper_open: {min_width: 0.08}
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct GripperOpen {
+    /// Metres (≥ 0). Default 0.08.
+    #[serde(default = "d_min_width", deserialize_with = "units::distance")]
+    #[schemars(range(min = 0.0))]
+    pub min_width: f64,
+}
+
+impl Default for GripperOpen {
+    fn default() -> Self {
+        Self { min_width: 0.08 }
+    }
+}
+
+/// Condition: every arm joint is within `tolerance` of the home pose.
+///
+/// ```yaml
+/// - at_home: {tolerance: deg(2)}
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct AtHome {
+    /// Per-joint tolerance, radians (≥ 0; `deg(..)` accepted). Default 0.04.
+    #[serde(default = "d_home_tol", deserialize_with = "units::angle_tolerance")]
+    #[schemars(with = "units::Angle")]
+    pub tolerance: f64,
+}
+
+impl Default for AtHome {
+    fn default() -> Self {
+        Self { tolerance: 0.04 }
+    }
+}
+
+/// A macro action, executed over several ticks by the driver.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ActionLeaf {
+    /// See [`Reach`].
+    Reach(Reach),
+    /// See [`MoveJoints`].
+    MoveJoints(MoveJoints),
+    /// See [`Home`].
+    Home(Home),
+    /// See [`Grasp`].
+    Grasp(Grasp),
+    /// See [`Carry`].
+    Carry(Carry),
+    /// See [`Release`].
+    Release(Release),
+}
+
+/// An instantaneous check of the world: the driver must answer Success or Failure in the same
+/// tick (a Running answer is treated as a Failure and reported).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ConditionLeaf {
+    /// See [`CubeGrasped`].
+    CubeGrasped(CubeGrasped),
+    /// See [`CubeLifted`].
+    CubeLifted(CubeLifted),
+    /// See [`CubeInBowl`].
+    CubeInBowl(CubeInBowl),
+    /// See [`CubeOnTable`].
+    CubeOnTable(CubeOnTable),
+    /// See [`GripperOpen`].
+    GripperOpen(GripperOpen),
+    /// See [`AtHome`].
+    AtHome(AtHome),
+}
+
+/// A leaf of the tree, with all parameters resolved.
+///
+/// Drivers see only [`Leaf::Action`] and [`Leaf::Condition`]; [`Leaf::Wait`] is handled by
+/// the runtime.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum Leaf {
+    /// A macro action (multi-tick).
+    Action(ActionLeaf),
+    /// A condition (instantaneous).
+    Condition(ConditionLeaf),
+    /// `wait: {seconds}` (runtime-internal).
+    Wait(Wait),
+}
+
+impl ActionLeaf {
+    /// The YAML node kind (`reach`, `grasp`, …).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            ActionLeaf::Reach(_) => "reach",
+            ActionLeaf::MoveJoints(_) => "move_joints",
+            ActionLeaf::Home(_) => "home",
+            ActionLeaf::Grasp(_) => "grasp",
+            ActionLeaf::Carry(_) => "carry",
+            ActionLeaf::Release(_) => "release",
+        }
+    }
+
+    /// The action's own time limit in simulated seconds (enforced by the driver).
+    pub fn timeout(&self) -> f64 {
+        match self {
+            ActionLeaf::Reach(p) => p.timeout,
+            ActionLeaf::MoveJoints(p) => p.timeout,
+            ActionLeaf::Home(p) => p.timeout,
+            ActionLeaf::Grasp(p) => p.timeout,
+            ActionLeaf::Carry(p) => p.timeout,
+            ActionLeaf::Release(p) => p.timeout,
+        }
+    }
+}
+
+impl ConditionLeaf {
+    /// The YAML node kind (`cube_grasped`, …).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            ConditionLeaf::CubeGrasped(_) => "cube_grasped",
+            ConditionLeaf::CubeLifted(_) => "cube_lifted",
+            ConditionLeaf::CubeInBowl(_) => "cube_in_bowl",
+            ConditionLeaf::CubeOnTable(_) => "cube_on_table",
+            ConditionLeaf::GripperOpen(_) => "gripper_open",
+            ConditionLeaf::AtHome(_) => "at_home",
+        }
+    }
+}
+
+impl Leaf {
+    /// The YAML node kind (`reach`, `cube_grasped`, `wait`, …).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Leaf::Action(a) => a.kind(),
+            Leaf::Condition(c) => c.kind(),
+            Leaf::Wait(_) => "wait",
+        }
+    }
+
+    /// True for condition leaves (instantaneous checks).
+    pub fn is_condition(&self) -> bool {
+        matches!(self, Leaf::Condition(_))
+    }
+
+    /// Compact one-line rendering of the parameters (JSON), for logs and diagrams.
+    pub fn params_json(&self) -> String {
+        let v = serde_json::to_value(self).unwrap_or(serde_json::Value::Null);
+        match v {
+            serde_json::Value::Object(m) => m
+                .into_iter()
+                .next()
+                .map(|(_, p)| p.to_string())
+                .unwrap_or_else(|| "{}".into()),
+            other => other.to_string(),
+        }
+    }
+}
+
+/// Kinds of action leaves, in documentation order.
+pub const ACTION_KINDS: &[&str] = &["reach", "move_joints", "home", "grasp", "carry", "release"];
+/// Kinds of condition leaves, in documentation order.
+pub const CONDITION_KINDS: &[&str] = &[
+    "cube_grasped",
+    "cube_lifted",
+    "cube_in_bowl",
+    "cube_on_table",
+    "gripper_open",
+    "at_home",
+];
+
+/// Read the parameters of leaf kind `kind` from `params`; `None` if `kind` is not a leaf kind.
+pub fn parse_leaf(
+    kind: &str,
+    params: &super::value::Value,
+) -> Option<Result<Leaf, super::de::DeError>> {
+    use super::de::from_value as f;
+    let a = |r: Result<ActionLeaf, _>| Some(r.map(Leaf::Action));
+    let c = |r: Result<ConditionLeaf, _>| Some(r.map(Leaf::Condition));
+    match kind {
+        "reach" => a(f(params).map(ActionLeaf::Reach)),
+        "move_joints" => a(f(params).map(ActionLeaf::MoveJoints)),
+        "home" => a(f(params).map(ActionLeaf::Home)),
+        "grasp" => a(f(params).map(ActionLeaf::Grasp)),
+        "carry" => a(f(params).map(ActionLeaf::Carry)),
+        "release" => a(f(params).map(ActionLeaf::Release)),
+        "wait" => Some(f(params).map(Leaf::Wait)),
+        "cube_grasped" => c(f(params).map(ConditionLeaf::CubeGrasped)),
+        "cube_lifted" => c(f(params).map(ConditionLeaf::CubeLifted)),
+        "cube_in_bowl" => c(f(params).map(ConditionLeaf::CubeInBowl)),
+        "cube_on_table" => c(f(params).map(ConditionLeaf::CubeOnTable)),
+        "gripper_open" => c(f(params).map(ConditionLeaf::GripperOpen)),
+        "at_home" => c(f(params).map(ConditionLeaf::AtHome)),
+        _ => None,
+    }
+}

@@ -1,0 +1,326 @@
+//! Loading tree files: read, follow `include:`, collect subtrees, expand `main:`.
+
+use std::collections::{HashMap, HashSet};
+use std::path::{Path, PathBuf};
+
+use super::diag::{Diagnostic, FileId, Issue, Loc, Sources};
+use super::expand::{Expander, undefined_params};
+use super::file::{SubtreeDef, TreeFile, parse_tree_file};
+use super::node::Node;
+use super::suggest::closest;
+use super::value::{MAX_FILE_BYTES, decode_utf8, parse_yaml};
+
+/// Deepest chain of includes.
+pub const MAX_INCLUDE_DEPTH: usize = 16;
+/// Most files loaded for one tree.
+pub const MAX_FILES: usize = 64;
+
+/// A loaded, fully expanded tree with the sources it came from.
+#[derive(Clone, Debug)]
+pub struct Spec {
+    /// The `main:` tree, subtrees expanded.
+    pub root: Node,
+    /// Every file read (the main file is id 0).
+    pub sources: Sources,
+    /// Every subtree definition found (main file and includes), in load order.
+    pub subtrees: Vec<SubtreeDef>,
+}
+
+/// Load a tree file from disk (following includes relative to it).
+pub fn load_file(path: &Path) -> Result<Spec, Vec<Diagnostic>> {
+    let mut l = Loader::default();
+    let name = path.display().to_string();
+    let text = match read_limited(path) {
+        Ok(t) => t,
+        Err((msg, help)) => {
+            let id = l.sources.add(name, "");
+            l.issues
+                .push(Issue::new(Loc::file_start(id), msg).help(help));
+            return Err(l.sources.diagnostics(&l.issues));
+        }
+    };
+    let text = match String::from_utf8(text) {
+        Ok(t) => t,
+        Err(e) => {
+            let id = l
+                .sources
+                .add(name, String::from_utf8_lossy(e.as_bytes()).into_owned());
+            let issue = decode_utf8(e.as_bytes(), id)
+                .err()
+                .unwrap_or_else(|| Issue::new(Loc::file_start(id), "not UTF-8"));
+            l.issues.push(issue);
+            return Err(l.sources.diagnostics(&l.issues));
+        }
+    };
+    if let Ok(c) = path.canonicalize() {
+        l.loaded.insert(c);
+    }
+    l.finish(&text, &name, path.parent())
+}
+
+/// Load a tree from text. `file_name` is used in diagnostics and, when it has a folder part,
+/// as the base for relative `include:` paths (otherwise the current folder).
+pub fn load_str(text: &str, file_name: &str) -> Result<Spec, Vec<Diagnostic>> {
+    let mut l = Loader::default();
+    let path = Path::new(file_name);
+    if let Ok(c) = path.canonicalize() {
+        l.loaded.insert(c);
+    }
+    l.finish(text, file_name, path.parent())
+}
+
+fn read_limited(path: &Path) -> Result<Vec<u8>, (String, String)> {
+    let meta = std::fs::metadata(path).map_err(|e| {
+        (
+            format!("cannot read `{}`: {e}", path.display()),
+            "check the path (include paths are relative to the including file)".to_string(),
+        )
+    })?;
+    if meta.is_dir() {
+        return Err((
+            format!("`{}` is a folder, not a tree file", path.display()),
+            "give the path of a `.yaml` file".to_string(),
+        ));
+    }
+    if meta.len() > MAX_FILE_BYTES as u64 {
+        return Err((
+            format!(
+                "file is too large: {} bytes (limit {MAX_FILE_BYTES} bytes)",
+                meta.len()
+            ),
+            "a behavior tree file is a few kilobytes; is this the right file?".to_string(),
+        ));
+    }
+    std::fs::read(path).map_err(|e| {
+        (
+            format!("cannot read `{}`: {e}", path.display()),
+            "check the path and permissions".to_string(),
+        )
+    })
+}
+
+#[derive(Default)]
+struct Loader {
+    sources: Sources,
+    issues: Vec<Issue>,
+    loaded: HashSet<PathBuf>,
+    defs: Vec<SubtreeDef>,
+}
+
+impl Loader {
+    fn finish(
+        mut self,
+        text: &str,
+        name: &str,
+        base: Option<&Path>,
+    ) -> Result<Spec, Vec<Diagnostic>> {
+        let id = self.sources.add(name, text);
+        let root_file = match parse_yaml(text, id) {
+            Ok(v) => parse_tree_file(&v, &mut self.issues),
+            Err(issue) => {
+                self.issues.push(issue);
+                return Err(self.sources.diagnostics(&self.issues));
+            }
+        };
+        self.collect(&root_file, base, 0);
+        let main = match (&root_file.main, root_file.main_key) {
+            (Some(m), _) => m.clone(),
+            _ => {
+                self.issues.push(
+                    Issue::new(Loc::file_start(id), "the file has no `main:` tree")
+                        .label("expected `main: <node>`")
+                        .help("add `main:` with the root node; files that only define subtrees are included with `include:`"),
+                );
+                return Err(self.sources.diagnostics(&self.issues));
+            }
+        };
+
+        // Subtree table (duplicates are errors).
+        let mut table: HashMap<String, SubtreeDef> = HashMap::new();
+        for d in &self.defs {
+            if let Some(first) = table.get(&d.name) {
+                self.issues.push(
+                    Issue::new(d.loc, format!("subtree `{}` is defined twice", d.name))
+                        .label("second definition")
+                        .note(format!(
+                            "first defined at {}",
+                            self.sources.describe(first.loc)
+                        ))
+                        .help("rename one of them"),
+                );
+            } else {
+                table.insert(d.name.clone(), d.clone());
+            }
+        }
+
+        // `$params` must be declared, and only used inside subtrees.
+        for d in &self.defs {
+            let names: Vec<&str> = d.params.iter().map(|p| p.name.as_str()).collect();
+            let mut undefined = Vec::new();
+            undefined_params(&d.root, &names, &mut undefined);
+            for (p, loc) in undefined {
+                let label = if names.is_empty() {
+                    format!("subtree `{}` declares no parameters", d.name)
+                } else {
+                    format!(
+                        "declared parameters: {}",
+                        names
+                            .iter()
+                            .map(|n| format!("`${n}`"))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )
+                };
+                self.issues.push(
+                    Issue::new(
+                        loc,
+                        format!("undefined parameter `${p}` in subtree `{}`", d.name),
+                    )
+                    .label(label)
+                    .maybe_help(
+                        closest(p, names.iter().copied()).map(|c| format!("did you mean `${c}`?")),
+                    )
+                    .help_or(format!("declare it: `params: {{{p}: <default or ~>}}`")),
+                );
+            }
+        }
+        let mut in_main = Vec::new();
+        undefined_params(&main, &[], &mut in_main);
+        for (p, loc) in in_main {
+            self.issues.push(
+                Issue::new(loc, format!("`${p}` is used outside a subtree"))
+                    .label("parameters only exist inside `subtrees:` bodies")
+                    .help("write the value itself here, or move this part into a subtree with `params:`"),
+            );
+        }
+
+        let mut ex = Expander::new(&table, &self.sources);
+        let root = ex.node(&main, 0);
+        let called: HashSet<String> = ex.calls.keys().cloned().collect();
+        self.issues.append(&mut ex.issues);
+
+        // Check unused subtrees that can be expanded with defaults alone.
+        let mut names: Vec<&String> = table.keys().collect();
+        names.sort();
+        for n in names {
+            let d = &table[n];
+            if called.contains(n) || d.params.iter().any(|p| p.default.is_none()) {
+                continue;
+            }
+            let mut ex = Expander::new(&table, &self.sources);
+            let call = super::value::Value::new(
+                super::value::ValueKind::Map(vec![(
+                    super::value::Value::new(super::value::ValueKind::Str("subtree".into()), d.loc),
+                    super::value::Value::new(
+                        super::value::ValueKind::Map(vec![(
+                            super::value::Value::new(
+                                super::value::ValueKind::Str("ref".into()),
+                                d.loc,
+                            ),
+                            super::value::Value::new(
+                                super::value::ValueKind::Str(n.clone()),
+                                d.loc,
+                            ),
+                        )]),
+                        d.loc,
+                    ),
+                )]),
+                d.loc,
+            );
+            let _ = ex.node(&call, 0);
+            self.issues.append(&mut ex.issues);
+        }
+
+        match root {
+            Some(root) if self.issues.is_empty() => Ok(Spec {
+                root,
+                sources: self.sources,
+                subtrees: self.defs,
+            }),
+            _ => {
+                if self.issues.is_empty() {
+                    self.issues.push(Issue::new(
+                        Loc::file_start(id),
+                        "the tree could not be read",
+                    ));
+                }
+                Err(self.sources.diagnostics(&self.issues))
+            }
+        }
+    }
+
+    /// Record `file`'s subtrees and load its includes (recursively).
+    fn collect(&mut self, file: &TreeFile, base: Option<&Path>, depth: usize) {
+        self.defs.extend(file.subtrees.iter().cloned());
+        for inc in &file.includes {
+            let rel = Path::new(&inc.path);
+            let path = match base {
+                Some(b) if !rel.is_absolute() => b.join(rel),
+                _ => rel.to_path_buf(),
+            };
+            if depth + 1 > MAX_INCLUDE_DEPTH {
+                self.issues.push(
+                    Issue::new(
+                        inc.loc,
+                        format!("includes are nested more than {MAX_INCLUDE_DEPTH} deep"),
+                    )
+                    .help("flatten the include chain"),
+                );
+                continue;
+            }
+            if self.sources.len() >= MAX_FILES {
+                self.issues.push(
+                    Issue::new(inc.loc, format!("more than {MAX_FILES} files are included"))
+                        .help("merge small libraries"),
+                );
+                continue;
+            }
+            let canon = match path.canonicalize() {
+                Ok(c) => c,
+                Err(e) => {
+                    self.issues.push(
+                        Issue::new(inc.loc, format!("cannot include `{}`: {e}", path.display()))
+                            .label("expected a path relative to this file's folder")
+                            .help("check the file name; include paths are relative to the file that includes them"),
+                    );
+                    continue;
+                }
+            };
+            if !self.loaded.insert(canon) {
+                continue; // already loaded (diamond or cycle): its subtrees are known
+            }
+            let name = path.display().to_string();
+            let bytes = match read_limited(&path) {
+                Ok(b) => b,
+                Err((msg, help)) => {
+                    self.issues.push(Issue::new(inc.loc, msg).help(help));
+                    continue;
+                }
+            };
+            let id: FileId;
+            let text = match String::from_utf8(bytes) {
+                Ok(t) => {
+                    id = self.sources.add(name, t.as_str());
+                    t
+                }
+                Err(e) => {
+                    id = self
+                        .sources
+                        .add(name, String::from_utf8_lossy(e.as_bytes()).into_owned());
+                    if let Err(issue) = decode_utf8(e.as_bytes(), id) {
+                        self.issues.push(issue);
+                    }
+                    continue;
+                }
+            };
+            match parse_yaml(&text, id) {
+                Ok(v) => {
+                    let f = parse_tree_file(&v, &mut self.issues);
+                    // A library's own `main:` is ignored (it can be a demo of its subtrees).
+                    self.collect(&f, path.parent(), depth + 1);
+                }
+                Err(issue) => self.issues.push(issue),
+            }
+        }
+    }
+}

@@ -1,0 +1,185 @@
+//! The typed tree: one [`Node`] per YAML node, subtrees already expanded.
+
+use super::diag::Loc;
+use super::leaves::Leaf;
+
+/// A node of the behavior tree as written (after subtree expansion), with its source location.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Node {
+    /// What the node is and its children.
+    pub kind: NodeKind,
+    /// The optional `name:` given in YAML.
+    pub name: Option<String>,
+    /// Where the node's kind key is written (`sequence:` …).
+    pub loc: Loc,
+}
+
+/// Every node kind. Semantics, halt behaviour and YAML examples are in `docs/tree_format.md`;
+/// the one-line summary is on each variant.
+#[derive(Clone, Debug, PartialEq)]
+pub enum NodeKind {
+    /// `sequence` — ticks children in order and remembers progress; fails on the first failure,
+    /// succeeds when all succeed (bonsai `Sequence`).
+    Sequence(Vec<Node>),
+    /// `fallback` — ticks children in order and remembers progress; succeeds on the first
+    /// success, fails when all fail (bonsai `Select`).
+    Fallback(Vec<Node>),
+    /// `reactive_sequence` — re-checks its leading conditions every tick while the last child
+    /// runs; a condition failing preempts (halts) the running child → Failure.
+    ReactiveSequence(Vec<Node>),
+    /// `reactive_fallback` — re-checks its leading conditions every tick while the last child
+    /// runs; a condition succeeding preempts (halts) the running child → Success.
+    ReactiveFallback(Vec<Node>),
+    /// `parallel` — ticks all children every tick; Success when all succeeded, Failure as soon as
+    /// one fails (the others are halted) (bonsai `WhenAll`).
+    Parallel(Vec<Node>),
+    /// `race` — ticks all children every tick; the first to finish decides (Success or Failure),
+    /// the others are halted (bonsai `Race`).
+    Race(Vec<Node>),
+    /// `guard` — runs `child` only while `condition` holds; checked every tick before the child;
+    /// when it fails the child is halted → Failure.
+    Guard {
+        /// A condition leaf (or an `inverter` of one).
+        condition: Box<Node>,
+        /// The guarded node.
+        child: Box<Node>,
+    },
+    /// `retry` — re-runs a failing child, up to `attempts` runs in total; the next attempt
+    /// starts on the next tick.
+    Retry {
+        /// Total number of runs allowed (≥ 1).
+        attempts: u32,
+        /// The node to retry.
+        child: Box<Node>,
+    },
+    /// `repeat` — runs the child `times` times in a row while it succeeds (a failure fails the
+    /// repeat); the next run starts on the next tick.
+    Repeat {
+        /// Number of successful runs required (≥ 1).
+        times: u32,
+        /// The node to repeat.
+        child: Box<Node>,
+    },
+    /// `timeout` — fails (halting the child) when the child has been running for `seconds` of
+    /// simulated time (bonsai `Timeout`).
+    Timeout {
+        /// Simulated seconds (> 0).
+        seconds: f64,
+        /// The node to time-limit.
+        child: Box<Node>,
+    },
+    /// `inverter` — swaps Success and Failure.
+    Inverter(Box<Node>),
+    /// `force_success` — turns Failure into Success.
+    ForceSuccess(Box<Node>),
+    /// `force_failure` — turns Success into Failure.
+    ForceFailure(Box<Node>),
+    /// `subtree` — a call of a named subtree, expanded in place (arguments substituted).
+    Subtree {
+        /// The subtree's name (`ref:`).
+        reference: String,
+        /// The arguments as given, rendered as compact YAML-ish text (for display).
+        args: Vec<(String, String)>,
+        /// The expanded body.
+        body: Box<Node>,
+    },
+    /// A leaf (action, condition or wait).
+    Leaf(Leaf),
+}
+
+/// Composite node kinds (take `children:`).
+pub const COMPOSITE_KINDS: &[&str] = &[
+    "sequence",
+    "fallback",
+    "reactive_sequence",
+    "reactive_fallback",
+    "parallel",
+    "race",
+];
+
+/// Decorator node kinds (take `child:`), plus `subtree`.
+pub const DECORATOR_KINDS: &[&str] = &[
+    "guard",
+    "retry",
+    "repeat",
+    "timeout",
+    "inverter",
+    "force_success",
+    "force_failure",
+    "subtree",
+];
+
+impl NodeKind {
+    /// The YAML kind name (`sequence`, `retry`, `reach`, …).
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            NodeKind::Sequence(_) => "sequence",
+            NodeKind::Fallback(_) => "fallback",
+            NodeKind::ReactiveSequence(_) => "reactive_sequence",
+            NodeKind::ReactiveFallback(_) => "reactive_fallback",
+            NodeKind::Parallel(_) => "parallel",
+            NodeKind::Race(_) => "race",
+            NodeKind::Guard { .. } => "guard",
+            NodeKind::Retry { .. } => "retry",
+            NodeKind::Repeat { .. } => "repeat",
+            NodeKind::Timeout { .. } => "timeout",
+            NodeKind::Inverter(_) => "inverter",
+            NodeKind::ForceSuccess(_) => "force_success",
+            NodeKind::ForceFailure(_) => "force_failure",
+            NodeKind::Subtree { .. } => "subtree",
+            NodeKind::Leaf(l) => l.kind(),
+        }
+    }
+
+    /// The children in tick order (a guard's condition comes first).
+    pub fn children(&self) -> Vec<&Node> {
+        match self {
+            NodeKind::Sequence(c)
+            | NodeKind::Fallback(c)
+            | NodeKind::ReactiveSequence(c)
+            | NodeKind::ReactiveFallback(c)
+            | NodeKind::Parallel(c)
+            | NodeKind::Race(c) => c.iter().collect(),
+            NodeKind::Guard { condition, child } => vec![condition, child],
+            NodeKind::Retry { child, .. }
+            | NodeKind::Repeat { child, .. }
+            | NodeKind::Timeout { child, .. }
+            | NodeKind::Inverter(child)
+            | NodeKind::ForceSuccess(child)
+            | NodeKind::ForceFailure(child) => vec![child],
+            NodeKind::Subtree { body, .. } => vec![body],
+            NodeKind::Leaf(_) => vec![],
+        }
+    }
+}
+
+impl Node {
+    /// Number of nodes in this subtree (itself included).
+    pub fn count(&self) -> usize {
+        1 + self
+            .kind
+            .children()
+            .iter()
+            .map(|c| c.count())
+            .sum::<usize>()
+    }
+
+    /// The leaf, if this node is one.
+    pub fn leaf(&self) -> Option<&Leaf> {
+        match &self.kind {
+            NodeKind::Leaf(l) => Some(l),
+            _ => None,
+        }
+    }
+
+    /// If this node is an instantaneous check usable as a guard or reactive condition — a
+    /// condition leaf, or an `inverter` of one — return the condition node and whether it is
+    /// inverted.
+    pub fn as_check(&self) -> Option<(&Node, bool)> {
+        match &self.kind {
+            NodeKind::Leaf(Leaf::Condition(_)) => Some((self, false)),
+            NodeKind::Inverter(c) => c.as_check().map(|(n, inv)| (n, !inv)),
+            _ => None,
+        }
+    }
+}

@@ -1,0 +1,373 @@
+//! Checked scalar parameters: lengths (m), durations (s), speeds (m/s), angles (rad), targets.
+//!
+//! Parameters are stored as plain `f64` in SI units; these helpers are used with
+//! `#[serde(deserialize_with = ...)]` so that a bad value (non-finite, negative duration, zero
+//! speed, …) is reported at its own line and column.
+
+use std::borrow::Cow;
+use std::fmt;
+
+use schemars::{JsonSchema, Schema, SchemaGenerator, json_schema};
+use serde::de::{self, Deserializer, SeqAccess, Visitor};
+use serde::{Deserialize, Serialize};
+
+use super::suggest::did_you_mean;
+
+fn finite<E: de::Error>(x: f64, what: &str) -> Result<f64, E> {
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(E::custom(format!(
+            "{what} must be a finite number, found `{x}`"
+        )))
+    }
+}
+
+fn number<'de, D: Deserializer<'de>>(d: D, what: &str) -> Result<f64, D::Error> {
+    let x = f64::deserialize(d)?;
+    finite(x, what)
+}
+
+/// A finite length in metres (any sign).
+pub fn length<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    number(d, "a length (m)")
+}
+
+/// A finite, non-negative distance in metres.
+pub fn distance<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let x = number(d, "a distance (m)")?;
+    if x < 0.0 {
+        return Err(de::Error::custom(format!(
+            "a distance (m) must be ≥ 0, found `{x}`"
+        )));
+    }
+    Ok(x)
+}
+
+/// An optional distance in metres (`~` or absent = `None`).
+pub fn opt_distance<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+    struct Dist(f64);
+    impl<'de> Deserialize<'de> for Dist {
+        fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            distance(d).map(Dist)
+        }
+    }
+    Ok(Option::<Dist>::deserialize(d)?.map(|x| x.0))
+}
+
+/// A finite, non-negative duration in (simulated) seconds.
+pub fn duration<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let x = number(d, "a duration (s)")?;
+    if x < 0.0 {
+        return Err(de::Error::custom(format!(
+            "a duration (s) must be ≥ 0, found `{x}`"
+        )));
+    }
+    Ok(x)
+}
+
+/// A finite, strictly positive time limit in (simulated) seconds.
+pub fn time_limit<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let x = number(d, "a time limit (s)")?;
+    if x <= 0.0 {
+        return Err(de::Error::custom(format!(
+            "a time limit (s) must be > 0, found `{x}`"
+        )));
+    }
+    Ok(x)
+}
+
+/// A finite, strictly positive speed in m/s.
+pub fn speed<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let x = number(d, "a speed (m/s)")?;
+    if x <= 0.0 {
+        return Err(de::Error::custom(format!(
+            "a speed (m/s) must be > 0, found `{x}`"
+        )));
+    }
+    Ok(x)
+}
+
+/// A finite, non-negative angular tolerance in radians (accepts `deg(2)` etc.).
+pub fn angle_tolerance<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let x = Angle::deserialize(d)?.0;
+    if x < 0.0 {
+        return Err(de::Error::custom(format!(
+            "an angular tolerance must be ≥ 0 rad, found `{x}`"
+        )));
+    }
+    Ok(x)
+}
+
+/// Three finite lengths `[x, y, z]` in metres.
+pub fn vec3<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
+    let v = <[f64; 3]>::deserialize(d)?;
+    for x in v {
+        finite::<D::Error>(x, "a coordinate (m)")?;
+    }
+    Ok(v)
+}
+
+/// Six joint angles in radians (each a number or `deg(..)`/`rad(..)`).
+pub fn joints6<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 6], D::Error> {
+    let v = <[Angle; 6]>::deserialize(d)?;
+    Ok(v.map(|a| a.0))
+}
+
+/// Parse an angle written as text: `deg(90)`, `rad(1.57)`, `pi/2`, `deg(-45)`; plain numbers are
+/// radians. Uses serde-saphyr's `robotics` angle evaluator. Returns radians.
+pub fn parse_angle_text(s: &str) -> Result<f64, String> {
+    let t = s.trim();
+    if t.is_empty() || t.len() > 200 {
+        return Err(format!("`{s}` is not an angle"));
+    }
+    let options = serde_saphyr::options! { angle_conversions: true };
+    match serde_saphyr::from_str_with_options::<f64>(t, options) {
+        Ok(x) if x.is_finite() => Ok(x),
+        Ok(x) => Err(format!("an angle must be finite, found `{x}`")),
+        Err(_) => Err(format!("`{s}` is not an angle")),
+    }
+}
+
+/// An angle in radians. YAML accepts a plain number (radians) or `deg(x)` / `rad(x)` (and simple
+/// expressions such as `rad(pi/2)`).
+#[derive(Copy, Clone, Debug, PartialEq, Serialize)]
+#[serde(transparent)]
+pub struct Angle(pub f64);
+
+struct AngleVisitor;
+
+impl Visitor<'_> for AngleVisitor {
+    type Value = Angle;
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("an angle: radians as a number, or `deg(90)` / `rad(1.57)`")
+    }
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<Angle, E> {
+        Ok(Angle(v as f64))
+    }
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<Angle, E> {
+        Ok(Angle(v as f64))
+    }
+    fn visit_f64<E: de::Error>(self, v: f64) -> Result<Angle, E> {
+        finite(v, "an angle (rad)").map(Angle)
+    }
+    fn visit_str<E: de::Error>(self, v: &str) -> Result<Angle, E> {
+        parse_angle_text(v).map(Angle).map_err(|m| {
+            E::custom(format!(
+                "{m}; write radians as a number, or `deg(90)` / `rad(1.57)`"
+            ))
+        })
+    }
+}
+
+impl<'de> Deserialize<'de> for Angle {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(AngleVisitor)
+    }
+}
+
+impl JsonSchema for Angle {
+    fn schema_name() -> Cow<'static, str> {
+        "Angle".into()
+    }
+    fn json_schema(_: &mut SchemaGenerator) -> Schema {
+        json_schema!({
+            "description": "An angle: radians as a number, or a string `deg(90)` / `rad(1.57)` (expressions like `rad(pi/2)` work).",
+            "anyOf": [
+                {"type": "number"},
+                {"type": "string", "pattern": "^\\s*(deg|rad)\\(.*\\)\\s*$|pi"}
+            ]
+        })
+    }
+}
+
+/// Where a motion goes: one of the scene's objects, or a fixed point.
+///
+/// YAML: `cube`, `bowl`, or `[x, y, z]` in world metres.
+#[derive(Copy, Clone, Debug, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Target {
+    /// The cube's current pose.
+    Cube,
+    /// The bowl's current pose.
+    Bowl,
+    /// A fixed point in the world frame, metres.
+    Point([f64; 3]),
+}
+
+const TARGET_NAMES: &[&str] = &["cube", "bowl"];
+
+struct TargetVisitor;
+
+impl<'de> Visitor<'de> for TargetVisitor {
+    type Value = Target;
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("`cube`, `bowl` or a point `[x, y, z]` in metres")
+    }
+    fn visit_str<E: de::Error>(self, v: &str) -> Result<Target, E> {
+        match v {
+            "cube" => Ok(Target::Cube),
+            "bowl" => Ok(Target::Bowl),
+            _ => {
+                let mut msg =
+                    format!("unknown target `{v}`: expected `cube`, `bowl` or `[x, y, z]`");
+                if let Some(h) = did_you_mean(v, TARGET_NAMES.iter().copied()) {
+                    msg.push_str(&format!(" ({h})"));
+                }
+                Err(E::custom(msg))
+            }
+        }
+    }
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Target, A::Error> {
+        let mut p = [0.0; 3];
+        for (i, slot) in p.iter_mut().enumerate() {
+            let x: f64 = seq
+                .next_element()?
+                .ok_or_else(|| de::Error::invalid_length(i, &"a point [x, y, z] in metres"))?;
+            *slot = finite(x, "a coordinate (m)")?;
+        }
+        if seq.next_element::<de::IgnoredAny>()?.is_some() {
+            return Err(de::Error::invalid_length(4, &"a point [x, y, z] in metres"));
+        }
+        Ok(Target::Point(p))
+    }
+}
+
+impl<'de> Deserialize<'de> for Target {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(TargetVisitor)
+    }
+}
+
+impl JsonSchema for Target {
+    fn schema_name() -> Cow<'static, str> {
+        "Target".into()
+    }
+    fn json_schema(_: &mut SchemaGenerator) -> Schema {
+        json_schema!({
+            "description": "`cube`, `bowl`, or a fixed point `[x, y, z]` in world metres.",
+            "anyOf": [
+                {"type": "string", "enum": ["cube", "bowl"]},
+                {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3}
+            ]
+        })
+    }
+}
+
+impl fmt::Display for Target {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Target::Cube => f.write_str("cube"),
+            Target::Bowl => f.write_str("bowl"),
+            Target::Point([x, y, z]) => write!(f, "[{x}, {y}, {z}]"),
+        }
+    }
+}
+
+/// The gripper's yaw (rotation about the world vertical) at the end of a `reach`.
+///
+/// YAML: `object` (default), `keep`, or an angle (`1.57`, `deg(90)`).
+#[derive(Copy, Clone, Debug, PartialEq, Serialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Yaw {
+    /// Match the target object's yaw (modulo 90°) so the fingers straddle two opposite faces.
+    #[default]
+    Object,
+    /// Keep the current tool yaw.
+    Keep,
+    /// This absolute yaw in the world frame, radians.
+    Angle(f64),
+}
+
+struct YawVisitor;
+
+impl Visitor<'_> for YawVisitor {
+    type Value = Yaw;
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("`object`, `keep`, or an angle (radians, or `deg(90)`)")
+    }
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<Yaw, E> {
+        Ok(Yaw::Angle(v as f64))
+    }
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<Yaw, E> {
+        Ok(Yaw::Angle(v as f64))
+    }
+    fn visit_f64<E: de::Error>(self, v: f64) -> Result<Yaw, E> {
+        finite(v, "a yaw angle (rad)").map(Yaw::Angle)
+    }
+    fn visit_str<E: de::Error>(self, v: &str) -> Result<Yaw, E> {
+        match v {
+            "object" => Ok(Yaw::Object),
+            "keep" => Ok(Yaw::Keep),
+            _ => parse_angle_text(v).map(Yaw::Angle).map_err(|_| {
+                let mut msg = format!(
+                    "unknown yaw `{v}`: expected `object`, `keep` or an angle like `deg(90)`"
+                );
+                if let Some(h) = did_you_mean(v, ["object", "keep"]) {
+                    msg.push_str(&format!(" ({h})"));
+                }
+                E::custom(msg)
+            }),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Yaw {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(YawVisitor)
+    }
+}
+
+impl JsonSchema for Yaw {
+    fn schema_name() -> Cow<'static, str> {
+        "Yaw".into()
+    }
+    fn json_schema(g: &mut SchemaGenerator) -> Schema {
+        let angle = g.subschema_for::<Angle>();
+        json_schema!({
+            "description": "`object` (match the target object's yaw so the fingers straddle two faces), `keep` (keep the current tool yaw), or an absolute yaw angle.",
+            "anyOf": [
+                {"type": "string", "enum": ["object", "keep"]},
+                angle
+            ]
+        })
+    }
+}
+
+/// How a `reach` moves the arm.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum PathKind {
+    /// Interpolate in joint space (fast, the tool path is curved).
+    #[default]
+    Joint,
+    /// Straight line of the tool centre point in Cartesian space (for the final approach).
+    Cartesian,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn angles() {
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-9;
+        assert!(close(
+            parse_angle_text("deg(90)").unwrap(),
+            std::f64::consts::FRAC_PI_2
+        ));
+        assert!(close(parse_angle_text("rad(1.5)").unwrap(), 1.5));
+        assert!(close(
+            parse_angle_text("rad(pi/2)").unwrap(),
+            std::f64::consts::FRAC_PI_2
+        ));
+        assert!(close(
+            parse_angle_text("deg(-45)").unwrap(),
+            -std::f64::consts::FRAC_PI_4
+        ));
+        assert!(parse_angle_text("object").is_err());
+        assert!(parse_angle_text("deg(").is_err());
+        assert!(parse_angle_text("[1, 2]").is_err());
+        assert!(parse_angle_text(".inf").is_err());
+    }
+}

@@ -1,0 +1,424 @@
+//! A generic YAML value tree in which every node remembers where it came from.
+//!
+//! Tree files are first read into this form (with serde-saphyr and hard resource limits), so
+//! that `$param` substitution in subtrees can happen *before* typed deserialization while every
+//! value keeps its own file:line:column. Typed parameters are then read from it with
+//! [`crate::spec::de`].
+
+use std::fmt;
+
+use serde::de::{self, Deserialize, Deserializer, MapAccess, SeqAccess, Visitor};
+use serde_saphyr::Spanned;
+
+use super::diag::{FileId, Issue, Loc};
+
+/// Largest tree file accepted, in bytes. Real trees are a few kB; this keeps a stray 50 MB file
+/// from being parsed at all.
+pub const MAX_FILE_BYTES: usize = 1024 * 1024;
+
+/// Deepest YAML nesting (mappings + sequences) accepted. One behavior-tree level costs about
+/// four YAML levels (`sequence:` map, its body map, `children:` list, child map).
+pub const MAX_YAML_DEPTH: usize = 160;
+
+/// Most YAML nodes (scalars + collections) in one file, after alias expansion.
+pub const MAX_YAML_NODES: usize = 100_000;
+
+/// A YAML value with its source location.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Value {
+    /// The value.
+    pub kind: ValueKind,
+    /// Where it was written.
+    pub loc: Loc,
+    /// For values substituted from a subtree `$param`: the location of the `$param` use.
+    pub via: Option<Loc>,
+}
+
+/// The shape of a [`Value`].
+#[derive(Clone, Debug, PartialEq)]
+pub enum ValueKind {
+    /// `~`, `null` or an empty value.
+    Null,
+    /// `true` / `false`.
+    Bool(bool),
+    /// An integer.
+    Int(i64),
+    /// A float (also integers too large for `i64`).
+    Float(f64),
+    /// Any other scalar.
+    Str(String),
+    /// A sequence.
+    Seq(Vec<Value>),
+    /// A mapping, in source order (keys are values too; tree files only use string keys).
+    Map(Vec<(Value, Value)>),
+}
+
+impl Value {
+    /// A value at `loc`.
+    pub fn new(kind: ValueKind, loc: Loc) -> Self {
+        Self {
+            kind,
+            loc,
+            via: None,
+        }
+    }
+
+    /// The string, if this is a string scalar.
+    pub fn as_str(&self) -> Option<&str> {
+        match &self.kind {
+            ValueKind::Str(s) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// The entries, if this is a mapping.
+    pub fn as_map(&self) -> Option<&[(Value, Value)]> {
+        match &self.kind {
+            ValueKind::Map(m) => Some(m),
+            _ => None,
+        }
+    }
+
+    /// The items, if this is a sequence.
+    pub fn as_seq(&self) -> Option<&[Value]> {
+        match &self.kind {
+            ValueKind::Seq(s) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// Look a string key up in a mapping.
+    pub fn get(&self, key: &str) -> Option<&Value> {
+        self.as_map()?
+            .iter()
+            .find(|(k, _)| k.as_str() == Some(key))
+            .map(|(_, v)| v)
+    }
+
+    /// A short description of the value's type for messages ("a mapping", "the string `x`").
+    pub fn describe(&self) -> String {
+        match &self.kind {
+            ValueKind::Null => "null".into(),
+            ValueKind::Bool(b) => format!("the boolean `{b}`"),
+            ValueKind::Int(i) => format!("the integer `{i}`"),
+            ValueKind::Float(x) => format!("the number `{x}`"),
+            ValueKind::Str(s) => {
+                let short: String = s.chars().take(40).collect();
+                format!("the string `{short}`")
+            }
+            ValueKind::Seq(_) => "a list".into(),
+            ValueKind::Map(_) => "a mapping".into(),
+        }
+    }
+
+    /// Number of YAML nodes in this value (itself included).
+    pub fn node_count(&self) -> usize {
+        1 + match &self.kind {
+            ValueKind::Seq(s) => s.iter().map(Value::node_count).sum(),
+            ValueKind::Map(m) => m.iter().map(|(k, v)| k.node_count() + v.node_count()).sum(),
+            _ => 0,
+        }
+    }
+
+    fn set_file(&mut self, file: FileId) {
+        self.loc.file = file;
+        match &mut self.kind {
+            ValueKind::Seq(s) => s.iter_mut().for_each(|v| v.set_file(file)),
+            ValueKind::Map(m) => m.iter_mut().for_each(|(k, v)| {
+                k.set_file(file);
+                v.set_file(file);
+            }),
+            _ => {}
+        }
+    }
+}
+
+fn loc_of(l: &serde_saphyr::Location) -> Loc {
+    Loc {
+        file: 0,
+        line: u32::try_from(l.line()).unwrap_or(u32::MAX),
+        col: u32::try_from(l.column()).unwrap_or(u32::MAX),
+        len: u32::try_from(l.span().len()).unwrap_or(u32::MAX),
+    }
+}
+
+/// Deserialization target used only while reading: the kind, whose children are spanned.
+struct RawKind(ValueKind);
+
+fn spanned_to_value(s: Spanned<RawKind>) -> Value {
+    Value::new(s.value.0, loc_of(&s.referenced))
+}
+
+impl<'de> Deserialize<'de> for RawKind {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(RawVisitor)
+    }
+}
+
+struct RawVisitor;
+
+impl<'de> Visitor<'de> for RawVisitor {
+    type Value = RawKind;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("any YAML value")
+    }
+    fn visit_bool<E: de::Error>(self, v: bool) -> Result<RawKind, E> {
+        Ok(RawKind(ValueKind::Bool(v)))
+    }
+    fn visit_i64<E: de::Error>(self, v: i64) -> Result<RawKind, E> {
+        Ok(RawKind(ValueKind::Int(v)))
+    }
+    fn visit_i128<E: de::Error>(self, v: i128) -> Result<RawKind, E> {
+        Ok(RawKind(match i64::try_from(v) {
+            Ok(i) => ValueKind::Int(i),
+            Err(_) => ValueKind::Float(v as f64),
+        }))
+    }
+    fn visit_u64<E: de::Error>(self, v: u64) -> Result<RawKind, E> {
+        Ok(RawKind(match i64::try_from(v) {
+            Ok(i) => ValueKind::Int(i),
+            Err(_) => ValueKind::Float(v as f64),
+        }))
+    }
+    fn visit_u128<E: de::Error>(self, v: u128) -> Result<RawKind, E> {
+        Ok(RawKind(match i64::try_from(v) {
+            Ok(i) => ValueKind::Int(i),
+            Err(_) => ValueKind::Float(v as f64),
+        }))
+    }
+    fn visit_f64<E: de::Error>(self, v: f64) -> Result<RawKind, E> {
+        Ok(RawKind(ValueKind::Float(v)))
+    }
+    fn visit_str<E: de::Error>(self, v: &str) -> Result<RawKind, E> {
+        Ok(RawKind(ValueKind::Str(v.to_string())))
+    }
+    fn visit_string<E: de::Error>(self, v: String) -> Result<RawKind, E> {
+        Ok(RawKind(ValueKind::Str(v)))
+    }
+    fn visit_bytes<E: de::Error>(self, v: &[u8]) -> Result<RawKind, E> {
+        Ok(RawKind(ValueKind::Str(
+            String::from_utf8_lossy(v).into_owned(),
+        )))
+    }
+    fn visit_none<E: de::Error>(self) -> Result<RawKind, E> {
+        Ok(RawKind(ValueKind::Null))
+    }
+    fn visit_unit<E: de::Error>(self) -> Result<RawKind, E> {
+        Ok(RawKind(ValueKind::Null))
+    }
+    fn visit_some<D: Deserializer<'de>>(self, d: D) -> Result<RawKind, D::Error> {
+        RawKind::deserialize(d)
+    }
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<RawKind, A::Error> {
+        let mut items = Vec::new();
+        while let Some(item) = seq.next_element::<Spanned<RawKind>>()? {
+            items.push(spanned_to_value(item));
+        }
+        Ok(RawKind(ValueKind::Seq(items)))
+    }
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<RawKind, A::Error> {
+        let mut entries = Vec::new();
+        while let Some((k, v)) = map.next_entry::<Spanned<RawKind>, Spanned<RawKind>>()? {
+            entries.push((spanned_to_value(k), spanned_to_value(v)));
+        }
+        Ok(RawKind(ValueKind::Map(entries)))
+    }
+}
+
+/// Read YAML text into a spanned [`Value`], never panicking, with resource limits
+/// ([`MAX_FILE_BYTES`], [`MAX_YAML_DEPTH`], [`MAX_YAML_NODES`], alias limits).
+///
+/// An empty document (or one with only comments) is an error: a tree file needs `main:`.
+pub fn parse_yaml(text: &str, file: FileId) -> Result<Value, Issue> {
+    let whole = Loc::file_start(file);
+    if text.len() > MAX_FILE_BYTES {
+        return Err(Issue::new(
+            whole,
+            format!(
+                "file is too large: {} bytes (limit {} bytes)",
+                text.len(),
+                MAX_FILE_BYTES
+            ),
+        )
+        .help("a behavior tree file is a few kilobytes; is this the right file?"));
+    }
+    if text.trim().is_empty()
+        || text
+            .lines()
+            .all(|l| l.trim().is_empty() || l.trim_start().starts_with('#'))
+    {
+        return Err(Issue::new(whole, "the file is empty")
+            .label("expected a mapping with a `main:` tree")
+            .help("start the file with `main:` followed by the root node, e.g. `main: {sequence: {children: [...]}}`"));
+    }
+    let budget = serde_saphyr::budget! {
+        max_depth: MAX_YAML_DEPTH,
+        max_nodes: MAX_YAML_NODES,
+        max_events: 4 * MAX_YAML_NODES,
+        max_aliases: 1_000,
+        max_anchors: 1_000,
+        max_documents: 1,
+        max_total_scalar_bytes: MAX_FILE_BYTES,
+        max_inclusion_depth: 0,
+    };
+    let options = serde_saphyr::options! {
+        budget: budget,
+        alias_limits: serde_saphyr::alias_limits! {
+            max_total_replayed_events: 4 * MAX_YAML_NODES,
+            max_replay_stack_depth: 16,
+        },
+        with_snippet: false,
+    };
+    let parsed: Result<Spanned<RawKind>, _> = serde_saphyr::from_str_with_options(text, options);
+    match parsed {
+        Ok(s) => {
+            let mut v = spanned_to_value(s);
+            v.set_file(file);
+            if v.node_count() > MAX_YAML_NODES {
+                return Err(Issue::new(
+                    whole,
+                    format!("the file expands to more than {MAX_YAML_NODES} YAML nodes"),
+                )
+                .help(
+                    "remove YAML aliases that multiply content (`*anchor` inside repeated lists)",
+                ));
+            }
+            Ok(v)
+        }
+        Err(e) => Err(yaml_error(&e, file)),
+    }
+}
+
+fn yaml_error(e: &serde_saphyr::Error, file: FileId) -> Issue {
+    let loc = e.location().map_or(Loc::file_start(file), |l| {
+        let mut loc = loc_of(&l);
+        loc.file = file;
+        if loc.line == 0 {
+            loc.line = 1;
+            loc.col = 1;
+        }
+        loc
+    });
+    let raw = e
+        .render_with_options(serde_saphyr::render_options! {
+            snippets: serde_saphyr::SnippetMode::Off,
+        })
+        .to_string();
+    // The plain rendering ends with " at line X, column Y"; we print the location ourselves.
+    let msg = match raw.rfind(" at line ") {
+        Some(i) => raw[..i].to_string(),
+        None => raw,
+    };
+    let msg: String = msg
+        .lines()
+        .next()
+        .unwrap_or("invalid YAML")
+        .chars()
+        .take(300)
+        .collect();
+    let lower = msg.to_lowercase();
+    let help = if lower.contains("budget")
+        || lower.contains("alias")
+        || lower.contains("depth")
+        || lower.contains("limit")
+    {
+        "tree files must stay small and shallow: avoid deep nesting and YAML anchors/aliases that multiply content"
+    } else {
+        "fix the YAML syntax here (indentation, a missing `:` or an unclosed bracket or quote)"
+    };
+    Issue::new(loc, format!("invalid YAML: {msg}")).help(help)
+}
+
+/// Read raw bytes (e.g. a file's content) as UTF-8 tree text; invalid UTF-8 is an error located
+/// at the first bad byte.
+pub fn decode_utf8(bytes: &[u8], file: FileId) -> Result<&str, Issue> {
+    if bytes.len() > MAX_FILE_BYTES {
+        return Err(Issue::new(
+            Loc::file_start(file),
+            format!(
+                "file is too large: {} bytes (limit {} bytes)",
+                bytes.len(),
+                MAX_FILE_BYTES
+            ),
+        )
+        .help("a behavior tree file is a few kilobytes; is this the right file?"));
+    }
+    std::str::from_utf8(bytes).map_err(|e| {
+        let good = &bytes[..e.valid_up_to()];
+        let good = std::str::from_utf8(good).unwrap_or("");
+        let line = good.matches('\n').count() + 1;
+        let col = good.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+        Issue::new(
+            Loc {
+                file,
+                line: u32::try_from(line).unwrap_or(u32::MAX),
+                col: u32::try_from(col).unwrap_or(u32::MAX),
+                len: 1,
+            },
+            format!(
+                "the file is not valid UTF-8 (bad byte at offset {})",
+                e.valid_up_to()
+            ),
+        )
+        .help("save the tree file as UTF-8 text; is this a binary file?")
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spans_point_at_values() {
+        let v = parse_yaml("main:\n  seq: [1, two, 3.5]\n", 0).unwrap();
+        let main = v.get("main").unwrap();
+        assert_eq!((main.loc.line, main.loc.col), (2, 3));
+        let seq = main.get("seq").unwrap().as_seq().unwrap();
+        assert_eq!(seq[1].kind, ValueKind::Str("two".into()));
+        assert_eq!(
+            (seq[1].loc.line, seq[1].loc.col, seq[1].loc.len),
+            (2, 12, 3)
+        );
+        assert_eq!(seq[2].kind, ValueKind::Float(3.5));
+    }
+
+    #[test]
+    fn syntax_error_is_located() {
+        let e = parse_yaml("main:\n  a: [1, 2\n", 0).unwrap_err();
+        assert!(e.message.starts_with("invalid YAML"), "{e:?}");
+        assert!(e.loc.line >= 2, "{e:?}");
+    }
+
+    #[test]
+    fn empty_file_is_an_error() {
+        assert!(parse_yaml("", 0).is_err());
+        assert!(parse_yaml("# only a comment\n", 0).is_err());
+    }
+
+    #[test]
+    fn alias_bomb_is_rejected() {
+        let mut s = String::from("a: &a [x, x, x, x, x, x, x, x, x, x]\n");
+        for i in 1..12 {
+            s.push_str(&format!(
+                "{}: &{} [*{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}]\n",
+                (b'a' + i) as char,
+                (b'a' + i) as char,
+                p = (b'a' + i - 1) as char
+            ));
+        }
+        assert!(parse_yaml(&s, 0).is_err());
+    }
+
+    #[test]
+    fn deep_nesting_is_rejected() {
+        let s = "[".repeat(100_000);
+        assert!(parse_yaml(&s, 0).is_err());
+        let mut s = String::new();
+        for i in 0..2000 {
+            s.push_str(&" ".repeat(i));
+            s.push_str("a:\n");
+        }
+        assert!(parse_yaml(&s, 0).is_err());
+    }
+}
