@@ -27,11 +27,20 @@ pub struct Carry {
 impl Carry {
     /// A carry controller for `spec`.
     pub fn new(spec: CarrySpec) -> Self {
-        Self { spec, waypoints: Vec::new(), phase: 0, goal_q: [0.0; 6], lost: 0 }
+        Self {
+            spec,
+            waypoints: Vec::new(),
+            phase: 0,
+            goal_q: [0.0; 6],
+            lost: 0,
+        }
     }
 
     fn limits(&self) -> MotionLimits {
-        MotionLimits { tool_speed: self.spec.speed, ..MotionLimits::default() }
+        MotionLimits {
+            tool_speed: self.spec.speed,
+            ..MotionLimits::default()
+        }
     }
 
     fn start_phase(&mut self, cell: &mut Cell) -> Result<(), String> {
@@ -95,6 +104,10 @@ impl MacroAction for Carry {
             }
             return Progress::Running;
         }
-        if Arrival::default().reached(cell, &self.goal_q) { Progress::Done } else { Progress::Running }
+        if Arrival::default().reached(cell, &self.goal_q) {
+            Progress::Done
+        } else {
+            Progress::Running
+        }
     }
 }

@@ -13,7 +13,10 @@ enum ArmPlan {
     /// Hold these joint angles (radians).
     Hold([f64; 6]),
     /// Follow a trajectory that started at `t0` (simulated seconds).
-    Track { trajectory: Box<dyn Trajectory>, t0: f64 },
+    Track {
+        trajectory: Box<dyn Trajectory>,
+        t0: f64,
+    },
 }
 
 /// Sees every physics step and every macro action that starts: fault injection acts on the
@@ -101,7 +104,10 @@ impl Cell {
 
     /// Starts following `trajectory` now.
     pub fn track(&mut self, trajectory: Box<dyn Trajectory>) {
-        self.arm = ArmPlan::Track { trajectory, t0: self.sim.time() };
+        self.arm = ArmPlan::Track {
+            trajectory,
+            t0: self.sim.time(),
+        };
     }
 
     /// Stops where the arm is commanded to be now and holds there (a halt).

@@ -49,7 +49,13 @@ pub struct MacroDriver<'a> {
 impl<'a> MacroDriver<'a> {
     /// A driver acting on `cell`.
     pub fn new(cell: &'a mut Cell) -> Self {
-        Self { cell, active: HashMap::new(), checks: ChecksRecorder::default(), counters: LeafCounters::default(), last_failure: None }
+        Self {
+            cell,
+            active: HashMap::new(),
+            checks: ChecksRecorder::default(),
+            counters: LeafCounters::default(),
+            last_failure: None,
+        }
     }
 
     /// The cell.
@@ -90,7 +96,9 @@ impl<'a> MacroDriver<'a> {
             ConditionLeaf::CubeGrasped(_) => cond::cube_grasped(w, cond::Tolerances::GRASP_OFF_AXIS),
             ConditionLeaf::CubeLifted(c) => cond::cube_lifted(w, c.min_height),
             ConditionLeaf::CubeInBowl(_) => cond::cube_in_bowl(w, cond::Tolerances::REST_SPEED),
-            ConditionLeaf::CubeOnTable(c) => cond::cube_on_table(w, c.tolerance, cond::Tolerances::REST_SPEED),
+            ConditionLeaf::CubeOnTable(c) => {
+                cond::cube_on_table(w, c.tolerance, cond::Tolerances::REST_SPEED)
+            }
             ConditionLeaf::GripperOpen(c) => cond::gripper_open(w, c.min_width),
             ConditionLeaf::AtHome(c) => cond::at_home(w, c.tolerance),
         }
@@ -125,7 +133,9 @@ impl LeafDriver for MacroDriver<'_> {
                 };
             }
             Leaf::Action(a) => a,
-            Leaf::Wait(_) => return LeafOutcome::Failure("wait is handled by the runtime, not the driver".into()),
+            Leaf::Wait(_) => {
+                return LeafOutcome::Failure("wait is handled by the runtime, not the driver".into());
+            }
         };
         if first || !self.active.contains_key(&id) {
             let mut controller = self.start_action(action);
@@ -135,7 +145,14 @@ impl LeafDriver for MacroDriver<'_> {
             }
             let now = self.cell.world().time;
             let timeout = action.timeout();
-            self.active.insert(id, Active { action: controller, deadline: now + timeout, timeout });
+            self.active.insert(
+                id,
+                Active {
+                    action: controller,
+                    deadline: now + timeout,
+                    timeout,
+                },
+            );
             return LeafOutcome::Running;
         }
         let now = self.cell.world().time;

@@ -23,7 +23,11 @@ pub struct Grasp {
 impl Grasp {
     /// A grasp controller for `spec`.
     pub fn new(spec: GraspSpec) -> Self {
-        Self { spec, t0: 0.0, stalled: 0 }
+        Self {
+            spec,
+            t0: 0.0,
+            stalled: 0,
+        }
     }
 }
 

@@ -24,11 +24,19 @@ impl MoveJoints {
 impl MacroAction for MoveJoints {
     fn start(&mut self, cell: &mut Cell) -> Result<(), String> {
         let from = cell.arm_setpoint();
-        cell.track(Box::new(JointMove::new(from, self.goal_q, &MotionLimits::default())));
+        cell.track(Box::new(JointMove::new(
+            from,
+            self.goal_q,
+            &MotionLimits::default(),
+        )));
         Ok(())
     }
 
     fn update(&mut self, cell: &mut Cell) -> Progress {
-        if Arrival::default().reached(cell, &self.goal_q) { Progress::Done } else { Progress::Running }
+        if Arrival::default().reached(cell, &self.goal_q) {
+            Progress::Done
+        } else {
+            Progress::Running
+        }
     }
 }

@@ -37,7 +37,10 @@ pub struct Arrival {
 
 impl Default for Arrival {
     fn default() -> Self {
-        Self { position: 0.002, joint_speed: 0.05 }
+        Self {
+            position: 0.002,
+            joint_speed: 0.05,
+        }
     }
 }
 

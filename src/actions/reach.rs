@@ -17,7 +17,10 @@ pub struct Reach {
 impl Reach {
     /// A reach controller for `spec`.
     pub fn new(spec: ReachSpec) -> Self {
-        Self { spec, goal_q: [0.0; 6] }
+        Self {
+            spec,
+            goal_q: [0.0; 6],
+        }
     }
 }
 
@@ -34,12 +37,16 @@ impl MacroAction for Reach {
         };
         let from = cell.arm_setpoint();
         let goal_q = ik_down(&position, yaw, quarter, &from).map_err(|e| format!("unreachable: {e}"))?;
-        let limits = MotionLimits { tool_speed: self.spec.speed, ..MotionLimits::default() };
+        let limits = MotionLimits {
+            tool_speed: self.spec.speed,
+            ..MotionLimits::default()
+        };
         match self.spec.path {
             PathKind::Joint => cell.track(Box::new(JointMove::new(from, goal_q, &limits))),
             PathKind::Cartesian => {
                 let pose = down_pose(&position, yaw_of_solution(&goal_q));
-                let mv = CartesianMove::new(from, pose, &limits).map_err(|e| format!("unreachable path: {e}"))?;
+                let mv =
+                    CartesianMove::new(from, pose, &limits).map_err(|e| format!("unreachable path: {e}"))?;
                 cell.track(Box::new(mv));
             }
         }
@@ -48,7 +55,11 @@ impl MacroAction for Reach {
     }
 
     fn update(&mut self, cell: &mut Cell) -> Progress {
-        if Arrival::default().reached(cell, &self.goal_q) { Progress::Done } else { Progress::Running }
+        if Arrival::default().reached(cell, &self.goal_q) {
+            Progress::Done
+        } else {
+            Progress::Running
+        }
     }
 }
 

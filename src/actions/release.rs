@@ -21,7 +21,11 @@ pub struct Release {
 impl Release {
     /// A release controller for `spec`.
     pub fn new(spec: ReleaseSpec) -> Self {
-        Self { spec, retreating: false, goal_q: [0.0; 6] }
+        Self {
+            spec,
+            retreating: false,
+            goal_q: [0.0; 6],
+        }
     }
 }
 
@@ -47,9 +51,15 @@ impl MacroAction for Release {
                     cell.track(Box::new(mv));
                     self.retreating = true;
                 }
-                Err(e) => return Progress::Failed(format!("cannot retreat {:.3} m up: {e}", self.spec.retreat)),
+                Err(e) => {
+                    return Progress::Failed(format!("cannot retreat {:.3} m up: {e}", self.spec.retreat));
+                }
             }
         }
-        if Arrival::default().reached(cell, &self.goal_q) { Progress::Done } else { Progress::Running }
+        if Arrival::default().reached(cell, &self.goal_q) {
+            Progress::Done
+        } else {
+            Progress::Running
+        }
     }
 }

@@ -39,8 +39,17 @@ fn numbers(s: &str, min: usize, max: usize, what: &str) -> Result<Vec<f64>, Stri
 impl FromStr for CubeArg {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        let v = numbers(s, 2, 3, "X,Y or X,Y,YAW_DEG (metres, degrees), e.g. 0.45,-0.18,30")?;
-        Ok(Self { x: v[0], y: v[1], yaw_deg: v.get(2).copied().unwrap_or(0.0) })
+        let v = numbers(
+            s,
+            2,
+            3,
+            "X,Y or X,Y,YAW_DEG (metres, degrees), e.g. 0.45,-0.18,30",
+        )?;
+        Ok(Self {
+            x: v[0],
+            y: v[1],
+            yaw_deg: v.get(2).copied().unwrap_or(0.0),
+        })
     }
 }
 
@@ -58,8 +67,22 @@ mod tests {
 
     #[test]
     fn cube_with_and_without_yaw() {
-        assert_eq!("0.4,-0.1".parse::<CubeArg>().unwrap(), CubeArg { x: 0.4, y: -0.1, yaw_deg: 0.0 });
-        assert_eq!("0.4, -0.1, 30".parse::<CubeArg>().unwrap(), CubeArg { x: 0.4, y: -0.1, yaw_deg: 30.0 });
+        assert_eq!(
+            "0.4,-0.1".parse::<CubeArg>().unwrap(),
+            CubeArg {
+                x: 0.4,
+                y: -0.1,
+                yaw_deg: 0.0
+            }
+        );
+        assert_eq!(
+            "0.4, -0.1, 30".parse::<CubeArg>().unwrap(),
+            CubeArg {
+                x: 0.4,
+                y: -0.1,
+                yaw_deg: 30.0
+            }
+        );
     }
 
     #[test]

@@ -15,7 +15,7 @@ use super::run::EpisodeArgs;
 use super::{CliError, load_plan_or_exit, load_scene_or_exit};
 use crate::actions::{Cell, StepObserver};
 use crate::episode::{NoObserver, run_in_cell};
-use crate::sim::{Sim, Scene};
+use crate::sim::{Scene, Sim};
 
 /// Arguments of `bench`.
 #[derive(Debug, Args)]
@@ -57,7 +57,10 @@ struct Recorder(Arc<Mutex<Vec<f64>>>);
 
 impl StepObserver for Recorder {
     fn before_step(&mut self, sim: &mut Sim) {
-        self.0.lock().expect("recorder lock").extend_from_slice(sim.ctrl());
+        self.0
+            .lock()
+            .expect("recorder lock")
+            .extend_from_slice(sim.ctrl());
     }
 }
 
@@ -112,7 +115,10 @@ pub fn bench(args: BenchArgs) -> Result<(), CliError> {
         result.ik_us_per_solve
     );
     if args.json {
-        println!("{}", serde_json::to_string(&result).expect("bench report serializes"));
+        println!(
+            "{}",
+            serde_json::to_string(&result).expect("bench report serializes")
+        );
     }
     Ok(())
 }

@@ -75,7 +75,12 @@ pub fn main() -> ExitCode {
 fn load_plan_or_exit(path: &std::path::Path) -> Result<crate::plan::Plan, CliError> {
     crate::plan::load_plan(path).map_err(|diags| {
         let text: Vec<String> = diags.iter().map(|d| d.to_string()).collect();
-        CliError::Input(format!("{}\nerror: {} is invalid ({} error(s))", text.join("\n"), path.display(), diags.len()))
+        CliError::Input(format!(
+            "{}\nerror: {} is invalid ({} error(s))",
+            text.join("\n"),
+            path.display(),
+            diags.len()
+        ))
     })
 }
 

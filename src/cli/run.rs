@@ -56,7 +56,12 @@ impl EpisodeArgs {
         if let Some(b) = self.bowl {
             layout.bowl_xy = [b.x, b.y];
         }
-        Ok(EpisodeConfig { layout, seed: self.seed, max_sim_time: self.max_sim_time, ..EpisodeConfig::default() })
+        Ok(EpisodeConfig {
+            layout,
+            seed: self.seed,
+            max_sim_time: self.max_sim_time,
+            ..EpisodeConfig::default()
+        })
     }
 }
 
@@ -68,15 +73,26 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
     tracing::info!(tree = %args.tree.display(), cube = ?config.layout.cube_xy, bowl = ?config.layout.bowl_xy, seed = config.seed, "episode start");
     let report = run_episode(&scene, plan, &config, &mut NoObserver);
     if report.success {
-        tracing::info!(sim_time_s = report.sim_time_s, grasp_attempts = report.grasp_attempts, "episode succeeded: the cube is in the bowl");
+        tracing::info!(
+            sim_time_s = report.sim_time_s,
+            grasp_attempts = report.grasp_attempts,
+            "episode succeeded: the cube is in the bowl"
+        );
     } else {
-        tracing::warn!(reason = report.failure_reason.as_deref().unwrap_or(""), "episode failed");
+        tracing::warn!(
+            reason = report.failure_reason.as_deref().unwrap_or(""),
+            "episode failed"
+        );
     }
     print_summary(&report);
     if args.json {
         println!("{}", serde_json::to_string(&report).expect("report serializes"));
     }
-    if report.success { Ok(()) } else { Err(CliError::TaskFailed) }
+    if report.success {
+        Ok(())
+    } else {
+        Err(CliError::TaskFailed)
+    }
 }
 
 fn print_summary(r: &crate::episode::EpisodeReport) {
@@ -95,7 +111,12 @@ fn print_summary(r: &crate::episode::EpisodeReport) {
     }
     println!(
         "  cube final ({:.3}, {:.3}, {:.3}) m, bowl target ({:.3}, {:.3}, {:.3}) m",
-        r.cube_final[0], r.cube_final[1], r.cube_final[2], r.bowl_target[0], r.bowl_target[1], r.bowl_target[2]
+        r.cube_final[0],
+        r.cube_final[1],
+        r.cube_final[2],
+        r.bowl_target[0],
+        r.bowl_target[1],
+        r.bowl_target[2]
     );
     println!(
         "  checks: grasp distance {} m, motion while closed {:.3} m, lift while closed {:.3} m, home error {:.4} rad, in bowl {}",

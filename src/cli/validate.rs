@@ -19,7 +19,12 @@ pub fn validate(args: ValidateArgs) -> Result<(), CliError> {
     let mut failed = 0;
     for tree in &args.trees {
         match crate::plan::load_plan(tree) {
-            Ok(plan) => println!("{}: ok ({} nodes, {} leaves)", tree.display(), plan.nodes.len(), plan.leaves.len()),
+            Ok(plan) => println!(
+                "{}: ok ({} nodes, {} leaves)",
+                tree.display(),
+                plan.nodes.len(),
+                plan.leaves.len()
+            ),
             Err(diags) => {
                 failed += 1;
                 for d in &diags {
@@ -29,7 +34,10 @@ pub fn validate(args: ValidateArgs) -> Result<(), CliError> {
         }
     }
     if failed > 0 {
-        Err(CliError::Input(format!("error: {failed} of {} file(s) invalid", args.trees.len())))
+        Err(CliError::Input(format!(
+            "error: {failed} of {} file(s) invalid",
+            args.trees.len()
+        )))
     } else {
         Ok(())
     }

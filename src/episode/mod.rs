@@ -91,5 +91,15 @@ pub fn run_in_cell(
     let counters = driver.counters;
     let last_failure = driver.last_failure.clone();
     let world = cell.world().clone();
-    EpisodeReport::new(status, timed_out, config, &world, checks.finish(&world), counters, cell.sim().steps(), wall.elapsed().as_secs_f64(), last_failure)
+    EpisodeReport::new(
+        status,
+        timed_out,
+        config,
+        &world,
+        checks.finish(&world),
+        counters,
+        cell.sim().steps(),
+        wall.elapsed().as_secs_f64(),
+        last_failure,
+    )
 }

@@ -70,7 +70,10 @@ impl EpisodeReport {
         let failure_reason = if success {
             None
         } else if timed_out {
-            Some(format!("time limit: the tree was still running after {:.1} s of simulated time", config.max_sim_time))
+            Some(format!(
+                "time limit: the tree was still running after {:.1} s of simulated time",
+                config.max_sim_time
+            ))
         } else if status == TreeStatus::Success {
             Some("the tree succeeded but the cube is not at rest in the bowl".into())
         } else {

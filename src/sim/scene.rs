@@ -147,7 +147,12 @@ impl Scene {
         let range = model.actuator_ctrlrange();
         let arm_gains = ids.arm_act.map(|a| (gain[a][0], -bias[a][2]));
         let arm_ctrlrange = ids.arm_act.map(|a| range[a]);
-        Ok(Self { model: Arc::new(model), ids, arm_gains, arm_ctrlrange })
+        Ok(Self {
+            model: Arc::new(model),
+            ids,
+            arm_gains,
+            arm_ctrlrange,
+        })
     }
 }
 

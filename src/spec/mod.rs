@@ -20,8 +20,8 @@ pub mod value;
 
 pub use diag::{Diagnostic, Issue, Loc, Sources};
 pub use leaves::{
-    ActionLeaf, AtHome, Carry, ConditionLeaf, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable,
-    Grasp, GripperOpen, Home, Leaf, MoveJoints, Reach, Release, Wait,
+    ActionLeaf, AtHome, Carry, ConditionLeaf, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, Grasp,
+    GripperOpen, Home, Leaf, MoveJoints, Reach, Release, Wait,
 };
 pub use load::{Spec, load_file, load_str};
 pub use node::{Node, NodeKind};
