@@ -18,7 +18,7 @@
 //! Each branch's angles are then moved by multiples of 2π to the equivalent nearest the seed
 //! within [`JOINT_LIMITS`]; the branch nearest the seed (Euclidean in joint space) wins.
 //!
-//! Cost: ≈ 1 µs per solve in release builds (see [`ik_benchmark`]); the reference's DLS IK costs
+//! Cost: ≈ 1.6–2 µs per solve in release builds on the 2-core box (see [`ik_benchmark`]); the reference's DLS IK costs
 //! ≈ 3.7 ms (220 iterations of a full `mj_forward`) and reports no failure.
 
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
