@@ -18,7 +18,7 @@
 //! Each branch's angles are then moved by multiples of 2π to the equivalent nearest the seed
 //! within [`JOINT_LIMITS`]; the branch nearest the seed (Euclidean in joint space) wins.
 //!
-//! Cost: ≈ 1 µs per solve in release builds (see [`ik_benchmark`]); the reference's DLS IK costs
+//! Cost: ≈ 1.6–2 µs per solve in release builds on the 2-core box (see [`ik_benchmark`]); the reference's DLS IK costs
 //! ≈ 3.7 ms (220 iterations of a full `mj_forward`) and reports no failure.
 
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
@@ -287,7 +287,17 @@ fn rot_tool_z(a: f64) -> Matrix3<f64> {
 
 /// The core solver: target (`p`, `r`), wrist 3 equivalent modulo `q6_period` (2π for a full pose,
 /// π or π/2 when the gripper's symmetry makes those yaws equivalent).
-fn solve(p: &Vector3<f64>, r: &Matrix3<f64>, seed: &[f64; 6], q6_period: f64) -> Result<[f64; 6], IkError> {
+fn solve(
+    p: &Vector3<f64>,
+    r: &Matrix3<f64>,
+    seed: &[f64; 6],
+    q6_period: f64,
+) -> Result<([f64; 6], Matrix3<f64>), IkError> {
+    if !(p.iter().chain(r.iter()).chain(seed.iter()).all(|v| v.is_finite())) {
+        return Err(IkError::Unreachable {
+            reason: format!("non-finite target {:?} or seed {seed:?}", p.as_slice()),
+        });
+    }
     let raw = closed_form(p, r, seed);
     if raw.n == 0 {
         return Err(IkError::Unreachable {
@@ -354,7 +364,7 @@ fn solve(p: &Vector3<f64>, r: &Matrix3<f64>, seed: &[f64; 6], q6_period: f64) ->
             residual_rad: sol.res_rad,
         });
     }
-    Ok(sol.q)
+    Ok((sol.q, r_eff))
 }
 
 /// Full-pose IK of the pinch site: closed-form UR solutions (Hawkins-style, up to 8 branches),
@@ -367,7 +377,7 @@ fn solve(p: &Vector3<f64>, r: &Matrix3<f64>, seed: &[f64; 6], q6_period: f64) ->
 pub fn ik(target: &Isometry3<f64>, seed: &[f64; 6]) -> Result<[f64; 6], IkError> {
     let p = target.translation.vector;
     let r = *target.rotation.to_rotation_matrix().matrix();
-    solve(&p, &r, seed, TAU)
+    solve(&p, &r, seed, TAU).map(|(q, _)| q)
 }
 
 /// Every closed-form solution of `target` (up to 8, angles in (−π, π], not wrapped to a seed,
@@ -410,8 +420,26 @@ pub fn ik_down(
     symmetric_quarter: bool,
     seed: &[f64; 6],
 ) -> Result<[f64; 6], IkError> {
+    ik_down_with_pose(position, yaw, symmetric_quarter, seed).map(|(q, _)| q)
+}
+
+/// [`ik_down`], also returning the pose it actually reached: `down_pose(position, yaw')` with
+/// `yaw'` the equivalent of `yaw` (modulo π, or π/2 with `symmetric_quarter`) that was chosen.
+/// Use that pose as the target of a [`crate::motion::CartesianMove`] so a straight-line move
+/// ends on the same wrist turn.
+pub fn ik_down_with_pose(
+    position: &Vector3<f64>,
+    yaw: f64,
+    symmetric_quarter: bool,
+    seed: &[f64; 6],
+) -> Result<([f64; 6], Isometry3<f64>), IkError> {
     let period = if symmetric_quarter { FRAC_PI_2 } else { PI };
-    solve(position, &down_rot(yaw), seed, period)
+    let (q, r) = solve(position, &down_rot(yaw), seed, period)?;
+    let pose = Isometry3::from_parts(
+        Translation3::from(*position),
+        UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(r)),
+    );
+    Ok((q, pose))
 }
 
 /// The task region used by the IK benchmark and the coverage tests: x ∈ [0.25, 0.65] m,
@@ -471,6 +499,35 @@ mod tests {
         // 0.1 + 2π is past the +6.28319 limit: 0.1 itself is the nearest admissible equivalent.
         assert_eq!(nearest_equivalent(0.1, 6.2, TAU, JOINT_LIMITS[0]), Some(0.1));
         assert!((nearest_equivalent(0.1, -6.0, TAU, JOINT_LIMITS[0]).unwrap() - (0.1 - TAU)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn non_finite_inputs_are_rejected() {
+        let mut seed = HOME_Q;
+        seed[3] = f64::NAN;
+        assert!(matches!(
+            ik(&fk(&HOME_Q), &seed),
+            Err(IkError::Unreachable { .. })
+        ));
+        let p = Vector3::new(f64::INFINITY, 0.0, 0.3);
+        assert!(matches!(
+            ik_down(&p, 0.0, false, &HOME_Q),
+            Err(IkError::Unreachable { .. })
+        ));
+    }
+
+    #[test]
+    fn ik_down_with_pose_reports_the_reached_yaw() {
+        let p = Vector3::new(0.4, 0.2, 0.1);
+        for yaw in [0.3, 1.2, -2.5, 3.0] {
+            for quarter in [false, true] {
+                let (q, pose) = ik_down_with_pose(&p, yaw, quarter, &HOME_Q).unwrap();
+                let reached = fk(&q);
+                assert!((reached.translation.vector - p).norm() < 1e-9);
+                assert!(reached.rotation.angle_to(&pose.rotation) < 1e-9);
+                assert!((pose.rotation * Vector3::z() + Vector3::z()).norm() < 1e-12);
+            }
+        }
     }
 
     #[test]
