@@ -1,9 +1,9 @@
 //! Physics cross-check: trajectories at the default limits, commanded sample by sample to the
-//! simulated position servos through `servo_command` (velocity + gravity feed-forward), are
+//! simulated position servos through `Sim::command_arm` (velocity + gravity feed-forward), are
 //! tracked to a few millimetres; the bare positions lag by decimetres (printed for the record).
 
 use macrotree::motion::{
-    CartesianMove, HOME_Q, JointMove, MotionLimits, Trajectory, fk, ik_down_with_pose, servo_command,
+    CartesianMove, HOME_Q, JointMove, MotionLimits, Trajectory, fk, ik_down_with_pose,
 };
 use macrotree::sim::{Scene, Sim, TIMESTEP};
 use nalgebra::Vector3;
@@ -17,12 +17,11 @@ fn track(sim: &mut Sim, tr: &dyn Trajectory, settle: f64, feedforward: bool) -> 
     for k in 1..=steps {
         let t = k as f64 * TIMESTEP;
         let (q, qd) = tr.sample(t);
-        let u = if feedforward {
-            servo_command(&q, &qd, 0.0)
+        if feedforward {
+            sim.command_arm(&q, &qd);
         } else {
-            q
-        };
-        sim.set_arm_ctrl(&u);
+            sim.set_arm_ctrl(&q);
+        }
         sim.step();
         let w = sim.observe();
         worst = worst.max((w.pinch_pos - fk(&q).translation.vector).norm());

@@ -86,8 +86,6 @@ pub(crate) struct Chain {
     pub origins: [Vector3<f64>; 6],
     /// Joint axes (world, unit).
     pub axes: [Vector3<f64>; 6],
-    /// World rotation of each moving body's frame (shoulder … wrist 3), after its joint.
-    pub frames: [Matrix3<f64>; 6],
     /// Pinch position (world), metres.
     pub pinch_pos: Vector3<f64>,
     /// Pinch rotation (world).
@@ -103,52 +101,44 @@ pub(crate) fn chain(q: &[f64; 6]) -> Chain {
     let mut p = Vector3::zeros();
     let mut origins = [Vector3::zeros(); 6];
     let mut axes = [Vector3::zeros(); 6];
-    let mut frames = [Matrix3::zeros(); 6];
     // shoulder_link
     p += r * Vector3::new(0.0, 0.0, SHOULDER_HEIGHT);
     origins[0] = p;
     axes[0] = r * ez;
     r *= rot_z(q[0]);
-    frames[0] = r;
     // upper_arm_link
     p += r * Vector3::new(0.0, 0.138, 0.0);
     r *= rot_y90();
     origins[1] = p;
     axes[1] = r * ey;
     r *= rot_y(q[1]);
-    frames[1] = r;
     // forearm_link
     p += r * Vector3::new(0.0, -0.131, UPPER_ARM);
     origins[2] = p;
     axes[2] = r * ey;
     r *= rot_y(q[2]);
-    frames[2] = r;
     // wrist_1_link
     p += r * Vector3::new(0.0, 0.0, FOREARM);
     r *= rot_y90();
     origins[3] = p;
     axes[3] = r * ey;
     r *= rot_y(q[3]);
-    frames[3] = r;
     // wrist_2_link
     p += r * Vector3::new(0.0, WRIST_1_TO_2, 0.0);
     origins[4] = p;
     axes[4] = r * ez;
     r *= rot_z(q[4]);
-    frames[4] = r;
     // wrist_3_link
     p += r * Vector3::new(0.0, 0.0, WRIST_2_TO_3);
     origins[5] = p;
     axes[5] = r * ey;
     r *= rot_y(q[5]);
-    frames[5] = r;
     // attachment_site + base_mount + base + pinch: all along wrist-3 y.
     let pinch_pos = p + r * Vector3::new(0.0, TOOL_LENGTH, 0.0);
     let pinch_rot = r * tool_rot_in_wrist3();
     Chain {
         origins,
         axes,
-        frames,
         pinch_pos,
         pinch_rot,
     }

@@ -9,19 +9,16 @@
 //! | [`kinematics`] | [`fk`], [`jacobian`], the chain's dimensions and [`JOINT_LIMITS`] |
 //! | [`mod@ik`] | closed-form [`ik()`] with nearest-to-seed branch choice, [`ik_down`], [`down_pose`], [`IkError`], [`ik_benchmark`] |
 //! | [`trajectory`] | the [`Trajectory`] trait, [`JointMove`], [`CartesianMove`], [`Hold`], [`MotionLimits`] |
-//! | [`servo`] | [`servo_command`]: velocity + gravity feed-forward so the position servos follow a trajectory |
 //! | [`gripper`] | command ↔ opening calibration of the simulated 2F-85 |
 
 pub mod gripper;
 pub mod ik;
 pub mod kinematics;
-pub mod servo;
 pub mod trajectory;
 
 pub use gripper::{CLOSED_CTRL, OPEN_CTRL, ctrl_for_width, width_for_ctrl};
 pub use ik::{IkError, down_pose, ik, ik_benchmark, ik_down, ik_down_with_pose};
 pub use kinematics::{JOINT_LIMITS, fk, jacobian};
-pub use servo::{gravity_torque, servo_command};
 pub use trajectory::{CartesianMove, Hold, JointMove, MotionLimits, Trajectory};
 
 /// Home joint angles of the UR5e (Menagerie keyframe `home`), radians — the same values as
