@@ -22,6 +22,7 @@
 pub mod actions;
 pub mod cli;
 pub mod episode;
+pub mod faults;
 pub mod motion;
 pub mod plan;
 pub mod runtime;

@@ -2,9 +2,7 @@
 //! simulated position servos through `Sim::command_arm` (velocity + gravity feed-forward), are
 //! tracked to a few millimetres; the bare positions lag by decimetres (printed for the record).
 
-use macrotree::motion::{
-    CartesianMove, HOME_Q, JointMove, MotionLimits, Trajectory, fk, ik_down_with_pose,
-};
+use macrotree::motion::{CartesianMove, HOME_Q, JointMove, MotionLimits, Trajectory, fk, ik_down_with_pose};
 use macrotree::sim::{Scene, Sim, TIMESTEP};
 use nalgebra::Vector3;
 

@@ -37,6 +37,9 @@ pub struct EpisodeArgs {
     /// Stop the episode (as a failure) after this much simulated time, seconds.
     #[arg(long, default_value_t = 60.0, value_name = "S")]
     pub max_sim_time: f64,
+    /// Inject a fault through physics (see docs/faults.md).
+    #[arg(long, value_enum)]
+    pub fault: Option<crate::faults::FaultKind>,
 }
 
 impl EpisodeArgs {

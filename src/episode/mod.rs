@@ -26,6 +26,8 @@ pub struct EpisodeConfig {
     pub max_sim_time: f64,
     /// Tree tick period, seconds (a whole number of 2 ms physics steps).
     pub control_period: f64,
+    /// A fault to inject through physics, if any.
+    pub fault: Option<crate::faults::FaultKind>,
 }
 
 impl Default for EpisodeConfig {
@@ -35,6 +37,7 @@ impl Default for EpisodeConfig {
             seed: 0,
             max_sim_time: 60.0,
             control_period: crate::actions::CONTROL_PERIOD,
+            fault: None,
         }
     }
 }
@@ -69,6 +72,10 @@ pub fn run_in_cell(
 ) -> EpisodeReport {
     let wall = Instant::now();
     cell.reset(&config.layout);
+    let observers_before = cell.observers.len();
+    if let Some(kind) = config.fault {
+        cell.observers.push(crate::faults::injector(kind, config.seed));
+    }
     let dt = cell.control_period();
     let mut runner = TreeRunner::new(plan);
     let mut driver = MacroDriver::new(cell);
@@ -90,6 +97,7 @@ pub fn run_in_cell(
     let checks = driver.checks.clone();
     let counters = driver.counters;
     let last_failure = driver.last_failure.clone();
+    cell.observers.truncate(observers_before);
     let world = cell.world().clone();
     EpisodeReport::new(
         status,
