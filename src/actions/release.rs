@@ -42,6 +42,9 @@ impl MacroAction for Release {
             if cell.world().gripper_width < OPEN_FRACTION * width_for_ctrl(OPEN_CTRL) {
                 return Progress::Running;
             }
+            if self.spec.retreat == 0.0 {
+                return Progress::Done;
+            }
             let from = cell.arm_setpoint();
             let mut pose = crate::motion::fk(&from);
             pose.translation.vector += Vector3::new(0.0, 0.0, self.spec.retreat);

@@ -51,7 +51,7 @@ impl Default for MotionLimits {
     fn default() -> Self {
         Self {
             max_joint_speed: 3.0,
-            max_joint_acc: 8.0,
+            max_joint_acc: 15.0,
             tool_speed: 0.5,
             min_duration: 0.2,
         }
@@ -80,12 +80,16 @@ pub struct JointMove {
 impl JointMove {
     /// A move from `from` to `to` (radians). Its duration is the shortest that keeps every joint
     /// within `limits.max_joint_speed` (rad/s) and `limits.max_joint_acc` (rad/s²), and at least
-    /// `limits.min_duration` seconds.
+    /// `limits.min_duration` seconds — except a move of zero length, which takes no time.
     pub fn new(from: [f64; 6], to: [f64; 6], limits: &MotionLimits) -> Self {
         let span = (0..6).map(|j| (to[j] - from[j]).abs()).fold(0.0, f64::max);
-        let duration = (MJ_PEAK_VEL * span / limits.max_joint_speed)
-            .max((MJ_PEAK_ACC * span / limits.max_joint_acc).sqrt())
-            .max(limits.min_duration);
+        let duration = if span == 0.0 {
+            0.0 // nothing to move: done at once
+        } else {
+            (MJ_PEAK_VEL * span / limits.max_joint_speed)
+                .max((MJ_PEAK_ACC * span / limits.max_joint_acc).sqrt())
+                .max(limits.min_duration)
+        };
         Self { from, to, duration }
     }
 
@@ -279,10 +283,14 @@ impl CartesianMove {
                 amax = amax.max((d2[j] * sd * sd + d1[j] * sdd).abs());
             }
         }
-        mv.duration = (MJ_PEAK_VEL * length / limits.tool_speed)
-            .max(DURATION_MARGIN * vmax / limits.max_joint_speed)
-            .max(DURATION_MARGIN * (amax / limits.max_joint_acc).sqrt())
-            .max(limits.min_duration);
+        mv.duration = if length == 0.0 && vmax == 0.0 {
+            0.0 // nothing to move: done at once
+        } else {
+            (MJ_PEAK_VEL * length / limits.tool_speed)
+                .max(DURATION_MARGIN * vmax / limits.max_joint_speed)
+                .max(DURATION_MARGIN * (amax / limits.max_joint_acc).sqrt())
+                .max(limits.min_duration)
+        };
         Ok(mv)
     }
 
@@ -401,10 +409,10 @@ mod tests {
     }
 
     #[test]
-    fn zero_length_cartesian_move_is_min_duration() {
+    fn zero_length_cartesian_move_takes_no_time() {
         let lim = MotionLimits::default();
         let m = CartesianMove::new(HOME_Q, fk(&HOME_Q), &lim).unwrap();
-        assert_eq!(m.duration(), lim.min_duration);
+        assert_eq!(m.duration(), 0.0);
         let (q, _) = m.sample(0.1);
         for j in 0..6 {
             assert!((q[j] - HOME_Q[j]).abs() < 1e-9);
