@@ -11,9 +11,11 @@ pub enum LogFormat {
     Json,
 }
 
-/// Installs the global subscriber on stderr. `RUST_LOG` wins over `-v`.
-pub fn init(verbose: u8, format: LogFormat) {
+/// Installs the global subscriber on stderr. `RUST_LOG` wins over `-v`. With `quiet`, the
+/// default level is warn (for commands that run many episodes, such as `bench`).
+pub fn init(verbose: u8, format: LogFormat, quiet: bool) {
     let default = match verbose {
+        0 if quiet => "macrotree=warn",
         0 => "macrotree=info",
         1 => "macrotree=debug",
         _ => "macrotree=trace",

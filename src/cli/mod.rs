@@ -53,7 +53,8 @@ pub enum CliError {
 /// Entry point of the `macrotree` binary.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
-    logging::init(cli.verbose, cli.log_format);
+    let quiet = matches!(cli.command, Command::Bench(_));
+    logging::init(cli.verbose, cli.log_format, quiet);
     let result = match cli.command {
         Command::Run(args) => run::run(args),
         Command::Validate(args) => validate::validate(args),

@@ -1,0 +1,155 @@
+//! The command-line contract: exit codes, the `--json` report, located errors for bad input.
+
+use std::process::{Command, Output};
+
+fn macrotree(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_macrotree"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env_remove("RUST_LOG")
+        .output()
+        .expect("macrotree runs")
+}
+
+fn last_json_line(out: &Output) -> serde_json::Value {
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let line = stdout.lines().last().expect("stdout has lines");
+    serde_json::from_str(line).unwrap_or_else(|e| panic!("last stdout line is not JSON ({e}): {line}"))
+}
+
+#[test]
+fn run_default_layout_succeeds_with_a_json_report() {
+    let out = macrotree(&["run", "trees/cube_to_bowl.yaml", "--json"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r = last_json_line(&out);
+    for key in [
+        "success",
+        "tree_status",
+        "sim_time_s",
+        "wall_time_s",
+        "physics_steps",
+        "grasp_attempts",
+        "cube_final",
+        "bowl_target",
+        "checks",
+    ] {
+        assert!(r.get(key).is_some(), "missing {key} in {r}");
+    }
+    for key in [
+        "grasp_distance",
+        "cube_motion_while_closed",
+        "cube_lift_while_closed",
+        "home_error",
+        "in_bowl",
+    ] {
+        assert!(r["checks"].get(key).is_some(), "missing checks.{key} in {r}");
+    }
+    assert_eq!(r["success"], true);
+    assert_eq!(r["tree_status"], "success");
+    assert!(r["sim_time_s"].as_f64().unwrap() > 1.0);
+    assert_eq!(r["bowl_target"][0].as_f64().unwrap(), 0.45);
+    // Live logs go to stderr: one line per status transition, not per tick.
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("grasp"), "no grasp transition logged: {stderr}");
+    assert!(
+        stderr.lines().count() < 200,
+        "too chatty: {} lines",
+        stderr.lines().count()
+    );
+}
+
+#[test]
+fn run_reports_task_failure_with_exit_1() {
+    // The cube far outside the reach of the arm: the reach fails with a reason.
+    let out = macrotree(&["run", "trees/cube_to_bowl.yaml", "--cube", "1.5,0.0", "--json"]);
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r = last_json_line(&out);
+    assert_eq!(r["success"], false);
+    let reason = r["failure_reason"].as_str().unwrap_or_default();
+    assert!(reason.contains("unreachable"), "reason: {reason}");
+}
+
+#[test]
+fn invalid_tree_exits_2_with_a_located_message() {
+    let out = macrotree(&["run", "tests/fixtures/cli/misspelled_param.yaml"]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("misspelled_param.yaml:4:"),
+        "no file:line:col in: {stderr}"
+    );
+    assert!(stderr.contains("ofset"), "does not name the bad key: {stderr}");
+    let out = macrotree(&[
+        "validate",
+        "tests/fixtures/cli/misspelled_param.yaml",
+        "trees/cube_to_bowl.yaml",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = macrotree(&["validate", "trees/cube_to_bowl.yaml"]);
+    assert_eq!(out.status.code(), Some(0));
+}
+
+#[test]
+fn bad_arguments_and_missing_files_exit_2_without_panicking() {
+    for args in [
+        vec!["run", "trees/cube_to_bowl.yaml", "--cube", "0.4"],
+        vec!["run", "trees/cube_to_bowl.yaml", "--bowl", "x,y"],
+        vec!["run", "trees/cube_to_bowl.yaml", "--max-sim-time", "-1"],
+        vec!["run", "no/such/tree.yaml"],
+        vec!["run"],
+    ] {
+        let out = macrotree(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
+        assert!(!stderr.trim().is_empty(), "{args:?}: no message");
+    }
+}
+
+#[test]
+fn missing_models_exit_2_and_say_how_to_get_them() {
+    let out = Command::new(env!("CARGO_BIN_EXE_macrotree"))
+        .args(["run", "trees/cube_to_bowl.yaml"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("MACROTREE_MENAGERIE", "/nonexistent/menagerie")
+        .output()
+        .expect("macrotree runs");
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("tools/bootstrap"), "{stderr}");
+}
+
+#[test]
+fn bench_prints_the_ratio_and_simulated_time() {
+    let out = macrotree(&["bench", "trees/cube_to_bowl.yaml", "--repeat", "1", "--json"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r = last_json_line(&out);
+    for key in [
+        "episode_wall_time_s",
+        "replay_wall_time_s",
+        "ratio",
+        "sim_time_s",
+        "physics_steps",
+        "ik_us_per_solve",
+    ] {
+        assert!(r[key].as_f64().is_some(), "missing {key} in {r}");
+    }
+    assert_eq!(r["success"], true);
+    // The replay runs exactly the episode's physics steps.
+    assert!(r["physics_steps"].as_u64().unwrap() > 1000);
+}
