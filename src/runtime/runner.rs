@@ -45,7 +45,8 @@ struct RunState {
     attempts: Vec<u32>,
     leaves: Vec<LeafRt>,
     yield_pending: Vec<bool>,
-    pending_yields: Vec<(usize, u64)>,
+    /// Yields that answered Running: (internal index, owning node, tick).
+    pending_yields: Vec<(usize, usize, u64)>,
     last_failure: Option<String>,
     transitions: Vec<Transition>,
     dropped: u64,
@@ -317,11 +318,11 @@ impl RunState {
                 self.touch(plan, node);
                 if self.yield_pending[i] {
                     self.yield_pending[i] = false;
-                    self.pending_yields.retain(|(y, _)| *y != i);
+                    self.pending_yields.retain(|(y, _, _)| *y != i);
                     (Status::Success, dt)
                 } else {
                     self.yield_pending[i] = true;
-                    self.pending_yields.push((i, self.tick));
+                    self.pending_yields.push((i, node, self.tick));
                     self.attempts[node] = iteration;
                     let info = &plan.nodes[node];
                     if info.kind == "retry" {
@@ -438,14 +439,17 @@ impl RunState {
             }
             self.set(plan, i, NodeStatus::Halted, Some(reason));
         }
-        // Yields reached but not completed are reset when not ticked any more.
+        // A yield that answered Running is only completed by its own execution: reset it when it
+        // was not ticked this tick or its retry/repeat stopped running (preempted).
         let tick = self.tick;
         let yp = &mut self.yield_pending;
-        self.pending_yields.retain(|&(y, t)| {
-            if t != tick {
+        let statuses = &self.statuses;
+        self.pending_yields.retain(|&(y, node, t)| {
+            let keep = t == tick && statuses[node] == NodeStatus::Running;
+            if !keep {
                 yp[y] = false;
             }
-            t == tick
+            keep
         });
     }
 
