@@ -31,6 +31,8 @@
 //! one, so each retry attempt / repeat iteration after the first starts on a fresh tick, after
 //! the world has been stepped and re-read. See `docs/tick_semantics.md`.
 
+#![warn(missing_docs)]
+
 mod compile;
 
 use std::path::Path;

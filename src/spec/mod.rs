@@ -7,6 +7,8 @@
 //!
 //! The format itself is documented in `docs/tree_format.md`.
 
+#![warn(missing_docs)]
+
 pub mod de;
 pub mod diag;
 pub mod expand;
