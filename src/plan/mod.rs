@@ -34,6 +34,7 @@
 #![warn(missing_docs)]
 
 mod compile;
+mod render;
 
 use std::path::Path;
 
@@ -42,6 +43,7 @@ use serde::Serialize;
 use crate::spec::{self, Diagnostic, Leaf};
 
 pub use compile::compile_spec;
+pub use render::{to_dot, to_mermaid};
 
 /// Index of a leaf: `plan.leaves[id.index()]` for ordinary leaves; internal leaves (probes and
 /// yields, see [`Internal`]) have the top bit set and index `plan.internal`.
