@@ -171,7 +171,7 @@ fn guard_keeps_child_state_while_condition_holds_and_halts_it_when_it_fails() {
 }
 
 #[test]
-fn guard_with_inverted_condition() {
+fn guard_with_inverted_condition_regression_inverter_logged_running_every_tick() {
     let p = plan(
         "main:\n  guard:\n    condition: {inverter: {child: {cube_on_table: {}}}}\n    child: {carry: {}}\n",
     );

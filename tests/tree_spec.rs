@@ -324,3 +324,24 @@ fn diagnostic_display_is_rustc_like() {
         "error: unknown parameter `targt` in `reach`\n --> bad.yaml:4:17\n  |\n4 |       - reach: {targt: cube}\n  |                 ^^^^^ expected one of `target`, `offset`, `yaw`, `path`, `speed`, `timeout` or `name`\n  = help: did you mean `target`?"
     );
 }
+
+/// Regression: with YAML 1.1 booleans, a parameter named `off` (or `on`, `yes`, `no`) was read as
+/// the boolean `false` and rejected as "invalid parameter name".
+#[test]
+fn regression_yaml11_boolean_words_are_plain_names() {
+    let src = "subtrees:\n  s:\n    params: {off: 0.1, on: 0.2, yes: 0.3, no: 0.4}\n    root: {reach: {target: cube, offset: [$off, $on, $yes]}}\nmain: {subtree: {ref: s, args: {no: 1}}}\n";
+    let plan = compile_str(src, "t.yaml").unwrap();
+    let Leaf::Action(ActionLeaf::Reach(r)) = &plan.leaves[0].kind else {
+        panic!()
+    };
+    assert_eq!(r.offset, [0.1, 0.2, 0.3]);
+}
+
+/// Regression: `.inf` was rejected by the YAML reader with a misleading "fix the YAML syntax"
+/// help; it must reach the parameter check, which explains the problem.
+#[test]
+fn regression_non_finite_numbers_reach_the_parameter_check() {
+    let d = errors("main: {timeout: {seconds: .nan, child: {home: {}}}}\n");
+    let e = find(&d, "must be a finite number");
+    assert_eq!(at(e), (1, 27));
+}

@@ -32,7 +32,10 @@ pub fn to_dot(plan: &Plan) -> String {
     let _ = writeln!(out, "digraph tree {{");
     let _ = writeln!(out, "  rankdir=TB;");
     let _ = writeln!(out, "  node [fontname=\"Helvetica\", fontsize=10];");
-    let _ = writeln!(out, "  edge [arrowsize=0.6];");
+    let _ = writeln!(
+        out,
+        "  edge [arrowsize=0.6, fontname=\"Helvetica\", fontsize=9];"
+    );
     for (i, n) in plan.nodes.iter().enumerate() {
         let style = match family(n.kind) {
             "composite" => "shape=box, style=\"rounded,bold\"",

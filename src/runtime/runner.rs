@@ -42,6 +42,9 @@ struct RunState {
     /// Root-first ancestors of each node, excluding the node itself.
     ancestors: Vec<Vec<usize>>,
     enclosing_retry: Vec<Option<usize>>,
+    /// `inverter` nodes folded into a re-checked condition: their status is set with the
+    /// condition's, never Running.
+    instant: Vec<bool>,
     attempts: Vec<u32>,
     leaves: Vec<LeafRt>,
     yield_pending: Vec<bool>,
@@ -75,8 +78,15 @@ impl RunState {
                 enclosing_retry[i] = Some(i);
             }
         }
+        let mut instant = vec![false; n];
+        for l in &plan.leaves {
+            for &inv in l.check.iter().flat_map(|c| c.inverters.iter()) {
+                instant[inv] = true;
+            }
+        }
         Self {
             statuses: vec![NodeStatus::Idle; n],
+            instant,
             reasons: vec![None; n],
             touched: vec![0; n],
             ancestors,
@@ -171,7 +181,9 @@ impl RunState {
         let tick = self.tick;
         for k in 0..self.ancestors[node].len() {
             let a = self.ancestors[node][k];
-            if self.touched[a] == tick && self.statuses[a] == NodeStatus::Running {
+            if self.instant[a]
+                || (self.touched[a] == tick && self.statuses[a] == NodeStatus::Running)
+            {
                 continue;
             }
             self.touched[a] = tick;
