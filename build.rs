@@ -8,9 +8,7 @@ fn main() {
     match std::env::var("MUJOCO_DYNAMIC_LINK_DIR") {
         Ok(dir) => {
             if !std::path::Path::new(&dir).join("libmujoco.so").exists() {
-                println!(
-                    "cargo:warning=libmujoco.so not found in {dir}: run tools/bootstrap first"
-                );
+                println!("cargo:warning=libmujoco.so not found in {dir}: run tools/bootstrap first");
             }
             println!("cargo:rustc-link-arg=-Wl,-rpath,{dir}");
         }

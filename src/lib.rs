@@ -14,12 +14,15 @@
 //! | kinematics, IK, trajectories, gripper calibration | [`motion`] | no |
 //! | MuJoCo scene, stepping, world extraction | [`sim`] | yes |
 //! | macro-action leaves (reach, grasp, carry, …) | [`actions`] | through [`sim`] |
+//! | one episode: tree + cell → report | [`episode`] | yes |
 //! | command-line interface | [`cli`] | yes |
 //!
 //! Units everywhere: metres, radians, seconds, unless a name says otherwise.
 
 pub mod actions;
 pub mod cli;
+pub mod episode;
+pub mod faults;
 pub mod motion;
 pub mod plan;
 pub mod runtime;

@@ -1,1 +1,23 @@
-//! (under construction)
+//! Macro-action leaves executed on the simulated cell: `reach`, `move_joints`, `home`, `grasp`,
+//! `carry`, `release`, plus the condition leaves, through [`MacroDriver`].
+//!
+//! Each action is a small controller ([`MacroAction`]) in its own file: planned on its first
+//! tick from the current world (IK, trajectories from [`crate::motion`]), checked every tick
+//! after, halted (arm holds its commanded pose) when the tree preempts it.
+
+mod carry;
+mod cell;
+mod checks;
+mod driver;
+mod grasp;
+mod joints;
+mod macro_action;
+mod reach;
+mod release;
+mod targets;
+
+pub use cell::{CONTROL_PERIOD, Cell, StepObserver};
+pub use checks::{Checks, ChecksRecorder, pad_cube_distance};
+pub use driver::{LeafCounters, MacroDriver};
+pub use macro_action::{Arrival, MacroAction, Progress};
+pub use targets::{resolve, tool_yaw};

@@ -1,1 +1,34 @@
-//! (under construction)
+//! The motion layer: kinematics, inverse kinematics, trajectories and gripper calibration of the
+//! Menagerie UR5e + Robotiq 2F-85, in pure nalgebra (no MuJoCo), so everything here is testable
+//! without physics. `tests/motion_*.rs` cross-check it against the simulator.
+//!
+//! Units: metres, radians, seconds; poses are of the 2F-85 `pinch` site in the world frame.
+//!
+//! | module | what |
+//! |---|---|
+//! | [`kinematics`] | [`fk`], [`jacobian`], the chain's dimensions and [`JOINT_LIMITS`] |
+//! | [`mod@ik`] | closed-form [`ik()`] with nearest-to-seed branch choice, [`ik_down`], [`down_pose`], [`IkError`], [`ik_benchmark`] |
+//! | [`trajectory`] | the [`Trajectory`] trait, [`JointMove`], [`CartesianMove`], [`Hold`], [`MotionLimits`] |
+//! | [`gripper`] | command ↔ opening calibration of the simulated 2F-85 |
+
+pub mod gripper;
+pub mod ik;
+pub mod kinematics;
+pub mod trajectory;
+
+pub use gripper::{CLOSED_CTRL, OPEN_CTRL, ctrl_for_width, width_for_ctrl};
+pub use ik::{IkError, down_pose, ik, ik_benchmark, ik_down, ik_down_with_pose};
+pub use kinematics::{JOINT_LIMITS, fk, jacobian};
+pub use trajectory::{CartesianMove, Hold, JointMove, MotionLimits, Trajectory};
+
+/// Home joint angles of the UR5e (Menagerie keyframe `home`), radians — the same values as
+/// `sim::HOME_Q`, repeated here so this layer stays MuJoCo-free. At home the pinch is at
+/// (−0.134, 0.492, 0.3322) m pointing straight down, its x axis along world +y.
+pub const HOME_Q: [f64; 6] = [
+    -std::f64::consts::FRAC_PI_2,
+    -std::f64::consts::FRAC_PI_2,
+    std::f64::consts::FRAC_PI_2,
+    -std::f64::consts::FRAC_PI_2,
+    -std::f64::consts::FRAC_PI_2,
+    0.0,
+];

@@ -136,9 +136,7 @@ fn node_label(n: &Node) -> String {
         NodeKind::Retry { attempts, .. } => format!("retry ×{attempts}"),
         NodeKind::Repeat { times, .. } => format!("repeat ×{times}"),
         NodeKind::Timeout { seconds, .. } => format!("timeout {} s", fmt_num(*seconds)),
-        NodeKind::Subtree {
-            reference, args, ..
-        } => {
+        NodeKind::Subtree { reference, args, .. } => {
             if args.is_empty() {
                 format!("subtree {reference}")
             } else {
@@ -170,9 +168,7 @@ pub(crate) fn behavior_size(b: &Behavior<LeafId>) -> usize {
         | WhenAny(v)
         | After(v)
         | Race(v) => v.iter().map(behavior_size).sum(),
-        While(c, v) | WhileAll(c, v) => {
-            behavior_size(c) + v.iter().map(behavior_size).sum::<usize>()
-        }
+        While(c, v) | WhileAll(c, v) => behavior_size(c) + v.iter().map(behavior_size).sum::<usize>(),
     }
 }
 
@@ -238,13 +234,7 @@ impl Compiler<'_> {
     }
 
     /// Compile a re-checked condition (a condition leaf, possibly under inverters).
-    fn check(
-        &mut self,
-        n: &Node,
-        parent: usize,
-        path: String,
-        continue_on: bool,
-    ) -> Behavior<LeafId> {
+    fn check(&mut self, n: &Node, parent: usize, path: String, continue_on: bool) -> Behavior<LeafId> {
         let mut inverters = Vec::new();
         let mut cur = n;
         let mut cur_parent = parent;
@@ -296,10 +286,7 @@ impl Compiler<'_> {
         let children = n.kind.children();
         let paths = child_paths(path, &children);
         match &n.kind {
-            NodeKind::Sequence(c)
-            | NodeKind::Fallback(c)
-            | NodeKind::Parallel(c)
-            | NodeKind::Race(c) => {
+            NodeKind::Sequence(c) | NodeKind::Fallback(c) | NodeKind::Parallel(c) | NodeKind::Race(c) => {
                 let bs: Vec<_> = c
                     .iter()
                     .zip(paths)
@@ -338,11 +325,7 @@ impl Compiler<'_> {
                 times: attempts,
                 child,
             } => {
-                let w = self.wrapped(
-                    child,
-                    Some(idx),
-                    paths.into_iter().next().unwrap_or_default(),
-                );
+                let w = self.wrapped(child, Some(idx), paths.into_iter().next().unwrap_or_default());
                 let size = behavior_size(&w).saturating_mul(*attempts as usize);
                 if size > MAX_BEHAVIOR_NODES {
                     self.too_big(n, size);
@@ -370,32 +353,20 @@ impl Compiler<'_> {
                 }
             }
             NodeKind::Timeout { seconds, child } => {
-                let w = self.wrapped(
-                    child,
-                    Some(idx),
-                    paths.into_iter().next().unwrap_or_default(),
-                );
+                let w = self.wrapped(child, Some(idx), paths.into_iter().next().unwrap_or_default());
                 Behavior::Timeout(*seconds, Box::new(w))
             }
-            NodeKind::Inverter(child)
-            | NodeKind::ForceSuccess(child)
-            | NodeKind::ForceFailure(child) => {
-                let w = self.wrapped(
-                    child,
-                    Some(idx),
-                    paths.into_iter().next().unwrap_or_default(),
-                );
+            NodeKind::Inverter(child) | NodeKind::ForceSuccess(child) | NodeKind::ForceFailure(child) => {
+                let w = self.wrapped(child, Some(idx), paths.into_iter().next().unwrap_or_default());
                 match &n.kind {
                     NodeKind::Inverter(_) => Behavior::Invert(Box::new(w)),
                     NodeKind::ForceSuccess(_) => Behavior::AlwaysSucceed(Box::new(w)),
                     _ => Behavior::Invert(Box::new(Behavior::AlwaysSucceed(Box::new(w)))),
                 }
             }
-            NodeKind::Subtree { body, .. } => self.wrapped(
-                body,
-                Some(idx),
-                paths.into_iter().next().unwrap_or_default(),
-            ),
+            NodeKind::Subtree { body, .. } => {
+                self.wrapped(body, Some(idx), paths.into_iter().next().unwrap_or_default())
+            }
             NodeKind::Leaf(_) => Behavior::WaitForever, // handled by `wrapped`
         }
     }

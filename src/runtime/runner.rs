@@ -197,13 +197,7 @@ impl RunState {
         self.touched[node] = tick;
     }
 
-    fn on_leaf(
-        &mut self,
-        plan: &Plan,
-        driver: &mut dyn LeafDriver,
-        id: LeafId,
-        dt: f64,
-    ) -> (Status, f64) {
+    fn on_leaf(&mut self, plan: &Plan, driver: &mut dyn LeafDriver, id: LeafId, dt: f64) -> (Status, f64) {
         if let Some(internal) = plan.internal(id) {
             return self.on_internal(plan, id, internal, dt);
         }
@@ -266,14 +260,7 @@ impl RunState {
             }
         };
         let Some(check) = &info.check else {
-            return (
-                if raw {
-                    Status::Success
-                } else {
-                    Status::Failure
-                },
-                leftover,
-            );
+            return (if raw { Status::Success } else { Status::Failure }, leftover);
         };
         // A re-checked condition: apply inverters (innermost first), then decide.
         let mut effective = raw;
@@ -302,13 +289,7 @@ impl RunState {
         }
     }
 
-    fn on_internal(
-        &mut self,
-        plan: &Plan,
-        id: LeafId,
-        internal: &Internal,
-        dt: f64,
-    ) -> (Status, f64) {
+    fn on_internal(&mut self, plan: &Plan, id: LeafId, internal: &Internal, dt: f64) -> (Status, f64) {
         match *internal {
             Internal::Probe { node, success } => {
                 if success {
@@ -321,11 +302,7 @@ impl RunState {
                     (Status::Failure, dt)
                 }
             }
-            Internal::Yield {
-                node,
-                iteration,
-                of,
-            } => {
+            Internal::Yield { node, iteration, of } => {
                 let i = id.index();
                 self.touch(plan, node);
                 if self.yield_pending[i] {
@@ -389,19 +366,14 @@ impl RunState {
                     format!("{} expired", info.label)
                 }
             }
-            "retry" => format!(
-                "all {} attempts failed; last: {last}",
-                self.attempts[node].max(1)
-            ),
+            "retry" => format!("all {} attempts failed; last: {last}", self.attempts[node].max(1)),
             "inverter" | "force_failure" => format!("{}: child succeeded", info.kind),
             "guard" | "reactive_sequence" => {
                 let cond_failed = info
                     .children
                     .iter()
                     .take(info.children.len().saturating_sub(1))
-                    .any(|&c| {
-                        self.touched[c] == self.tick && self.statuses[c] == NodeStatus::Failure
-                    });
+                    .any(|&c| self.touched[c] == self.tick && self.statuses[c] == NodeStatus::Failure);
                 if cond_failed {
                     format!("condition failed: {last}")
                 } else {

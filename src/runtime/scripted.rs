@@ -102,11 +102,7 @@ impl ScriptedDriver {
     /// Append `outcomes` to the queue of the selected leaves: each tick of such a leaf pops one.
     /// When the queue is empty, the leaf answers its `eventually` outcome (see
     /// [`set`](Self::set)), or the default.
-    pub fn script(
-        &mut self,
-        selector: &str,
-        outcomes: impl IntoIterator<Item = LeafOutcome>,
-    ) -> &mut Self {
+    pub fn script(&mut self, selector: &str, outcomes: impl IntoIterator<Item = LeafOutcome>) -> &mut Self {
         let outcomes: Vec<LeafOutcome> = outcomes.into_iter().collect();
         for id in self.select(selector) {
             self.scripts

@@ -1,1 +1,12 @@
-//! (under construction)
+//! The MuJoCo adapter: scene composition, layouts, stepping and world extraction.
+//! Nothing outside this module (and the viewer) touches MuJoCo types.
+
+pub mod error;
+pub mod layout;
+pub mod scene;
+pub mod simulator;
+
+pub use error::SimError;
+pub use layout::Layout;
+pub use scene::Scene;
+pub use simulator::{HOME_Q, Sim, TIMESTEP};

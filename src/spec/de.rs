@@ -123,8 +123,7 @@ impl de::Error for DeError {
     }
 
     fn invalid_length(len: usize, exp: &dyn de::Expected) -> Self {
-        Self::msg(format!("wrong number of items: found {len}"))
-            .with_label(format!("expected {exp}"))
+        Self::msg(format!("wrong number of items: found {len}")).with_label(format!("expected {exp}"))
     }
 
     fn unknown_variant(variant: &str, expected: &'static [&'static str]) -> Self {
@@ -278,15 +277,9 @@ struct SeqAcc<'a> {
 impl<'de> SeqAccess<'de> for SeqAcc<'_> {
     type Error = DeError;
 
-    fn next_element_seed<T: DeserializeSeed<'de>>(
-        &mut self,
-        seed: T,
-    ) -> Result<Option<T::Value>, DeError> {
+    fn next_element_seed<T: DeserializeSeed<'de>>(&mut self, seed: T) -> Result<Option<T::Value>, DeError> {
         match self.items.next() {
-            Some(item) => seed
-                .deserialize(ValueDe(item))
-                .map(Some)
-                .map_err(|e| e.at(item)),
+            Some(item) => seed.deserialize(ValueDe(item)).map(Some).map_err(|e| e.at(item)),
             None => Ok(None),
         }
     }
@@ -305,10 +298,7 @@ struct MapAcc<'a> {
 impl<'de> MapAccess<'de> for MapAcc<'_> {
     type Error = DeError;
 
-    fn next_key_seed<K: DeserializeSeed<'de>>(
-        &mut self,
-        seed: K,
-    ) -> Result<Option<K::Value>, DeError> {
+    fn next_key_seed<K: DeserializeSeed<'de>>(&mut self, seed: K) -> Result<Option<K::Value>, DeError> {
         match self.entries.next() {
             Some((k, v)) => {
                 self.pending = Some(v);
@@ -335,18 +325,13 @@ impl<'de, 'a> EnumAccess<'de> for EnumAcc<'a> {
     type Error = DeError;
     type Variant = VariantAcc<'a>;
 
-    fn variant_seed<T: DeserializeSeed<'de>>(
-        self,
-        seed: T,
-    ) -> Result<(T::Value, VariantAcc<'a>), DeError> {
+    fn variant_seed<T: DeserializeSeed<'de>>(self, seed: T) -> Result<(T::Value, VariantAcc<'a>), DeError> {
         let tag = self.tag;
         let name = match &tag.kind {
             ValueKind::Str(s) => s.as_str(),
             _ => {
-                return Err(
-                    DeError::msg(format!("wrong type: found {}", tag.describe()))
-                        .with_label("expected a name"),
-                )
+                return Err(DeError::msg(format!("wrong type: found {}", tag.describe()))
+                    .with_label("expected a name"))
                 .map_err(|e| e.at(tag));
             }
         };

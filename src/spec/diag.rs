@@ -86,10 +86,7 @@ impl fmt::Display for Diagnostic {
         write!(f, "{pad}--> {}", self.location())?;
         if let Some(src) = &self.source_line {
             // Replace tabs so the caret lines up.
-            let shown: String = src
-                .chars()
-                .map(|c| if c == '\t' { ' ' } else { c })
-                .collect();
+            let shown: String = src.chars().map(|c| if c == '\t' { ' ' } else { c }).collect();
             writeln!(f)?;
             writeln!(f, "{pad} |")?;
             writeln!(f, "{} | {}", self.line, shown.trim_end())?;

@@ -83,9 +83,7 @@ impl<'a> Expander<'a> {
                 self.err(
                     Issue::new(
                         v.loc,
-                        format!(
-                            "the tree has more than {MAX_TREE_NODES} nodes after subtree expansion"
-                        ),
+                        format!("the tree has more than {MAX_TREE_NODES} nodes after subtree expansion"),
                     )
                     .help("check for subtrees that call each other many times"),
                 );
@@ -115,10 +113,7 @@ impl<'a> Expander<'a> {
                 self.err(
                     Issue::new(
                         v.loc,
-                        format!(
-                            "a node must have exactly one kind, found {}",
-                            keys.join(", ")
-                        ),
+                        format!("a node must have exactly one kind, found {}", keys.join(", ")),
                     )
                     .label("expected one key such as `sequence:` or `reach:`")
                     .help(help),
@@ -126,11 +121,9 @@ impl<'a> Expander<'a> {
                 return None;
             }
             ValueKind::Str(s) => {
-                let mut issue = Issue::new(
-                    v.loc,
-                    format!("a node must be a mapping, found {}", v.describe()),
-                )
-                .label("expected `kind: {parameters}`");
+                let mut issue =
+                    Issue::new(v.loc, format!("a node must be a mapping, found {}", v.describe()))
+                        .label("expected `kind: {parameters}`");
                 if let Some(r) = param_ref(s) {
                     issue = issue.help(format!(
                         "`${r}` stands for a value, not a node; pass nodes as subtrees"
@@ -145,19 +138,14 @@ impl<'a> Expander<'a> {
             }
             _ => {
                 self.err(
-                    Issue::new(
-                        v.loc,
-                        format!("a node must be a mapping, found {}", v.describe()),
-                    )
-                    .label("expected `kind: {parameters}`, e.g. `home: {}`"),
+                    Issue::new(v.loc, format!("a node must be a mapping, found {}", v.describe()))
+                        .label("expected `kind: {parameters}`, e.g. `home: {}`"),
                 );
                 return None;
             }
         };
         let Some(kind) = key.as_str() else {
-            self.err(
-                Issue::new(key.loc, "a node kind must be a name").label("expected e.g. `sequence`"),
-            );
+            self.err(Issue::new(key.loc, "a node kind must be a name").label("expected e.g. `sequence`"));
             return None;
         };
         let kind = kind.to_string();
@@ -212,8 +200,8 @@ impl<'a> Expander<'a> {
                 }
             }
         } else {
-            let mut issue = Issue::new(key.loc, format!("unknown node kind `{k}`"))
-                .label("expected a node kind");
+            let mut issue =
+                Issue::new(key.loc, format!("unknown node kind `{k}`")).label("expected a node kind");
             if self.subtrees.contains_key(k) {
                 issue = issue.help(format!(
                     "`{k}` is a subtree: call it with `subtree: {{ref: {k}}}`"
@@ -221,8 +209,7 @@ impl<'a> Expander<'a> {
             } else if let Some(h) = did_you_mean(k, all_kinds()) {
                 issue = issue.help(h);
             } else {
-                issue =
-                    issue.help("see docs/tree_format.md (or `macrotree nodes`) for the node kinds");
+                issue = issue.help("see docs/tree_format.md (or `macrotree nodes`) for the node kinds");
             }
             self.err(issue);
             return None;
@@ -242,17 +229,16 @@ impl<'a> Expander<'a> {
                 self.err(
                     Issue::new(v.loc, format!("invalid node name `{s}`"))
                         .label("expected 1–80 characters without `/`, `[`, `]`, `#` or line breaks")
-                        .help("names appear in node paths like `main/sequence[pick]/reach`; keep them simple"),
+                        .help(
+                            "names appear in node paths like `main/sequence[pick]/reach`; keep them simple",
+                        ),
                 );
                 None
             }
             None => {
                 self.err(
-                    Issue::new(
-                        v.loc,
-                        format!("`name` must be text, found {}", v.describe()),
-                    )
-                    .label("expected a short label"),
+                    Issue::new(v.loc, format!("`name` must be text, found {}", v.describe()))
+                        .label("expected a short label"),
                 );
                 None
             }
@@ -260,12 +246,7 @@ impl<'a> Expander<'a> {
     }
 
     /// Check that `body` has only `allowed` keys (plus `name`); return them.
-    fn fields<'v>(
-        &mut self,
-        kind: &str,
-        body: &'v Value,
-        allowed: &[&str],
-    ) -> HashMap<String, &'v Value> {
+    fn fields<'v>(&mut self, kind: &str, body: &'v Value, allowed: &[&str]) -> HashMap<String, &'v Value> {
         let mut out = HashMap::new();
         for (k, v) in body.as_map().unwrap_or(&[]) {
             match k.as_str() {
@@ -279,11 +260,9 @@ impl<'a> Expander<'a> {
                         .chain(&["name"])
                         .map(|a| format!("`{a}`"))
                         .collect();
-                    let mut issue =
-                        Issue::new(k.loc, format!("unknown parameter `{key}` in `{kind}`"))
-                            .label(format!("expected one of {}", expected.join(", ")));
-                    issue = issue
-                        .maybe_help(did_you_mean(key, allowed.iter().copied().chain(["name"])));
+                    let mut issue = Issue::new(k.loc, format!("unknown parameter `{key}` in `{kind}`"))
+                        .label(format!("expected one of {}", expected.join(", ")));
+                    issue = issue.maybe_help(did_you_mean(key, allowed.iter().copied().chain(["name"])));
                     if issue.help.is_none() && key == "children" {
                         issue = issue.help(format!("`{kind}` takes a single `child:`"));
                     } else if issue.help.is_none() && key == "child" {
@@ -303,9 +282,7 @@ impl<'a> Expander<'a> {
             self.err(
                 Issue::new(loc, format!("`{kind}` needs `children:`"))
                     .label("expected `children: [...]` with at least one node")
-                    .help(format!(
-                        "write `{kind}: {{children: [{{home: {{}}}}, ...]}}`"
-                    )),
+                    .help(format!("write `{kind}: {{children: [{{home: {{}}}}, ...]}}`")),
             );
             return None;
         };
@@ -399,13 +376,7 @@ impl<'a> Expander<'a> {
         }
     }
 
-    fn count(
-        &mut self,
-        kind: &str,
-        loc: Loc,
-        f: &HashMap<String, &Value>,
-        key: &str,
-    ) -> Option<u32> {
+    fn count(&mut self, kind: &str, loc: Loc, f: &HashMap<String, &Value>, key: &str) -> Option<u32> {
         let Some(v) = f.get(key) else {
             self.err(
                 Issue::new(loc, format!("`{kind}` needs `{key}:`"))
@@ -449,9 +420,15 @@ impl<'a> Expander<'a> {
                 let condition = condition?;
                 if condition.as_check().is_none() {
                     self.err(
-                        Issue::new(condition.loc, format!("a guard's condition must be a condition leaf, found `{}`", condition.kind.kind_name()))
-                            .label(format!("expected one of {}", CONDITION_KINDS.join(", ")))
-                            .help("conditions are checked every tick and never run; put actions in `child:`"),
+                        Issue::new(
+                            condition.loc,
+                            format!(
+                                "a guard's condition must be a condition leaf, found `{}`",
+                                condition.kind.kind_name()
+                            ),
+                        )
+                        .label(format!("expected one of {}", CONDITION_KINDS.join(", ")))
+                        .help("conditions are checked every tick and never run; put actions in `child:`"),
                     );
                     return None;
                 }
@@ -765,9 +742,7 @@ pub fn undefined_params<'v>(v: &'v Value, params: &[&str], out: &mut Vec<(&'v st
             }
         }
         ValueKind::Seq(items) => items.iter().for_each(|i| undefined_params(i, params, out)),
-        ValueKind::Map(entries) => entries
-            .iter()
-            .for_each(|(_, x)| undefined_params(x, params, out)),
+        ValueKind::Map(entries) => entries.iter().for_each(|(_, x)| undefined_params(x, params, out)),
         _ => {}
     }
 }
@@ -782,11 +757,7 @@ pub fn render_value(v: &Value) -> String {
         ValueKind::Str(s) => s.clone(),
         ValueKind::Seq(items) => format!(
             "[{}]",
-            items
-                .iter()
-                .map(render_value)
-                .collect::<Vec<_>>()
-                .join(", ")
+            items.iter().map(render_value).collect::<Vec<_>>().join(", ")
         ),
         ValueKind::Map(entries) => format!(
             "{{{}}}",

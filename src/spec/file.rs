@@ -131,10 +131,7 @@ fn parse_includes(v: &Value, out: &mut Vec<IncludeRef>, issues: &mut Vec<Issue>)
             issues.push(
                 Issue::new(
                     v.loc,
-                    format!(
-                        "`include` must be a list of file paths, found {}",
-                        v.describe()
-                    ),
+                    format!("`include` must be a list of file paths, found {}", v.describe()),
                 )
                 .label("expected e.g. `[lib/pick_place.yaml]`"),
             );
@@ -190,12 +187,7 @@ fn parse_subtrees(v: &Value, out: &mut Vec<SubtreeDef>, issues: &mut Vec<Issue>)
     }
 }
 
-fn parse_subtree_def(
-    name: &str,
-    loc: Loc,
-    v: &Value,
-    issues: &mut Vec<Issue>,
-) -> Option<SubtreeDef> {
+fn parse_subtree_def(name: &str, loc: Loc, v: &Value, issues: &mut Vec<Issue>) -> Option<SubtreeDef> {
     let Some(entries) = v.as_map() else {
         issues.push(
             Issue::new(
@@ -230,11 +222,12 @@ fn parse_subtree_def(
                     .label("expected a one-line description"),
                 ),
             },
-            Some("params") => match &val.kind {
-                ValueKind::Null => {}
-                ValueKind::Map(ps) => {
-                    for (pk, pv) in ps {
-                        match pk.as_str().filter(|n| is_identifier(n)) {
+            Some("params") => {
+                match &val.kind {
+                    ValueKind::Null => {}
+                    ValueKind::Map(ps) => {
+                        for (pk, pv) in ps {
+                            match pk.as_str().filter(|n| is_identifier(n)) {
                             Some(pname) => def.params.push(ParamDef {
                                 name: pname.to_string(),
                                 default: (pv.kind != ValueKind::Null).then(|| pv.clone()),
@@ -246,26 +239,24 @@ fn parse_subtree_def(
                                     .help("write parameters without the `$`, e.g. `params: {approach: 0.15}`"),
                             ),
                         }
+                        }
                     }
+                    _ => issues.push(
+                        Issue::new(
+                            val.loc,
+                            format!("`params` must be a mapping, found {}", val.describe()),
+                        )
+                        .label("expected `{name: default, other: ~}` (`~` = required)"),
+                    ),
                 }
-                _ => issues.push(
-                    Issue::new(
-                        val.loc,
-                        format!("`params` must be a mapping, found {}", val.describe()),
-                    )
-                    .label("expected `{name: default, other: ~}` (`~` = required)"),
-                ),
-            },
+            }
             Some(other) => issues.push(
                 Issue::new(k.loc, format!("unknown key `{other}` in subtree `{name}`"))
                     .label("expected `params`, `root` or `description`")
                     .maybe_help(did_you_mean(other, SUBTREE_KEYS.iter().copied()))
-                    .help_or(
-                        "a subtree has `params:` (optional), `root:` and `description:` (optional)",
-                    ),
+                    .help_or("a subtree has `params:` (optional), `root:` and `description:` (optional)"),
             ),
-            None => issues
-                .push(Issue::new(k.loc, "keys must be names").label("expected `params` or `root`")),
+            None => issues.push(Issue::new(k.loc, "keys must be names").label("expected `params` or `root`")),
         }
     }
     if !has_root {

@@ -467,10 +467,7 @@ pub const CONDITION_KINDS: &[&str] = &[
 ];
 
 /// Read the parameters of leaf kind `kind` from `params`; `None` if `kind` is not a leaf kind.
-pub fn parse_leaf(
-    kind: &str,
-    params: &super::value::Value,
-) -> Option<Result<Leaf, super::de::DeError>> {
+pub fn parse_leaf(kind: &str, params: &super::value::Value) -> Option<Result<Leaf, super::de::DeError>> {
     use super::de::from_value as f;
     let a = |r: Result<ActionLeaf, _>| Some(r.map(Leaf::Action));
     let c = |r: Result<ConditionLeaf, _>| Some(r.map(Leaf::Condition));

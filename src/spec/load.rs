@@ -34,8 +34,7 @@ pub fn load_file(path: &Path) -> Result<Spec, Vec<Diagnostic>> {
         Ok(t) => t,
         Err((msg, help)) => {
             let id = l.sources.add(name, "");
-            l.issues
-                .push(Issue::new(Loc::file_start(id), msg).help(help));
+            l.issues.push(Issue::new(Loc::file_start(id), msg).help(help));
             return Err(l.sources.diagnostics(&l.issues));
         }
     };
@@ -108,12 +107,7 @@ struct Loader {
 }
 
 impl Loader {
-    fn finish(
-        mut self,
-        text: &str,
-        name: &str,
-        base: Option<&Path>,
-    ) -> Result<Spec, Vec<Diagnostic>> {
+    fn finish(mut self, text: &str, name: &str, base: Option<&Path>) -> Result<Spec, Vec<Diagnostic>> {
         let id = self.sources.add(name, text);
         let root_file = match parse_yaml(text, id).map(|v| parse_tree_file(&v, &mut self.issues)) {
             Ok(Some(f)) => f,
@@ -143,10 +137,7 @@ impl Loader {
                 self.issues.push(
                     Issue::new(d.loc, format!("subtree `{}` is defined twice", d.name))
                         .label("second definition")
-                        .note(format!(
-                            "first defined at {}",
-                            self.sources.describe(first.loc)
-                        ))
+                        .note(format!("first defined at {}", self.sources.describe(first.loc)))
                         .help("rename one of them"),
                 );
             } else {
@@ -173,15 +164,12 @@ impl Loader {
                     )
                 };
                 self.issues.push(
-                    Issue::new(
-                        loc,
-                        format!("undefined parameter `${p}` in subtree `{}`", d.name),
-                    )
-                    .label(label)
-                    .maybe_help(
-                        closest(p, names.iter().copied()).map(|c| format!("did you mean `${c}`?")),
-                    )
-                    .help_or(format!("declare it: `params: {{{p}: <default or ~>}}`")),
+                    Issue::new(loc, format!("undefined parameter `${p}` in subtree `{}`", d.name))
+                        .label(label)
+                        .maybe_help(
+                            closest(p, names.iter().copied()).map(|c| format!("did you mean `${c}`?")),
+                        )
+                        .help_or(format!("declare it: `params: {{{p}: <default or ~>}}`")),
                 );
             }
         }
@@ -214,14 +202,8 @@ impl Loader {
                     super::value::Value::new(super::value::ValueKind::Str("subtree".into()), d.loc),
                     super::value::Value::new(
                         super::value::ValueKind::Map(vec![(
-                            super::value::Value::new(
-                                super::value::ValueKind::Str("ref".into()),
-                                d.loc,
-                            ),
-                            super::value::Value::new(
-                                super::value::ValueKind::Str(n.clone()),
-                                d.loc,
-                            ),
+                            super::value::Value::new(super::value::ValueKind::Str("ref".into()), d.loc),
+                            super::value::Value::new(super::value::ValueKind::Str(n.clone()), d.loc),
                         )]),
                         d.loc,
                     ),
@@ -240,10 +222,8 @@ impl Loader {
             }),
             _ => {
                 if self.issues.is_empty() {
-                    self.issues.push(Issue::new(
-                        Loc::file_start(id),
-                        "the tree could not be read",
-                    ));
+                    self.issues
+                        .push(Issue::new(Loc::file_start(id), "the tree could not be read"));
                 }
                 Err(self.sources.diagnostics(&self.issues))
             }

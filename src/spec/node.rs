@@ -156,12 +156,7 @@ impl NodeKind {
 impl Node {
     /// Number of nodes in this subtree (itself included).
     pub fn count(&self) -> usize {
-        1 + self
-            .kind
-            .children()
-            .iter()
-            .map(|c| c.count())
-            .sum::<usize>()
+        1 + self.kind.children().iter().map(|c| c.count()).sum::<usize>()
     }
 
     /// The leaf, if this node is one.

@@ -57,10 +57,7 @@ pub fn closest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) ->
 }
 
 /// `Some("did you mean `x`?")` when a candidate is close to `word`.
-pub fn did_you_mean<'a>(
-    word: &str,
-    candidates: impl IntoIterator<Item = &'a str>,
-) -> Option<String> {
+pub fn did_you_mean<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<String> {
     closest(word, candidates).map(|c| format!("did you mean `{c}`?"))
 }
 
@@ -78,18 +75,9 @@ mod tests {
 
     #[test]
     fn suggestions() {
-        let kinds = [
-            "sequence",
-            "fallback",
-            "reactive_sequence",
-            "retry",
-            "reach",
-        ];
+        let kinds = ["sequence", "fallback", "reactive_sequence", "retry", "reach"];
         assert_eq!(closest("sequnce", kinds), Some("sequence"));
-        assert_eq!(
-            closest("reactive-sequence", kinds),
-            Some("reactive_sequence")
-        );
+        assert_eq!(closest("reactive-sequence", kinds), Some("reactive_sequence"));
         assert_eq!(closest("retyr", kinds), Some("retry"));
         assert_eq!(closest("banana", kinds), None);
     }

@@ -17,9 +17,7 @@ fn finite<E: de::Error>(x: f64, what: &str) -> Result<f64, E> {
     if x.is_finite() {
         Ok(x)
     } else {
-        Err(E::custom(format!(
-            "{what} must be a finite number, found `{x}`"
-        )))
+        Err(E::custom(format!("{what} must be a finite number, found `{x}`")))
     }
 }
 
@@ -209,8 +207,7 @@ impl<'de> Visitor<'de> for TargetVisitor {
             "cube" => Ok(Target::Cube),
             "bowl" => Ok(Target::Bowl),
             _ => {
-                let mut msg =
-                    format!("unknown target `{v}`: expected `cube`, `bowl` or `[x, y, z]`");
+                let mut msg = format!("unknown target `{v}`: expected `cube`, `bowl` or `[x, y, z]`");
                 if let Some(h) = did_you_mean(v, TARGET_NAMES.iter().copied()) {
                     msg.push_str(&format!(" ({h})"));
                 }
@@ -300,9 +297,8 @@ impl Visitor<'_> for YawVisitor {
             "object" => Ok(Yaw::Object),
             "keep" => Ok(Yaw::Keep),
             _ => parse_angle_text(v).map(Yaw::Angle).map_err(|_| {
-                let mut msg = format!(
-                    "unknown yaw `{v}`: expected `object`, `keep` or an angle like `deg(90)`"
-                );
+                let mut msg =
+                    format!("unknown yaw `{v}`: expected `object`, `keep` or an angle like `deg(90)`");
                 if let Some(h) = did_you_mean(v, ["object", "keep"]) {
                     msg.push_str(&format!(" ({h})"));
                 }

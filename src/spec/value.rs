@@ -56,11 +56,7 @@ pub enum ValueKind {
 impl Value {
     /// A value at `loc`.
     pub fn new(kind: ValueKind, loc: Loc) -> Self {
-        Self {
-            kind,
-            loc,
-            via: None,
-        }
+        Self { kind, loc, via: None }
     }
 
     /// The string, if this is a string scalar.
@@ -197,9 +193,7 @@ impl<'de> Visitor<'de> for RawVisitor {
         Ok(RawKind(ValueKind::Str(v)))
     }
     fn visit_bytes<E: de::Error>(self, v: &[u8]) -> Result<RawKind, E> {
-        Ok(RawKind(ValueKind::Str(
-            String::from_utf8_lossy(v).into_owned(),
-        )))
+        Ok(RawKind(ValueKind::Str(String::from_utf8_lossy(v).into_owned())))
     }
     fn visit_none<E: de::Error>(self) -> Result<RawKind, E> {
         Ok(RawKind(ValueKind::Null))
@@ -284,9 +278,7 @@ pub fn parse_yaml(text: &str, file: FileId) -> Result<Value, Issue> {
                     whole,
                     format!("the file expands to more than {MAX_YAML_NODES} YAML nodes"),
                 )
-                .help(
-                    "remove YAML aliases that multiply content (`*anchor` inside repeated lists)",
-                ));
+                .help("remove YAML aliases that multiply content (`*anchor` inside repeated lists)"));
             }
             Ok(v)
         }
@@ -380,10 +372,7 @@ mod tests {
         assert_eq!((main.loc.line, main.loc.col), (2, 3));
         let seq = main.get("seq").unwrap().as_seq().unwrap();
         assert_eq!(seq[1].kind, ValueKind::Str("two".into()));
-        assert_eq!(
-            (seq[1].loc.line, seq[1].loc.col, seq[1].loc.len),
-            (2, 12, 3)
-        );
+        assert_eq!((seq[1].loc.line, seq[1].loc.col, seq[1].loc.len), (2, 12, 3));
         assert_eq!(seq[2].kind, ValueKind::Float(3.5));
     }
 

@@ -1,0 +1,159 @@
+//! [`Cell`]: the simulated work cell as the macro actions see it — the simulation, the arm's
+//! trajectory tracker, the gripper command and the latest [`World`] snapshot.
+
+use crate::motion::Trajectory;
+use crate::sim::{Layout, Scene, Sim, TIMESTEP};
+use crate::world::World;
+
+/// Default control period: the tree is ticked every 4 ms of simulated time (2 physics steps).
+pub const CONTROL_PERIOD: f64 = 0.004;
+
+/// What the arm is doing between ticks.
+enum ArmPlan {
+    /// Hold these joint angles (radians).
+    Hold([f64; 6]),
+    /// Follow a trajectory that started at `t0` (simulated seconds).
+    Track {
+        trajectory: Box<dyn Trajectory>,
+        t0: f64,
+    },
+}
+
+/// Sees every physics step and every macro action that starts: fault injection acts on the
+/// physics through it, benchmarks record the controls.
+pub trait StepObserver: Send {
+    /// Called after the controls for the coming physics step are set; may act on the physics
+    /// (fault injection) or record the controls.
+    fn before_step(&mut self, sim: &mut Sim);
+    /// A macro action of `kind` (`"reach"`, `"grasp"`, `"carry"`, …) starts now.
+    fn on_action_start(&mut self, _kind: &str, _world: &World) {}
+}
+
+/// The simulated cell: simulation, arm tracker, gripper command and the latest world snapshot.
+pub struct Cell {
+    sim: Sim,
+    world: World,
+    arm: ArmPlan,
+    gripper_ctrl: f64,
+    steps_per_tick: u32,
+    /// Per-step hooks (fault injection, control recording), called in order.
+    pub observers: Vec<Box<dyn StepObserver>>,
+}
+
+impl Cell {
+    /// A cell of `scene` reset to `layout`, ticked every `control_period` seconds
+    /// (rounded to a whole number of physics steps, at least one).
+    pub fn new(scene: &Scene, layout: &Layout, control_period: f64) -> Self {
+        let sim = Sim::new(scene);
+        let world = sim.observe();
+        let steps_per_tick = ((control_period / TIMESTEP).round() as u32).max(1);
+        let mut cell = Self {
+            sim,
+            world,
+            arm: ArmPlan::Hold(crate::sim::HOME_Q),
+            gripper_ctrl: 0.0,
+            steps_per_tick,
+            observers: Vec::new(),
+        };
+        cell.reset(layout);
+        cell
+    }
+
+    /// Back to home, gripper open, cube and bowl where `layout` puts them, time zero.
+    pub fn reset(&mut self, layout: &Layout) {
+        self.sim.reset(layout);
+        self.arm = ArmPlan::Hold(crate::sim::HOME_Q);
+        self.gripper_ctrl = 0.0;
+        self.world = self.sim.observe();
+    }
+
+    /// Tells the observers that a macro action of `kind` starts.
+    pub fn notify_action_start(&mut self, kind: &str) {
+        for obs in &mut self.observers {
+            obs.on_action_start(kind, &self.world);
+        }
+    }
+
+    /// The control period, seconds.
+    pub fn control_period(&self) -> f64 {
+        self.steps_per_tick as f64 * TIMESTEP
+    }
+
+    /// The latest world snapshot (refreshed after every control period).
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// The simulation.
+    pub fn sim(&self) -> &Sim {
+        &self.sim
+    }
+
+    /// The simulation, mutably (fault injection acts on physics through it).
+    pub fn sim_mut(&mut self) -> &mut Sim {
+        &mut self.sim
+    }
+
+    /// The joint angles the arm is commanded to right now (not the measured, possibly lagging ones), radians.
+    pub fn arm_setpoint(&self) -> [f64; 6] {
+        match &self.arm {
+            ArmPlan::Hold(q) => *q,
+            ArmPlan::Track { trajectory, t0 } => trajectory.sample(self.sim.time() - t0).0,
+        }
+    }
+
+    /// Starts following `trajectory` now.
+    pub fn track(&mut self, trajectory: Box<dyn Trajectory>) {
+        self.arm = ArmPlan::Track {
+            trajectory,
+            t0: self.sim.time(),
+        };
+    }
+
+    /// Stops where the arm is commanded to be now and holds there (a halt).
+    pub fn hold(&mut self) {
+        self.arm = ArmPlan::Hold(self.arm_setpoint());
+    }
+
+    /// The current trajectory has reached its end (or the arm is holding).
+    pub fn arm_motion_finished(&self) -> bool {
+        match &self.arm {
+            ArmPlan::Hold(_) => true,
+            ArmPlan::Track { trajectory, t0 } => self.sim.time() - t0 >= trajectory.duration(),
+        }
+    }
+
+    /// Commands the gripper actuator (0 = open … 255 = closed).
+    pub fn set_gripper(&mut self, ctrl: f64) {
+        self.gripper_ctrl = ctrl.clamp(0.0, 255.0);
+    }
+
+    /// The gripper actuator command.
+    pub fn gripper_command(&self) -> f64 {
+        self.gripper_ctrl
+    }
+
+    /// Advances the physics by one control period, commanding the arm at every physics step,
+    /// then refreshes the world snapshot.
+    pub fn advance(&mut self) {
+        for _ in 0..self.steps_per_tick {
+            let t = self.sim.time();
+            let (q, qd) = match &self.arm {
+                ArmPlan::Hold(q) => (*q, [0.0; 6]),
+                ArmPlan::Track { trajectory, t0 } if t - t0 >= trajectory.duration() => {
+                    let end = trajectory.end();
+                    self.arm = ArmPlan::Hold(end);
+                    (end, [0.0; 6])
+                }
+                ArmPlan::Track { trajectory, t0 } => trajectory.sample(t - t0),
+            };
+            self.sim.command_arm(&q, &qd);
+            self.sim.set_gripper_ctrl(self.gripper_ctrl);
+            for obs in &mut self.observers {
+                obs.before_step(&mut self.sim);
+            }
+            self.sim.step();
+        }
+        self.world = self.sim.observe();
+    }
+}

@@ -1,0 +1,68 @@
+//! `grasp`: close the gripper to a width or until the fingers stall, then verify the cube is held.
+
+use super::cell::Cell;
+use super::macro_action::{MacroAction, Progress};
+use crate::motion::gripper::{CLOSED_CTRL, ctrl_for_width};
+use crate::spec::Grasp as GraspSpec;
+use crate::world::conditions::{Tolerances, cube_grasped};
+
+/// Driver-joint speed below which the fingers count as stalled, rad/s.
+const STALL_SPEED: f64 = 0.02;
+/// Consecutive stalled ticks needed before the grasp is judged.
+const STALL_TICKS: u32 = 5;
+/// Time the fingers get to start moving before a stall counts, seconds.
+const MIN_CLOSE_TIME: f64 = 0.1;
+
+/// Executes a [`GraspSpec`].
+pub struct Grasp {
+    spec: GraspSpec,
+    t0: f64,
+    stalled: u32,
+}
+
+impl Grasp {
+    /// A grasp controller for `spec`.
+    pub fn new(spec: GraspSpec) -> Self {
+        Self {
+            spec,
+            t0: 0.0,
+            stalled: 0,
+        }
+    }
+}
+
+impl MacroAction for Grasp {
+    fn start(&mut self, cell: &mut Cell) -> Result<(), String> {
+        cell.hold();
+        let ctrl = self.spec.width.map_or(CLOSED_CTRL, ctrl_for_width);
+        cell.set_gripper(ctrl);
+        self.t0 = cell.world().time;
+        self.stalled = 0;
+        Ok(())
+    }
+
+    fn update(&mut self, cell: &mut Cell) -> Progress {
+        let w = cell.world();
+        if w.time - self.t0 < MIN_CLOSE_TIME {
+            return Progress::Running;
+        }
+        if w.gripper_speed.abs() < STALL_SPEED {
+            self.stalled += 1;
+        } else {
+            self.stalled = 0;
+        }
+        if self.stalled < STALL_TICKS {
+            return Progress::Running;
+        }
+        if cube_grasped(w, Tolerances::GRASP_OFF_AXIS) {
+            Progress::Done
+        } else {
+            Progress::Failed(format!(
+                "grasp failed: fingers stopped at {:.1} mm without holding the cube (pad contacts: left {}, right {})",
+                w.gripper_width * 1e3,
+                w.left_pad_contact,
+                w.right_pad_contact
+            ))
+        }
+    }
+}

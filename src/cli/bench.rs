@@ -1,0 +1,137 @@
+//! `macrotree bench TREE`: what all that is not physics costs.
+//!
+//! Runs the episode while recording every physics step's actuator commands, then replays those
+//! commands on a fresh copy of the same model with nothing but `mj_step` in a loop. The ratio of
+//! the two wall times is the overhead of the tree, the controllers, IK and world extraction.
+
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use clap::Args;
+use serde::Serialize;
+
+use super::run::EpisodeArgs;
+use super::{CliError, load_plan_or_exit, load_scene_or_exit};
+use crate::actions::{Cell, StepObserver};
+use crate::episode::{NoObserver, run_in_cell};
+use crate::sim::{Scene, Sim};
+
+/// Arguments of `bench`.
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    /// The tree file (YAML).
+    pub tree: PathBuf,
+    #[command(flatten)]
+    pub episode: EpisodeArgs,
+    /// Repetitions; the median of each timing is reported.
+    #[arg(long, default_value_t = 5)]
+    pub repeat: usize,
+    /// Print the result as one JSON object on the last line of stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// What `bench` measures. Times in seconds.
+#[derive(Debug, Clone, Serialize)]
+pub struct BenchReport {
+    /// Median wall time of the whole episode (tree, controllers, IK, physics).
+    pub episode_wall_time_s: f64,
+    /// Median wall time of replaying the same controls with bare mj_step.
+    pub replay_wall_time_s: f64,
+    /// episode / replay.
+    pub ratio: f64,
+    /// Simulated time of the episode.
+    pub sim_time_s: f64,
+    /// Physics steps of the episode.
+    pub physics_steps: u64,
+    /// The episode succeeded.
+    pub success: bool,
+    /// Mean IK solve time over 10 000 task-region targets, microseconds.
+    pub ik_us_per_solve: f64,
+    /// Repetitions behind each median.
+    pub repeat: usize,
+}
+
+struct Recorder(Arc<Mutex<Vec<f64>>>);
+
+impl StepObserver for Recorder {
+    fn before_step(&mut self, sim: &mut Sim) {
+        self.0
+            .lock()
+            .expect("recorder lock")
+            .extend_from_slice(sim.ctrl());
+    }
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Runs `macrotree bench`.
+pub fn bench(args: BenchArgs) -> Result<(), CliError> {
+    let config = args.episode.config()?;
+    let plan = Arc::new(load_plan_or_exit(&args.tree)?);
+    let scene = load_scene_or_exit()?;
+    let repeat = args.repeat.max(1);
+    let mut episode_times = Vec::new();
+    let mut replay_times = Vec::new();
+    let mut last = None;
+    for _ in 0..repeat {
+        let controls = Arc::new(Mutex::new(Vec::new()));
+        let mut cell = Cell::new(&scene, &config.layout, config.control_period);
+        // Not recorded: the first run warms caches; recording costs one copy per step, which is
+        // charged to the episode (conservative).
+        cell.observers.push(Box::new(Recorder(controls.clone())));
+        let t = Instant::now();
+        let report = run_in_cell(&mut cell, plan.clone(), &config, &mut NoObserver);
+        episode_times.push(t.elapsed().as_secs_f64());
+        let controls = controls.lock().expect("recorder lock").clone();
+        replay_times.push(replay(&scene, &config.layout, &controls));
+        last = Some(report);
+    }
+    let report = last.expect("repeat >= 1");
+    let episode = median(episode_times);
+    let replay = median(replay_times);
+    let result = BenchReport {
+        episode_wall_time_s: episode,
+        replay_wall_time_s: replay,
+        ratio: episode / replay,
+        sim_time_s: report.sim_time_s,
+        physics_steps: report.physics_steps,
+        success: report.success,
+        ik_us_per_solve: crate::motion::ik_benchmark(10_000),
+        repeat,
+    };
+    println!(
+        "episode {:.4} s wall, replay (bare mj_step) {:.4} s wall, ratio {:.3}; {:.2} s simulated, {} steps, success {}; IK {:.2} µs/solve (median of {repeat})",
+        result.episode_wall_time_s,
+        result.replay_wall_time_s,
+        result.ratio,
+        result.sim_time_s,
+        result.physics_steps,
+        result.success,
+        result.ik_us_per_solve
+    );
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string(&result).expect("bench report serializes")
+        );
+    }
+    Ok(())
+}
+
+/// Wall time of stepping a fresh simulation through `controls` (nu values per step), seconds.
+fn replay(scene: &Scene, layout: &crate::sim::Layout, controls: &[f64]) -> f64 {
+    let mut sim = Sim::new(scene);
+    sim.reset(layout);
+    let nu = sim.ctrl().len();
+    let t = Instant::now();
+    for ctrl in controls.chunks_exact(nu) {
+        sim.set_ctrl(ctrl);
+        sim.step();
+    }
+    t.elapsed().as_secs_f64()
+}

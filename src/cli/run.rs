@@ -1,0 +1,132 @@
+//! `macrotree run TREE`: one headless episode.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use clap::Args;
+
+use super::args::{CubeArg, XyArg};
+use super::{CliError, load_plan_or_exit, load_scene_or_exit};
+use crate::episode::{EpisodeConfig, NoObserver, run_episode};
+use crate::sim::Layout;
+
+/// Arguments of `run`.
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// The tree file (YAML).
+    pub tree: PathBuf,
+    #[command(flatten)]
+    pub episode: EpisodeArgs,
+    /// Print the episode report as one JSON object on the last line of stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Layout and limits shared by `run` and `bench`.
+#[derive(Debug, Args)]
+pub struct EpisodeArgs {
+    /// Cube centre and yaw: X,Y[,YAW_DEG] (metres, degrees). Default 0.45,-0.18,0.
+    #[arg(long, value_name = "X,Y[,YAW_DEG]", allow_hyphen_values = true)]
+    pub cube: Option<CubeArg>,
+    /// Bowl centre: X,Y (metres). Default 0.45,0.08.
+    #[arg(long, value_name = "X,Y", allow_hyphen_values = true)]
+    pub bowl: Option<XyArg>,
+    /// Seed for fault timing and magnitude.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Stop the episode (as a failure) after this much simulated time, seconds.
+    #[arg(long, default_value_t = 60.0, value_name = "S")]
+    pub max_sim_time: f64,
+    /// Inject a fault through physics (see docs/faults.md).
+    #[arg(long, value_enum)]
+    pub fault: Option<crate::faults::FaultKind>,
+}
+
+impl EpisodeArgs {
+    /// The episode configuration these arguments describe.
+    pub fn config(&self) -> Result<EpisodeConfig, CliError> {
+        if !(self.max_sim_time.is_finite() && self.max_sim_time > 0.0) {
+            return Err(CliError::Input(format!(
+                "error: --max-sim-time must be a positive number of seconds, got {}",
+                self.max_sim_time
+            )));
+        }
+        let mut layout = Layout::default();
+        if let Some(c) = self.cube {
+            layout.cube_xy = [c.x, c.y];
+            layout.cube_yaw = c.yaw_deg.to_radians();
+        }
+        if let Some(b) = self.bowl {
+            layout.bowl_xy = [b.x, b.y];
+        }
+        Ok(EpisodeConfig {
+            layout,
+            seed: self.seed,
+            max_sim_time: self.max_sim_time,
+            ..EpisodeConfig::default()
+        })
+    }
+}
+
+/// Runs `macrotree run`.
+pub fn run(args: RunArgs) -> Result<(), CliError> {
+    let config = args.episode.config()?;
+    let plan = Arc::new(load_plan_or_exit(&args.tree)?);
+    let scene = load_scene_or_exit()?;
+    tracing::info!(tree = %args.tree.display(), cube = ?config.layout.cube_xy, bowl = ?config.layout.bowl_xy, seed = config.seed, "episode start");
+    let report = run_episode(&scene, plan, &config, &mut NoObserver);
+    if report.success {
+        tracing::info!(
+            sim_time_s = report.sim_time_s,
+            grasp_attempts = report.grasp_attempts,
+            "episode succeeded: the cube is in the bowl"
+        );
+    } else {
+        tracing::warn!(
+            reason = report.failure_reason.as_deref().unwrap_or(""),
+            "episode failed"
+        );
+    }
+    print_summary(&report);
+    if args.json {
+        println!("{}", serde_json::to_string(&report).expect("report serializes"));
+    }
+    if report.success {
+        Ok(())
+    } else {
+        Err(CliError::TaskFailed)
+    }
+}
+
+fn print_summary(r: &crate::episode::EpisodeReport) {
+    let c = &r.checks;
+    println!(
+        "{}: tree {}, {:.2} s simulated in {:.3} s wall ({} physics steps), {} grasp attempt(s)",
+        if r.success { "SUCCESS" } else { "FAILURE" },
+        r.tree_status,
+        r.sim_time_s,
+        r.wall_time_s,
+        r.physics_steps,
+        r.grasp_attempts
+    );
+    if let Some(reason) = &r.failure_reason {
+        println!("  reason: {reason}");
+    }
+    println!(
+        "  cube final ({:.3}, {:.3}, {:.3}) m, bowl target ({:.3}, {:.3}, {:.3}) m",
+        r.cube_final[0],
+        r.cube_final[1],
+        r.cube_final[2],
+        r.bowl_target[0],
+        r.bowl_target[1],
+        r.bowl_target[2]
+    );
+    println!(
+        "  checks: grasp distance {} m, motion while closed {:.3} m, lift while closed {:.3} m, home error {:.4} rad, in bowl {}",
+        c.grasp_distance.map_or("-".into(), |d| format!("{d:.4}")),
+        c.cube_motion_while_closed,
+        c.cube_lift_while_closed,
+        c.home_error,
+        c.in_bowl
+    );
+}

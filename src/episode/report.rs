@@ -1,0 +1,102 @@
+//! [`EpisodeReport`]: the outcome of one episode, as `run --json` prints it.
+
+use serde::Serialize;
+
+use super::EpisodeConfig;
+use crate::actions::{Checks, LeafCounters};
+use crate::runtime::TreeStatus;
+use crate::world::World;
+
+/// What happened in one episode. Lengths in metres, times in seconds.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EpisodeReport {
+    /// The tree succeeded and the cube rests in the bowl.
+    pub success: bool,
+    /// Final status of the tree: "success", "failure", or "running" when the time limit hit.
+    pub tree_status: &'static str,
+    /// Why it failed (the first failing leaf's reason, or the time limit), if it did.
+    pub failure_reason: Option<String>,
+    /// Simulated time of the episode.
+    pub sim_time_s: f64,
+    /// Wall-clock time of the episode (tree + physics), seconds.
+    pub wall_time_s: f64,
+    /// MuJoCo steps taken.
+    pub physics_steps: u64,
+    /// Grasp leaves started.
+    pub grasp_attempts: u32,
+    /// Leaves preempted while running.
+    pub halts: u32,
+    /// Final cube centre [x, y, z].
+    pub cube_final: [f64; 3],
+    /// Bowl target [x, y, z].
+    pub bowl_target: [f64; 3],
+    /// The reference tutorial's checks.
+    pub checks: Checks,
+    /// The layout: cube [x, y, yaw_deg] and bowl [x, y].
+    pub layout: LayoutJson,
+    /// The seed.
+    pub seed: u64,
+}
+
+/// A layout as JSON.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LayoutJson {
+    /// Cube centre x, y (metres) and yaw (degrees).
+    pub cube: [f64; 3],
+    /// Bowl centre x, y (metres).
+    pub bowl: [f64; 2],
+}
+
+impl EpisodeReport {
+    /// Assembles a report.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        status: TreeStatus,
+        timed_out: bool,
+        config: &EpisodeConfig,
+        world: &World,
+        checks: Checks,
+        counters: LeafCounters,
+        physics_steps: u64,
+        wall_time_s: f64,
+        tree_failure: Option<String>,
+    ) -> Self {
+        let tree_status = match status {
+            TreeStatus::Success => "success",
+            TreeStatus::Failure => "failure",
+            TreeStatus::Running => "running",
+        };
+        let success = status == TreeStatus::Success && checks.in_bowl;
+        let failure_reason = if success {
+            None
+        } else if timed_out {
+            Some(format!(
+                "time limit: the tree was still running after {:.1} s of simulated time",
+                config.max_sim_time
+            ))
+        } else if status == TreeStatus::Success {
+            Some("the tree succeeded but the cube is not at rest in the bowl".into())
+        } else {
+            Some(tree_failure.unwrap_or_else(|| "the tree failed".into()))
+        };
+        let l = &config.layout;
+        Self {
+            success,
+            tree_status,
+            failure_reason,
+            sim_time_s: world.time,
+            wall_time_s,
+            physics_steps,
+            grasp_attempts: counters.grasp_attempts,
+            halts: counters.halts,
+            cube_final: world.cube_pos.into(),
+            bowl_target: world.bowl_target.into(),
+            checks,
+            layout: LayoutJson {
+                cube: [l.cube_xy[0], l.cube_xy[1], l.cube_yaw.to_degrees()],
+                bowl: l.bowl_xy,
+            },
+            seed: config.seed,
+        }
+    }
+}

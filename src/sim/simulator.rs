@@ -1,0 +1,230 @@
+//! [`Sim`]: one MuJoCo data instance of the [`Scene`], reset to a [`Layout`], stepped, and read
+//! back into a [`World`].
+
+use std::sync::Arc;
+
+use mujoco_rs::prelude::*;
+use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
+
+use super::layout::Layout;
+use super::scene::Scene;
+use crate::world::{BowlGeometry, World};
+
+pub use crate::motion::HOME_Q;
+
+/// Half-thickness of a 2F-85 pad box across the grip (Menagerie `pad_box1/2` size y), metres.
+pub const PAD_HALF_THICKNESS: f64 = 0.004;
+
+/// Physics time step of the scene, seconds (set in assets/scene.xml).
+pub const TIMESTEP: f64 = 0.002;
+
+/// A running simulation of the task scene.
+pub struct Sim {
+    scene: Scene,
+    data: MjData<Arc<MjModel>>,
+    steps: u64,
+}
+
+impl Sim {
+    /// A fresh simulation of `scene`, reset to the default layout.
+    pub fn new(scene: &Scene) -> Self {
+        let data = MjData::new(scene.model.clone());
+        let mut sim = Self {
+            scene: scene.clone(),
+            data,
+            steps: 0,
+        };
+        sim.reset(&Layout::default());
+        sim
+    }
+
+    /// The scene this simulation runs.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// Puts the arm at home with its servos holding home, the gripper open, the cube resting on
+    /// the table at the layout's pose and the bowl at its place; time and step count go to zero.
+    pub fn reset(&mut self, layout: &Layout) {
+        let ids = self.scene.ids.clone();
+        self.data.reset();
+        {
+            let qpos = self.data.qpos_mut();
+            for (i, &a) in ids.arm_qpos.iter().enumerate() {
+                qpos[a] = HOME_Q[i];
+            }
+            let c = ids.cube_qpos;
+            let half_yaw = layout.cube_yaw / 2.0;
+            qpos[c..c + 7].copy_from_slice(&[
+                layout.cube_xy[0],
+                layout.cube_xy[1],
+                crate::world::CUBE_HALF,
+                half_yaw.cos(),
+                0.0,
+                0.0,
+                half_yaw.sin(),
+            ]);
+        }
+        self.data.mocap_pos_mut()[ids.bowl_mocap] = [layout.bowl_xy[0], layout.bowl_xy[1], 0.0];
+        self.set_arm_ctrl(&HOME_Q);
+        self.set_gripper_ctrl(0.0);
+        self.data.forward();
+        self.steps = 0;
+    }
+
+    /// Commands the arm's position servos, radians.
+    pub fn set_arm_ctrl(&mut self, q: &[f64; 6]) {
+        let acts = self.scene.ids.arm_act;
+        let ctrl = self.data.ctrl_mut();
+        for (i, &a) in acts.iter().enumerate() {
+            ctrl[a] = q[i];
+        }
+    }
+
+    /// Commands the arm to track joint angles `q` (radians) moving at `qd` (rad/s), with feedforward.
+    ///
+    /// Menagerie's UR5e servos are plain PD position actuators, `τ = kp (ctrl − q) − kv q̇`, with
+    /// no gravity compensation: holding a pose they sag by about 0.6° (≈1 cm at the tool), and
+    /// tracking a moving target they lag by `kv/kp · q̇`. This command shifts the servo set point
+    /// so that `τ = kp (q − q_meas) + kv (qd − q̇_meas) + bias`, where `bias` is MuJoCo's
+    /// gravity + Coriolis torque at the current state (`qfrc_bias`) — the feedforward a real UR
+    /// controller applies. Call it before every physics step while tracking.
+    pub fn command_arm(&mut self, q: &[f64; 6], qd: &[f64; 6]) {
+        let ids = &self.scene.ids;
+        let bias = self.data.qfrc_bias();
+        let mut set = [0.0; 6];
+        for i in 0..6 {
+            let (kp, kv) = self.scene.arm_gains[i];
+            let u = q[i] + (kv * qd[i] + bias[ids.arm_dof[i]]) / kp;
+            let [lo, hi] = self.scene.arm_ctrlrange[i];
+            set[i] = u.clamp(lo, hi);
+        }
+        self.set_arm_ctrl(&set);
+    }
+
+    /// Commands the gripper actuator (0 = open … 255 = closed).
+    pub fn set_gripper_ctrl(&mut self, u: f64) {
+        let a = self.scene.ids.gripper_act;
+        self.data.ctrl_mut()[a] = u.clamp(0.0, 255.0);
+    }
+
+    /// The current actuator commands (6 arm + gripper, in actuator order).
+    pub fn ctrl(&self) -> &[f64] {
+        self.data.ctrl()
+    }
+
+    /// Overwrites all actuator commands (used by replays).
+    pub fn set_ctrl(&mut self, ctrl: &[f64]) {
+        self.data.ctrl_mut().copy_from_slice(ctrl);
+    }
+
+    /// Advances the physics by one time step ([`TIMESTEP`]).
+    pub fn step(&mut self) {
+        self.data.step();
+        self.steps += 1;
+    }
+
+    /// Physics steps taken since the last reset.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// Simulated time since the last reset, seconds.
+    pub fn time(&self) -> f64 {
+        self.data.ffi().time
+    }
+
+    /// Read-only access to the MuJoCo data (for the viewer and tests).
+    pub fn data(&self) -> &MjData<Arc<MjModel>> {
+        &self.data
+    }
+
+    /// Mutable access to the MuJoCo data, for fault injection through physics (pushes, friction).
+    pub fn data_mut(&mut self) -> &mut MjData<Arc<MjModel>> {
+        &mut self.data
+    }
+
+    /// Full physics state (qpos, qvel, act, ctrl, time) as bits, for determinism checks.
+    pub fn state_fingerprint(&self) -> Vec<u64> {
+        let d = &self.data;
+        d.qpos()
+            .iter()
+            .chain(d.qvel())
+            .chain(d.ctrl())
+            .chain(std::iter::once(&d.ffi().time))
+            .map(|v| v.to_bits())
+            .collect()
+    }
+
+    /// Reads the current state into a [`World`] snapshot.
+    pub fn observe(&self) -> World {
+        let ids = &self.scene.ids;
+        let d = &self.data;
+        let qpos = d.qpos();
+        let qvel = d.qvel();
+        let ctrl = d.ctrl();
+        let mut arm_q = [0.0; 6];
+        let mut arm_qd = [0.0; 6];
+        let mut arm_cmd = [0.0; 6];
+        for i in 0..6 {
+            arm_q[i] = qpos[ids.arm_qpos[i]];
+            arm_qd[i] = qvel[ids.arm_dof[i]];
+            arm_cmd[i] = ctrl[ids.arm_act[i]];
+        }
+        let gx = d.geom_xpos();
+        let v3 = |p: [f64; 3]| Vector3::new(p[0], p[1], p[2]);
+        let left_pad_pos = (v3(gx[ids.left_pads[0]]) + v3(gx[ids.left_pads[1]])) / 2.0;
+        let right_pad_pos = (v3(gx[ids.right_pads[0]]) + v3(gx[ids.right_pads[1]])) / 2.0;
+        let mut left_pad_contact = false;
+        let mut right_pad_contact = false;
+        for c in d.contact() {
+            let (a, b) = (c.geom[0] as usize, c.geom[1] as usize);
+            let other = if a == ids.cube_geom {
+                b
+            } else if b == ids.cube_geom {
+                a
+            } else {
+                continue;
+            };
+            left_pad_contact |= ids.left_pads.contains(&other);
+            right_pad_contact |= ids.right_pads.contains(&other);
+        }
+        let c = ids.cube_qpos;
+        let cube_quat = UnitQuaternion::from_quaternion(Quaternion::new(
+            qpos[c + 3],
+            qpos[c + 4],
+            qpos[c + 5],
+            qpos[c + 6],
+        ));
+        let cd = ids.cube_dof;
+        let nsite = self.scene.model.ffi().nsite as usize;
+        // SAFETY: site_xmat holds nsite * 9 doubles for the lifetime of `data`.
+        let site_xmat = unsafe { std::slice::from_raw_parts(d.ffi().site_xmat, nsite * 9) };
+        let m = &site_xmat[ids.pinch_site * 9..ids.pinch_site * 9 + 9];
+        let pinch_rot = Matrix3::from_row_slice(m);
+        let sx = d.site_xpos();
+        let bowl = d.mocap_pos()[ids.bowl_mocap];
+        World {
+            time: d.ffi().time,
+            arm_q,
+            arm_qd,
+            arm_cmd,
+            gripper_width: (left_pad_pos - right_pad_pos).norm() - 2.0 * PAD_HALF_THICKNESS,
+            gripper_speed: qvel[ids.gripper_driver_dof],
+            pinch_pos: v3(sx[ids.pinch_site]),
+            pinch_rot,
+            left_pad_contact,
+            right_pad_contact,
+            left_pad_pos,
+            right_pad_pos,
+            cube_pos: Vector3::new(qpos[c], qpos[c + 1], qpos[c + 2]),
+            cube_quat,
+            cube_linvel: Vector3::new(qvel[cd], qvel[cd + 1], qvel[cd + 2]),
+            cube_angvel: Vector3::new(qvel[cd + 3], qvel[cd + 4], qvel[cd + 5]),
+            bowl_pos: v3(bowl),
+            bowl_target: v3(sx[ids.bowl_target_site]),
+            bowl: BowlGeometry::TRAY,
+            home_q: HOME_Q,
+        }
+    }
+}
