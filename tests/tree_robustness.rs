@@ -14,8 +14,7 @@ fn errors(src: &str) -> Vec<Diagnostic> {
 }
 
 fn temp_file(name: &str, bytes: &[u8]) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("macrotree-tree-robustness-{}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("macrotree-tree-robustness-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let p = dir.join(name);
     std::fs::write(&p, bytes).unwrap();
@@ -75,8 +74,7 @@ fn deep_but_valid_yaml_hits_the_tree_depth_limit() {
     }
     let d = errors(&src);
     assert!(
-        d.iter()
-            .any(|d| d.message.contains("nested more than 64 levels")),
+        d.iter().any(|d| d.message.contains("nested more than 64 levels")),
         "{d:?}"
     );
 }
@@ -101,8 +99,7 @@ fn exponential_subtree_expansion_is_capped() {
 
 #[test]
 fn nested_retries_are_capped() {
-    let src =
-        "main: {retry: {attempts: 1000, child: {retry: {attempts: 1000, child: {home: {}}}}}}";
+    let src = "main: {retry: {attempts: 1000, child: {retry: {attempts: 1000, child: {home: {}}}}}}";
     let d = errors(src);
     assert!(
         d.iter().any(|d| d.message.contains("bonsai nodes (limit")),
@@ -166,10 +163,7 @@ fn fifty_megabyte_file_is_rejected_before_parsing() {
 
 #[test]
 fn missing_file_and_folder() {
-    let d = load_plan(std::path::Path::new(
-        "tests/fixtures/trees/does_not_exist.yaml",
-    ))
-    .unwrap_err();
+    let d = load_plan(std::path::Path::new("tests/fixtures/trees/does_not_exist.yaml")).unwrap_err();
     assert!(d[0].message.starts_with("cannot read"), "{}", d[0]);
     let d = load_plan(std::path::Path::new("tests/fixtures/trees")).unwrap_err();
     assert!(d[0].message.contains("is a folder"), "{}", d[0]);

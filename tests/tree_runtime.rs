@@ -72,10 +72,7 @@ fn sequence_remembers_progress_and_stops_at_first_failure() {
     assert_eq!(d.ticks("grasp"), 3);
     assert_eq!(d.starts("grasp"), 1);
     assert_eq!(d.ticks("release"), 0);
-    assert_eq!(
-        r.status_of("main/sequence/grasp"),
-        Some(NodeStatus::Failure)
-    );
+    assert_eq!(r.status_of("main/sequence/grasp"), Some(NodeStatus::Failure));
     assert_eq!(r.status_of("main/sequence/release"), Some(NodeStatus::Idle));
     assert_eq!(r.node_reasons()[0].as_deref(), Some("grasp: stalled"));
 }
@@ -181,10 +178,7 @@ fn guard_with_inverted_condition_regression_inverter_logged_running_every_tick()
     let mut r = TreeRunner::new(p.clone());
     assert_eq!(run(&mut r, &mut d, 10), (TreeStatus::Failure, 3));
     assert_eq!(d.halts("carry"), 1);
-    assert_eq!(
-        r.status_of("main/guard/inverter"),
-        Some(NodeStatus::Failure)
-    );
+    assert_eq!(r.status_of("main/guard/inverter"), Some(NodeStatus::Failure));
 }
 
 #[test]
@@ -195,11 +189,7 @@ fn parallel_succeeds_when_all_succeed() {
     d.script("grasp", [Running, Success]);
     let mut r = TreeRunner::new(p.clone());
     assert_eq!(run(&mut r, &mut d, 10), (TreeStatus::Success, 3));
-    assert_eq!(
-        d.ticks("grasp"),
-        2,
-        "finished children are not ticked again"
-    );
+    assert_eq!(d.ticks("grasp"), 2, "finished children are not ticked again");
     assert_eq!(d.halts("home") + d.halts("grasp"), 0);
 }
 
@@ -240,10 +230,7 @@ fn retry_exhausts_attempts_then_fails() {
     let mut r = TreeRunner::new(p.clone());
     let (status, ticks) = run(&mut r, &mut d, 20);
     assert_eq!(status, TreeStatus::Failure);
-    assert_eq!(
-        ticks, 3,
-        "attempt k+1 starts on the tick after attempt k failed"
-    );
+    assert_eq!(ticks, 3, "attempt k+1 starts on the tick after attempt k failed");
     assert_eq!(d.starts("grasp"), 3);
     assert_eq!(r.attempt(0), 3);
     let reason = r.node_reasons()[0].clone().unwrap();
@@ -266,14 +253,8 @@ fn retry_succeeds_on_attempt_two_with_exactly_two_starts() {
     let t = r.drain_transitions();
     let grasp: Vec<_> = t.iter().filter(|t| t.path.ends_with("/grasp")).collect();
     assert_eq!(grasp.len(), 2);
-    assert_eq!(
-        (grasp[0].to, grasp[0].attempt),
-        (NodeStatus::Failure, Some(1))
-    );
-    assert_eq!(
-        (grasp[1].to, grasp[1].attempt),
-        (NodeStatus::Success, Some(2))
-    );
+    assert_eq!((grasp[0].to, grasp[0].attempt), (NodeStatus::Failure, Some(1)));
+    assert_eq!((grasp[1].to, grasp[1].attempt), (NodeStatus::Success, Some(2)));
 }
 
 #[test]
@@ -283,11 +264,7 @@ fn retry_next_attempt_starts_on_the_next_tick_not_the_same_one() {
     d.script("grasp", [fail("slipped"), Success]);
     let mut r = TreeRunner::new(p.clone());
     assert_eq!(r.tick(0.0, DT, &mut d), TreeStatus::Running);
-    assert_eq!(
-        d.ticks("grasp"),
-        1,
-        "no second attempt inside the failing tick"
-    );
+    assert_eq!(d.ticks("grasp"), 1, "no second attempt inside the failing tick");
     assert_eq!(r.status_of("main/retry"), Some(NodeStatus::Running));
     assert_eq!(r.tick(DT, DT, &mut d), TreeStatus::Success);
     assert_eq!(d.ticks("grasp"), 2);
@@ -376,11 +353,7 @@ fn inverter_and_force_decorators() {
         let mut d = ScriptedDriver::new(&p);
         d.set("cube_in_bowl", leaf.clone());
         let mut r = TreeRunner::new(p);
-        assert_eq!(
-            run(&mut r, &mut d, 5),
-            (expected, 1),
-            "{yaml} with {leaf:?}"
-        );
+        assert_eq!(run(&mut r, &mut d, 5), (expected, 1), "{yaml} with {leaf:?}");
     }
 }
 
@@ -485,9 +458,7 @@ fn subtree_arguments_reach_the_leaves() {
         .leaves
         .iter()
         .filter_map(|l| match &l.kind {
-            macrotree::spec::Leaf::Action(macrotree::spec::ActionLeaf::Reach(r)) => {
-                Some(r.offset[2])
-            }
+            macrotree::spec::Leaf::Action(macrotree::spec::ActionLeaf::Reach(r)) => Some(r.offset[2]),
             _ => None,
         })
         .collect();
@@ -503,9 +474,8 @@ fn subtree_arguments_reach_the_leaves() {
 /// Regression (forester#65 bug class): decorators must start from scratch when re-entered.
 #[test]
 fn retry_counter_resets_when_the_retry_is_re_entered() {
-    let p = plan(
-        "main:\n  repeat:\n    times: 2\n    child:\n      retry: {attempts: 2, child: {grasp: {}}}\n",
-    );
+    let p =
+        plan("main:\n  repeat:\n    times: 2\n    child:\n      retry: {attempts: 2, child: {grasp: {}}}\n");
     let mut d = ScriptedDriver::new(&p);
     // First run of the retry: fail, succeed (2 attempts). Second run: fail, succeed again —
     // only possible if the retry's attempts were reset.
@@ -540,8 +510,7 @@ fn retry_yield_pending_at_preemption_is_reset() {
 
 #[test]
 fn first_flag_is_set_again_after_a_halt() {
-    let p =
-        plan("main: {retry: {attempts: 2, child: {timeout: {seconds: 0.15, child: {home: {}}}}}}");
+    let p = plan("main: {retry: {attempts: 2, child: {timeout: {seconds: 0.15, child: {home: {}}}}}}");
     let mut d = ScriptedDriver::new(&p);
     d.set("home", Running);
     let mut r = TreeRunner::new(p.clone());

@@ -33,10 +33,7 @@ fn schema_lists_every_catalog_kind() {
     let cat: Vec<&str> = catalog().iter().map(|d| d.kind).collect();
     assert_eq!(kinds, cat);
     // Leaf parameters come from the Rust structs, with units and defaults.
-    let reach = &variants
-        .iter()
-        .find(|v| v["required"][0] == "reach")
-        .unwrap()["properties"]["reach"];
+    let reach = &variants.iter().find(|v| v["required"][0] == "reach").unwrap()["properties"]["reach"];
     assert_eq!(reach["required"][0], "target");
     assert_eq!(reach["properties"]["speed"]["default"], 0.5);
     assert!(

@@ -14,10 +14,7 @@ fn errors(yaml: &str) -> Vec<Diagnostic> {
 
 /// The one diagnostic whose message contains `needle`.
 fn find<'a>(diags: &'a [Diagnostic], needle: &str) -> &'a Diagnostic {
-    let found: Vec<&Diagnostic> = diags
-        .iter()
-        .filter(|d| d.message.contains(needle))
-        .collect();
+    let found: Vec<&Diagnostic> = diags.iter().filter(|d| d.message.contains(needle)).collect();
     assert!(
         found.len() == 1,
         "expected one diagnostic containing {needle:?}, got:\n{}",
@@ -39,10 +36,7 @@ fn fixture_with_include_and_subtrees_compiles() {
     let plan = load_plan(Path::new("tests/fixtures/trees/pick_place.yaml")).unwrap_or_else(|d| {
         panic!(
             "{}",
-            d.iter()
-                .map(|d| d.to_string())
-                .collect::<Vec<_>>()
-                .join("\n")
+            d.iter().map(|d| d.to_string()).collect::<Vec<_>>().join("\n")
         );
     });
     let paths: Vec<&str> = plan.leaves.iter().map(|l| l.path.as_str()).collect();
@@ -74,9 +68,7 @@ fn fixture_with_include_and_subtrees_compiles() {
     // Node sources point into the library file.
     let carry = plan.node_by_path(paths[6]).unwrap();
     assert!(
-        plan.nodes[carry]
-            .source
-            .ends_with("lib/pick_place.yaml:24:23"),
+        plan.nodes[carry].source.ends_with("lib/pick_place.yaml:24:23"),
         "{}",
         plan.nodes[carry].source
     );

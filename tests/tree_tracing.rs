@@ -17,12 +17,10 @@ struct Recorded {
 
 impl Visit for Recorded {
     fn record_debug(&mut self, field: &Field, value: &dyn std::fmt::Debug) {
-        self.fields
-            .push((field.name().to_string(), format!("{value:?}")));
+        self.fields.push((field.name().to_string(), format!("{value:?}")));
     }
     fn record_str(&mut self, field: &Field, value: &str) {
-        self.fields
-            .push((field.name().to_string(), value.to_string()));
+        self.fields.push((field.name().to_string(), value.to_string()));
     }
 }
 
@@ -95,11 +93,7 @@ fn one_event_per_transition_with_fields() {
     });
     let events = events.lock().unwrap();
     let status_events: Vec<&Recorded> = events.iter().filter(|e| e.get("to").is_some()).collect();
-    assert_eq!(
-        status_events.len(),
-        transitions.len(),
-        "one event per transition"
-    );
+    assert_eq!(status_events.len(), transitions.len(), "one event per transition");
     for (e, t) in status_events.iter().zip(&transitions) {
         assert_eq!(e.get("path"), Some(t.path.as_str()));
         assert_eq!(e.get("to"), Some(t.to.as_str()));
@@ -110,9 +104,7 @@ fn one_event_per_transition_with_fields() {
     // The failing condition carries its reason and attempt; the carry is halted.
     let cond_fail = status_events
         .iter()
-        .find(|e| {
-            e.get("path") == Some("main/retry/guard/cube_grasped") && e.get("to") == Some("failure")
-        })
+        .find(|e| e.get("path") == Some("main/retry/guard/cube_grasped") && e.get("to") == Some("failure"))
         .unwrap();
     assert_eq!(cond_fail.get("reason"), Some("cube_grasped: slipped"));
     assert_eq!(cond_fail.get("attempt"), Some("1"));
@@ -120,8 +112,7 @@ fn one_event_per_transition_with_fields() {
     assert!(
         status_events
             .iter()
-            .any(|e| e.get("path") == Some("main/retry/guard/carry")
-                && e.get("to") == Some("halted"))
+            .any(|e| e.get("path") == Some("main/retry/guard/carry") && e.get("to") == Some("halted"))
     );
     // The retry announces its second attempt.
     assert!(events.iter().any(|e| e.get("path") == Some("main/retry")

@@ -7,10 +7,12 @@ use super::Plan;
 /// Visual family of a node kind.
 fn family(kind: &str) -> &'static str {
     match kind {
-        "sequence" | "fallback" | "reactive_sequence" | "reactive_fallback" | "parallel"
-        | "race" => "composite",
-        "guard" | "retry" | "repeat" | "timeout" | "inverter" | "force_success"
-        | "force_failure" => "decorator",
+        "sequence" | "fallback" | "reactive_sequence" | "reactive_fallback" | "parallel" | "race" => {
+            "composite"
+        }
+        "guard" | "retry" | "repeat" | "timeout" | "inverter" | "force_success" | "force_failure" => {
+            "decorator"
+        }
         "subtree" => "subtree",
         "wait" => "runtime",
         k if crate::spec::leaves::CONDITION_KINDS.contains(&k) => "condition",
@@ -19,9 +21,7 @@ fn family(kind: &str) -> &'static str {
 }
 
 fn dot_escape(s: &str) -> String {
-    s.replace('\\', "\\\\")
-        .replace('"', "\\\"")
-        .replace('\n', "\\n")
+    s.replace('\\', "\\\\").replace('"', "\\\"").replace('\n', "\\n")
 }
 
 /// Graphviz DOT of the plan: one box per node (composites rounded, decorators hexagons, actions
@@ -32,10 +32,7 @@ pub fn to_dot(plan: &Plan) -> String {
     let _ = writeln!(out, "digraph tree {{");
     let _ = writeln!(out, "  rankdir=TB;");
     let _ = writeln!(out, "  node [fontname=\"Helvetica\", fontsize=10];");
-    let _ = writeln!(
-        out,
-        "  edge [arrowsize=0.6, fontname=\"Helvetica\", fontsize=9];"
-    );
+    let _ = writeln!(out, "  edge [arrowsize=0.6, fontname=\"Helvetica\", fontsize=9];");
     for (i, n) in plan.nodes.iter().enumerate() {
         let style = match family(n.kind) {
             "composite" => "shape=box, style=\"rounded,bold\"",

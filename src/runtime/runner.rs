@@ -181,9 +181,7 @@ impl RunState {
         let tick = self.tick;
         for k in 0..self.ancestors[node].len() {
             let a = self.ancestors[node][k];
-            if self.instant[a]
-                || (self.touched[a] == tick && self.statuses[a] == NodeStatus::Running)
-            {
+            if self.instant[a] || (self.touched[a] == tick && self.statuses[a] == NodeStatus::Running) {
                 continue;
             }
             self.touched[a] = tick;

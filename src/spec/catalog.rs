@@ -7,8 +7,8 @@ use serde::Serialize;
 use serde_json::{Map, Value, json};
 
 use super::leaves::{
-    AtHome, Carry, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, Grasp, GripperOpen, Home,
-    MoveJoints, Reach, Release, Wait,
+    AtHome, Carry, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, Grasp, GripperOpen, Home, MoveJoints,
+    Reach, Release, Wait,
 };
 
 /// One parameter of a node kind.
@@ -258,9 +258,7 @@ fn p(name: &str, ty: &str, required: bool, default: Option<&str>, doc: &str) -> 
 }
 
 fn generator() -> SchemaGenerator {
-    SchemaSettings::draft2020_12()
-        .for_deserialize()
-        .into_generator()
+    SchemaSettings::draft2020_12().for_deserialize().into_generator()
 }
 
 /// Leaf parameter struct schemas by kind: (kind, definition name).
@@ -349,8 +347,7 @@ pub fn catalog() -> Vec<NodeDoc> {
         .iter()
         .map(|s| {
             let params = match s.kind {
-                "sequence" | "fallback" | "reactive_sequence" | "reactive_fallback"
-                | "parallel" | "race" => {
+                "sequence" | "fallback" | "reactive_sequence" | "reactive_fallback" | "parallel" | "race" => {
                     vec![p(
                         "children",
                         "list of nodes",
@@ -370,13 +367,7 @@ pub fn catalog() -> Vec<NodeDoc> {
                     p("child", "node", true, None, "the guarded node"),
                 ],
                 "retry" => vec![
-                    p(
-                        "attempts",
-                        "integer",
-                        true,
-                        None,
-                        "total runs allowed, 1 to 1000",
-                    ),
+                    p("attempts", "integer", true, None, "total runs allowed, 1 to 1000"),
                     p("child", "node", true, None, "the node to retry"),
                 ],
                 "repeat" => vec![
@@ -486,11 +477,12 @@ pub fn json_schema() -> Value {
         };
         for s in STATIC {
             let b = match s.kind {
-                "sequence" | "fallback" | "reactive_sequence" | "reactive_fallback"
-                | "parallel" | "race" => body(
-                    json!({"children": {"type": "array", "items": node_ref, "minItems": 1}}),
-                    &["children"],
-                ),
+                "sequence" | "fallback" | "reactive_sequence" | "reactive_fallback" | "parallel" | "race" => {
+                    body(
+                        json!({"children": {"type": "array", "items": node_ref, "minItems": 1}}),
+                        &["children"],
+                    )
+                }
                 "guard" => body(
                     json!({"condition": cond_ref, "child": node_ref}),
                     &["condition", "child"],
