@@ -31,7 +31,10 @@
 //! one, so each retry attempt / repeat iteration after the first starts on a fresh tick, after
 //! the world has been stepped and re-read. See `docs/tick_semantics.md`.
 
+#![warn(missing_docs)]
+
 mod compile;
+mod render;
 
 use std::path::Path;
 
@@ -40,6 +43,7 @@ use serde::Serialize;
 use crate::spec::{self, Diagnostic, Leaf};
 
 pub use compile::compile_spec;
+pub use render::{to_dot, to_mermaid};
 
 /// Index of a leaf: `plan.leaves[id.index()]` for ordinary leaves; internal leaves (probes and
 /// yields, see [`Internal`]) have the top bit set and index `plan.internal`.

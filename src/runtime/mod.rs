@@ -1,7 +1,7 @@
 //! Plan → running tree: ticks on simulated time, leaf lifecycle (first tick, halts), per-node
 //! statuses, status transitions and `tracing` events.
 //!
-//! The runtime owns a bonsai [`BT`](bonsai_bt::BT) built from [`Plan::behavior`] and answers its
+//! The runtime owns a bonsai [`BT`](bonsai_bt::BT) built from [`Plan::behavior`](crate::plan::Plan::behavior) and answers its
 //! leaf calls: ordinary leaves go to a [`LeafDriver`] (the MuJoCo-backed one lives in
 //! [`crate::actions`], a scripted one for tests in [`scripted`]); `wait`, probes and yields are
 //! handled here. Semantics (leftover dt, retry yield, halt detection, guards) are described in
@@ -27,6 +27,8 @@
 //! assert_eq!(status, TreeStatus::Success);
 //! assert_eq!(driver.starts("home"), 1);
 //! ```
+
+#![warn(missing_docs)]
 
 mod runner;
 pub mod scripted;

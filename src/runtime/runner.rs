@@ -42,10 +42,14 @@ struct RunState {
     /// Root-first ancestors of each node, excluding the node itself.
     ancestors: Vec<Vec<usize>>,
     enclosing_retry: Vec<Option<usize>>,
+    /// `inverter` nodes folded into a re-checked condition: their status is set with the
+    /// condition's, never Running.
+    instant: Vec<bool>,
     attempts: Vec<u32>,
     leaves: Vec<LeafRt>,
     yield_pending: Vec<bool>,
-    pending_yields: Vec<(usize, u64)>,
+    /// Yields that answered Running: (internal index, owning node, tick).
+    pending_yields: Vec<(usize, usize, u64)>,
     last_failure: Option<String>,
     transitions: Vec<Transition>,
     dropped: u64,
@@ -74,8 +78,15 @@ impl RunState {
                 enclosing_retry[i] = Some(i);
             }
         }
+        let mut instant = vec![false; n];
+        for l in &plan.leaves {
+            for &inv in l.check.iter().flat_map(|c| c.inverters.iter()) {
+                instant[inv] = true;
+            }
+        }
         Self {
             statuses: vec![NodeStatus::Idle; n],
+            instant,
             reasons: vec![None; n],
             touched: vec![0; n],
             ancestors,
@@ -170,7 +181,7 @@ impl RunState {
         let tick = self.tick;
         for k in 0..self.ancestors[node].len() {
             let a = self.ancestors[node][k];
-            if self.touched[a] == tick && self.statuses[a] == NodeStatus::Running {
+            if self.instant[a] || (self.touched[a] == tick && self.statuses[a] == NodeStatus::Running) {
                 continue;
             }
             self.touched[a] = tick;
@@ -294,11 +305,11 @@ impl RunState {
                 self.touch(plan, node);
                 if self.yield_pending[i] {
                     self.yield_pending[i] = false;
-                    self.pending_yields.retain(|(y, _)| *y != i);
+                    self.pending_yields.retain(|(y, _, _)| *y != i);
                     (Status::Success, dt)
                 } else {
                     self.yield_pending[i] = true;
-                    self.pending_yields.push((i, self.tick));
+                    self.pending_yields.push((i, node, self.tick));
                     self.attempts[node] = iteration;
                     let info = &plan.nodes[node];
                     if info.kind == "retry" {
@@ -410,14 +421,17 @@ impl RunState {
             }
             self.set(plan, i, NodeStatus::Halted, Some(reason));
         }
-        // Yields reached but not completed are reset when not ticked any more.
+        // A yield that answered Running is only completed by its own execution: reset it when it
+        // was not ticked this tick or its retry/repeat stopped running (preempted).
         let tick = self.tick;
         let yp = &mut self.yield_pending;
-        self.pending_yields.retain(|&(y, t)| {
-            if t != tick {
+        let statuses = &self.statuses;
+        self.pending_yields.retain(|&(y, node, t)| {
+            let keep = t == tick && statuses[node] == NodeStatus::Running;
+            if !keep {
                 yp[y] = false;
             }
-            t == tick
+            keep
         });
     }
 

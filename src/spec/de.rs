@@ -88,6 +88,17 @@ impl fmt::Display for DeError {
 
 impl std::error::Error for DeError {}
 
+/// Serde's Rust-flavoured expectations in user words.
+fn plain_expected(exp: &str) -> String {
+    match exp {
+        "f64" | "f32" => "a number".into(),
+        "u32" | "u64" | "i64" | "i32" | "u8" | "usize" => "an integer".into(),
+        "a string" | "a borrowed string" => "text".into(),
+        other if other.starts_with("struct ") => "a mapping of parameters, e.g. `{}`".into(),
+        other => other.to_string(),
+    }
+}
+
 fn list(expected: &[&str]) -> String {
     let items: Vec<String> = expected.iter().map(|e| format!("`{e}`")).collect();
     match items.len() {
@@ -103,7 +114,8 @@ impl de::Error for DeError {
     }
 
     fn invalid_type(unexp: de::Unexpected, exp: &dyn de::Expected) -> Self {
-        Self::msg(format!("wrong type: found {unexp}")).with_label(format!("expected {exp}"))
+        Self::msg(format!("wrong type: found {unexp}"))
+            .with_label(format!("expected {}", plain_expected(&exp.to_string())))
     }
 
     fn invalid_value(unexp: de::Unexpected, exp: &dyn de::Expected) -> Self {

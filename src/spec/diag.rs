@@ -98,7 +98,7 @@ impl fmt::Display for Diagnostic {
             }
         } else if let Some(label) = &self.label {
             writeln!(f)?;
-            write!(f, "{pad} = expected: {label}")?;
+            write!(f, "{pad} = {label}")?;
         }
         if let Some(note) = &self.note {
             writeln!(f)?;
@@ -173,6 +173,19 @@ impl Issue {
     }
 }
 
+/// Replace control characters (except tabs) so that a diagnostic never garbles a terminal.
+fn sanitize(s: &str) -> String {
+    s.chars()
+        .map(|c| {
+            if c.is_control() && c != '\t' {
+                '\u{FFFD}'
+            } else {
+                c
+            }
+        })
+        .collect()
+}
+
 /// One loaded source file.
 #[derive(Clone, Debug)]
 pub struct SourceFile {
@@ -239,7 +252,7 @@ impl Sources {
             f.text
                 .lines()
                 .nth(issue.loc.line as usize - 1)
-                .map(|l| l.chars().take(300).collect::<String>())
+                .map(|l| sanitize(&l.chars().take(300).collect::<String>()))
         });
         let width = match &source_line {
             Some(l) => {
@@ -252,10 +265,10 @@ impl Sources {
             file: file.map_or_else(|| "<unknown>".to_string(), |f| f.name.clone()),
             line: issue.loc.line,
             column: issue.loc.col,
-            message: issue.message.clone(),
-            label: issue.label.clone(),
-            help: issue.help.clone(),
-            note: issue.note.clone(),
+            message: sanitize(&issue.message),
+            label: issue.label.as_deref().map(sanitize),
+            help: issue.help.as_deref().map(sanitize),
+            note: issue.note.as_deref().map(sanitize),
             source_line,
             width,
         }

@@ -190,6 +190,11 @@ impl<'a> Expander<'a> {
                 Err(e) => {
                     let mut issue = e.into_issue(body.loc, |l| self.sources.describe(l));
                     issue.message = format!("{} in `{k}`", issue.message);
+                    if issue.help.is_none() {
+                        issue.help = Some(format!(
+                            "see `{k}` in docs/tree_format.md (or `macrotree nodes`) for its parameters and units"
+                        ));
+                    }
                     self.err(issue);
                     return None;
                 }

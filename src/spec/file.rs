@@ -71,8 +71,8 @@ pub fn param_ref(s: &str) -> Option<&str> {
 }
 
 /// Read the top level of a tree file. Problems are pushed to `issues`; what could be read is
-/// returned.
-pub fn parse_tree_file(v: &Value, issues: &mut Vec<Issue>) -> TreeFile {
+/// returned (`None` when the file is not a mapping at all).
+pub fn parse_tree_file(v: &Value, issues: &mut Vec<Issue>) -> Option<TreeFile> {
     let mut out = TreeFile::default();
     let Some(entries) = v.as_map() else {
         issues.push(
@@ -83,7 +83,7 @@ pub fn parse_tree_file(v: &Value, issues: &mut Vec<Issue>) -> TreeFile {
             .label("expected `main:` (and optionally `include:` and `subtrees:`)")
             .help("start the file with `main:` followed by the root node"),
         );
-        return out;
+        return None;
     };
     for (k, val) in entries {
         match k.as_str() {
@@ -108,7 +108,7 @@ pub fn parse_tree_file(v: &Value, issues: &mut Vec<Issue>) -> TreeFile {
             ),
         }
     }
-    out
+    Some(out)
 }
 
 impl Issue {

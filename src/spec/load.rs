@@ -109,8 +109,9 @@ struct Loader {
 impl Loader {
     fn finish(mut self, text: &str, name: &str, base: Option<&Path>) -> Result<Spec, Vec<Diagnostic>> {
         let id = self.sources.add(name, text);
-        let root_file = match parse_yaml(text, id) {
-            Ok(v) => parse_tree_file(&v, &mut self.issues),
+        let root_file = match parse_yaml(text, id).map(|v| parse_tree_file(&v, &mut self.issues)) {
+            Ok(Some(f)) => f,
+            Ok(None) => return Err(self.sources.diagnostics(&self.issues)),
             Err(issue) => {
                 self.issues.push(issue);
                 return Err(self.sources.diagnostics(&self.issues));
@@ -295,9 +296,10 @@ impl Loader {
             };
             match parse_yaml(&text, id) {
                 Ok(v) => {
-                    let f = parse_tree_file(&v, &mut self.issues);
                     // A library's own `main:` is ignored (it can be a demo of its subtrees).
-                    self.collect(&f, path.parent(), depth + 1);
+                    if let Some(f) = parse_tree_file(&v, &mut self.issues) {
+                        self.collect(&f, path.parent(), depth + 1);
+                    }
                 }
                 Err(issue) => self.issues.push(issue),
             }

@@ -7,6 +7,9 @@
 //!
 //! The format itself is documented in `docs/tree_format.md`.
 
+#![warn(missing_docs)]
+
+pub mod catalog;
 pub mod de;
 pub mod diag;
 pub mod expand;
@@ -18,6 +21,7 @@ pub mod suggest;
 pub mod units;
 pub mod value;
 
+pub use catalog::{NodeDoc, ParamDoc, catalog, json_schema};
 pub use diag::{Diagnostic, Issue, Loc, Sources};
 pub use leaves::{
     ActionLeaf, AtHome, Carry, ConditionLeaf, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, Grasp,

@@ -263,6 +263,10 @@ pub fn parse_yaml(text: &str, file: FileId) -> Result<Value, Issue> {
             max_replay_stack_depth: 16,
         },
         with_snippet: false,
+        // YAML 1.2 booleans only: `off:`, `on:`, `no:` are names, not booleans.
+        strict_booleans: true,
+        // `.inf`/`.nan` are read as numbers so that the parameter check can explain the problem.
+        non_finite_float_policy: serde_saphyr::NonFiniteFloatPolicy::PassThrough,
     };
     let parsed: Result<Spanned<RawKind>, _> = serde_saphyr::from_str_with_options(text, options);
     match parsed {

@@ -1,0 +1,600 @@
+//! The node catalog (for `macrotree nodes`) and the JSON Schema of tree files, both generated
+//! from the Rust spec types.
+
+use schemars::JsonSchema;
+use schemars::generate::{SchemaGenerator, SchemaSettings};
+use serde::Serialize;
+use serde_json::{Map, Value, json};
+
+use super::leaves::{
+    AtHome, Carry, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, Grasp, GripperOpen, Home, MoveJoints,
+    Reach, Release, Wait,
+};
+
+/// One parameter of a node kind.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ParamDoc {
+    /// Parameter name as written in YAML.
+    pub name: String,
+    /// Short type, e.g. `number`, `[number; 3]`, `Target`, `node`, `list of nodes`.
+    pub ty: String,
+    /// Whether it must be given.
+    pub required: bool,
+    /// Default value as compact JSON, when optional.
+    pub default: Option<String>,
+    /// What it means, with its unit.
+    pub doc: String,
+}
+
+/// Documentation of one node kind.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NodeDoc {
+    /// The YAML kind (`sequence`, `reach`, …).
+    pub kind: &'static str,
+    /// `composite`, `decorator`, `action`, `condition` or `runtime` (handled by the runtime).
+    pub category: &'static str,
+    /// One-line description.
+    pub summary: &'static str,
+    /// What happens when the node is halted.
+    pub halt: &'static str,
+    /// Parameters (`name` is accepted by every node and not listed).
+    pub params: Vec<ParamDoc>,
+    /// A YAML example.
+    pub example: &'static str,
+}
+
+struct Static {
+    kind: &'static str,
+    category: &'static str,
+    summary: &'static str,
+    halt: &'static str,
+    example: &'static str,
+}
+
+const HALT_CHILD: &str = "its running child is halted";
+const HALT_ARM: &str = "the driver stops the arm where it is (holds position)";
+const HALT_NONE: &str = "nothing to halt (instantaneous)";
+
+const STATIC: &[Static] = &[
+    Static {
+        kind: "sequence",
+        category: "composite",
+        summary: "Tick children in order with memory; fail on the first failure, succeed when all succeed.",
+        halt: HALT_CHILD,
+        example: "sequence: {children: [{home: {}}, {grasp: {}}]}",
+    },
+    Static {
+        kind: "fallback",
+        category: "composite",
+        summary: "Tick children in order with memory; succeed on the first success, fail when all fail.",
+        halt: HALT_CHILD,
+        example: "fallback: {children: [{cube_in_bowl: {}}, {subtree: {ref: place}}]}",
+    },
+    Static {
+        kind: "reactive_sequence",
+        category: "composite",
+        summary: "Re-check the leading conditions every tick while the last child runs; a failing condition halts it (Failure).",
+        halt: HALT_CHILD,
+        example: "reactive_sequence: {children: [{cube_grasped: {}}, {carry: {}}]}",
+    },
+    Static {
+        kind: "reactive_fallback",
+        category: "composite",
+        summary: "Re-check the leading conditions every tick while the last child runs; a succeeding condition halts it (Success).",
+        halt: HALT_CHILD,
+        example: "reactive_fallback: {children: [{cube_in_bowl: {}}, {carry: {}}]}",
+    },
+    Static {
+        kind: "parallel",
+        category: "composite",
+        summary: "Tick all children every tick; Success when all succeed, Failure (halting the others) when one fails.",
+        halt: "all running children are halted",
+        example: "parallel: {children: [{home: {}}, {release: {retreat: 0}}]}",
+    },
+    Static {
+        kind: "race",
+        category: "composite",
+        summary: "Tick all children every tick; the first to finish decides, the others are halted.",
+        halt: "all running children are halted",
+        example: "race: {children: [{carry: {}}, {wait: {seconds: 8}}]}",
+    },
+    Static {
+        kind: "guard",
+        category: "decorator",
+        summary: "Run the child only while the condition holds (checked every tick first); a failing condition halts it (Failure).",
+        halt: HALT_CHILD,
+        example: "guard: {condition: {cube_grasped: {}}, child: {carry: {to: bowl}}}",
+    },
+    Static {
+        kind: "retry",
+        category: "decorator",
+        summary: "Re-run a failing child, up to `attempts` runs; each new attempt starts on the next tick.",
+        halt: "the running attempt is halted; the attempt count restarts at 1",
+        example: "retry: {attempts: 3, child: {subtree: {ref: pick}}}",
+    },
+    Static {
+        kind: "repeat",
+        category: "decorator",
+        summary: "Run the child `times` times in a row (next run on the next tick); a failure fails the repeat.",
+        halt: HALT_CHILD,
+        example: "repeat: {times: 2, child: {subtree: {ref: wiggle}}}",
+    },
+    Static {
+        kind: "timeout",
+        category: "decorator",
+        summary: "Fail (halting the child) after `seconds` of simulated time running.",
+        halt: HALT_CHILD,
+        example: "timeout: {seconds: 20, child: {subtree: {ref: pick}}}",
+    },
+    Static {
+        kind: "inverter",
+        category: "decorator",
+        summary: "Swap Success and Failure.",
+        halt: HALT_CHILD,
+        example: "inverter: {child: {cube_on_table: {}}}",
+    },
+    Static {
+        kind: "force_success",
+        category: "decorator",
+        summary: "Turn Failure into Success.",
+        halt: HALT_CHILD,
+        example: "force_success: {child: {release: {}}}",
+    },
+    Static {
+        kind: "force_failure",
+        category: "decorator",
+        summary: "Turn Success into Failure.",
+        halt: HALT_CHILD,
+        example: "force_failure: {child: {home: {}}}",
+    },
+    Static {
+        kind: "subtree",
+        category: "decorator",
+        summary: "Expand a named subtree in place, substituting `$param`s with `args` (or defaults).",
+        halt: "the running body is halted",
+        example: "subtree: {ref: pick, args: {approach: 0.12}}",
+    },
+    Static {
+        kind: "reach",
+        category: "action",
+        summary: "Move the tool to a target (cube, bowl or point) plus an offset.",
+        halt: HALT_ARM,
+        example: "reach: {target: cube, offset: [0, 0, 0.15]}",
+    },
+    Static {
+        kind: "move_joints",
+        category: "action",
+        summary: "Move the arm to six joint angles.",
+        halt: HALT_ARM,
+        example: "move_joints: {joints: [0, deg(-90), deg(90), deg(-90), deg(-90), 0]}",
+    },
+    Static {
+        kind: "home",
+        category: "action",
+        summary: "Move the arm to its home pose.",
+        halt: HALT_ARM,
+        example: "home: {}",
+    },
+    Static {
+        kind: "grasp",
+        category: "action",
+        summary: "Close the gripper to a width or until contact/stall.",
+        halt: "the driver stops closing (keeps the current opening)",
+        example: "grasp: {}",
+    },
+    Static {
+        kind: "carry",
+        category: "action",
+        summary: "Lift the held cube, move it above the target and lower it to `place_height`.",
+        halt: "the driver stops the arm where it is (gripper stays closed)",
+        example: "carry: {to: bowl, lift: 0.2}",
+    },
+    Static {
+        kind: "release",
+        category: "action",
+        summary: "Open the gripper and retreat straight up.",
+        halt: HALT_ARM,
+        example: "release: {retreat: 0.1}",
+    },
+    Static {
+        kind: "wait",
+        category: "runtime",
+        summary: "Wait for simulated seconds (handled by the runtime, never reaches the driver).",
+        halt: "nothing to stop; the next run starts from 0",
+        example: "wait: {seconds: 0.5}",
+    },
+    Static {
+        kind: "cube_grasped",
+        category: "condition",
+        summary: "Both finger pads touch the cube.",
+        halt: HALT_NONE,
+        example: "cube_grasped: {}",
+    },
+    Static {
+        kind: "cube_lifted",
+        category: "condition",
+        summary: "The cube's bottom is at least `min_height` above the table.",
+        halt: HALT_NONE,
+        example: "cube_lifted: {min_height: 0.05}",
+    },
+    Static {
+        kind: "cube_in_bowl",
+        category: "condition",
+        summary: "The cube rests inside the bowl.",
+        halt: HALT_NONE,
+        example: "cube_in_bowl: {}",
+    },
+    Static {
+        kind: "cube_on_table",
+        category: "condition",
+        summary: "The cube rests on the table.",
+        halt: HALT_NONE,
+        example: "cube_on_table: {}",
+    },
+    Static {
+        kind: "gripper_open",
+        category: "condition",
+        summary: "The gripper is open at least `min_width`.",
+        halt: HALT_NONE,
+        example: "gripper_open: {min_width: 0.08}",
+    },
+    Static {
+        kind: "at_home",
+        category: "condition",
+        summary: "Every joint is within `tolerance` of the home pose.",
+        halt: HALT_NONE,
+        example: "at_home: {tolerance: deg(2)}",
+    },
+];
+
+fn p(name: &str, ty: &str, required: bool, default: Option<&str>, doc: &str) -> ParamDoc {
+    ParamDoc {
+        name: name.into(),
+        ty: ty.into(),
+        required,
+        default: default.map(str::to_string),
+        doc: doc.into(),
+    }
+}
+
+fn generator() -> SchemaGenerator {
+    SchemaSettings::draft2020_12().for_deserialize().into_generator()
+}
+
+/// Leaf parameter struct schemas by kind: (kind, definition name).
+fn leaf_schemas(g: &mut SchemaGenerator) -> Vec<(&'static str, String)> {
+    fn one<T: JsonSchema>(g: &mut SchemaGenerator, kind: &'static str) -> (&'static str, String) {
+        let _ = g.subschema_for::<T>();
+        (kind, T::schema_name().into_owned())
+    }
+    vec![
+        one::<Reach>(g, "reach"),
+        one::<MoveJoints>(g, "move_joints"),
+        one::<Home>(g, "home"),
+        one::<Grasp>(g, "grasp"),
+        one::<Carry>(g, "carry"),
+        one::<Release>(g, "release"),
+        one::<Wait>(g, "wait"),
+        one::<CubeGrasped>(g, "cube_grasped"),
+        one::<CubeLifted>(g, "cube_lifted"),
+        one::<CubeInBowl>(g, "cube_in_bowl"),
+        one::<CubeOnTable>(g, "cube_on_table"),
+        one::<GripperOpen>(g, "gripper_open"),
+        one::<AtHome>(g, "at_home"),
+    ]
+}
+
+fn short_type(s: &Value) -> String {
+    if let Some(r) = s.get("$ref").and_then(Value::as_str) {
+        return r.rsplit('/').next().unwrap_or(r).to_string();
+    }
+    match s.get("type") {
+        Some(Value::String(t)) if t == "array" => {
+            let item = s.get("items").map_or("any".into(), short_type);
+            match s.get("minItems").and_then(Value::as_u64) {
+                Some(n) if s.get("maxItems").and_then(Value::as_u64) == Some(n) => {
+                    format!("[{item}; {n}]")
+                }
+                _ => format!("list of {item}"),
+            }
+        }
+        Some(Value::String(t)) => t.clone(),
+        Some(Value::Array(ts)) => ts
+            .iter()
+            .filter_map(Value::as_str)
+            .filter(|t| *t != "null")
+            .collect::<Vec<_>>()
+            .join(" | "),
+        _ => "value".into(),
+    }
+}
+
+fn params_from_schema(def: &Value) -> Vec<ParamDoc> {
+    let required: Vec<&str> = def
+        .get("required")
+        .and_then(Value::as_array)
+        .map(|r| r.iter().filter_map(Value::as_str).collect())
+        .unwrap_or_default();
+    let Some(props) = def.get("properties").and_then(Value::as_object) else {
+        return vec![];
+    };
+    // Required parameters first, then alphabetical (the schema's property order).
+    let mut out: Vec<ParamDoc> = props
+        .iter()
+        .map(|(name, s)| ParamDoc {
+            name: name.clone(),
+            ty: short_type(s),
+            required: required.contains(&name.as_str()),
+            default: s.get("default").map(|d| d.to_string()),
+            doc: s
+                .get("description")
+                .and_then(Value::as_str)
+                .unwrap_or("")
+                .replace('\n', " "),
+        })
+        .collect();
+    out.sort_by_key(|p| !p.required);
+    out
+}
+
+/// Every node kind with its parameters (units, defaults), one-line description, halt behaviour
+/// and a YAML example; generated from the Rust types (for `macrotree nodes`).
+pub fn catalog() -> Vec<NodeDoc> {
+    let mut g = generator();
+    let leaves = leaf_schemas(&mut g);
+    let defs = g.take_definitions(true);
+    STATIC
+        .iter()
+        .map(|s| {
+            let params = match s.kind {
+                "sequence" | "fallback" | "reactive_sequence" | "reactive_fallback" | "parallel" | "race" => {
+                    vec![p(
+                        "children",
+                        "list of nodes",
+                        true,
+                        None,
+                        "the children, at least one",
+                    )]
+                }
+                "guard" => vec![
+                    p(
+                        "condition",
+                        "condition node",
+                        true,
+                        None,
+                        "a condition leaf (or an `inverter` of one), checked every tick",
+                    ),
+                    p("child", "node", true, None, "the guarded node"),
+                ],
+                "retry" => vec![
+                    p("attempts", "integer", true, None, "total runs allowed, 1 to 1000"),
+                    p("child", "node", true, None, "the node to retry"),
+                ],
+                "repeat" => vec![
+                    p(
+                        "times",
+                        "integer",
+                        true,
+                        None,
+                        "successful runs required, 1 to 1000",
+                    ),
+                    p("child", "node", true, None, "the node to repeat"),
+                ],
+                "timeout" => vec![
+                    p("seconds", "number", true, None, "simulated seconds (> 0)"),
+                    p("child", "node", true, None, "the node to time-limit"),
+                ],
+                "inverter" | "force_success" | "force_failure" => {
+                    vec![p("child", "node", true, None, "the decorated node")]
+                }
+                "subtree" => vec![
+                    p(
+                        "ref",
+                        "string",
+                        true,
+                        None,
+                        "name of a subtree under `subtrees:` (here or in an included file)",
+                    ),
+                    p(
+                        "args",
+                        "mapping",
+                        false,
+                        Some("{}"),
+                        "argument values by parameter name; omitted ones take their defaults",
+                    ),
+                ],
+                kind => leaves
+                    .iter()
+                    .find(|(k, _)| *k == kind)
+                    .and_then(|(_, name)| defs.get(name))
+                    .map(params_from_schema)
+                    .unwrap_or_default(),
+            };
+            NodeDoc {
+                kind: s.kind,
+                category: s.category,
+                summary: s.summary,
+                halt: s.halt,
+                params,
+                example: s.example,
+            }
+        })
+        .collect()
+}
+
+/// Wrap a value schema so that a `$param` reference is also accepted (inside subtree bodies).
+fn templated(s: &Value) -> Value {
+    let mut inner = s.clone();
+    let mut out = Map::new();
+    // Keep documentation at the outer level so editors still show it.
+    if let Some(obj) = inner.as_object_mut() {
+        for k in ["description", "default"] {
+            if let Some(v) = obj.remove(k) {
+                out.insert(k.into(), v);
+            }
+        }
+        if let Some(items) = obj.get("items").cloned() {
+            obj.insert("items".into(), templated(&items));
+        }
+    }
+    out.insert("anyOf".into(), json!([inner, {"$ref": "#/$defs/ParamRef"}]));
+    Value::Object(out)
+}
+
+/// The JSON Schema (draft 2020-12) of a tree file, generated from the Rust spec types.
+///
+/// Committed as `schema/tree.schema.json` (editors use it through a
+/// `# yaml-language-server: $schema=…` first line). Regenerate with
+/// `UPDATE_SCHEMA=1 cargo test --test tree_schema`. Inside `subtrees:` bodies every parameter
+/// value may also be a `$param` reference.
+pub fn json_schema() -> Value {
+    let mut g = generator();
+    let leaves = leaf_schemas(&mut g);
+    let mut defs = g.take_definitions(true);
+
+    defs.insert(
+        "NodeName".into(),
+        json!({"type": "string", "minLength": 1, "maxLength": 80, "pattern": "^[^/\\[\\]#\\n\\r]+$",
+               "description": "Optional label used in node paths, logs and diagrams."}),
+    );
+    defs.insert(
+        "ParamRef".into(),
+        json!({"type": "string", "pattern": "^\\$[A-Za-z_][A-Za-z0-9_]*$",
+               "description": "A subtree parameter, `$name`, replaced by the call's argument or the default."}),
+    );
+
+    for template in [false, true] {
+        let suffix = if template { "Template" } else { "" };
+        let node_ref = json!({"$ref": format!("#/$defs/Node{suffix}")});
+        let cond_ref = json!({"$ref": format!("#/$defs/Condition{suffix}")});
+        let scalar = |s: Value| if template { templated(&s) } else { s };
+        let mut variants = Vec::new();
+        let mut cond_variants = Vec::new();
+        let body = |props: Value, required: &[&str]| {
+            let mut props = props;
+            props["name"] = json!({"$ref": "#/$defs/NodeName"});
+            json!({"type": "object", "properties": props, "required": required, "additionalProperties": false})
+        };
+        for s in STATIC {
+            let b = match s.kind {
+                "sequence" | "fallback" | "reactive_sequence" | "reactive_fallback" | "parallel" | "race" => {
+                    body(
+                        json!({"children": {"type": "array", "items": node_ref, "minItems": 1}}),
+                        &["children"],
+                    )
+                }
+                "guard" => body(
+                    json!({"condition": cond_ref, "child": node_ref}),
+                    &["condition", "child"],
+                ),
+                "retry" => body(
+                    json!({"attempts": scalar(json!({"type": "integer", "minimum": 1, "maximum": 1000})), "child": node_ref}),
+                    &["attempts", "child"],
+                ),
+                "repeat" => body(
+                    json!({"times": scalar(json!({"type": "integer", "minimum": 1, "maximum": 1000})), "child": node_ref}),
+                    &["times", "child"],
+                ),
+                "timeout" => body(
+                    json!({"seconds": scalar(json!({"type": "number", "exclusiveMinimum": 0})), "child": node_ref}),
+                    &["seconds", "child"],
+                ),
+                "inverter" | "force_success" | "force_failure" => {
+                    body(json!({"child": node_ref}), &["child"])
+                }
+                "subtree" => body(
+                    json!({"ref": {"type": "string", "pattern": "^[A-Za-z_][A-Za-z0-9_]*$"},
+                           "args": {"type": "object", "propertyNames": {"pattern": "^[A-Za-z_][A-Za-z0-9_]*$"}}}),
+                    &["ref"],
+                ),
+                kind => {
+                    let def_name = leaves
+                        .iter()
+                        .find(|(k, _)| *k == kind)
+                        .map(|(_, n)| n.clone())
+                        .unwrap_or_default();
+                    let def = defs.get(&def_name).cloned().unwrap_or(json!({}));
+                    let mut props = def.get("properties").cloned().unwrap_or(json!({}));
+                    if let Some(obj) = props.as_object_mut() {
+                        for v in obj.values_mut() {
+                            *v = scalar(v.clone());
+                        }
+                    }
+                    let required: Vec<&str> = def
+                        .get("required")
+                        .and_then(Value::as_array)
+                        .map(|r| r.iter().filter_map(Value::as_str).collect())
+                        .unwrap_or_default();
+                    let b = body(props, &required);
+                    if required.is_empty() {
+                        json!({"anyOf": [b, {"type": "null"}]})
+                    } else {
+                        b
+                    }
+                }
+            };
+            let variant = json!({
+                "type": "object",
+                "description": format!("{} Halt: {}. Example: `{}`", s.summary, s.halt, s.example),
+                "properties": {s.kind: b},
+                "required": [s.kind],
+                "additionalProperties": false,
+            });
+            if s.category == "condition" {
+                cond_variants.push(variant.clone());
+            }
+            variants.push(variant);
+        }
+        // A check is a condition leaf or an inverter of one.
+        let inv = json!({
+            "type": "object",
+            "properties": {"inverter": {"type": "object", "properties": {"child": cond_ref, "name": {"$ref": "#/$defs/NodeName"}},
+                                         "required": ["child"], "additionalProperties": false}},
+            "required": ["inverter"], "additionalProperties": false
+        });
+        cond_variants.push(inv);
+        defs.insert(
+            format!("Node{suffix}"),
+            json!({"description": "A behavior-tree node: a mapping with exactly one key, its kind.", "oneOf": variants}),
+        );
+        defs.insert(
+            format!("Condition{suffix}"),
+            json!({"description": "A condition leaf, or an `inverter` of one.", "oneOf": cond_variants}),
+        );
+    }
+    // Leaf parameter structs are inlined into the node variants; drop their standalone copies.
+    for (_, name) in &leaves {
+        defs.remove(name);
+    }
+
+    json!({
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "$id": "https://macrotree.invalid/schema/tree.schema.json",
+        "title": "macrotree behavior tree file",
+        "description": "A behavior tree in YAML for the UR5e + Robotiq gripper. See docs/tree_format.md. Units: m, s, m/s, rad (or deg(..)).",
+        "type": "object",
+        "properties": {
+            "include": {"description": "Files with subtrees to load, relative to this file.",
+                        "anyOf": [{"type": "string"}, {"type": "array", "items": {"type": "string"}}]},
+            "subtrees": {
+                "description": "Reusable subtrees by name.",
+                "type": "object",
+                "propertyNames": {"pattern": "^[A-Za-z_][A-Za-z0-9_]*$"},
+                "additionalProperties": {
+                    "type": "object",
+                    "properties": {
+                        "description": {"type": "string"},
+                        "params": {"description": "Parameter names with default values (`~` = required).",
+                                   "type": "object", "propertyNames": {"pattern": "^[A-Za-z_][A-Za-z0-9_]*$"}},
+                        "root": {"$ref": "#/$defs/NodeTemplate"}
+                    },
+                    "required": ["root"],
+                    "additionalProperties": false
+                }
+            },
+            "main": {"$ref": "#/$defs/Node"}
+        },
+        "additionalProperties": false,
+        "$defs": Value::Object(defs),
+    })
+}

@@ -1,0 +1,71 @@
+//! The committed JSON Schema must match the one generated from the Rust types.
+//!
+//! Regenerate after changing a node kind or parameter:
+//! `UPDATE_SCHEMA=1 cargo test --test tree_schema`
+
+use macrotree::spec::{catalog, json_schema};
+
+const PATH: &str = "schema/tree.schema.json";
+
+#[test]
+fn committed_schema_is_up_to_date() {
+    let generated = serde_json::to_string_pretty(&json_schema()).unwrap() + "\n";
+    if std::env::var_os("UPDATE_SCHEMA").is_some() {
+        std::fs::create_dir_all("schema").unwrap();
+        std::fs::write(PATH, &generated).unwrap();
+        return;
+    }
+    let committed = std::fs::read_to_string(PATH).unwrap_or_default();
+    assert!(
+        committed == generated,
+        "{PATH} is out of date: run `UPDATE_SCHEMA=1 cargo test --test tree_schema` and commit it"
+    );
+}
+
+#[test]
+fn schema_lists_every_catalog_kind() {
+    let schema = json_schema();
+    let variants = schema["$defs"]["Node"]["oneOf"].as_array().unwrap();
+    let kinds: Vec<&str> = variants
+        .iter()
+        .map(|v| v["required"][0].as_str().unwrap())
+        .collect();
+    let cat: Vec<&str> = catalog().iter().map(|d| d.kind).collect();
+    assert_eq!(kinds, cat);
+    // Leaf parameters come from the Rust structs, with units and defaults.
+    let reach = &variants.iter().find(|v| v["required"][0] == "reach").unwrap()["properties"]["reach"];
+    assert_eq!(reach["required"][0], "target");
+    assert_eq!(reach["properties"]["speed"]["default"], 0.5);
+    assert!(
+        reach["properties"]["speed"]["description"]
+            .as_str()
+            .unwrap()
+            .contains("m/s")
+    );
+    assert_eq!(reach["additionalProperties"], false);
+}
+
+#[test]
+fn catalog_documents_every_node() {
+    let cat = catalog();
+    assert_eq!(cat.len(), 27);
+    for d in &cat {
+        assert!(
+            !d.summary.is_empty() && !d.example.is_empty() && !d.halt.is_empty(),
+            "{}",
+            d.kind
+        );
+        // Every example is a valid node.
+        let yaml = format!(
+            "subtrees:\n  pick: {{params: {{approach: 0.1}}, root: {{home: {{}}}}}}\n  place: {{root: {{home: {{}}}}}}\n  wiggle: {{root: {{home: {{}}}}}}\nmain:\n  {}\n",
+            d.example
+        );
+        if let Err(e) = macrotree::plan::compile_str(&yaml, "example.yaml") {
+            panic!("example of `{}` does not compile: {}", d.kind, e[0]);
+        }
+    }
+    let carry = cat.iter().find(|d| d.kind == "carry").unwrap();
+    let lift = carry.params.iter().find(|p| p.name == "lift").unwrap();
+    assert_eq!(lift.default.as_deref(), Some("0.2"));
+    assert!(lift.doc.contains("metres"));
+}

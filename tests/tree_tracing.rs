@@ -1,0 +1,127 @@
+//! Exactly one `tracing` event per node status transition, with the documented fields.
+
+use std::sync::{Arc, Mutex};
+
+use macrotree::plan::compile_str;
+use macrotree::runtime::scripted::ScriptedDriver;
+use macrotree::runtime::{LeafOutcome, TreeRunner, TreeStatus};
+use tracing::field::{Field, Visit};
+use tracing_subscriber::layer::{Context, SubscriberExt};
+use tracing_subscriber::{Layer, Registry};
+
+#[derive(Default, Clone, Debug)]
+struct Recorded {
+    fields: Vec<(String, String)>,
+    level: String,
+}
+
+impl Visit for Recorded {
+    fn record_debug(&mut self, field: &Field, value: &dyn std::fmt::Debug) {
+        self.fields.push((field.name().to_string(), format!("{value:?}")));
+    }
+    fn record_str(&mut self, field: &Field, value: &str) {
+        self.fields.push((field.name().to_string(), value.to_string()));
+    }
+}
+
+struct Collect(Arc<Mutex<Vec<Recorded>>>);
+
+impl<S: tracing::Subscriber> Layer<S> for Collect {
+    fn on_event(&self, event: &tracing::Event<'_>, _ctx: Context<'_, S>) {
+        if event.metadata().target() != "macrotree::tree" {
+            return;
+        }
+        let mut r = Recorded {
+            level: event.metadata().level().to_string(),
+            ..Default::default()
+        };
+        event.record(&mut r);
+        self.0.lock().unwrap().push(r);
+    }
+}
+
+impl Recorded {
+    fn get(&self, name: &str) -> Option<&str> {
+        self.fields
+            .iter()
+            .find(|(k, _)| k == name)
+            .map(|(_, v)| v.as_str())
+    }
+}
+
+#[test]
+fn one_event_per_transition_with_fields() {
+    let plan = Arc::new(
+        compile_str(
+            "main:\n  retry:\n    attempts: 2\n    child:\n      guard:\n        condition: {cube_grasped: {}}\n        child: {carry: {}}\n",
+            "t.yaml",
+        )
+        .unwrap(),
+    );
+    let mut d = ScriptedDriver::new(&plan);
+    d.script(
+        "cube_grasped",
+        [
+            LeafOutcome::Success,
+            LeafOutcome::Success,
+            LeafOutcome::Failure("slipped".into()),
+        ],
+    );
+    d.eventually("cube_grasped", LeafOutcome::Success);
+    d.script(
+        "carry",
+        [
+            LeafOutcome::Running,
+            LeafOutcome::Running,
+            LeafOutcome::Running,
+            LeafOutcome::Success,
+        ],
+    );
+    let events = Arc::new(Mutex::new(Vec::new()));
+    let subscriber = Registry::default().with(Collect(events.clone()));
+    let mut runner = TreeRunner::new(plan.clone());
+    let mut transitions = Vec::new();
+    tracing::subscriber::with_default(subscriber, || {
+        for i in 0..20 {
+            let s = runner.tick(i as f64 * 0.1, 0.1, &mut d);
+            transitions.extend(runner.drain_transitions());
+            if s != TreeStatus::Running {
+                assert_eq!(s, TreeStatus::Success);
+                break;
+            }
+        }
+    });
+    let events = events.lock().unwrap();
+    let status_events: Vec<&Recorded> = events.iter().filter(|e| e.get("to").is_some()).collect();
+    assert_eq!(status_events.len(), transitions.len(), "one event per transition");
+    for (e, t) in status_events.iter().zip(&transitions) {
+        assert_eq!(e.get("path"), Some(t.path.as_str()));
+        assert_eq!(e.get("to"), Some(t.to.as_str()));
+        assert_eq!(e.get("from"), Some(t.from.as_str()));
+        assert_eq!(e.get("tick"), Some(t.tick.to_string().as_str()));
+        assert!(e.get("sim_time").is_some() && e.get("kind").is_some());
+    }
+    // The failing condition carries its reason and attempt; the carry is halted.
+    let cond_fail = status_events
+        .iter()
+        .find(|e| e.get("path") == Some("main/retry/guard/cube_grasped") && e.get("to") == Some("failure"))
+        .unwrap();
+    assert_eq!(cond_fail.get("reason"), Some("cube_grasped: slipped"));
+    assert_eq!(cond_fail.get("attempt"), Some("1"));
+    assert_eq!(cond_fail.level, "INFO");
+    assert!(
+        status_events
+            .iter()
+            .any(|e| e.get("path") == Some("main/retry/guard/carry") && e.get("to") == Some("halted"))
+    );
+    // The retry announces its second attempt.
+    assert!(events.iter().any(|e| e.get("path") == Some("main/retry")
+        && e.get("attempt") == Some("2")
+        && e.get("to").is_none()));
+    // The guard condition holding tick after tick produces no events of its own.
+    let cond_events = status_events
+        .iter()
+        .filter(|e| e.get("path") == Some("main/retry/guard/cube_grasped"))
+        .count();
+    assert_eq!(cond_events, 3, "success, failure, success again");
+}
