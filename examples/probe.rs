@@ -1,16 +1,13 @@
-use macrotree::sim::{HOME_Q, Scene, Sim};
+use macrotree::sim::{Scene, Sim};
 fn main() {
     let scene = Scene::load().unwrap();
-    println!("gains {:?}", scene.arm_gains);
-    let mut sim = Sim::new(&scene);
-    for _ in 0..1000 {
-        sim.command_arm(&HOME_Q, &[0.0; 6]);
-        sim.step();
-    }
+    let sim = Sim::new(&scene);
     let w = sim.observe();
     println!(
-        "after 2s with ff: pinch {:?} err {:?}",
+        "left {:?} right {:?} pinch {:?} yaw {}",
+        w.left_pad_pos,
+        w.right_pad_pos,
         w.pinch_pos,
-        macrotree::world::conditions::home_error(&w)
+        macrotree::actions::tool_yaw(&w.pinch_rot)
     );
 }

@@ -31,7 +31,7 @@ impl MacroAction for Reach {
         let position = resolve(&self.spec.target, w) + offset;
         let current_yaw = tool_yaw(&w.pinch_rot);
         let (yaw, quarter) = match (&self.spec.yaw, &self.spec.target) {
-            (Yaw::Object, Target::Cube) => (w.cube_yaw(), true),
+            (Yaw::Object, Target::Cube) => grasp_yaw(w),
             (Yaw::Object, _) | (Yaw::Keep, _) => (current_yaw, false),
             (Yaw::Angle(a), _) => (*a, false),
         };
@@ -61,6 +61,29 @@ impl MacroAction for Reach {
             Progress::Running
         }
     }
+}
+
+/// Distance from the bowl within which the finger axis is chosen for clearance, metres: an open
+/// 2F-85 reaches about 6 cm from the pinch along its finger axis.
+const BOWL_CLEARANCE: f64 = 0.08;
+
+/// Tool yaw for grasping the cube and whether its quarter turns are equivalent.
+///
+/// The fingers must straddle two opposite faces, so the finger axis is the cube's yaw or a quarter
+/// turn from it. Far from the bowl either will do (the IK picks the one nearest the wrist); near it,
+/// the one whose fingers point most across the direction to the bowl is taken, so the open
+/// fingertips do not land on its wall.
+fn grasp_yaw(w: &crate::world::World) -> (f64, bool) {
+    let yaw = w.cube_yaw();
+    let away = w.from_bowl(&w.cube_pos);
+    if away.norm() >= BOWL_CLEARANCE || away.norm() == 0.0 {
+        return (yaw, true);
+    }
+    let toward_bowl = away.normalize();
+    // At tool yaw ψ the pads separate along (cos ψ, sin ψ) in the table plane.
+    let along = |psi: f64| (psi.cos() * toward_bowl.x + psi.sin() * toward_bowl.y).abs();
+    let other = yaw + std::f64::consts::FRAC_PI_2;
+    (if along(yaw) <= along(other) { yaw } else { other }, false)
 }
 
 /// The tool yaw that joint solution `q` gives, radians.

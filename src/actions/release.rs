@@ -1,19 +1,20 @@
-//! `release`: open the gripper, then retreat straight up.
+//! `release`: open the gripper (fully or to a width), then retreat straight up.
 
 use nalgebra::Vector3;
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
-use crate::motion::gripper::{OPEN_CTRL, width_for_ctrl};
+use crate::motion::gripper::{OPEN_CTRL, ctrl_for_width, width_for_ctrl};
 use crate::motion::{CartesianMove, MotionLimits, Trajectory};
 use crate::spec::Release as ReleaseSpec;
 
-/// Fraction of the fully open width at which the gripper counts as open.
-const OPEN_FRACTION: f64 = 0.95;
+/// How close the opening must come to its target, metres.
+const WIDTH_TOLERANCE: f64 = 0.002;
 
 /// Executes a [`ReleaseSpec`].
 pub struct Release {
     spec: ReleaseSpec,
+    target_width: f64,
     retreating: bool,
     goal_q: [f64; 6],
 }
@@ -23,6 +24,7 @@ impl Release {
     pub fn new(spec: ReleaseSpec) -> Self {
         Self {
             spec,
+            target_width: 0.0,
             retreating: false,
             goal_q: [0.0; 6],
         }
@@ -32,14 +34,19 @@ impl Release {
 impl MacroAction for Release {
     fn start(&mut self, cell: &mut Cell) -> Result<(), String> {
         cell.hold();
-        cell.set_gripper(OPEN_CTRL);
+        let (ctrl, width) = match self.spec.width {
+            Some(w) => (ctrl_for_width(w), w.min(width_for_ctrl(OPEN_CTRL))),
+            None => (OPEN_CTRL, width_for_ctrl(OPEN_CTRL)),
+        };
+        cell.set_gripper(ctrl);
+        self.target_width = width;
         self.retreating = false;
         Ok(())
     }
 
     fn update(&mut self, cell: &mut Cell) -> Progress {
         if !self.retreating {
-            if cell.world().gripper_width < OPEN_FRACTION * width_for_ctrl(OPEN_CTRL) {
+            if (cell.world().gripper_width - self.target_width).abs() > WIDTH_TOLERANCE {
                 return Progress::Running;
             }
             if self.spec.retreat == 0.0 {

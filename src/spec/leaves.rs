@@ -197,16 +197,24 @@ pub struct Carry {
     pub timeout: f64,
 }
 
-/// Open the gripper, then retreat straight up by `retreat`.
+/// Open the gripper (fully, or to `width`), then retreat straight up by `retreat`.
 ///
-/// Halt: the driver stops the arm; the gripper keeps its current opening.
+/// With `width` it also pre-shapes the hand before a grasp: a 65 mm opening clears a 44 mm cube
+/// by about 1 cm a side while keeping the fingertips away from a nearby bowl wall.
+///
+/// Halt: the driver stops the arm; the gripper keeps its current command.
 ///
 /// ```yaml
 /// - release: {retreat: 0.1}
+/// - release: {width: 0.065, retreat: 0}
 /// ```
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Release {
+    /// Opening to go to, metres (pad face to pad face, 0 … 0.085). Default: fully open (≈ 0.085).
+    #[serde(default, deserialize_with = "units::opt_distance")]
+    #[schemars(range(min = 0.0))]
+    pub width: Option<f64>,
     /// Vertical retreat after opening, metres (≥ 0). Default 0.10.
     #[serde(default = "d_retreat", deserialize_with = "units::distance")]
     #[schemars(range(min = 0.0))]

@@ -10,6 +10,8 @@ pub const CUBE_HALF: f64 = 0.022;
 pub struct BowlGeometry {
     /// Half-width of the free space inside the walls, metres.
     pub inner_half_width: f64,
+    /// Half-width of the footprint, walls included, metres.
+    pub outer_half_width: f64,
     /// Height of the rim above the table, metres.
     pub rim_height: f64,
     /// Height of the bowl's floor (top surface) above the table, metres.
@@ -20,6 +22,7 @@ impl BowlGeometry {
     /// The tray in `assets/scene.xml`.
     pub const TRAY: Self = Self {
         inner_half_width: 0.075,
+        outer_half_width: 0.085,
         rim_height: 0.06,
         floor_height: 0.01,
     };
@@ -74,6 +77,13 @@ impl World {
     /// Yaw of the cube about world z, folded into [-45°, 45°) (a cube looks the same every 90°), radians.
     pub fn cube_yaw(&self) -> f64 {
         fold_quarter_turn(yaw_of(&self.cube_quat))
+    }
+
+    /// Horizontal vector from the nearest point of the bowl's footprint to `p` (zero inside it), metres.
+    pub fn from_bowl(&self, p: &Vector3<f64>) -> nalgebra::Vector2<f64> {
+        let h = self.bowl.outer_half_width;
+        let d = nalgebra::Vector2::new(p.x - self.bowl_pos.x, p.y - self.bowl_pos.y);
+        d - d.map(|c| c.clamp(-h, h))
     }
 
     /// Lowest point of the cube above the table, metres (exact for any orientation).
