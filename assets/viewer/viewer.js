@@ -161,6 +161,11 @@
     if (meta.tree) renderTree(meta.tree);
     var a = viewer.animator;
     var duration = a.duration || meta.duration || 0;
+    // set_animation started playing; hold at t = 0 until the first frame has rendered (shader
+    // compilation can take a second), then play from the start.
+    var autoplay = a.actions.length > 0;
+    a.pause();
+    a.seek(0);
     var bar = $("replay-bar");
     bar.hidden = false;
     var play = $("play");
@@ -185,7 +190,15 @@
       return a.actions.length ? a.actions[0].time : 0;
     }
 
+    var wasPlaying = false;
+    var userPaused = false;
     function tick() {
+      if (wasPlaying && !a.playing && !userPaused) {
+        // Finished by itself (played once to the end).
+        scrub.value = String(duration);
+      }
+      wasPlaying = a.playing;
+      userPaused = false;
       var t = a.playing ? current() : Number(scrub.value);
       if (a.playing) scrub.value = String(t);
       label.textContent = t.toFixed(2) + " / " + duration.toFixed(2) + " s";
@@ -198,6 +211,7 @@
     play.onclick = function () {
       if (a.playing) {
         var t = current();
+        userPaused = true;
         a.pause();
         scrub.value = String(t);
       } else {
@@ -208,6 +222,7 @@
       }
     };
     scrub.oninput = function () {
+      userPaused = true;
       if (a.playing) a.pause();
       a.seek(Number(scrub.value));
     };
@@ -217,7 +232,12 @@
         play.onclick();
       }
     });
-    mt.seek = function (t) { if (a.playing) a.pause(); scrub.value = String(t); a.seek(t); };
-    requestAnimationFrame(tick);
+    mt.seek = function (t) { userPaused = true; if (a.playing) a.pause(); scrub.value = String(t); a.seek(t); };
+    requestAnimationFrame(function () {
+      requestAnimationFrame(function () {
+        if (autoplay) { a.play(); a.seek(0); }
+        tick();
+      });
+    });
   };
 })();

@@ -106,9 +106,9 @@ impl From<std::io::Error> for ViewerError {
 }
 
 /// Where the default camera looks (Z-up world), metres.
-pub const CAMERA_TARGET: [f64; 3] = [0.3, 0.0, 0.2];
+pub const CAMERA_TARGET: [f64; 3] = [0.3, 0.0, 0.25];
 /// Default camera position relative to [`CAMERA_TARGET`] (Z-up world), metres.
-pub const CAMERA_OFFSET: [f64; 3] = [0.95, -0.85, 0.55];
+pub const CAMERA_OFFSET: [f64; 3] = [0.7, -0.65, 0.4];
 
 /// The scene tree a browser starts from: view settings (camera, hidden grid) and one object per
 /// drawn geom. Body transforms follow with the first poses.
@@ -119,6 +119,8 @@ pub fn initial_tree(layout: &SceneLayout) -> SceneTree {
     };
     // The floor plane sits at z = 0 like the grid: hide the grid to avoid z-fighting.
     prop("/Grid", "visible", Value::Boolean(false));
+    // The origin axes would poke through the floor; they can be switched on in the controls.
+    prop("/Axes", "visible", Value::Boolean(false));
     // Camera position is in the Y-up frame of the rotated camera node: (x, y, z) -> (x, z, -y).
     let [x, y, z] = CAMERA_OFFSET;
     prop(
