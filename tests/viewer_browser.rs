@@ -360,6 +360,11 @@ fn live_page_renders_the_scene_and_the_tree_panel() {
         assert!(Instant::now() < deadline, "panel shows {shown}");
         std::thread::sleep(Duration::from_millis(100));
     }
+    if let Some(path) = std::env::var_os("MACROTREE_VIEWER_SCREENSHOT") {
+        std::thread::sleep(Duration::from_millis(300));
+        std::fs::write(&path, dt.screenshot()).unwrap();
+        eprintln!("saved {}", PathBuf::from(path).display());
+    }
     // Poses move the robot in the page.
     let mut q = HOME_Q;
     q[0] += 0.9;
@@ -379,11 +384,6 @@ fn live_page_renders_the_scene_and_the_tree_panel() {
         diff > 500,
         "the robot did not move in the page: {diff} bytes differ"
     );
-    if let Some(path) = std::env::var_os("MACROTREE_VIEWER_SCREENSHOT") {
-        std::thread::sleep(Duration::from_millis(300));
-        std::fs::write(&path, dt.screenshot()).unwrap();
-        eprintln!("saved {}", PathBuf::from(path).display());
-    }
 
     // Without our objects the same colours are gone: they came from the scene.
     viewer.delete("/mujoco");
@@ -485,10 +485,22 @@ fn a_default_length_episode_replay_stays_under_15_mb() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// CPU time of the calling thread so far (Linux `schedstat`), seconds.
+fn thread_cpu() -> f64 {
+    let stat = std::fs::read_to_string("/proc/thread-self/schedstat").unwrap_or_default();
+    stat.split_whitespace()
+        .next()
+        .and_then(|v| v.parse::<f64>().ok())
+        .unwrap_or(0.0)
+        / 1e9
+}
+
 /// Runs an episode-like loop: `steps` physics steps, poses published at 30 Hz of sim time.
-fn episode(sim: &mut Sim, viewer: Option<&LiveViewer>, steps: usize) -> Duration {
+/// Returns (wall seconds, sim-thread CPU seconds).
+fn episode(sim: &mut Sim, viewer: Option<&LiveViewer>, steps: usize) -> (f64, f64) {
     sim.reset(&macrotree::sim::Layout::default());
     let started = Instant::now();
+    let cpu = thread_cpu();
     let mut next_publish = 0.0;
     for i in 0..steps {
         let t = sim.time();
@@ -505,7 +517,17 @@ fn episode(sim: &mut Sim, viewer: Option<&LiveViewer>, steps: usize) -> Duration
             v.publish_poses(sim.data(), sim.time());
         }
     }
-    started.elapsed()
+    (started.elapsed().as_secs_f64(), thread_cpu() - cpu)
+}
+
+/// Median wall and CPU seconds of `rounds` episodes.
+fn measure(sim: &mut Sim, viewer: Option<&LiveViewer>, steps: usize, rounds: usize) -> (f64, f64) {
+    let (mut wall, mut cpu): (Vec<f64>, Vec<f64>) = (0..rounds).map(|_| episode(sim, viewer, steps)).unzip();
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    (median(&mut wall), median(&mut cpu))
 }
 
 #[test]
@@ -516,7 +538,14 @@ fn measure_overhead_with_one_browser() {
     }
     let scene = Scene::load().unwrap();
     let mut sim = Sim::new(&scene);
-    let steps = 3000;
+    // 60 s of sim time (30 000 steps), poses published at 30 Hz of sim time: 1800 frames.
+    let steps: usize = std::env::var("MACROTREE_OVERHEAD_STEPS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(30_000);
+    let rounds = 7;
+    episode(&mut sim, None, steps); // warm-up
+    let base = measure(&mut sim, None, steps, rounds);
     let viewer = LiveViewer::start(
         &scene.model,
         &ViewerOptions {
@@ -525,25 +554,36 @@ fn measure_overhead_with_one_browser() {
         },
     )
     .unwrap();
+    let no_client = measure(&mut sim, Some(&viewer), steps, rounds);
     let browser = Chromium::open(&viewer.url(), 1000, 600);
     assert!(viewer.wait_for_clients(1, Duration::from_secs(60)));
     viewer.capture_image(Duration::from_secs(120)).unwrap(); // the snapshot is loaded
-    let rounds = 5;
-    let (mut without, mut with) = (Vec::new(), Vec::new());
-    episode(&mut sim, None, steps); // warm-up
-    for _ in 0..rounds {
-        without.push(episode(&mut sim, None, steps).as_secs_f64());
-        with.push(episode(&mut sim, Some(&viewer), steps).as_secs_f64());
-    }
-    let median = |v: &mut Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2]
-    };
-    let (a, b) = (median(&mut without), median(&mut with));
-    eprintln!(
-        "{steps} steps, 30 Hz publish: without viewer {a:.3} s, with viewer + 1 browser {b:.3} s: overhead {:+.1} % ({:?})",
-        (b / a - 1.0) * 100.0,
-        viewer.stats()
-    );
+    let with_browser = measure(&mut sim, Some(&viewer), steps, rounds);
+    let stats = viewer.stats();
     drop(browser);
+    drop(viewer);
+    std::thread::sleep(Duration::from_millis(500));
+    let base2 = measure(&mut sim, None, steps, rounds);
+    let pct = |x: f64, b: f64| (x / b - 1.0) * 100.0;
+    let (bw, bc) = (base.0.min(base2.0), base.1.min(base2.1));
+    eprintln!(
+        "{steps} steps ({:.0} s of sim time), poses published at 30 Hz of sim time, median of {rounds}:\n\
+         \x20 no viewer:            wall {:.3} s / {:.3} s (before / after), sim-thread CPU {:.3} s / {:.3} s\n\
+         \x20 viewer, no browser:   wall {:.3} s ({:+.1} %), sim-thread CPU {:.3} s ({:+.1} %)\n\
+         \x20 viewer + 1 browser:   wall {:.3} s ({:+.1} %), sim-thread CPU {:.3} s ({:+.1} %)\n\
+         \x20 {stats:?}",
+        steps as f64 * macrotree::sim::TIMESTEP,
+        base.0,
+        base2.0,
+        base.1,
+        base2.1,
+        no_client.0,
+        pct(no_client.0, bw),
+        no_client.1,
+        pct(no_client.1, bc),
+        with_browser.0,
+        pct(with_browser.0, bw),
+        with_browser.1,
+        pct(with_browser.1, bc),
+    );
 }

@@ -483,3 +483,20 @@ fn standalone_html_inlines_everything() {
     let b64 = base64::engine::general_purpose::STANDARD.encode(&cmds[1]);
     assert!(html.contains(&b64));
 }
+
+#[test]
+fn the_fast_pose_encoder_matches_the_generic_one() {
+    let m = proto::mat_from_pos_xmat([0.1, -2.0, 3e-9], [0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
+    for path in [
+        "/a",
+        "/mujoco/ur5e_shoulder_link",
+        &format!("/{}", "x".repeat(40)),
+        &format!("/{}", "y".repeat(300)),
+    ] {
+        assert_eq!(
+            proto::encode_set_transform(path, &m),
+            proto::encode(&proto::set_transform(path, &m)),
+            "{path}"
+        );
+    }
+}

@@ -106,9 +106,9 @@ impl From<std::io::Error> for ViewerError {
 }
 
 /// Where the default camera looks (Z-up world), metres.
-pub const CAMERA_TARGET: [f64; 3] = [0.3, 0.0, 0.25];
+pub const CAMERA_TARGET: [f64; 3] = [0.3, -0.05, 0.18];
 /// Default camera position relative to [`CAMERA_TARGET`] (Z-up world), metres.
-pub const CAMERA_OFFSET: [f64; 3] = [0.7, -0.65, 0.4];
+pub const CAMERA_OFFSET: [f64; 3] = [0.5, -0.55, 0.42];
 
 /// The scene tree a browser starts from: view settings (camera, hidden grid) and one object per
 /// drawn geom. Body transforms follow with the first poses.
@@ -227,7 +227,7 @@ impl LiveViewer {
                 }
                 last[b] = Some(pose);
                 let m = proto::mat_from_pos_xmat(pose.0, pose.1);
-                poses.push((b, path.as_str(), proto::encode(&proto::set_transform(path, &m))));
+                poses.push((b, path.as_str(), proto::encode_set_transform(path, &m)));
             }
         }
         self.hub.publish_poses(poses, sim_time);

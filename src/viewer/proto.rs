@@ -99,6 +99,41 @@ pub fn set_transform(path: &str, matrix: &Mat4) -> Value {
     ])
 }
 
+/// The bytes of [`set_transform`] written directly (no intermediate value tree): the same
+/// encoding, several times faster, for the per-frame pose path.
+pub fn encode_set_transform(path: &str, matrix: &Mat4) -> Bytes {
+    let mut buf = Vec::with_capacity(48 + path.len() + 16 * 9);
+    buf.push(0x83); // fixmap, 3 entries
+    write_str(&mut buf, "type");
+    write_str(&mut buf, "set_transform");
+    write_str(&mut buf, "path");
+    write_str(&mut buf, path);
+    write_str(&mut buf, "matrix");
+    buf.extend_from_slice(&[0xdc, 0x00, 0x10]); // array16, 16 entries
+    for v in matrix {
+        buf.push(0xcb); // float64, big-endian
+        buf.extend_from_slice(&v.to_be_bytes());
+    }
+    Bytes::from(buf)
+}
+
+/// A msgpack string header + bytes (shortest form).
+fn write_str(buf: &mut Vec<u8>, text: &str) {
+    let n = text.len();
+    if n < 32 {
+        buf.push(0xa0 | n as u8);
+    } else if n < 256 {
+        buf.extend_from_slice(&[0xd9, n as u8]);
+    } else if n < 65536 {
+        buf.push(0xda);
+        buf.extend_from_slice(&(n as u16).to_be_bytes());
+    } else {
+        buf.push(0xdb);
+        buf.extend_from_slice(&(n as u32).to_be_bytes());
+    }
+    buf.extend_from_slice(text.as_bytes());
+}
+
 /// `delete`: removes the subtree at `path`.
 pub fn delete(path: &str) -> Value {
     map(vec![("type", s("delete")), ("path", s(path))])

@@ -16,7 +16,7 @@ use std::net::{SocketAddr, TcpListener, TcpStream};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use tungstenite::protocol::{Role, WebSocket};
 use tungstenite::{Bytes, Message};
@@ -34,6 +34,9 @@ pub const MAX_CONNECTIONS: usize = 64;
 pub const WRITE_TIMEOUT: Duration = Duration::from_secs(30);
 /// How long a client thread sleeps when it has nothing to send (it then polls for input).
 const IDLE_POLL: Duration = Duration::from_millis(25);
+/// Pose batches are written to a client at most this often (40 Hz of wall time): a sim that
+/// runs faster than real time publishes more often, and the browser gets the latest pose only.
+pub const MIN_POSE_INTERVAL: Duration = Duration::from_millis(25);
 
 /// Counters of one connected client.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -96,6 +99,8 @@ pub(crate) struct HubState {
     clients: Vec<Arc<Client>>,
     capture: Option<(u64, mpsc::Sender<CaptureReply>)>,
     pub frames_published: u64,
+    /// Sim time of the latest pose frame (sent to late joiners).
+    latest_time: Option<f64>,
 }
 
 /// Shared state between the simulation thread and the server threads.
@@ -139,6 +144,7 @@ impl Hub {
     pub fn publish_poses(&self, poses: Vec<(usize, &str, Bytes)>, sim_time: f64) {
         let mut st = self.lock();
         st.frames_published += 1;
+        st.latest_time = Some(sim_time);
         for (_, path, msg) in &poses {
             st.tree.set_transform(path, msg.clone());
         }
@@ -181,6 +187,7 @@ impl Hub {
             out: Mutex::new(Outbox {
                 queue: snapshot.into(),
                 queued_bytes,
+                time: st.latest_time,
                 tree_dirty: st.panel.tree_message().is_some(),
                 status_dirty: st.panel.tree_message().is_some(),
                 stats: ClientStats {
@@ -506,38 +513,46 @@ struct Batch {
     closed: bool,
 }
 
-fn take_batch(client: &Client) -> Batch {
+/// Takes what is due: structural messages and panel updates at once, poses at most every
+/// [`MIN_POSE_INTERVAL`] (the newer ones replace older ones meanwhile). Waits up to
+/// [`IDLE_POLL`] when nothing is due.
+fn take_batch(client: &Client, next_pose_at: &mut Instant) -> Batch {
     let mut out = client.lock();
-    let idle = |o: &Outbox| {
-        o.queue.is_empty()
-            && !o.poses_pending
-            && o.time.is_none()
-            && !o.resync
-            && !o.tree_dirty
-            && !o.status_dirty
-            && !o.closed
-    };
-    if idle(&out) {
+    let deadline = Instant::now() + IDLE_POLL;
+    loop {
+        let now = Instant::now();
+        let other = !out.queue.is_empty() || out.resync || out.tree_dirty || out.status_dirty || out.closed;
+        let poses_due = (out.poses_pending || out.time.is_some()) && now >= *next_pose_at;
+        if other || poses_due || now >= deadline {
+            break;
+        }
+        let mut wait = deadline - now;
+        if out.poses_pending || out.time.is_some() {
+            wait = wait.min(next_pose_at.saturating_duration_since(now));
+        }
         out = client
             .wake
-            .wait_timeout(out, IDLE_POLL)
+            .wait_timeout(out, wait)
             .unwrap_or_else(|e| e.into_inner())
             .0;
     }
-    let poses: Vec<Bytes> = if out.poses_pending {
-        out.poses.iter_mut().filter_map(Option::take).collect()
-    } else {
-        Vec::new()
-    };
-    if out.poses_pending {
-        out.stats.frames_sent += 1;
+    let now = Instant::now();
+    let mut poses = Vec::new();
+    let mut time = None;
+    if now >= *next_pose_at && (out.poses_pending || out.time.is_some()) {
+        if out.poses_pending {
+            poses = out.poses.iter_mut().filter_map(Option::take).collect();
+            out.stats.frames_sent += 1;
+            out.poses_pending = false;
+        }
+        time = out.time.take();
+        *next_pose_at = now + MIN_POSE_INTERVAL;
     }
-    out.poses_pending = false;
     out.queued_bytes = 0;
     Batch {
         queue: std::mem::take(&mut out.queue),
         poses,
-        time: out.time.take(),
+        time,
         resync: std::mem::take(&mut out.resync),
         tree: std::mem::take(&mut out.tree_dirty),
         status: std::mem::take(&mut out.status_dirty),
@@ -564,8 +579,9 @@ fn ws_err(e: tungstenite::Error) -> io::Error {
 
 fn client_loop(ws: &mut WebSocket<TcpStream>, hub: &Hub, client: &Client) -> io::Result<()> {
     let mut events_seen = 0u64;
+    let mut next_pose_at = Instant::now();
     loop {
-        let mut batch = take_batch(client);
+        let mut batch = take_batch(client, &mut next_pose_at);
         if batch.closed || hub.shutdown.load(Ordering::SeqCst) {
             return Ok(());
         }
