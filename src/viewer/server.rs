@@ -60,6 +60,9 @@ struct Outbox {
     queue: VecDeque<Bytes>,
     queued_bytes: usize,
     resync: bool,
+    /// Sent after the pending poses, which are then flushed at once (capture requests: the
+    /// image must show everything published before the request).
+    after_poses: Vec<Bytes>,
     /// Latest pose message per slot (body id); `None` once written.
     poses: Vec<Option<Bytes>>,
     poses_pending: bool,
@@ -228,10 +231,7 @@ impl Hub {
         let client = st.clients.first()?.clone();
         let (tx, rx) = mpsc::channel();
         st.capture = Some((client.id, tx));
-        let mut out = client.lock();
-        out.queued_bytes += msg.len();
-        out.queue.push_back(msg);
-        drop(out);
+        client.lock().after_poses.push(msg);
         client.wake.notify_all();
         Some(rx)
     }
@@ -506,6 +506,7 @@ fn serve_connection(mut stream: TcpStream, hub: &Hub, site: &Site) -> io::Result
 struct Batch {
     queue: VecDeque<Bytes>,
     poses: Vec<Bytes>,
+    after_poses: Vec<Bytes>,
     time: Option<f64>,
     resync: bool,
     tree: bool,
@@ -521,7 +522,12 @@ fn take_batch(client: &Client, next_pose_at: &mut Instant) -> Batch {
     let deadline = Instant::now() + IDLE_POLL;
     loop {
         let now = Instant::now();
-        let other = !out.queue.is_empty() || out.resync || out.tree_dirty || out.status_dirty || out.closed;
+        let other = !out.queue.is_empty()
+            || !out.after_poses.is_empty()
+            || out.resync
+            || out.tree_dirty
+            || out.status_dirty
+            || out.closed;
         let poses_due = (out.poses_pending || out.time.is_some()) && now >= *next_pose_at;
         if other || poses_due || now >= deadline {
             break;
@@ -539,7 +545,8 @@ fn take_batch(client: &Client, next_pose_at: &mut Instant) -> Batch {
     let now = Instant::now();
     let mut poses = Vec::new();
     let mut time = None;
-    if now >= *next_pose_at && (out.poses_pending || out.time.is_some()) {
+    let flush = !out.after_poses.is_empty();
+    if (now >= *next_pose_at || flush) && (out.poses_pending || out.time.is_some()) {
         if out.poses_pending {
             poses = out.poses.iter_mut().filter_map(Option::take).collect();
             out.stats.frames_sent += 1;
@@ -552,6 +559,7 @@ fn take_batch(client: &Client, next_pose_at: &mut Instant) -> Batch {
     Batch {
         queue: std::mem::take(&mut out.queue),
         poses,
+        after_poses: std::mem::take(&mut out.after_poses),
         time,
         resync: std::mem::take(&mut out.resync),
         tree: std::mem::take(&mut out.tree_dirty),
@@ -598,7 +606,12 @@ fn client_loop(ws: &mut WebSocket<TcpStream>, hub: &Hub, client: &Client) -> io:
         }
         let mut messages = 0u64;
         let mut bytes = 0u64;
-        for msg in batch.queue.drain(..).chain(batch.poses.drain(..)) {
+        let ordered = batch
+            .queue
+            .drain(..)
+            .chain(batch.poses.drain(..))
+            .chain(batch.after_poses.drain(..));
+        for msg in ordered {
             messages += 1;
             bytes += msg.len() as u64;
             ws.write(Message::Binary(msg)).map_err(ws_err)?;
