@@ -28,4 +28,5 @@ pub mod plan;
 pub mod runtime;
 pub mod sim;
 pub mod spec;
+pub mod viewer;
 pub mod world;
