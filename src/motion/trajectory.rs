@@ -283,7 +283,7 @@ impl CartesianMove {
                 amax = amax.max((d2[j] * sd * sd + d1[j] * sdd).abs());
             }
         }
-        mv.duration = if length == 0.0 && vmax == 0.0 {
+        mv.duration = if length < 1e-9 && vmax < 1e-6 {
             0.0 // nothing to move: done at once
         } else {
             (MJ_PEAK_VEL * length / limits.tool_speed)
