@@ -8,6 +8,7 @@ mod bench;
 mod logging;
 mod run;
 mod validate;
+mod view;
 
 use std::process::ExitCode;
 

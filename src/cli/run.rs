@@ -6,9 +6,11 @@ use std::sync::Arc;
 use clap::Args;
 
 use super::args::{CubeArg, XyArg};
+use super::view::ViewObserver;
 use super::{CliError, load_plan_or_exit, load_scene_or_exit};
 use crate::episode::{EpisodeConfig, NoObserver, run_episode};
 use crate::sim::Layout;
+use crate::viewer::{LiveViewer, Recorder, ViewerOptions};
 
 /// Arguments of `run`.
 #[derive(Debug, Args)]
@@ -20,6 +22,22 @@ pub struct RunArgs {
     /// Print the episode report as one JSON object on the last line of stdout.
     #[arg(long)]
     pub json: bool,
+    /// Serve the live 3D view (MeshCat) and the tree's status on http://127.0.0.1:PORT; keeps
+    /// serving after the episode until Ctrl-C.
+    #[arg(long)]
+    pub view: bool,
+    /// Port of the live view (0 picks a free one).
+    #[arg(long, default_value_t = crate::viewer::DEFAULT_PORT, requires = "view")]
+    pub port: u16,
+    /// Pace the simulation to wall-clock time so a person can watch.
+    #[arg(long, conflicts_with = "speed")]
+    pub realtime: bool,
+    /// Pace the simulation at X times real time.
+    #[arg(long, value_name = "X")]
+    pub speed: Option<f64>,
+    /// Write the episode as one self-contained HTML replay (plays offline).
+    #[arg(long, value_name = "FILE.html")]
+    pub record: Option<PathBuf>,
 }
 
 /// Layout and limits shared by `run` and `bench`.
@@ -74,7 +92,66 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
     let plan = Arc::new(load_plan_or_exit(&args.tree)?);
     let scene = load_scene_or_exit()?;
     tracing::info!(tree = %args.tree.display(), cube = ?config.layout.cube_xy, bowl = ?config.layout.bowl_xy, seed = config.seed, "episode start");
-    let report = run_episode(&scene, plan, &config, &mut NoObserver);
+    let speed = match (args.realtime, args.speed) {
+        (true, _) => Some(1.0),
+        (false, Some(x)) if x.is_finite() && x > 0.0 => Some(x),
+        (false, Some(x)) => {
+            return Err(CliError::Input(format!(
+                "error: --speed must be a positive number, got {x}"
+            )));
+        }
+        (false, None) => None,
+    };
+    let live = if args.view {
+        let opts = ViewerOptions {
+            port: args.port,
+            ..ViewerOptions::default()
+        };
+        let live =
+            LiveViewer::start(&scene.model, &opts).map_err(|e| CliError::Input(format!("error: {e}")))?;
+        eprintln!("live view: {} (Ctrl-C to stop)", live.url());
+        Some(live)
+    } else {
+        None
+    };
+    if args.record.is_some() {
+        // Fail before simulating if the bundle the replay inlines is missing.
+        crate::viewer::page::load_bundle().map_err(|path| {
+            CliError::Input(format!(
+                "error: {}",
+                crate::viewer::ViewerError::BundleMissing { path }
+            ))
+        })?;
+    }
+    let recorder = args.record.as_ref().map(|_| Recorder::new(&scene.model));
+    let report = if live.is_some() || recorder.is_some() || speed.is_some() {
+        let mut view = ViewObserver::new(&plan, live, recorder, speed);
+        let report = run_episode(&scene, plan.clone(), &config, &mut view);
+        let (live, recorder) = view.finish();
+        if let (Some(rec), Some(path)) = (recorder, &args.record) {
+            rec.write(path)
+                .map_err(|e| CliError::Input(format!("error: cannot write {}: {e}", path.display())))?;
+            eprintln!("replay written to {}", path.display());
+        }
+        finish_report(&report, args.json);
+        if let Some(live) = live {
+            eprintln!("episode over; still serving {} (Ctrl-C to stop)", live.url());
+            live.serve_forever();
+        }
+        report
+    } else {
+        let report = run_episode(&scene, plan, &config, &mut NoObserver);
+        finish_report(&report, args.json);
+        report
+    };
+    if report.success {
+        Ok(())
+    } else {
+        Err(CliError::TaskFailed)
+    }
+}
+
+fn finish_report(report: &crate::episode::EpisodeReport, json: bool) {
     if report.success {
         tracing::info!(
             sim_time_s = report.sim_time_s,
@@ -87,14 +164,9 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
             "episode failed"
         );
     }
-    print_summary(&report);
-    if args.json {
-        println!("{}", serde_json::to_string(&report).expect("report serializes"));
-    }
-    if report.success {
-        Ok(())
-    } else {
-        Err(CliError::TaskFailed)
+    print_summary(report);
+    if json {
+        println!("{}", serde_json::to_string(report).expect("report serializes"));
     }
 }
 
