@@ -129,7 +129,7 @@ impl LeafDriver for MacroDriver<'_> {
                 return if self.condition(c) {
                     LeafOutcome::Success
                 } else {
-                    LeafOutcome::Failure(format!("{} is false", c.kind()))
+                    LeafOutcome::Failure("not satisfied".into())
                 };
             }
             Leaf::Action(a) => a,

@@ -1,13 +1,21 @@
-//! Tracing subscriber setup: pretty and colored on a terminal, JSON lines for machines.
+//! Tracing subscriber setup: a compact, colored line per event on a terminal (simulated time,
+//! the node, its transition, the reason), or one JSON object per event for machines.
 
+use std::fmt;
+
+use tracing::field::{Field, Visit};
+use tracing::{Event, Level, Subscriber};
 use tracing_subscriber::EnvFilter;
+use tracing_subscriber::fmt::format::Writer;
+use tracing_subscriber::fmt::{FmtContext, FormatEvent, FormatFields};
+use tracing_subscriber::registry::LookupSpan;
 
 /// Log output format.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum LogFormat {
     /// Human-readable, colored when stderr is a terminal.
     Pretty,
-    /// One JSON object per event.
+    /// One JSON object per event, with every field (tick, sim_time, path, kind, from, to, …).
     Json,
 }
 
@@ -26,10 +34,99 @@ pub fn init(verbose: u8, format: LogFormat, quiet: bool) {
         .with_writer(std::io::stderr);
     let _ = match format {
         LogFormat::Pretty => builder
-            .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
-            .without_time()
-            .with_target(false)
+            .event_format(Pretty {
+                ansi: std::io::IsTerminal::is_terminal(&std::io::stderr()),
+            })
             .try_init(),
         LogFormat::Json => builder.json().flatten_event(true).try_init(),
     };
+}
+
+/// Fields that the pretty line shows in its own way (or leaves to `--log-format json`).
+const SHOWN_ELSEWHERE: [&str; 7] = ["message", "tick", "sim_time", "path", "kind", "from", "to"];
+
+#[derive(Default)]
+struct Fields {
+    message: String,
+    sim_time: Option<f64>,
+    to: Option<String>,
+    rest: Vec<(&'static str, String)>,
+}
+
+impl Visit for Fields {
+    fn record_f64(&mut self, field: &Field, value: f64) {
+        if field.name() == "sim_time" {
+            self.sim_time = Some(value);
+        } else {
+            self.rest.push((field.name(), format!("{value}")));
+        }
+    }
+
+    fn record_str(&mut self, field: &Field, value: &str) {
+        match field.name() {
+            "to" => self.to = Some(value.to_string()),
+            "message" => self.message = value.to_string(),
+            name if SHOWN_ELSEWHERE.contains(&name) => {}
+            name => self.rest.push((name, value.to_string())),
+        }
+    }
+
+    fn record_debug(&mut self, field: &Field, value: &dyn fmt::Debug) {
+        match field.name() {
+            "message" => self.message = format!("{value:?}"),
+            name if SHOWN_ELSEWHERE.contains(&name) => {}
+            name => self.rest.push((name, format!("{value:?}"))),
+        }
+    }
+}
+
+/// `  2.244 s  reach "above cube" running → success  attempt=1`
+struct Pretty {
+    ansi: bool,
+}
+
+impl Pretty {
+    fn paint(&self, code: &str, text: &str) -> String {
+        if self.ansi {
+            format!("\x1b[{code}m{text}\x1b[0m")
+        } else {
+            text.to_string()
+        }
+    }
+}
+
+impl<S, N> FormatEvent<S, N> for Pretty
+where
+    S: Subscriber + for<'a> LookupSpan<'a>,
+    N: for<'a> FormatFields<'a> + 'static,
+{
+    fn format_event(&self, _ctx: &FmtContext<'_, S, N>, mut w: Writer<'_>, event: &Event<'_>) -> fmt::Result {
+        let mut f = Fields::default();
+        event.record(&mut f);
+        let level = *event.metadata().level();
+        match f.sim_time {
+            Some(t) => write!(w, "{} ", self.paint("2", &format!("{t:7.3} s")))?,
+            None => write!(w, "{:9} ", "")?,
+        }
+        if level != Level::INFO {
+            let code = match level {
+                Level::ERROR => "31;1",
+                Level::WARN => "33;1",
+                _ => "2",
+            };
+            write!(w, "{} ", self.paint(code, level.as_str()))?;
+        }
+        let code = match f.to.as_deref() {
+            Some("success") => "32",
+            Some("failure") => "31",
+            Some("halted") => "33",
+            Some("running") => "36",
+            _ => "0",
+        };
+        write!(w, "{}", self.paint(code, &f.message))?;
+        for (name, value) in &f.rest {
+            write!(w, "  {}={value}", self.paint("2", name))?;
+        }
+        writeln!(w)
+    }
 }

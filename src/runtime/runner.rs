@@ -157,8 +157,8 @@ impl RunState {
                     to = t.to.as_str(),
                     reason = t.reason.as_deref(),
                     attempt = t.attempt,
-                    "{} {} -> {}",
-                    t.path,
+                    "{} {} → {}",
+                    display_name(info),
                     t.from,
                     t.to
                 )
@@ -322,7 +322,7 @@ impl RunState {
                             attempt = iteration,
                             reason = self.last_failure.as_deref(),
                             "{}: attempt {} of {} starts next tick",
-                            info.path,
+                            display_name(info),
                             iteration,
                             of
                         );
@@ -335,7 +335,7 @@ impl RunState {
                             kind = info.kind,
                             iteration,
                             "{}: iteration {} of {} starts next tick",
-                            info.path,
+                            display_name(info),
                             iteration,
                             of
                         );
@@ -574,5 +574,14 @@ impl TreeRunner {
     pub fn reset(&mut self) {
         self.bt.reset_bt();
         self.st = RunState::new(&self.plan);
+    }
+}
+
+/// How log messages name a node: its `name:` with its kind (`"above cube" (reach)`), or its
+/// label with the key parameters (`reach cube +[0, 0, 0.12]`).
+fn display_name(info: &crate::plan::NodeInfo) -> String {
+    match &info.name {
+        Some(name) => format!("\"{name}\" ({})", info.kind),
+        None => info.label.clone(),
     }
 }
