@@ -80,3 +80,127 @@ pub fn home_error(w: &World) -> f64 {
 pub fn at_home(w: &World, tolerance: f64) -> bool {
     home_error(w) <= tolerance
 }
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+
+    use super::*;
+    use crate::world::{BowlGeometry, CUBE_HALF};
+
+    /// A cube resting on the table at (0.45, −0.18), open gripper far above it, bowl at (0.45, 0.08).
+    fn resting() -> World {
+        World {
+            time: 0.0,
+            arm_q: [0.0; 6],
+            arm_qd: [0.0; 6],
+            arm_cmd: [0.0; 6],
+            gripper_width: 0.085,
+            gripper_speed: 0.0,
+            pinch_pos: Vector3::new(0.45, -0.18, 0.3),
+            pinch_rot: Matrix3::identity(),
+            left_pad_contact: false,
+            right_pad_contact: false,
+            left_pad_pos: Vector3::new(0.40, -0.18, 0.3),
+            right_pad_pos: Vector3::new(0.50, -0.18, 0.3),
+            cube_pos: Vector3::new(0.45, -0.18, CUBE_HALF),
+            cube_quat: UnitQuaternion::identity(),
+            cube_linvel: Vector3::zeros(),
+            cube_angvel: Vector3::zeros(),
+            bowl_pos: Vector3::new(0.45, 0.08, 0.0),
+            bowl_target: Vector3::new(0.45, 0.08, 0.01),
+            bowl: BowlGeometry::TRAY,
+            home_q: [0.0; 6],
+        }
+    }
+
+    /// The same cube held between the pads 10 cm above the table.
+    fn held() -> World {
+        let mut w = resting();
+        w.cube_pos = Vector3::new(0.45, -0.18, 0.10 + CUBE_HALF);
+        w.left_pad_pos = Vector3::new(0.45 - CUBE_HALF - 0.004, -0.18, 0.125);
+        w.right_pad_pos = Vector3::new(0.45 + CUBE_HALF + 0.004, -0.18, 0.125);
+        w.left_pad_contact = true;
+        w.right_pad_contact = true;
+        w.gripper_width = 2.0 * CUBE_HALF;
+        w
+    }
+
+    #[test]
+    fn grasped_needs_both_pads_and_the_cube_between_them() {
+        assert!(cube_grasped(&held(), Tolerances::GRASP_OFF_AXIS));
+        let mut one_pad = held();
+        one_pad.right_pad_contact = false;
+        assert!(!cube_grasped(&one_pad, Tolerances::GRASP_OFF_AXIS));
+        // Both pads touch, but the cube centre is outside the segment between them (pinched on an edge).
+        let mut beside = held();
+        beside.cube_pos.x += 0.05;
+        assert!(!cube_grasped(&beside, Tolerances::GRASP_OFF_AXIS));
+        // Between the pads along the axis, but 4 cm below their line.
+        let mut low = held();
+        low.cube_pos.z -= 0.04;
+        assert!(!cube_grasped(&low, Tolerances::GRASP_OFF_AXIS));
+        assert!(!cube_grasped(&resting(), Tolerances::GRASP_OFF_AXIS));
+    }
+
+    #[test]
+    fn lifted_uses_the_lowest_point_even_when_the_cube_is_tilted() {
+        assert!(!cube_lifted(&resting(), 0.03));
+        assert!(cube_lifted(&held(), 0.03));
+        assert!(!cube_lifted(&held(), 0.11));
+        // Tilted 45° about x: the lowest edge is √2·half below the centre.
+        let mut tilted = resting();
+        tilted.cube_pos.z = 0.03 + CUBE_HALF * std::f64::consts::SQRT_2;
+        tilted.cube_quat = UnitQuaternion::from_euler_angles(std::f64::consts::FRAC_PI_4, 0.0, 0.0);
+        assert!((tilted.cube_bottom() - 0.03).abs() < 1e-12);
+        assert!(cube_lifted(&tilted, 0.029) && !cube_lifted(&tilted, 0.031));
+    }
+
+    #[test]
+    fn in_bowl_means_inside_the_walls_below_the_rim_and_at_rest() {
+        let mut w = resting();
+        w.cube_pos = Vector3::new(0.47, 0.06, 0.01 + CUBE_HALF);
+        assert!(cube_in_bowl(&w, Tolerances::REST_SPEED));
+        assert!(!cube_on_table(&w, 0.01, Tolerances::REST_SPEED));
+        let mut moving = w.clone();
+        moving.cube_linvel = Vector3::new(0.0, 0.0, -0.3);
+        assert!(!cube_in_bowl(&moving, Tolerances::REST_SPEED));
+        let mut above = w.clone();
+        above.cube_pos.z = 0.2;
+        assert!(!cube_in_bowl(&above, Tolerances::REST_SPEED));
+        let mut on_rim = w.clone();
+        on_rim.cube_pos.x = 0.45 + 0.08;
+        assert!(!cube_in_bowl(&on_rim, Tolerances::REST_SPEED));
+        assert!(!cube_in_bowl(&resting(), Tolerances::REST_SPEED));
+    }
+
+    #[test]
+    fn on_table_is_resting_outside_the_bowl() {
+        assert!(cube_on_table(&resting(), 0.005, Tolerances::REST_SPEED));
+        assert!(!cube_on_table(&held(), 0.005, Tolerances::REST_SPEED));
+        let mut sliding = resting();
+        sliding.cube_linvel = Vector3::new(0.2, 0.0, 0.0);
+        assert!(!cube_on_table(&sliding, 0.005, Tolerances::REST_SPEED));
+    }
+
+    #[test]
+    fn gripper_open_and_at_home_compare_against_their_tolerances() {
+        assert!(gripper_open(&resting(), 0.08));
+        assert!(!gripper_open(&held(), 0.08));
+        let mut w = resting();
+        w.arm_q = [0.03, 0.0, 0.0, 0.0, 0.0, 0.0];
+        assert!((home_error(&w) - 0.03).abs() < 1e-12);
+        assert!(at_home(&w, 0.04));
+        w.arm_q = [0.03, 0.03, 0.0, 0.0, 0.0, 0.0];
+        assert!(!at_home(&w, 0.04), "the norm, not the largest joint, is compared");
+    }
+
+    #[test]
+    fn distance_from_the_bowl_footprint() {
+        let w = resting();
+        let inside = w.from_bowl(&Vector3::new(0.45, 0.08, 0.0));
+        assert_eq!(inside.norm(), 0.0);
+        let d = w.from_bowl(&Vector3::new(0.45, -0.18, 0.0));
+        assert!((d.y - (-0.26 + 0.085)).abs() < 1e-12 && d.x == 0.0);
+    }
+}
