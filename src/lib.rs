@@ -28,5 +28,6 @@ pub mod plan;
 pub mod runtime;
 pub mod sim;
 pub mod spec;
+pub mod sweep;
 pub mod viewer;
 pub mod world;

@@ -7,6 +7,7 @@ mod args;
 mod bench;
 mod logging;
 mod run;
+mod sweep;
 mod validate;
 mod view;
 
@@ -40,6 +41,8 @@ pub enum Command {
     Validate(validate::ValidateArgs),
     /// Run an episode, then replay its controls with bare mj_step, and compare wall times.
     Bench(bench::BenchArgs),
+    /// Run a tree over many seeded random layouts in parallel (optionally with a fault) and summarize.
+    Sweep(sweep::SweepArgs),
 }
 
 /// A failure that maps to an exit code.
@@ -54,12 +57,13 @@ pub enum CliError {
 /// Entry point of the `macrotree` binary.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
-    let quiet = matches!(cli.command, Command::Bench(_));
+    let quiet = matches!(cli.command, Command::Bench(_) | Command::Sweep(_));
     logging::init(cli.verbose, cli.log_format, quiet);
     let result = match cli.command {
         Command::Run(args) => run::run(args),
         Command::Validate(args) => validate::validate(args),
         Command::Bench(args) => bench::bench(args),
+        Command::Sweep(args) => sweep::sweep(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

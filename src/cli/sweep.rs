@@ -1,0 +1,116 @@
+//! `macrotree sweep TREE --scenarios N`: the tree over N seeded random layouts, in parallel.
+//!
+//! Exit codes: 0 when every scenario succeeded, 1 when any failed, 2 on bad input.
+
+use std::fs::File;
+use std::io::{BufWriter, IsTerminal, Write};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use super::{CliError, load_plan_or_exit, load_scene_or_exit};
+use crate::faults::FaultKind;
+use crate::sweep::{Shard, Summary, SweepConfig, run_sweep};
+
+/// Arguments of `sweep`.
+#[derive(Debug, Args)]
+pub struct SweepArgs {
+    /// The tree file (YAML).
+    pub tree: PathBuf,
+    /// Number of scenarios (indices 0..N); with --shard, only this shard's share of them runs.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub scenarios: u64,
+    /// Sweep seed: scenario k of seed S is the same layout and episode seed everywhere.
+    #[arg(long, default_value_t = 0, value_name = "S")]
+    pub seed: u64,
+    /// Worker threads (default: one per core).
+    #[arg(long, short = 'j', value_name = "J", value_parser = clap::value_parser!(u64).range(1..))]
+    pub jobs: Option<u64>,
+    /// Inject this fault through physics in every scenario (see docs/faults.md).
+    #[arg(long, value_enum)]
+    pub fault: Option<FaultKind>,
+    /// Write one JSON line per scenario here, in scenario order.
+    #[arg(long, value_name = "FILE.jsonl")]
+    pub out: Option<PathBuf>,
+    /// Print the summary as one JSON object on the last line of stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Run only the scenarios with index ≡ K (mod M), 0 ≤ K < M.
+    #[arg(long, value_name = "K/M")]
+    pub shard: Option<Shard>,
+    /// Stop each episode (as a failure) after this much simulated time, seconds.
+    #[arg(long, default_value_t = 60.0, value_name = "S")]
+    pub max_sim_time: f64,
+}
+
+/// Runs `macrotree sweep`.
+pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
+    if !(args.max_sim_time.is_finite() && args.max_sim_time > 0.0) {
+        return Err(CliError::Input(format!(
+            "error: --max-sim-time must be a positive number of seconds, got {}",
+            args.max_sim_time
+        )));
+    }
+    let plan = Arc::new(load_plan_or_exit(&args.tree)?);
+    let scene = load_scene_or_exit()?;
+    let mut out = match &args.out {
+        Some(path) => Some(BufWriter::new(File::create(path).map_err(|e| {
+            CliError::Input(format!("error: cannot write {}: {e}", path.display()))
+        })?)),
+        None => None,
+    };
+    let config = SweepConfig {
+        scenarios: args.scenarios,
+        seed: args.seed,
+        jobs: args.jobs.map_or(0, |j| j as usize),
+        fault: args.fault,
+        shard: args.shard,
+        max_sim_time: args.max_sim_time,
+    };
+    let total = config.indices().len() as u64;
+    let bar = if std::io::stderr().is_terminal() {
+        ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
+    } else {
+        ProgressBar::hidden()
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} {per_sec} eta {eta} {msg}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    let mut failures = 0u64;
+    let mut write_error = None;
+    let run = run_sweep(&scene, &plan, &config, |r| {
+        if let (Some(w), None) = (out.as_mut(), &write_error)
+            && let Err(e) = writeln!(w, "{}", r.to_jsonl()).and_then(|()| w.flush())
+        {
+            write_error = Some(e);
+        }
+        if !r.success {
+            failures += 1;
+            bar.set_message(format!("{failures} failed"));
+        }
+        bar.inc(1);
+    })
+    .map_err(|e| CliError::Input(format!("error: cannot start {} worker threads: {e}", config.jobs)))?;
+    bar.finish_and_clear();
+    if let (Some(e), Some(path)) = (write_error, &args.out) {
+        return Err(CliError::Input(format!(
+            "error: writing {} failed: {e}",
+            path.display()
+        )));
+    }
+    let tree = args.tree.display().to_string();
+    let summary = Summary::new(&tree, &config, &run.results, run.wall_time_s, run.jobs);
+    print!("{}", summary.to_text());
+    if args.json {
+        println!("{}", serde_json::to_string(&summary).expect("summary serializes"));
+    }
+    if summary.all_succeeded() {
+        Ok(())
+    } else {
+        Err(CliError::TaskFailed)
+    }
+}

@@ -1,0 +1,385 @@
+//! Sweeps: a tree run over many seeded, randomized layouts (optionally with a fault), in
+//! parallel, with results in scenario order — the library behind `macrotree sweep`.
+//!
+//! Scenario `k` of sweep seed `S` ([`sample_scenario`]) depends only on `(S, k)`, so a sweep gives
+//! the same results for any number of jobs, and the shards `K/M` of a sweep (the scenarios with
+//! `k ≡ K mod M`) concatenate into the full sweep. One [`Cell`] (one `MjData` of the shared model)
+//! per worker thread is reset before every scenario.
+//!
+//! ```no_run
+//! use std::sync::Arc;
+//! use macrotree::sweep::{SweepConfig, run_sweep};
+//!
+//! let scene = macrotree::sim::Scene::load().unwrap();
+//! let plan = Arc::new(macrotree::plan::load_plan("trees/cube_to_bowl.yaml".as_ref()).unwrap());
+//! let config = SweepConfig { scenarios: 100, seed: 1, ..SweepConfig::default() };
+//! let run = run_sweep(&scene, &plan, &config, |r| println!("{}", r.to_jsonl())).unwrap();
+//! println!("{} of {} succeeded", run.results.iter().filter(|r| r.success).count(), run.results.len());
+//! ```
+
+pub mod layout;
+mod summary;
+
+use std::collections::BTreeMap;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::str::FromStr;
+use std::sync::Arc;
+use std::sync::mpsc;
+use std::time::Instant;
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+pub use layout::{Region, Scenario, ScenarioLayout, sample_scenario, sample_scenario_in};
+pub use summary::{Failure, Summary, percentile, wilson_interval};
+
+use crate::actions::{CONTROL_PERIOD, Cell, Checks};
+use crate::episode::{EpisodeConfig, EpisodeReport, NoObserver, run_in_cell};
+use crate::faults::FaultKind;
+use crate::plan::Plan;
+use crate::sim::{Layout, Scene};
+
+/// `--shard K/M`: the scenarios whose index is ≡ K (mod M), `0 ≤ K < M`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Shard {
+    /// K.
+    pub index: u64,
+    /// M.
+    pub count: u64,
+}
+
+impl Shard {
+    /// Scenario `i` belongs to this shard.
+    pub fn contains(&self, i: u64) -> bool {
+        i % self.count == self.index
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+impl FromStr for Shard {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let form = "expected K/M with 0 ≤ K < M, e.g. 0/4 (shard K of M, counted from 0)";
+        let (k, m) = s.split_once('/').ok_or_else(|| format!("{s:?}: {form}"))?;
+        let k: u64 = k.trim().parse().map_err(|_| format!("{s:?}: {form}"))?;
+        let m: u64 = m.trim().parse().map_err(|_| format!("{s:?}: {form}"))?;
+        if m == 0 || k >= m {
+            return Err(format!("{s:?}: {form}"));
+        }
+        Ok(Self { index: k, count: m })
+    }
+}
+
+/// What to sweep.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepConfig {
+    /// Scenarios 0..N of the sweep (before sharding).
+    pub scenarios: u64,
+    /// Sweep seed S.
+    pub seed: u64,
+    /// Worker threads (0 = one per core).
+    pub jobs: usize,
+    /// A fault injected in every scenario.
+    pub fault: Option<FaultKind>,
+    /// Only this shard's scenarios.
+    pub shard: Option<Shard>,
+    /// Per-episode simulated time limit, seconds.
+    pub max_sim_time: f64,
+}
+
+impl Default for SweepConfig {
+    fn default() -> Self {
+        Self {
+            scenarios: 100,
+            seed: 0,
+            jobs: 0,
+            fault: None,
+            shard: None,
+            max_sim_time: EpisodeConfig::default().max_sim_time,
+        }
+    }
+}
+
+impl SweepConfig {
+    /// The scenario indices this sweep runs, ascending.
+    pub fn indices(&self) -> Vec<u64> {
+        (0..self.scenarios)
+            .filter(|&i| self.shard.is_none_or(|s| s.contains(i)))
+            .collect()
+    }
+
+    /// The episode configuration of `scenario`: exactly what `macrotree run` builds from the
+    /// reproduction command [`ScenarioResult::reproduce`] prints.
+    pub fn episode_config(&self, scenario: &Scenario) -> EpisodeConfig {
+        EpisodeConfig {
+            layout: scenario.layout.to_layout(),
+            seed: scenario.seed,
+            max_sim_time: self.max_sim_time,
+            control_period: CONTROL_PERIOD,
+            fault: self.fault,
+        }
+    }
+}
+
+/// One line of the sweep's JSONL: the scenario and its episode's outcome (the fields of
+/// `run --json`, except the wall time, so that a sweep's output is byte-identical for any number
+/// of jobs and any machine).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ScenarioResult {
+    /// Scenario index k.
+    pub index: u64,
+    /// Sweep seed S.
+    pub sweep_seed: u64,
+    /// Episode seed (`run --seed`).
+    pub seed: u64,
+    /// The injected fault.
+    pub fault: Option<FaultKind>,
+    /// The layout, exactly as sampled (and as `run --cube X,Y,YAW --bowl X,Y` takes it).
+    pub layout: ScenarioLayout,
+    /// The tree succeeded and the cube rests in the bowl.
+    pub success: bool,
+    /// Final status of the tree.
+    pub tree_status: &'static str,
+    /// Why it failed, if it did.
+    pub failure_reason: Option<String>,
+    /// Simulated time, seconds.
+    pub sim_time_s: f64,
+    /// Grasp leaves started.
+    pub grasp_attempts: u32,
+    /// Leaves preempted while running.
+    pub halts: u32,
+    /// MuJoCo steps taken.
+    pub physics_steps: u64,
+    /// Final cube centre [x, y, z], metres.
+    pub cube_final: [f64; 3],
+    /// Bowl target [x, y, z] at the end, metres.
+    pub bowl_target: [f64; 3],
+    /// The reference tutorial's checks.
+    pub checks: Checks,
+    /// Wall-clock time of the episode, seconds (not written to the JSONL).
+    #[serde(skip)]
+    pub wall_time_s: f64,
+}
+
+impl ScenarioResult {
+    /// The result of `scenario` from its episode report.
+    pub fn new(scenario: &Scenario, fault: Option<FaultKind>, r: EpisodeReport) -> Self {
+        Self {
+            index: scenario.index,
+            sweep_seed: scenario.sweep_seed,
+            seed: scenario.seed,
+            fault,
+            layout: scenario.layout,
+            success: r.success,
+            tree_status: r.tree_status,
+            failure_reason: r.failure_reason,
+            sim_time_s: r.sim_time_s,
+            grasp_attempts: r.grasp_attempts,
+            halts: r.halts,
+            physics_steps: r.physics_steps,
+            cube_final: r.cube_final,
+            bowl_target: r.bowl_target,
+            checks: r.checks,
+            wall_time_s: r.wall_time_s,
+        }
+    }
+
+    /// A result for an episode that panicked.
+    fn panicked(scenario: &Scenario, fault: Option<FaultKind>, message: String) -> Self {
+        Self {
+            index: scenario.index,
+            sweep_seed: scenario.sweep_seed,
+            seed: scenario.seed,
+            fault,
+            layout: scenario.layout,
+            success: false,
+            tree_status: "failure",
+            failure_reason: Some(format!("panicked: {message}")),
+            sim_time_s: 0.0,
+            grasp_attempts: 0,
+            halts: 0,
+            physics_steps: 0,
+            cube_final: [f64::NAN; 3],
+            bowl_target: [f64::NAN; 3],
+            checks: Checks {
+                grasp_distance: None,
+                cube_motion_while_closed: 0.0,
+                cube_lift_while_closed: 0.0,
+                home_error: f64::NAN,
+                in_bowl: false,
+            },
+            wall_time_s: 0.0,
+        }
+    }
+
+    /// The result as one JSON line (without the newline).
+    pub fn to_jsonl(&self) -> String {
+        serde_json::to_string(self).expect("a scenario result serializes")
+    }
+
+    /// The `macrotree run …` command that reproduces this scenario bit for bit. Floats are
+    /// printed with Rust's shortest round-trip formatting, so they parse back to the same bits.
+    pub fn reproduce(&self, tree: &str, max_sim_time: f64) -> String {
+        let l = &self.layout;
+        let mut cmd = format!(
+            "macrotree run {} --cube {},{},{} --bowl {},{} --seed {}",
+            shell_quote(tree),
+            l.cube[0],
+            l.cube[1],
+            l.cube[2],
+            l.bowl[0],
+            l.bowl[1],
+            self.seed
+        );
+        if let Some(fault) = self.fault {
+            cmd += &format!(" --fault {fault}");
+        }
+        if max_sim_time != EpisodeConfig::default().max_sim_time {
+            cmd += &format!(" --max-sim-time {max_sim_time}");
+        }
+        cmd
+    }
+}
+
+/// Quotes `s` for a POSIX shell when it holds anything but `[A-Za-z0-9_./+-]`.
+fn shell_quote(s: &str) -> String {
+    if !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_./+-".contains(c))
+    {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
+/// Runs scenario `scenario` of `config` in `cell` (reset first).
+pub fn run_scenario(
+    cell: &mut Cell,
+    plan: &Arc<Plan>,
+    config: &SweepConfig,
+    scenario: &Scenario,
+) -> ScenarioResult {
+    let episode = config.episode_config(scenario);
+    let report = run_in_cell(cell, plan.clone(), &episode, &mut NoObserver);
+    ScenarioResult::new(scenario, config.fault, report)
+}
+
+/// The outcome of a sweep.
+#[derive(Debug, Clone)]
+pub struct SweepRun {
+    /// One result per scenario run, in index order.
+    pub results: Vec<ScenarioResult>,
+    /// Wall-clock time of the whole sweep, seconds.
+    pub wall_time_s: f64,
+    /// Worker threads used.
+    pub jobs: usize,
+}
+
+/// Runs the sweep on `config.jobs` worker threads (one [`Cell`] each) and calls `on_result` on
+/// the calling thread for every scenario, in index order, as soon as it and all before it are
+/// done. An episode that panics is recorded as a failure (its worker gets a fresh cell).
+pub fn run_sweep(
+    scene: &Scene,
+    plan: &Arc<Plan>,
+    config: &SweepConfig,
+    mut on_result: impl FnMut(&ScenarioResult),
+) -> Result<SweepRun, rayon::ThreadPoolBuildError> {
+    let wall = Instant::now();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(config.jobs)
+        .thread_name(|i| format!("sweep-{i}"))
+        .build()?;
+    let jobs = pool.current_num_threads();
+    let indices = config.indices();
+    let mut results = Vec::with_capacity(indices.len());
+    let (tx, rx) = mpsc::channel::<(usize, ScenarioResult)>();
+    std::thread::scope(|s| {
+        let indices = &indices;
+        s.spawn(move || {
+            let new_cell = || Cell::new(scene, &Layout::default(), CONTROL_PERIOD);
+            pool.install(|| {
+                // par_bridge hands out scenarios in index order, so results arrive nearly in order.
+                indices.iter().copied().enumerate().par_bridge().for_each_init(
+                    new_cell,
+                    |cell, (pos, index)| {
+                        let scenario = sample_scenario(config.seed, index);
+                        let outcome =
+                            catch_unwind(AssertUnwindSafe(|| run_scenario(cell, plan, config, &scenario)));
+                        let result = outcome.unwrap_or_else(|payload| {
+                            *cell = new_cell();
+                            ScenarioResult::panicked(&scenario, config.fault, panic_message(&*payload))
+                        });
+                        // The receiver lives until every result is in.
+                        let _ = tx.send((pos, result));
+                    },
+                );
+            });
+        });
+        let mut pending = BTreeMap::new();
+        for (pos, result) in rx {
+            pending.insert(pos, result);
+            while let Some(result) = pending.remove(&results.len()) {
+                on_result(&result);
+                results.push(result);
+            }
+        }
+    });
+    Ok(SweepRun {
+        results,
+        wall_time_s: wall.elapsed().as_secs_f64(),
+        jobs,
+    })
+}
+
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".into())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shards_parse_and_reject_bad_input() {
+        assert_eq!("1/4".parse::<Shard>(), Ok(Shard { index: 1, count: 4 }));
+        for bad in ["3/2", "2/2", "0/0", "1", "a/2", "-1/2", ""] {
+            assert!(bad.parse::<Shard>().is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn shards_partition_the_indices() {
+        let all = SweepConfig {
+            scenarios: 10,
+            ..SweepConfig::default()
+        };
+        let mut union: Vec<u64> = (0..3)
+            .flat_map(|k| {
+                SweepConfig {
+                    shard: Some(Shard { index: k, count: 3 }),
+                    ..all.clone()
+                }
+                .indices()
+            })
+            .collect();
+        union.sort();
+        assert_eq!(union, all.indices());
+    }
+
+    #[test]
+    fn shell_quoting() {
+        assert_eq!(shell_quote("trees/a_b-1.yaml"), "trees/a_b-1.yaml");
+        assert_eq!(shell_quote("my tree.yaml"), "'my tree.yaml'");
+        assert_eq!(shell_quote("it's.yaml"), r"'it'\''s.yaml'");
+    }
+}

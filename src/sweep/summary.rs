@@ -1,0 +1,220 @@
+//! [`Summary`]: what a sweep found — success rate with a Wilson interval, attempts, sim-time
+//! percentiles, throughput and every failure with the command that reproduces it.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use serde::Serialize;
+
+use super::{ScenarioResult, Shard, SweepConfig};
+use crate::faults::FaultKind;
+
+/// z for a two-sided 95% interval.
+const Z95: f64 = 1.959_963_984_540_054;
+
+/// One failing scenario.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Failure {
+    /// Scenario index.
+    pub index: u64,
+    /// Episode seed.
+    pub seed: u64,
+    /// Cube x, y (metres), yaw (degrees).
+    pub cube: [f64; 3],
+    /// Bowl x, y (metres).
+    pub bowl: [f64; 2],
+    /// Why it failed.
+    pub reason: String,
+    /// Grasp attempts made.
+    pub grasp_attempts: u32,
+    /// The `macrotree run …` command that reproduces it.
+    pub reproduce: String,
+}
+
+/// The summary of a sweep (`--json` prints it as the last stdout line).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Summary {
+    /// The tree file, as given.
+    pub tree: String,
+    /// Sweep seed S.
+    pub seed: u64,
+    /// The injected fault.
+    pub fault: Option<FaultKind>,
+    /// The shard run, `K/M`, if any.
+    pub shard: Option<String>,
+    /// Worker threads.
+    pub jobs: usize,
+    /// Scenarios run.
+    pub scenarios: u64,
+    /// Scenarios that succeeded.
+    pub successes: u64,
+    /// successes / scenarios (0 when no scenario ran).
+    pub success_rate: f64,
+    /// 95% Wilson score interval of the success rate, [low, high].
+    pub success_rate_ci95: [f64; 2],
+    /// Number of scenarios by grasp attempts made (JSON keys are the attempt counts).
+    pub attempts_histogram: BTreeMap<u32, u64>,
+    /// Median simulated time over all scenarios (nearest rank), seconds.
+    pub median_sim_time_s: f64,
+    /// 95th percentile of the simulated time over all scenarios (nearest rank), seconds.
+    pub p95_sim_time_s: f64,
+    /// Wall-clock time of the sweep, seconds.
+    pub wall_time_s: f64,
+    /// Scenarios per minute of wall-clock time.
+    pub scenarios_per_minute: f64,
+    /// Every failing scenario, by index.
+    pub failures: Vec<Failure>,
+}
+
+impl Summary {
+    /// Summarizes `results` of a sweep of `tree` with `config` that took `wall_time_s` on `jobs` workers.
+    pub fn new(
+        tree: &str,
+        config: &SweepConfig,
+        results: &[ScenarioResult],
+        wall_time_s: f64,
+        jobs: usize,
+    ) -> Self {
+        let n = results.len() as u64;
+        let successes = results.iter().filter(|r| r.success).count() as u64;
+        let mut attempts_histogram = BTreeMap::new();
+        for r in results {
+            *attempts_histogram.entry(r.grasp_attempts).or_insert(0) += 1;
+        }
+        let mut times: Vec<f64> = results.iter().map(|r| r.sim_time_s).collect();
+        times.sort_by(f64::total_cmp);
+        let failures = results
+            .iter()
+            .filter(|r| !r.success)
+            .map(|r| Failure {
+                index: r.index,
+                seed: r.seed,
+                cube: r.layout.cube,
+                bowl: r.layout.bowl,
+                reason: r.failure_reason.clone().unwrap_or_else(|| "failed".into()),
+                grasp_attempts: r.grasp_attempts,
+                reproduce: r.reproduce(tree, config.max_sim_time),
+            })
+            .collect();
+        Self {
+            tree: tree.to_string(),
+            seed: config.seed,
+            fault: config.fault,
+            shard: config.shard.as_ref().map(Shard::to_string),
+            jobs,
+            scenarios: n,
+            successes,
+            success_rate: if n == 0 { 0.0 } else { successes as f64 / n as f64 },
+            success_rate_ci95: wilson_interval(successes, n),
+            attempts_histogram,
+            median_sim_time_s: percentile(&times, 0.5),
+            p95_sim_time_s: percentile(&times, 0.95),
+            wall_time_s,
+            scenarios_per_minute: if wall_time_s > 0.0 {
+                n as f64 * 60.0 / wall_time_s
+            } else {
+                0.0
+            },
+            failures,
+        }
+    }
+
+    /// Every scenario run succeeded (true for an empty shard).
+    pub fn all_succeeded(&self) -> bool {
+        self.successes == self.scenarios
+    }
+
+    /// The summary for people, several lines.
+    pub fn to_text(&self) -> String {
+        let mut s = String::new();
+        let [lo, hi] = self.success_rate_ci95;
+        let _ = writeln!(
+            s,
+            "{} of {} scenarios succeeded: {:.2}% (95% CI {:.2}–{:.2}%), seed {}{}{}",
+            self.successes,
+            self.scenarios,
+            self.success_rate * 100.0,
+            lo * 100.0,
+            hi * 100.0,
+            self.seed,
+            self.fault.map_or(String::new(), |f| format!(", fault {f}")),
+            self.shard
+                .as_ref()
+                .map_or(String::new(), |k| format!(", shard {k}")),
+        );
+        let hist: Vec<String> = self
+            .attempts_histogram
+            .iter()
+            .map(|(a, c)| format!("{a}: {c}"))
+            .collect();
+        let _ = writeln!(s, "  grasp attempts: {}", hist.join(", "));
+        let _ = writeln!(
+            s,
+            "  sim time: median {:.2} s, p95 {:.2} s",
+            self.median_sim_time_s, self.p95_sim_time_s
+        );
+        let _ = writeln!(
+            s,
+            "  wall time {:.1} s on {} job(s): {:.0} scenarios/minute",
+            self.wall_time_s, self.jobs, self.scenarios_per_minute
+        );
+        if !self.failures.is_empty() {
+            let _ = writeln!(s, "  failures ({}):", self.failures.len());
+            for f in &self.failures {
+                let _ = writeln!(s, "    #{}: {}", f.index, f.reason);
+                let _ = writeln!(s, "      {}", f.reproduce);
+            }
+        }
+        s
+    }
+}
+
+/// The 95% Wilson score interval of `successes` out of `n`, [low, high] ([0, 1] when `n` is 0).
+pub fn wilson_interval(successes: u64, n: u64) -> [f64; 2] {
+    if n == 0 {
+        return [0.0, 1.0];
+    }
+    let n = n as f64;
+    let p = successes as f64 / n;
+    let z2 = Z95 * Z95;
+    let denom = 1.0 + z2 / n;
+    let centre = (p + z2 / (2.0 * n)) / denom;
+    let half = Z95 * (p * (1.0 - p) / n + z2 / (4.0 * n * n)).sqrt() / denom;
+    [(centre - half).max(0.0), (centre + half).min(1.0)]
+}
+
+/// The nearest-rank `q`-quantile (0 < q ≤ 1) of `sorted` (ascending); 0 when empty.
+pub fn percentile(sorted: &[f64], q: f64) -> f64 {
+    if sorted.is_empty() {
+        return 0.0;
+    }
+    let rank = (q * sorted.len() as f64).ceil() as usize;
+    sorted[rank.clamp(1, sorted.len()) - 1]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wilson_matches_known_values() {
+        // 95 of 100: the textbook interval is [0.8883, 0.9785].
+        let [lo, hi] = wilson_interval(95, 100);
+        assert!(
+            (lo - 0.8883).abs() < 1e-4 && (hi - 0.9785).abs() < 1e-4,
+            "{lo} {hi}"
+        );
+        let [lo, hi] = wilson_interval(10, 10);
+        assert!((lo - 0.7225).abs() < 1e-4 && hi == 1.0, "{lo} {hi}");
+        assert_eq!(wilson_interval(0, 0), [0.0, 1.0]);
+    }
+
+    #[test]
+    fn nearest_rank_percentiles() {
+        let v: Vec<f64> = (1..=20).map(f64::from).collect();
+        assert_eq!(percentile(&v, 0.5), 10.0);
+        assert_eq!(percentile(&v, 0.95), 19.0);
+        assert_eq!(percentile(&[3.0], 0.95), 3.0);
+        assert_eq!(percentile(&[], 0.5), 0.0);
+    }
+}
