@@ -180,7 +180,18 @@ pub fn wilson_interval(successes: u64, n: u64) -> [f64; 2] {
     let denom = 1.0 + z2 / n;
     let centre = (p + z2 / (2.0 * n)) / denom;
     let half = Z95 * (p * (1.0 - p) / n + z2 / (4.0 * n * n)).sqrt() / denom;
-    [(centre - half).max(0.0), (centre + half).min(1.0)]
+    // At 0 or n successes the bound is exactly 0 or 1 (rounding would leave 1 − ε).
+    let lo = if successes == 0 {
+        0.0
+    } else {
+        (centre - half).max(0.0)
+    };
+    let hi = if successes as f64 == n {
+        1.0
+    } else {
+        (centre + half).min(1.0)
+    };
+    [lo, hi]
 }
 
 /// The nearest-rank `q`-quantile (0 < q ≤ 1) of `sorted` (ascending); 0 when empty.

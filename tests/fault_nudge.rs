@@ -1,0 +1,108 @@
+//! `--fault nudge` (and the other faults) on real physics: the cube is really pushed as the
+//! gripper closes, and a seeded batch of 10 all still succeed.
+
+use std::sync::{Arc, OnceLock};
+
+use macrotree::actions::{CONTROL_PERIOD, Cell};
+use macrotree::episode::{EpisodeConfig, EpisodeObserver, run_in_cell};
+use macrotree::faults::{FaultKind, injector_with_log};
+use macrotree::plan::Plan;
+use macrotree::runtime::TreeRunner;
+use macrotree::sim::{Layout, Scene};
+use macrotree::sweep::{SweepConfig, run_sweep};
+
+fn scene() -> &'static Scene {
+    static SCENE: OnceLock<Scene> = OnceLock::new();
+    SCENE.get_or_init(|| Scene::load().expect("scene (run tools/bootstrap)"))
+}
+
+fn plan() -> Arc<Plan> {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/trees/cube_to_bowl.yaml");
+    Arc::new(macrotree::plan::load_plan(std::path::Path::new(path)).expect("flagship tree is valid"))
+}
+
+#[test]
+fn ten_seeded_nudges_all_succeed() {
+    let config = SweepConfig {
+        scenarios: 10,
+        seed: 2024,
+        jobs: 2,
+        fault: Some(FaultKind::Nudge),
+        ..SweepConfig::default()
+    };
+    let run = run_sweep(scene(), &plan(), &config, |_| {}).expect("thread pool");
+    for r in &run.results {
+        assert!(r.success, "#{} {:?}: {:?}", r.index, r.layout, r.failure_reason);
+    }
+}
+
+/// The largest horizontal distance the cube moved from its start before the first grasp ended.
+#[derive(Default)]
+struct Moved {
+    start: Option<nalgebra::Vector3<f64>>,
+    max: f64,
+}
+
+impl EpisodeObserver for Moved {
+    fn on_tick(&mut self, cell: &Cell, _runner: &mut TreeRunner) {
+        let w = cell.world();
+        let start = *self.start.get_or_insert(w.cube_pos);
+        if cell.gripper_command() > 0.0 && w.cube_pos.z < 0.03 {
+            self.max = self.max.max((w.cube_pos - start).xy().norm());
+        }
+    }
+}
+
+#[test]
+fn a_nudge_really_moves_the_cube_as_the_gripper_closes() {
+    for seed in [1, 2, 3] {
+        let layout = Layout::default();
+        let mut cell = Cell::new(scene(), &layout, CONTROL_PERIOD);
+        let (nudge, log) = injector_with_log(FaultKind::Nudge, seed);
+        cell.observers.push(nudge);
+        let config = EpisodeConfig {
+            layout,
+            seed,
+            ..EpisodeConfig::default()
+        };
+        let mut moved = Moved::default();
+        let report = run_in_cell(&mut cell, plan(), &config, &mut moved);
+        let event = log.lock().unwrap().clone().expect("the nudge fired");
+        eprintln!(
+            "seed {seed}: {} ; moved {:.1} mm; {:?}",
+            event.detail,
+            moved.max * 1e3,
+            report.failure_reason
+        );
+        assert!(
+            moved.max > 0.01,
+            "seed {seed}: the cube moved only {:.1} mm",
+            moved.max * 1e3
+        );
+        assert!(report.success, "seed {seed}: {:?}", report.failure_reason);
+    }
+}
+
+#[test]
+fn every_fault_fires_exactly_once_in_an_episode() {
+    let layout = Layout::default();
+    let mut cell = Cell::new(scene(), &layout, CONTROL_PERIOD);
+    for kind in FaultKind::ALL {
+        let (fault, log) = injector_with_log(kind, 7);
+        cell.observers.push(fault);
+        let config = EpisodeConfig {
+            layout,
+            seed: 7,
+            ..EpisodeConfig::default()
+        };
+        let report = run_in_cell(&mut cell, plan(), &config, &mut macrotree::episode::NoObserver);
+        cell.observers.clear();
+        let event = log.lock().unwrap().clone();
+        let event = event.unwrap_or_else(|| panic!("{kind} never fired"));
+        eprintln!(
+            "{kind}: {} at {:.2} s; success {}",
+            event.detail, event.time, report.success
+        );
+        assert_eq!(event.kind, kind);
+    }
+}
