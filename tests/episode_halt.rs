@@ -43,14 +43,23 @@ main:
     let report = run_in_cell(&mut cell, plan, &EpisodeConfig::default(), &mut trace);
     assert_eq!(report.tree_status, "success");
     assert_eq!(report.halts, 1, "exactly one leaf halted");
-    let halted: Vec<&Transition> = trace.transitions.iter().filter(|t| t.to == NodeStatus::Halted).collect();
+    let halted: Vec<&Transition> = trace
+        .transitions
+        .iter()
+        .filter(|t| t.to == NodeStatus::Halted)
+        .collect();
     assert_eq!(halted.len(), 1, "transitions: {:?}", trace.transitions);
     assert_eq!(halted[0].kind, "reach");
     let t_halt = halted[0].sim_time;
     assert!((0.28..0.35).contains(&t_halt), "halted at {t_halt} s");
     // After the halt the arm comes to rest near where it was and stays there: the last 0.5 s of
     // the wait move the pinch by less than a millimetre, and it stopped well short of the target.
-    let late: Vec<_> = trace.pinch.iter().filter(|(t, _)| *t > t_halt + 0.5).map(|(_, p)| *p).collect();
+    let late: Vec<_> = trace
+        .pinch
+        .iter()
+        .filter(|(t, _)| *t > t_halt + 0.5)
+        .map(|(_, p)| *p)
+        .collect();
     let spread = late.iter().map(|p| (p - late[0]).norm()).fold(0.0, f64::max);
     assert!(spread < 1e-3, "arm still moving {spread} m after the halt");
     let target = nalgebra::Vector3::new(0.45, -0.25, 0.25);
