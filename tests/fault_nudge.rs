@@ -55,7 +55,11 @@ impl EpisodeObserver for Moved {
 
 #[test]
 fn a_nudge_really_moves_the_cube_as_the_gripper_closes() {
-    for seed in [1, 2, 3] {
+    // The hand is pre-shaped to 65 mm around the 44 mm cube: pushed along the finger axis the
+    // cube stops against a finger after 5–10 mm, pushed across it the closing fingers catch it
+    // 1–2 cm off-centre. Either way it really moved before the fingers closed on it.
+    let mut moves = Vec::new();
+    for seed in [1, 2, 3, 4, 5, 6] {
         let layout = Layout::default();
         let mut cell = Cell::new(scene(), &layout, CONTROL_PERIOD);
         let (nudge, log) = injector_with_log(FaultKind::Nudge, seed);
@@ -69,18 +73,25 @@ fn a_nudge_really_moves_the_cube_as_the_gripper_closes() {
         let report = run_in_cell(&mut cell, plan(), &config, &mut moved);
         let event = log.lock().unwrap().clone().expect("the nudge fired");
         eprintln!(
-            "seed {seed}: {} ; moved {:.1} mm; {:?}",
+            "seed {seed}: {}; moved {:.1} mm; {} grasp(s)",
             event.detail,
             moved.max * 1e3,
-            report.failure_reason
+            report.grasp_attempts
         );
+        assert!(report.success, "seed {seed}: {:?}", report.failure_reason);
         assert!(
-            moved.max > 0.01,
+            moved.max > 0.005,
             "seed {seed}: the cube moved only {:.1} mm",
             moved.max * 1e3
         );
-        assert!(report.success, "seed {seed}: {:?}", report.failure_reason);
+        moves.push(moved.max);
     }
+    let farthest = moves.iter().copied().fold(0.0, f64::max);
+    assert!(
+        farthest > 0.01,
+        "no nudge moved the cube more than {:.1} mm",
+        farthest * 1e3
+    );
 }
 
 #[test]

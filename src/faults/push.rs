@@ -30,8 +30,9 @@ impl Push {
     /// A horizontal push meant to slide the cube about `distance` metres along the table in
     /// direction `angle` (radians from world +x): the impulse that gives the cube the speed
     /// friction stops within `distance`, delivered over `steps` steps plus the friction it
-    /// overcomes meanwhile. The force acts 4 mm above the cube's bottom face (a torque is added
-    /// for the offset from the centre of mass) so the cube slides rather than tips.
+    /// overcomes meanwhile. The force's line of action is lowered below the centre of mass (a
+    /// torque is added) by just enough to cancel the tipping moment of the table's friction, so
+    /// the cube slides without tipping either way while it is pushed.
     pub fn slide(sim: &Sim, angle: f64, distance: f64, steps: u32) -> Self {
         let model = &sim.scene().model;
         let ids = &sim.scene().ids;
@@ -43,7 +44,9 @@ impl Push {
         let magnitude = mass * speed / duration + mu * mass * g;
         let dir = Vector3::new(angle.cos(), angle.sin(), 0.0);
         let force = dir * magnitude;
-        let arm = Vector3::new(0.0, 0.0, -(CUBE_HALF - 0.004));
+        // Friction μ·m·g acts at the bottom face, CUBE_HALF below the centre: the push's moment
+        // about the centre must match it.
+        let arm = Vector3::new(0.0, 0.0, -mu * mass * g * CUBE_HALF / magnitude);
         Self::new(force, arm.cross(&force), steps)
     }
 
