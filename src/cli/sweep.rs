@@ -76,8 +76,14 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
         ProgressBar::hidden()
     };
     bar.set_style(
-        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} {per_sec} eta {eta} {msg}")
+        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} {rate} eta {eta} {msg}")
             .expect("valid template")
+            .with_key(
+                "rate",
+                |s: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                    let _ = write!(w, "{:.0}/min", s.per_sec() * 60.0);
+                },
+            )
             .progress_chars("=> "),
     );
     let mut failures = 0u64;
