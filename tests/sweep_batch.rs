@@ -166,7 +166,6 @@ fn reproduction_commands_spell_the_fault_and_the_time_limit() {
 /// Ignored until `EpisodeArgs::config` (src/cli/run.rs) copies `--fault` into the episode
 /// configuration; it currently drops it.
 #[test]
-#[ignore = "src/cli/run.rs: EpisodeArgs::config drops --fault"]
 fn run_fault_option_reaches_the_episode() {
     let cmd = sample_scenario(3, 4).layout;
     let words = [

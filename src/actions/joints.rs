@@ -7,12 +7,16 @@ use crate::motion::{JointMove, MotionLimits};
 /// Moves the arm in joint space to fixed joint angles (radians).
 pub struct MoveJoints {
     goal_q: [f64; 6],
+    arrival: Arrival,
 }
 
 impl MoveJoints {
     /// A joint move to `goal_q` (radians).
     pub fn new(goal_q: [f64; 6]) -> Self {
-        Self { goal_q }
+        Self {
+            goal_q,
+            arrival: Arrival::default(),
+        }
     }
 
     /// A joint move to the UR5e home configuration.
@@ -33,10 +37,6 @@ impl MacroAction for MoveJoints {
     }
 
     fn update(&mut self, cell: &mut Cell) -> Progress {
-        if Arrival::default().reached(cell, &self.goal_q) {
-            Progress::Done
-        } else {
-            Progress::Running
-        }
+        self.arrival.progress(cell, &self.goal_q)
     }
 }

@@ -26,36 +26,58 @@ pub trait MacroAction: Send {
     }
 }
 
-/// Tolerances that decide when an arm motion has arrived.
+/// Decides when an arm motion has arrived — or is blocked.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Arrival {
     /// Largest pinch position error, metres.
     pub position: f64,
     /// Largest joint speed, rad/s.
     pub joint_speed: f64,
+    /// How long the arm may rest short of its goal after the trajectory ended before the motion
+    /// counts as blocked (by contact, e.g. fingers on a rim), seconds.
+    pub blocked_after: f64,
+    resting_since: Option<f64>,
 }
 
 impl Default for Arrival {
+    /// 2 mm, 0.05 rad/s, blocked after 0.3 s at rest short of the goal.
     fn default() -> Self {
         Self {
             position: 0.002,
             joint_speed: 0.05,
+            blocked_after: 0.3,
+            resting_since: None,
         }
     }
 }
 
 impl Arrival {
-    /// The trajectory has ended, the pinch is within `position` of where `goal_q` puts it and every
-    /// joint moves slower than `joint_speed`.
-    pub fn reached(&self, cell: &Cell, goal_q: &[f64; 6]) -> bool {
+    /// Progress of a motion towards the joint goal `goal_q`: Done when the trajectory has ended,
+    /// the pinch is within `position` of where `goal_q` puts it and every joint moves slower than
+    /// `joint_speed`; Failed when the arm has rested short of it for `blocked_after`.
+    pub fn progress(&mut self, cell: &Cell, goal_q: &[f64; 6]) -> Progress {
         let w = cell.world();
-        cell.arm_motion_finished()
-            && (crate::motion::fk(goal_q).translation.vector - w.pinch_pos).norm() <= self.position
-            && w.arm_qd.iter().all(|v| v.abs() <= self.joint_speed)
-    }
-
-    /// Pinch position error to the pose `goal_q` gives, metres (for failure reasons).
-    pub fn error(cell: &Cell, goal_q: &[f64; 6]) -> f64 {
-        (crate::motion::fk(goal_q).translation.vector - cell.world().pinch_pos).norm()
+        if !cell.arm_motion_finished() {
+            self.resting_since = None;
+            return Progress::Running;
+        }
+        let error = (crate::motion::fk(goal_q).translation.vector - w.pinch_pos).norm();
+        let resting = w.arm_qd.iter().all(|v| v.abs() <= self.joint_speed);
+        if resting && error <= self.position {
+            return Progress::Done;
+        }
+        if !resting {
+            self.resting_since = None;
+            return Progress::Running;
+        }
+        let since = *self.resting_since.get_or_insert(w.time);
+        if w.time - since >= self.blocked_after {
+            Progress::Failed(format!(
+                "blocked: the arm stopped {:.1} mm short of its goal (contact?)",
+                error * 1e3
+            ))
+        } else {
+            Progress::Running
+        }
     }
 }

@@ -12,6 +12,7 @@ use crate::spec::{PathKind, Reach as ReachSpec, Target, Yaw};
 pub struct Reach {
     spec: ReachSpec,
     goal_q: [f64; 6],
+    arrival: Arrival,
 }
 
 impl Reach {
@@ -20,6 +21,7 @@ impl Reach {
         Self {
             spec,
             goal_q: [0.0; 6],
+            arrival: Arrival::default(),
         }
     }
 }
@@ -55,11 +57,7 @@ impl MacroAction for Reach {
     }
 
     fn update(&mut self, cell: &mut Cell) -> Progress {
-        if Arrival::default().reached(cell, &self.goal_q) {
-            Progress::Done
-        } else {
-            Progress::Running
-        }
+        self.arrival.progress(cell, &self.goal_q)
     }
 }
 

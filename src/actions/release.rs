@@ -17,6 +17,7 @@ pub struct Release {
     target_width: f64,
     retreating: bool,
     goal_q: [f64; 6],
+    arrival: Arrival,
 }
 
 impl Release {
@@ -27,6 +28,7 @@ impl Release {
             target_width: 0.0,
             retreating: false,
             goal_q: [0.0; 6],
+            arrival: Arrival::default(),
         }
     }
 }
@@ -66,10 +68,6 @@ impl MacroAction for Release {
                 }
             }
         }
-        if Arrival::default().reached(cell, &self.goal_q) {
-            Progress::Done
-        } else {
-            Progress::Running
-        }
+        self.arrival.progress(cell, &self.goal_q)
     }
 }

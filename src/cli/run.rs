@@ -81,6 +81,7 @@ impl EpisodeArgs {
             layout,
             seed: self.seed,
             max_sim_time: self.max_sim_time,
+            fault: self.fault,
             ..EpisodeConfig::default()
         })
     }

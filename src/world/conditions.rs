@@ -45,13 +45,15 @@ pub fn cube_lifted(w: &World, min_height: f64) -> bool {
     w.cube_bottom() >= min_height
 }
 
-/// The cube is at rest (speed below `rest_speed`, m/s) inside the bowl: its centre within the
-/// inner footprint and below the rim.
+/// The cube is at rest (speed below `rest_speed`, m/s) inside the bowl, released: its centre
+/// within the inner footprint and below the rim, and no pad touching it (a cube squeezed onto the
+/// rim by a closed gripper is not in the bowl).
 pub fn cube_in_bowl(w: &World, rest_speed: f64) -> bool {
     let d = w.cube_pos - w.bowl_pos;
     let inside = d.x.abs() < w.bowl.inner_half_width && d.y.abs() < w.bowl.inner_half_width;
     let below_rim = w.cube_pos.z < w.bowl.rim_height;
-    inside && below_rim && w.cube_linvel.norm() < rest_speed
+    let released = !(w.left_pad_contact || w.right_pad_contact);
+    inside && below_rim && released && w.cube_linvel.norm() < rest_speed
 }
 
 /// The cube rests on the table (bottom within `max_height` metres of z = 0, at rest), outside the bowl.
@@ -81,15 +83,15 @@ pub fn at_home(w: &World, tolerance: f64) -> bool {
     home_error(w) <= tolerance
 }
 
+/// Hand-built worlds for unit tests.
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests_support {
     use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
-    use super::*;
-    use crate::world::{BowlGeometry, CUBE_HALF};
+    use crate::world::{BowlGeometry, CUBE_HALF, World};
 
     /// A cube resting on the table at (0.45, −0.18), open gripper far above it, bowl at (0.45, 0.08).
-    fn resting() -> World {
+    pub fn resting() -> World {
         World {
             time: 0.0,
             arm_q: [0.0; 6],
@@ -115,7 +117,7 @@ mod tests {
     }
 
     /// The same cube held between the pads 10 cm above the table.
-    fn held() -> World {
+    pub fn held() -> World {
         let mut w = resting();
         w.cube_pos = Vector3::new(0.45, -0.18, 0.10 + CUBE_HALF);
         w.left_pad_pos = Vector3::new(0.45 - CUBE_HALF - 0.004, -0.18, 0.125);
@@ -125,6 +127,15 @@ mod tests {
         w.gripper_width = 2.0 * CUBE_HALF;
         w
     }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{UnitQuaternion, Vector3};
+
+    use super::tests_support::{held, resting};
+    use super::*;
+    use crate::world::CUBE_HALF;
 
     #[test]
     fn grasped_needs_both_pads_and_the_cube_between_them() {
@@ -168,6 +179,13 @@ mod tests {
         let mut above = w.clone();
         above.cube_pos.z = 0.2;
         assert!(!cube_in_bowl(&above, Tolerances::REST_SPEED));
+        let mut squeezed = w.clone();
+        squeezed.left_pad_contact = true;
+        squeezed.right_pad_contact = true;
+        assert!(
+            !cube_in_bowl(&squeezed, Tolerances::REST_SPEED),
+            "a held cube is not in the bowl"
+        );
         let mut on_rim = w.clone();
         on_rim.cube_pos.x = 0.45 + 0.08;
         assert!(!cube_in_bowl(&on_rim, Tolerances::REST_SPEED));

@@ -74,9 +74,16 @@ pub struct World {
 }
 
 impl World {
-    /// Yaw of the cube about world z, folded into [-45°, 45°) (a cube looks the same every 90°), radians.
+    /// Yaw of the cube's side faces about world z, folded into [-45°, 45°) (a cube looks the
+    /// same every 90°), radians. Taken from whichever cube axis lies most horizontal, so it is
+    /// right for a cube resting on any of its faces, not only the one it started on.
     pub fn cube_yaw(&self) -> f64 {
-        fold_quarter_turn(yaw_of(&self.cube_quat))
+        let r = self.cube_quat.to_rotation_matrix();
+        let axis = (0..3)
+            .map(|i| r.matrix().column(i).into_owned())
+            .min_by(|a, b| a.z.abs().total_cmp(&b.z.abs()))
+            .expect("three axes");
+        fold_quarter_turn(axis.y.atan2(axis.x))
     }
 
     /// Horizontal vector from the nearest point of the bowl's footprint to `p` (zero inside it), metres.
@@ -109,6 +116,28 @@ pub fn fold_quarter_turn(a: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn cube_yaw_is_read_from_the_side_faces_whatever_face_it_rests_on() {
+        let mut w = crate::world::conditions::tests_support::resting();
+        for yaw_deg in [-40.0f64, -10.0, 0.0, 20.6, 44.0] {
+            let yaw = yaw_deg.to_radians();
+            // Upright, then tipped onto a side face (90° about its own x or y axis) and turned.
+            for tip in [
+                UnitQuaternion::identity(),
+                UnitQuaternion::from_euler_angles(std::f64::consts::FRAC_PI_2, 0.0, 0.0),
+                UnitQuaternion::from_euler_angles(0.0, std::f64::consts::FRAC_PI_2, 0.0),
+            ] {
+                w.cube_quat = UnitQuaternion::from_euler_angles(0.0, 0.0, yaw) * tip;
+                let got = w.cube_yaw();
+                assert!(
+                    (fold_quarter_turn(got - yaw)).abs() < 1e-9,
+                    "yaw {yaw_deg}°, tip {tip:?}: got {}°",
+                    got.to_degrees()
+                );
+            }
+        }
+    }
 
     #[test]
     fn quarter_turn_folding_stays_in_range() {
