@@ -27,7 +27,7 @@ use std::fmt;
 use nalgebra::{Isometry3, Matrix3, Matrix6, Rotation3, Translation3, UnitQuaternion, Vector3, Vector6};
 
 use super::kinematics::{
-    FOREARM, JOINT_LIMITS, LATERAL_OFFSET, SHOULDER_HEIGHT, TOOL_LENGTH, UPPER_ARM, WRIST_1_TO_2,
+    ARM_JOINTS, FOREARM, JOINT_LIMITS, LATERAL_OFFSET, SHOULDER_HEIGHT, TOOL_LENGTH, UPPER_ARM, WRIST_1_TO_2,
     WRIST_2_TO_3, chain, jacobian_of, rotation_vector,
 };
 
@@ -86,15 +86,6 @@ impl fmt::Display for IkError {
 }
 
 impl std::error::Error for IkError {}
-
-const JOINT_NAMES: [&str; 6] = [
-    "shoulder_pan",
-    "shoulder_lift",
-    "elbow",
-    "wrist_1",
-    "wrist_2",
-    "wrist_3",
-];
 
 /// Wraps `a` into (−π, π].
 #[inline]
@@ -317,7 +308,7 @@ fn solve(
                     limit_note.get_or_insert_with(|| {
                         format!(
                             "{} would need {:.4} rad, outside its range [{}, {}]",
-                            JOINT_NAMES[j], sol[j], JOINT_LIMITS[j].0, JOINT_LIMITS[j].1
+                            ARM_JOINTS[j], sol[j], JOINT_LIMITS[j].0, JOINT_LIMITS[j].1
                         )
                     });
                     continue 'branches;
@@ -353,7 +344,7 @@ fn solve(
             return Err(IkError::JointLimits {
                 reason: format!(
                     "{} at {:.4} rad after polishing, outside its range [{}, {}]",
-                    JOINT_NAMES[j], v, JOINT_LIMITS[j].0, JOINT_LIMITS[j].1
+                    ARM_JOINTS[j], v, JOINT_LIMITS[j].0, JOINT_LIMITS[j].1
                 ),
             });
         }

@@ -41,6 +41,17 @@ pub(crate) const WRIST_1_TO_2: f64 = 0.127;
 /// + base 0.0038 + pinch 0.145), metres.
 pub const TOOL_LENGTH: f64 = 0.1 + 0.007 + 0.0038 + 0.145;
 
+/// Names of the UR5e arm joints, base to wrist (Menagerie names without the `_joint` suffix;
+/// the position actuators carry the same names).
+pub const ARM_JOINTS: [&str; 6] = [
+    "shoulder_pan",
+    "shoulder_lift",
+    "elbow",
+    "wrist_1",
+    "wrist_2",
+    "wrist_3",
+];
+
 /// Joint limits used by IK and trajectories, radians: the position servos' `ctrlrange` in the
 /// Menagerie UR5e (±6.2831 for every joint, ±3.1415 for the elbow), which is a hair inside the
 /// joint `range` (±6.28319, elbow ±3.1415) — so every solution is a command the servos accept

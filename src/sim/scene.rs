@@ -29,15 +29,7 @@ pub fn menagerie_dir() -> PathBuf {
     }
 }
 
-/// Names of the UR5e arm joints (and of their position actuators), base to wrist.
-pub const ARM_JOINTS: [&str; 6] = [
-    "shoulder_pan",
-    "shoulder_lift",
-    "elbow",
-    "wrist_1",
-    "wrist_2",
-    "wrist_3",
-];
+pub use crate::motion::ARM_JOINTS;
 
 /// Indices into the compiled model that the simulator reads every step.
 #[derive(Debug, Clone)]
