@@ -1,0 +1,124 @@
+//! `run --view` and `run --record` through the binary: the live server answers and keeps serving
+//! after the episode, a taken port is a clear error (exit 2), and a replay file is written.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::{TcpListener, TcpStream};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn macrotree() -> Command {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_macrotree"));
+    cmd.current_dir(env!("CARGO_MANIFEST_DIR")).env_remove("RUST_LOG");
+    cmd
+}
+
+/// Kills the child when dropped, so a failing assertion leaves no server behind.
+struct Killed(Child);
+impl Drop for Killed {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn http_get(addr: &str, path: &str) -> String {
+    let mut s = TcpStream::connect(addr).expect("connect to the live view");
+    s.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
+    write!(
+        s,
+        "GET {path} HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n\r\n"
+    )
+    .unwrap();
+    let mut body = Vec::new();
+    let _ = s.read_to_end(&mut body);
+    String::from_utf8_lossy(&body).into_owned()
+}
+
+#[test]
+fn view_serves_the_page_and_keeps_serving_after_the_episode() {
+    let mut child = macrotree()
+        .args(["run", "trees/cube_to_bowl.yaml", "--view", "--port", "0"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start macrotree");
+    let stderr = child.stderr.take().unwrap();
+    let child = Killed(child);
+    let mut lines = BufReader::new(stderr).lines();
+    let mut url = None;
+    let mut over = false;
+    let deadline = Instant::now() + Duration::from_secs(60);
+    // The URL comes first; "episode over; still serving" after the episode.
+    while let Some(Ok(line)) = lines.next() {
+        if url.is_none()
+            && let Some(i) = line.find("http://127.0.0.1:")
+        {
+            url = Some(line[i + 7..].split(['/', ' ']).next().unwrap().to_string());
+        }
+        if line.contains("still serving") {
+            over = true;
+            break;
+        }
+        assert!(Instant::now() < deadline, "no end of episode");
+    }
+    let addr = url.expect("the live view URL is printed");
+    assert!(over, "the episode did not finish");
+    let page = http_get(&addr, "/");
+    assert!(
+        page.starts_with("HTTP/1.1 200"),
+        "{}",
+        &page[..page.len().min(200)]
+    );
+    assert!(page.contains("macrotree"), "not our page");
+    // Still serving: a second request after the episode is answered too.
+    assert!(http_get(&addr, "/").starts_with("HTTP/1.1 200"));
+    drop(child);
+}
+
+#[test]
+fn a_taken_port_exits_2_and_says_what_to_do() {
+    let blocker = TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = blocker.local_addr().unwrap().port().to_string();
+    let out = macrotree()
+        .args(["run", "trees/cube_to_bowl.yaml", "--view", "--port", &port])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("--port"), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
+fn record_writes_a_self_contained_replay() {
+    let dir = std::env::temp_dir().join(format!("macrotree-record-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("episode.html");
+    let out = macrotree()
+        .args([
+            "run",
+            "trees/cube_to_bowl.yaml",
+            "--record",
+            file.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let html = std::fs::read_to_string(&file).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(html.len() < 15_000_000, "replay is {} bytes", html.len());
+    assert!(
+        !html.contains("<script src=\"http"),
+        "the replay must not load anything from the network"
+    );
+    assert!(html.contains("MeshCat"), "the viewer bundle is not inlined");
+    assert!(
+        html.contains("set_animation") || html.contains("animation"),
+        "no animation in the replay"
+    );
+}
