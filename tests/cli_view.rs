@@ -6,6 +6,9 @@ use std::net::{TcpListener, TcpStream};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
+#[path = "support/browser.rs"]
+mod browser;
+
 fn macrotree() -> Command {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_macrotree"));
     cmd.current_dir(env!("CARGO_MANIFEST_DIR")).env_remove("RUST_LOG");
@@ -32,6 +35,72 @@ fn http_get(addr: &str, path: &str) -> String {
     let mut body = Vec::new();
     let _ = s.read_to_end(&mut body);
     String::from_utf8_lossy(&body).into_owned()
+}
+
+/// Starts `run TREE --view --port 0 EXTRA…`; returns the server and its `host:port`.
+fn start_view(extra: &[&str]) -> (Killed, BufReader<std::process::ChildStderr>, String) {
+    let mut child = macrotree()
+        .args(["run", "trees/cube_to_bowl.yaml", "--view", "--port", "0"])
+        .args(extra)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start macrotree");
+    let mut stderr = BufReader::new(child.stderr.take().unwrap());
+    let child = Killed(child);
+    let mut line = String::new();
+    loop {
+        line.clear();
+        assert!(
+            stderr.read_line(&mut line).unwrap() > 0,
+            "macrotree ended without printing the URL"
+        );
+        if let Some(i) = line.find("http://127.0.0.1:") {
+            let addr = line[i + 7..].split(['/', ' ', '\n']).next().unwrap().to_string();
+            return (child, stderr, addr);
+        }
+    }
+}
+
+#[test]
+fn live_page_of_a_real_episode_shows_the_robot_and_the_tree_in_a_browser() {
+    if !browser::browser_available() {
+        return;
+    }
+    // A slowed-down episode, so the browser joins while it runs.
+    let (_server, _stderr, addr) = start_view(&["--speed", "0.5"]);
+    let chromium = browser::Chromium::open(&format!("http://{addr}/"), 1000, 600);
+    let mut dt = chromium.devtools();
+    let deadline = Instant::now() + Duration::from_secs(60);
+    // The tree panel lists the flagship's nodes with live statuses (some running or done).
+    loop {
+        let shown = dt.eval(
+            "JSON.stringify([document.querySelectorAll('#tree .node').length, \
+             document.querySelectorAll('#tree .node.running, #tree .node.success').length, \
+             document.querySelector('#conn').textContent])",
+        );
+        let v: serde_json::Value = serde_json::from_str(shown.as_str().unwrap_or("[]")).unwrap_or_default();
+        if v[0].as_u64().unwrap_or(0) >= 15 && v[1].as_u64().unwrap_or(0) >= 1 && v[2] == "live" {
+            break;
+        }
+        assert!(Instant::now() < deadline, "panel shows {shown}");
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    // The scene (meshes stream in after the page loads) shows the robot, the cube and the bowl.
+    let mut last = None;
+    while Instant::now() < deadline {
+        let png = dt.screenshot();
+        let classes = browser::classify(&browser::decode_png(&png));
+        if classes.robot_dark > 100 && classes.cube > 15 && classes.bowl > 60 && classes.distinct > 30 {
+            if let Some(path) = std::env::var_os("MACROTREE_VIEW_SCREENSHOT") {
+                std::fs::write(path, &png).unwrap();
+            }
+            return;
+        }
+        last = Some(classes);
+        std::thread::sleep(Duration::from_millis(250));
+    }
+    panic!("the scene never showed robot, cube and bowl: {last:?}");
 }
 
 #[test]
