@@ -19,6 +19,8 @@
 //!
 //! Units everywhere: metres, radians, seconds, unless a name says otherwise.
 
+#![warn(missing_docs)]
+
 pub mod actions;
 pub mod cli;
 pub mod episode;

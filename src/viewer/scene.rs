@@ -27,18 +27,48 @@ pub const INFINITE_PLANE: f64 = 10.0;
 #[derive(Debug, Clone, PartialEq)]
 pub enum Shape {
     /// `BoxGeometry`: full extents along x, y, z.
-    Box { width: f64, height: f64, depth: f64 },
+    Box {
+        /// Extent along x, metres.
+        width: f64,
+        /// Extent along y, metres.
+        height: f64,
+        /// Extent along z, metres.
+        depth: f64,
+    },
     /// `SphereGeometry` (also the unit sphere of an ellipsoid).
-    Sphere { radius: f64 },
+    Sphere {
+        /// Radius, metres.
+        radius: f64,
+    },
     /// `CylinderGeometry` along three's Y axis (rotated onto Z by the object matrix).
-    Cylinder { radius: f64, height: f64 },
+    Cylinder {
+        /// Radius, metres.
+        radius: f64,
+        /// Full length, metres.
+        height: f64,
+    },
     /// A capsule along Z, generated as an indexed `BufferGeometry` (three r132 has no
     /// `CapsuleGeometry`).
-    Capsule { radius: f64, half_length: f64 },
+    Capsule {
+        /// Radius, metres.
+        radius: f64,
+        /// Half the length of the cylindrical part, metres.
+        half_length: f64,
+    },
     /// `PlaneGeometry` in the XY plane, normal +Z.
-    Plane { width: f64, height: f64 },
+    Plane {
+        /// Extent along x, metres.
+        width: f64,
+        /// Extent along y, metres.
+        height: f64,
+    },
     /// A triangle mesh: compiled MuJoCo vertices (x, y, z flat) and faces (3 indices each).
-    Mesh { vertices: Vec<f32>, faces: Vec<u32> },
+    Mesh {
+        /// Vertex coordinates, x, y, z per vertex, metres.
+        vertices: Vec<f32>,
+        /// Vertex indices, three per triangle.
+        faces: Vec<u32>,
+    },
 }
 
 /// One drawable geom of the model.
