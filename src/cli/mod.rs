@@ -1,12 +1,16 @@
-//! The `macrotree` command line: `run`, `validate`, `bench` (and more as they land).
+//! The `macrotree` command line: `run`, `validate`, `bench`, `sweep`, and the authoring tools
+//! `schema`, `graph` and `nodes`.
 //!
 //! Exit codes are a contract: 0 = the task succeeded (or the input is valid), 1 = the task
 //! failed, 2 = bad input (unreadable or invalid tree, bad arguments, missing assets).
 
 mod args;
 mod bench;
+mod graph;
 mod logging;
+mod nodes;
 mod run;
+mod schema;
 mod sweep;
 mod validate;
 mod view;
@@ -43,6 +47,12 @@ pub enum Command {
     Bench(bench::BenchArgs),
     /// Run a tree over many seeded random layouts in parallel (optionally with a fault) and summarize.
     Sweep(sweep::SweepArgs),
+    /// Print the JSON Schema of tree files (for editors; same as schema/tree.schema.json).
+    Schema(schema::SchemaArgs),
+    /// Print a tree as a Graphviz DOT or Mermaid diagram.
+    Graph(graph::GraphArgs),
+    /// List the node kinds with their parameters, units, defaults and examples.
+    Nodes(nodes::NodesArgs),
 }
 
 /// A failure that maps to an exit code.
@@ -64,6 +74,9 @@ pub fn main() -> ExitCode {
         Command::Validate(args) => validate::validate(args),
         Command::Bench(args) => bench::bench(args),
         Command::Sweep(args) => sweep::sweep(args),
+        Command::Schema(args) => schema::schema(args),
+        Command::Graph(args) => graph::graph(args),
+        Command::Nodes(args) => nodes::nodes(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -93,4 +106,20 @@ fn load_plan_or_exit(path: &std::path::Path) -> Result<crate::plan::Plan, CliErr
 /// Loads the scene, or returns a bad-input error that says how to get the models.
 fn load_scene_or_exit() -> Result<crate::sim::Scene, CliError> {
     crate::sim::Scene::load().map_err(|e| CliError::Input(format!("error: {e}")))
+}
+
+/// Writes `text` to `out`, or to stdout when `out` is `None`. A closed stdout pipe (`| head`)
+/// ends the output quietly; a file that cannot be written is bad input (exit 2).
+fn write_output(out: Option<&std::path::Path>, text: &str) -> Result<(), CliError> {
+    use std::io::Write as _;
+    match out {
+        None => match std::io::stdout().lock().write_all(text.as_bytes()) {
+            Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+                Err(CliError::Input(format!("error: cannot write to stdout: {e}")))
+            }
+            _ => Ok(()),
+        },
+        Some(path) => std::fs::write(path, text)
+            .map_err(|e| CliError::Input(format!("error: cannot write {}: {e}", path.display()))),
+    }
 }

@@ -38,19 +38,20 @@ pub fn closest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) ->
     if w.chars().count() > 64 {
         return None;
     }
-    let mut best: Option<(usize, &str)> = None;
+    // Ranked by (plausibility, edit distance): a prefix counts as one edit for plausibility, and
+    // the true edit distance breaks ties (`reac` → `reach`, not `reactive_sequence`).
+    let mut best: Option<((usize, usize), &str)> = None;
     for c in candidates {
         let cn = norm(c);
-        let d = if cn == w {
-            0
-        } else if w.len() >= 3 && (cn.starts_with(&w) || w.starts_with(&cn)) {
-            1
+        let ed = edit_distance(&w, &cn);
+        let d = if w.len() >= 3 && (cn.starts_with(&w) || w.starts_with(&cn)) {
+            ed.min(1)
         } else {
-            edit_distance(&w, &cn)
+            ed
         };
         let limit = (w.chars().count().max(cn.chars().count()) / 3).max(1);
-        if d <= limit && best.is_none_or(|(bd, _)| d < bd) {
-            best = Some((d, c));
+        if d <= limit && best.is_none_or(|(bd, _)| (d, ed) < bd) {
+            best = Some(((d, ed), c));
         }
     }
     best.map(|(_, c)| c)
@@ -77,6 +78,9 @@ mod tests {
     fn suggestions() {
         let kinds = ["sequence", "fallback", "reactive_sequence", "retry", "reach"];
         assert_eq!(closest("sequnce", kinds), Some("sequence"));
+        // Regression: a prefix of several kinds suggested the first, not the nearest.
+        assert_eq!(closest("reac", kinds), Some("reach"));
+        assert_eq!(closest("reactive", kinds), Some("reactive_sequence"));
         assert_eq!(closest("reactive-sequence", kinds), Some("reactive_sequence"));
         assert_eq!(closest("retyr", kinds), Some("retry"));
         assert_eq!(closest("banana", kinds), None);
