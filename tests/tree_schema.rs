@@ -69,3 +69,29 @@ fn catalog_documents_every_node() {
     assert_eq!(lift.default.as_deref(), Some("0.2"));
     assert!(lift.doc.contains("metres"));
 }
+
+#[test]
+fn docs_nodes_holds_one_file_per_kind_and_nothing_else() {
+    let mut files: Vec<String> = std::fs::read_dir("docs/nodes")
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    files.sort();
+    let mut expected: Vec<String> = catalog().iter().map(|d| format!("{}.md", d.kind)).collect();
+    expected.sort();
+    assert_eq!(
+        files, expected,
+        "docs/nodes/ must hold exactly one file per node kind"
+    );
+}
+
+#[test]
+fn node_doc_parts_are_read_from_the_markdown() {
+    let (summary, details, halt, example) = macrotree::spec::catalog::parse_node_doc(
+        "Do a thing\nin two lines.\n\nMore about it.\n\nHalt: it stops.\n\n```yaml\nthing: {}\n```\n",
+    );
+    assert_eq!(summary, "Do a thing in two lines.");
+    assert_eq!(details, "More about it.");
+    assert_eq!(halt, "it stops");
+    assert_eq!(example, "thing: {}");
+}

@@ -337,3 +337,27 @@ fn regression_non_finite_numbers_reach_the_parameter_check() {
     let e = find(&d, "must be a finite number");
     assert_eq!(at(e), (1, 27));
 }
+
+#[test]
+fn condition_tolerances_are_overridable_and_checked() {
+    use macrotree::spec::ConditionLeaf;
+    let yaml = "main:\n  sequence:\n    children:\n      - cube_grasped: {off_axis: 0.01}\n      - cube_in_bowl: {rest_speed: 0.02}\n      - cube_in_bowl: {}\n";
+    let plan = compile_str(yaml, "t.yaml").unwrap();
+    let conds: Vec<&ConditionLeaf> = plan
+        .leaves
+        .iter()
+        .filter_map(|l| match &l.kind {
+            Leaf::Condition(c) => Some(c),
+            _ => None,
+        })
+        .collect();
+    assert!(matches!(conds[0], ConditionLeaf::CubeGrasped(c) if c.off_axis == 0.01));
+    assert!(matches!(conds[1], ConditionLeaf::CubeInBowl(c) if c.rest_speed == 0.02));
+    // Omitted tolerances are the condition module's defaults.
+    let default = macrotree::world::conditions::Tolerances::REST_SPEED;
+    assert!(matches!(conds[2], ConditionLeaf::CubeInBowl(c) if c.rest_speed == default));
+
+    let diags = errors("main:\n  cube_in_bowl: {rest_speed: 0}\n");
+    let d = find(&diags, "speed");
+    assert_eq!(at(d), (2, 30), "{d}");
+}

@@ -93,12 +93,10 @@ impl<'a> MacroDriver<'a> {
     fn condition(&self, leaf: &ConditionLeaf) -> bool {
         let w = self.cell.world();
         match leaf {
-            ConditionLeaf::CubeGrasped(_) => cond::cube_grasped(w, cond::Tolerances::GRASP_OFF_AXIS),
+            ConditionLeaf::CubeGrasped(c) => cond::cube_grasped(w, c.off_axis),
             ConditionLeaf::CubeLifted(c) => cond::cube_lifted(w, c.min_height),
-            ConditionLeaf::CubeInBowl(_) => cond::cube_in_bowl(w, cond::Tolerances::REST_SPEED),
-            ConditionLeaf::CubeOnTable(c) => {
-                cond::cube_on_table(w, c.tolerance, cond::Tolerances::REST_SPEED)
-            }
+            ConditionLeaf::CubeInBowl(c) => cond::cube_in_bowl(w, c.rest_speed),
+            ConditionLeaf::CubeOnTable(c) => cond::cube_on_table(w, c.tolerance, c.rest_speed),
             ConditionLeaf::GripperOpen(c) => cond::gripper_open(w, c.min_width),
             ConditionLeaf::AtHome(c) => cond::at_home(w, c.tolerance),
         }

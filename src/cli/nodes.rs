@@ -59,6 +59,11 @@ pub fn render(docs: &[&NodeDoc]) -> String {
         let _ = writeln!(out, "{}", heading(category));
         for d in group {
             let _ = writeln!(out, "\n  {} — {}", d.kind, d.summary);
+            for paragraph in d.details.lines() {
+                for line in wrap(paragraph, 90) {
+                    let _ = writeln!(out, "      {line}");
+                }
+            }
             let width = d.params.iter().map(|p| p.name.len()).max().unwrap_or(0);
             for p in &d.params {
                 let when = match (&p.default, p.required) {
@@ -86,4 +91,23 @@ fn heading(category: &str) -> &'static str {
         "runtime" => "RUNTIME LEAVES (handled by the tree runtime)",
         _ => "CONDITIONS (instantaneous checks of the world)",
     }
+}
+
+/// Greedy word wrap to lines of at most `width` characters (a longer word gets a line).
+fn wrap(text: &str, width: usize) -> Vec<String> {
+    let mut lines = vec![];
+    let mut line = String::new();
+    for word in text.split_whitespace() {
+        if !line.is_empty() && line.chars().count() + 1 + word.chars().count() > width {
+            lines.push(std::mem::take(&mut line));
+        }
+        if !line.is_empty() {
+            line.push(' ');
+        }
+        line.push_str(word);
+    }
+    if !line.is_empty() {
+        lines.push(line);
+    }
+    lines
 }

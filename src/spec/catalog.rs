@@ -34,7 +34,9 @@ pub struct NodeDoc {
     /// `composite`, `decorator`, `action`, `condition` or `runtime` (handled by the runtime).
     pub category: &'static str,
     /// One-line description.
-    pub summary: &'static str,
+    pub summary: String,
+    /// Further semantics (may be empty), one paragraph per line.
+    pub details: String,
     /// What happens when the node is halted.
     pub halt: &'static str,
     /// Parameters (`name` is accepted by every node and not listed).
@@ -43,209 +45,135 @@ pub struct NodeDoc {
     pub example: &'static str,
 }
 
-struct Static {
-    kind: &'static str,
-    category: &'static str,
-    summary: &'static str,
-    halt: &'static str,
-    example: &'static str,
-}
-
-const HALT_CHILD: &str = "its running child is halted";
-const HALT_ARM: &str = "the driver stops the arm where it is (holds position)";
-const HALT_NONE: &str = "nothing to halt (instantaneous)";
-
-const STATIC: &[Static] = &[
-    Static {
-        kind: "sequence",
-        category: "composite",
-        summary: "Tick children in order with memory; fail on the first failure, succeed when all succeed.",
-        halt: HALT_CHILD,
-        example: "sequence: {children: [{home: {}}, {grasp: {}}]}",
-    },
-    Static {
-        kind: "fallback",
-        category: "composite",
-        summary: "Tick children in order with memory; succeed on the first success, fail when all fail.",
-        halt: HALT_CHILD,
-        example: "fallback: {children: [{cube_in_bowl: {}}, {subtree: {ref: place}}]}",
-    },
-    Static {
-        kind: "reactive_sequence",
-        category: "composite",
-        summary: "Re-check the leading conditions every tick while the last child runs; a failing condition halts it (Failure).",
-        halt: HALT_CHILD,
-        example: "reactive_sequence: {children: [{cube_grasped: {}}, {carry: {}}]}",
-    },
-    Static {
-        kind: "reactive_fallback",
-        category: "composite",
-        summary: "Re-check the leading conditions every tick while the last child runs; a succeeding condition halts it (Success).",
-        halt: HALT_CHILD,
-        example: "reactive_fallback: {children: [{cube_in_bowl: {}}, {carry: {}}]}",
-    },
-    Static {
-        kind: "parallel",
-        category: "composite",
-        summary: "Tick all children every tick; Success when all succeed, Failure (halting the others) when one fails.",
-        halt: "all running children are halted",
-        example: "parallel: {children: [{home: {}}, {release: {retreat: 0}}]}",
-    },
-    Static {
-        kind: "race",
-        category: "composite",
-        summary: "Tick all children every tick; the first to finish decides, the others are halted.",
-        halt: "all running children are halted",
-        example: "race: {children: [{carry: {}}, {wait: {seconds: 8}}]}",
-    },
-    Static {
-        kind: "guard",
-        category: "decorator",
-        summary: "Run the child only while the condition holds (checked every tick first); a failing condition halts it (Failure).",
-        halt: HALT_CHILD,
-        example: "guard: {condition: {cube_grasped: {}}, child: {carry: {to: bowl}}}",
-    },
-    Static {
-        kind: "retry",
-        category: "decorator",
-        summary: "Re-run a failing child, up to `attempts` runs; each new attempt starts on the next tick.",
-        halt: "the running attempt is halted; the attempt count restarts at 1",
-        example: "retry: {attempts: 3, child: {subtree: {ref: pick}}}",
-    },
-    Static {
-        kind: "repeat",
-        category: "decorator",
-        summary: "Run the child `times` times in a row (next run on the next tick); a failure fails the repeat.",
-        halt: HALT_CHILD,
-        example: "repeat: {times: 2, child: {subtree: {ref: wiggle}}}",
-    },
-    Static {
-        kind: "timeout",
-        category: "decorator",
-        summary: "Fail (halting the child) after `seconds` of simulated time running.",
-        halt: HALT_CHILD,
-        example: "timeout: {seconds: 20, child: {subtree: {ref: pick}}}",
-    },
-    Static {
-        kind: "inverter",
-        category: "decorator",
-        summary: "Swap Success and Failure.",
-        halt: HALT_CHILD,
-        example: "inverter: {child: {cube_on_table: {}}}",
-    },
-    Static {
-        kind: "force_success",
-        category: "decorator",
-        summary: "Turn Failure into Success.",
-        halt: HALT_CHILD,
-        example: "force_success: {child: {release: {}}}",
-    },
-    Static {
-        kind: "force_failure",
-        category: "decorator",
-        summary: "Turn Success into Failure.",
-        halt: HALT_CHILD,
-        example: "force_failure: {child: {home: {}}}",
-    },
-    Static {
-        kind: "subtree",
-        category: "decorator",
-        summary: "Expand a named subtree in place, substituting `$param`s with `args` (or defaults).",
-        halt: "the running body is halted",
-        example: "subtree: {ref: pick, args: {approach: 0.12}}",
-    },
-    Static {
-        kind: "reach",
-        category: "action",
-        summary: "Move the tool to a target (cube, bowl or point) plus an offset.",
-        halt: HALT_ARM,
-        example: "reach: {target: cube, offset: [0, 0, 0.15]}",
-    },
-    Static {
-        kind: "move_joints",
-        category: "action",
-        summary: "Move the arm to six joint angles.",
-        halt: HALT_ARM,
-        example: "move_joints: {joints: [0, deg(-90), deg(90), deg(-90), deg(-90), 0]}",
-    },
-    Static {
-        kind: "home",
-        category: "action",
-        summary: "Move the arm to its home pose.",
-        halt: HALT_ARM,
-        example: "home: {}",
-    },
-    Static {
-        kind: "grasp",
-        category: "action",
-        summary: "Close the gripper to a width or until contact/stall.",
-        halt: "the driver stops closing (keeps the current opening)",
-        example: "grasp: {}",
-    },
-    Static {
-        kind: "carry",
-        category: "action",
-        summary: "Lift the held cube, move it above the target and lower it to `place_height`.",
-        halt: "the driver stops the arm where it is (gripper stays closed)",
-        example: "carry: {to: bowl, lift: 0.2}",
-    },
-    Static {
-        kind: "release",
-        category: "action",
-        summary: "Open the gripper and retreat straight up.",
-        halt: HALT_ARM,
-        example: "release: {retreat: 0.1}",
-    },
-    Static {
-        kind: "wait",
-        category: "runtime",
-        summary: "Wait for simulated seconds (handled by the runtime, never reaches the driver).",
-        halt: "nothing to stop; the next run starts from 0",
-        example: "wait: {seconds: 0.5}",
-    },
-    Static {
-        kind: "cube_grasped",
-        category: "condition",
-        summary: "Both finger pads touch the cube.",
-        halt: HALT_NONE,
-        example: "cube_grasped: {}",
-    },
-    Static {
-        kind: "cube_lifted",
-        category: "condition",
-        summary: "The cube's bottom is at least `min_height` above the table.",
-        halt: HALT_NONE,
-        example: "cube_lifted: {min_height: 0.05}",
-    },
-    Static {
-        kind: "cube_in_bowl",
-        category: "condition",
-        summary: "The cube rests inside the bowl.",
-        halt: HALT_NONE,
-        example: "cube_in_bowl: {}",
-    },
-    Static {
-        kind: "cube_on_table",
-        category: "condition",
-        summary: "The cube rests on the table.",
-        halt: HALT_NONE,
-        example: "cube_on_table: {}",
-    },
-    Static {
-        kind: "gripper_open",
-        category: "condition",
-        summary: "The gripper is open at least `min_width`.",
-        halt: HALT_NONE,
-        example: "gripper_open: {min_width: 0.08}",
-    },
-    Static {
-        kind: "at_home",
-        category: "condition",
-        summary: "Every joint is within `tolerance` of the home pose.",
-        halt: HALT_NONE,
-        example: "at_home: {tolerance: deg(2)}",
-    },
+/// The documentation of every node kind, one Markdown file each under `docs/nodes/`: the same
+/// text is the rustdoc of the node's variant or parameter struct (`#[doc = include_str!(…)]`).
+/// Each file is a one-line summary paragraph, optional details, a `Halt: …` paragraph and a
+/// ```` ```yaml ```` example; [`parse_node_doc`] reads them.
+const NODE_DOCS: &[(&str, &str, &str)] = &[
+    (
+        "sequence",
+        "composite",
+        include_str!("../../docs/nodes/sequence.md"),
+    ),
+    (
+        "fallback",
+        "composite",
+        include_str!("../../docs/nodes/fallback.md"),
+    ),
+    (
+        "reactive_sequence",
+        "composite",
+        include_str!("../../docs/nodes/reactive_sequence.md"),
+    ),
+    (
+        "reactive_fallback",
+        "composite",
+        include_str!("../../docs/nodes/reactive_fallback.md"),
+    ),
+    (
+        "parallel",
+        "composite",
+        include_str!("../../docs/nodes/parallel.md"),
+    ),
+    ("race", "composite", include_str!("../../docs/nodes/race.md")),
+    ("guard", "decorator", include_str!("../../docs/nodes/guard.md")),
+    ("retry", "decorator", include_str!("../../docs/nodes/retry.md")),
+    ("repeat", "decorator", include_str!("../../docs/nodes/repeat.md")),
+    (
+        "timeout",
+        "decorator",
+        include_str!("../../docs/nodes/timeout.md"),
+    ),
+    (
+        "inverter",
+        "decorator",
+        include_str!("../../docs/nodes/inverter.md"),
+    ),
+    (
+        "force_success",
+        "decorator",
+        include_str!("../../docs/nodes/force_success.md"),
+    ),
+    (
+        "force_failure",
+        "decorator",
+        include_str!("../../docs/nodes/force_failure.md"),
+    ),
+    (
+        "subtree",
+        "decorator",
+        include_str!("../../docs/nodes/subtree.md"),
+    ),
+    ("reach", "action", include_str!("../../docs/nodes/reach.md")),
+    (
+        "move_joints",
+        "action",
+        include_str!("../../docs/nodes/move_joints.md"),
+    ),
+    ("home", "action", include_str!("../../docs/nodes/home.md")),
+    ("grasp", "action", include_str!("../../docs/nodes/grasp.md")),
+    ("carry", "action", include_str!("../../docs/nodes/carry.md")),
+    ("release", "action", include_str!("../../docs/nodes/release.md")),
+    ("wait", "runtime", include_str!("../../docs/nodes/wait.md")),
+    (
+        "cube_grasped",
+        "condition",
+        include_str!("../../docs/nodes/cube_grasped.md"),
+    ),
+    (
+        "cube_lifted",
+        "condition",
+        include_str!("../../docs/nodes/cube_lifted.md"),
+    ),
+    (
+        "cube_in_bowl",
+        "condition",
+        include_str!("../../docs/nodes/cube_in_bowl.md"),
+    ),
+    (
+        "cube_on_table",
+        "condition",
+        include_str!("../../docs/nodes/cube_on_table.md"),
+    ),
+    (
+        "gripper_open",
+        "condition",
+        include_str!("../../docs/nodes/gripper_open.md"),
+    ),
+    (
+        "at_home",
+        "condition",
+        include_str!("../../docs/nodes/at_home.md"),
+    ),
 ];
+
+/// The parts of a node's documentation file: (summary, details, halt, example).
+///
+/// The summary is the first paragraph, the halt text follows `Halt: ` (without the final
+/// period), the example is the body of the first ```` ```yaml ```` block, and the details are
+/// the paragraphs in between. Missing parts are empty strings (a test requires all of them).
+pub fn parse_node_doc(text: &'static str) -> (String, String, &'static str, &'static str) {
+    let (prose, example) = match text.split_once("```yaml\n") {
+        Some((prose, rest)) => (prose, rest.split("```").next().unwrap_or("").trim_end()),
+        None => (text, ""),
+    };
+    let paragraphs: Vec<&str> = prose
+        .split("\n\n")
+        .map(str::trim)
+        .filter(|p| !p.is_empty())
+        .collect();
+    let one_line = |p: &str| p.split_whitespace().collect::<Vec<_>>().join(" ");
+    let summary = paragraphs.first().map(|p| one_line(p)).unwrap_or_default();
+    let mut halt = "";
+    let mut details = vec![];
+    for p in paragraphs.iter().skip(1) {
+        match p.strip_prefix("Halt: ") {
+            Some(h) => halt = h.trim_end_matches('.'),
+            None => details.push(one_line(p)),
+        }
+    }
+    (summary, details.join("\n"), halt, example)
+}
 
 fn p(name: &str, ty: &str, required: bool, default: Option<&str>, doc: &str) -> ParamDoc {
     ParamDoc {
@@ -343,10 +271,10 @@ pub fn catalog() -> Vec<NodeDoc> {
     let mut g = generator();
     let leaves = leaf_schemas(&mut g);
     let defs = g.take_definitions(true);
-    STATIC
+    NODE_DOCS
         .iter()
-        .map(|s| {
-            let params = match s.kind {
+        .map(|&(kind, category, text)| {
+            let params = match kind {
                 "sequence" | "fallback" | "reactive_sequence" | "reactive_fallback" | "parallel" | "race" => {
                     vec![p(
                         "children",
@@ -410,13 +338,15 @@ pub fn catalog() -> Vec<NodeDoc> {
                     .map(params_from_schema)
                     .unwrap_or_default(),
             };
+            let (summary, details, halt, example) = parse_node_doc(text);
             NodeDoc {
-                kind: s.kind,
-                category: s.category,
-                summary: s.summary,
-                halt: s.halt,
+                kind,
+                category,
+                summary,
+                details,
+                halt,
                 params,
-                example: s.example,
+                example,
             }
         })
         .collect()
@@ -475,8 +405,9 @@ pub fn json_schema() -> Value {
             props["name"] = json!({"$ref": "#/$defs/NodeName"});
             json!({"type": "object", "properties": props, "required": required, "additionalProperties": false})
         };
-        for s in STATIC {
-            let b = match s.kind {
+        for &(kind, category, text) in NODE_DOCS {
+            let (summary, details, halt, example) = parse_node_doc(text);
+            let b = match kind {
                 "sequence" | "fallback" | "reactive_sequence" | "reactive_fallback" | "parallel" | "race" => {
                     body(
                         json!({"children": {"type": "array", "items": node_ref, "minItems": 1}}),
@@ -533,14 +464,20 @@ pub fn json_schema() -> Value {
                     }
                 }
             };
+            let description = [summary, details.replace('\n', " "), format!("Halt: {halt}.")]
+                .into_iter()
+                .filter(|part| !part.is_empty())
+                .chain([format!("Example: `{example}`")])
+                .collect::<Vec<_>>()
+                .join(" ");
             let variant = json!({
                 "type": "object",
-                "description": format!("{} Halt: {}. Example: `{}`", s.summary, s.halt, s.example),
-                "properties": {s.kind: b},
-                "required": [s.kind],
+                "description": description,
+                "properties": {kind: b},
+                "required": [kind],
                 "additionalProperties": false,
             });
-            if s.category == "condition" {
+            if category == "condition" {
                 cond_variants.push(variant.clone());
             }
             variants.push(variant);

@@ -192,7 +192,7 @@ impl<'a> Expander<'a> {
                     issue.message = format!("{} in `{k}`", issue.message);
                     if issue.help.is_none() {
                         issue.help = Some(format!(
-                            "see `{k}` in docs/tree_format.md (or `macrotree nodes`) for its parameters and units"
+                            "see `macrotree nodes {k}` (or docs/nodes/{k}.md) for its parameters and units"
                         ));
                     }
                     self.err(issue);

@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 use schemars::JsonSchema;
 
 use super::units::{self, PathKind, Target, Yaw};
+use crate::world::conditions::Tolerances;
 
 fn d_zero3() -> [f64; 3] {
     [0.0, 0.0, 0.0]
@@ -44,28 +45,27 @@ fn d_place_height() -> f64 {
 fn d_retreat() -> f64 {
     0.10
 }
+// Condition defaults live with the conditions, in `world::Tolerances`.
 fn d_min_height() -> f64 {
-    0.03
+    Tolerances::LIFT_HEIGHT
 }
 fn d_min_width() -> f64 {
-    0.08
+    Tolerances::OPEN_WIDTH
 }
 fn d_home_tol() -> f64 {
-    0.04
+    Tolerances::HOME_TOLERANCE
 }
 fn d_table_tol() -> f64 {
-    0.01
+    Tolerances::ON_TABLE_HEIGHT
+}
+fn d_off_axis() -> f64 {
+    Tolerances::GRASP_OFF_AXIS
+}
+fn d_rest_speed() -> f64 {
+    Tolerances::REST_SPEED
 }
 
-/// Move the tool to a target (plus an offset), e.g. above the cube (pre-grasp) or down onto it.
-///
-/// Succeeds when the tool is at the goal pose; fails if the goal is unreachable (IK) or the
-/// leaf's `timeout` expires. Halt: the driver stops the arm where it is (holds position).
-///
-/// ```yaml
-/// - reach: {target: cube, offset: [0, 0, 0.15]}                  # pre-grasp, 15 cm above
-/// - reach: {target: cube, offset: [0, 0, 0.0], path: cartesian}  # straight down onto it
-/// ```
+#[doc = include_str!("../../docs/nodes/reach.md")]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Reach {
@@ -91,13 +91,7 @@ pub struct Reach {
     pub timeout: f64,
 }
 
-/// Move the arm to six joint angles (radians, or `deg(..)`), shoulder pan first.
-///
-/// Halt: the driver stops the arm where it is.
-///
-/// ```yaml
-/// - move_joints: {joints: [0, deg(-90), deg(90), deg(-90), deg(-90), 0]}
-/// ```
+#[doc = include_str!("../../docs/nodes/move_joints.md")]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MoveJoints {
@@ -111,13 +105,7 @@ pub struct MoveJoints {
     pub timeout: f64,
 }
 
-/// Move the arm to its named home pose (joint space).
-///
-/// Halt: the driver stops the arm where it is.
-///
-/// ```yaml
-/// - home: {}
-/// ```
+#[doc = include_str!("../../docs/nodes/home.md")]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Home {
@@ -133,15 +121,7 @@ impl Default for Home {
     }
 }
 
-/// Close the gripper. Succeeds when it has closed to `width` or stalled on contact; whether the
-/// cube is actually held is a separate check (`cube_grasped`).
-///
-/// Halt: the driver stops closing the fingers (keeps the current opening).
-///
-/// ```yaml
-/// - grasp: {}              # close until contact/stall
-/// - grasp: {width: 0.045}  # close to 45 mm pad-to-pad
-/// ```
+#[doc = include_str!("../../docs/nodes/grasp.md")]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Grasp {
@@ -164,15 +144,7 @@ impl Default for Grasp {
     }
 }
 
-/// Carry the held cube: lift it, transfer it above `to`, and lower it until its bottom is
-/// `place_height` above the target (without opening the gripper).
-///
-/// Put it under `guard: {condition: {cube_grasped: {}}, ...}` so a slip aborts the carry.
-/// Halt: the driver stops the arm where it is (the gripper stays closed).
-///
-/// ```yaml
-/// - carry: {to: bowl, lift: 0.2, place_height: 0.03}
-/// ```
+#[doc = include_str!("../../docs/nodes/carry.md")]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Carry {
@@ -197,17 +169,7 @@ pub struct Carry {
     pub timeout: f64,
 }
 
-/// Open the gripper (fully, or to `width`), then retreat straight up by `retreat`.
-///
-/// With `width` it also pre-shapes the hand before a grasp: a 65 mm opening clears a 44 mm cube
-/// by about 1 cm a side while keeping the fingertips away from a nearby bowl wall.
-///
-/// Halt: the driver stops the arm; the gripper keeps its current command.
-///
-/// ```yaml
-/// - release: {retreat: 0.1}
-/// - release: {width: 0.065, retreat: 0}
-/// ```
+#[doc = include_str!("../../docs/nodes/release.md")]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Release {
@@ -225,15 +187,7 @@ pub struct Release {
     pub timeout: f64,
 }
 
-/// Wait for a number of simulated seconds. Handled by the runtime (never reaches the driver):
-/// Running until the accumulated `dt` reaches `seconds`, then Success, passing the unused part of
-/// the tick on (bonsai's leftover-dt rule).
-///
-/// Halt: nothing to do (the elapsed time restarts at 0 on the next execution).
-///
-/// ```yaml
-/// - wait: {seconds: 0.5}
-/// ```
+#[doc = include_str!("../../docs/nodes/wait.md")]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Wait {
@@ -243,20 +197,26 @@ pub struct Wait {
     pub seconds: f64,
 }
 
-/// Condition: both finger pads touch the cube (it is held). Success or Failure, never Running.
-///
-/// ```yaml
-/// - cube_grasped: {}
-/// ```
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema, Default)]
+#[doc = include_str!("../../docs/nodes/cube_grasped.md")]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
-pub struct CubeGrasped {}
+pub struct CubeGrasped {
+    /// Largest distance of the cube's centre from the line between the pad centres, metres
+    /// (≥ 0). Default 0.03.
+    #[serde(default = "d_off_axis", deserialize_with = "units::distance")]
+    #[schemars(range(min = 0.0))]
+    pub off_axis: f64,
+}
 
-/// Condition: the cube's bottom is at least `min_height` above the table.
-///
-/// ```yaml
-/// - cube_lifted: {min_height: 0.05}
-/// ```
+impl Default for CubeGrasped {
+    fn default() -> Self {
+        Self {
+            off_axis: d_off_axis(),
+        }
+    }
+}
+
+#[doc = include_str!("../../docs/nodes/cube_lifted.md")]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CubeLifted {
@@ -268,24 +228,31 @@ pub struct CubeLifted {
 
 impl Default for CubeLifted {
     fn default() -> Self {
-        Self { min_height: 0.03 }
+        Self {
+            min_height: d_min_height(),
+        }
     }
 }
 
-/// Condition: the cube rests inside the bowl (inside its rim, not held).
-///
-/// ```yaml
-/// - cube_in_bowl: {}
-/// ```
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema, Default)]
+#[doc = include_str!("../../docs/nodes/cube_in_bowl.md")]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
-pub struct CubeInBowl {}
+pub struct CubeInBowl {
+    /// Cube speed below which it counts as at rest, m/s (> 0). Default 0.05.
+    #[serde(default = "d_rest_speed", deserialize_with = "units::speed")]
+    #[schemars(range(min = 0.0))]
+    pub rest_speed: f64,
+}
 
-/// Condition: the cube rests on the table (its bottom within `tolerance` of the table top).
-///
-/// ```yaml
-/// - cube_on_table: {}
-/// ```
+impl Default for CubeInBowl {
+    fn default() -> Self {
+        Self {
+            rest_speed: d_rest_speed(),
+        }
+    }
+}
+
+#[doc = include_str!("../../docs/nodes/cube_on_table.md")]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CubeOnTable {
@@ -293,19 +260,22 @@ pub struct CubeOnTable {
     #[serde(default = "d_table_tol", deserialize_with = "units::distance")]
     #[schemars(range(min = 0.0))]
     pub tolerance: f64,
+    /// Cube speed below which it counts as at rest, m/s (> 0). Default 0.05.
+    #[serde(default = "d_rest_speed", deserialize_with = "units::speed")]
+    #[schemars(range(min = 0.0))]
+    pub rest_speed: f64,
 }
 
 impl Default for CubeOnTable {
     fn default() -> Self {
-        Self { tolerance: 0.01 }
+        Self {
+            tolerance: d_table_tol(),
+            rest_speed: d_rest_speed(),
+        }
     }
 }
 
-/// Condition: the gripper is open at least `min_width` (pad-to-pad).
-///
-/// ```yaml
-/// - gripper_open: {min_width: 0.08}
-/// ```
+#[doc = include_str!("../../docs/nodes/gripper_open.md")]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GripperOpen {
@@ -317,19 +287,18 @@ pub struct GripperOpen {
 
 impl Default for GripperOpen {
     fn default() -> Self {
-        Self { min_width: 0.08 }
+        Self {
+            min_width: d_min_width(),
+        }
     }
 }
 
-/// Condition: every arm joint is within `tolerance` of the home pose.
-///
-/// ```yaml
-/// - at_home: {tolerance: deg(2)}
-/// ```
+#[doc = include_str!("../../docs/nodes/at_home.md")]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct AtHome {
-    /// Per-joint tolerance, radians (≥ 0; `deg(..)` accepted). Default 0.04.
+    /// Joint-space distance to home (Euclidean norm over the six joints), radians (≥ 0;
+    /// `deg(..)` accepted). Default 0.04.
     #[serde(default = "d_home_tol", deserialize_with = "units::angle_tolerance")]
     #[schemars(with = "units::Angle")]
     pub tolerance: f64,
@@ -337,7 +306,9 @@ pub struct AtHome {
 
 impl Default for AtHome {
     fn default() -> Self {
-        Self { tolerance: 0.04 }
+        Self {
+            tolerance: d_home_tol(),
+        }
     }
 }
 

@@ -18,63 +18,53 @@ pub struct Node {
 /// the one-line summary is on each variant.
 #[derive(Clone, Debug, PartialEq)]
 pub enum NodeKind {
-    /// `sequence` — ticks children in order and remembers progress; fails on the first failure,
-    /// succeeds when all succeed (bonsai `Sequence`).
+    #[doc = include_str!("../../docs/nodes/sequence.md")]
     Sequence(Vec<Node>),
-    /// `fallback` — ticks children in order and remembers progress; succeeds on the first
-    /// success, fails when all fail (bonsai `Select`).
+    #[doc = include_str!("../../docs/nodes/fallback.md")]
     Fallback(Vec<Node>),
-    /// `reactive_sequence` — re-checks its leading conditions every tick while the last child
-    /// runs; a condition failing preempts (halts) the running child → Failure.
+    #[doc = include_str!("../../docs/nodes/reactive_sequence.md")]
     ReactiveSequence(Vec<Node>),
-    /// `reactive_fallback` — re-checks its leading conditions every tick while the last child
-    /// runs; a condition succeeding preempts (halts) the running child → Success.
+    #[doc = include_str!("../../docs/nodes/reactive_fallback.md")]
     ReactiveFallback(Vec<Node>),
-    /// `parallel` — ticks all children every tick; Success when all succeeded, Failure as soon as
-    /// one fails (the others are halted) (bonsai `WhenAll`).
+    #[doc = include_str!("../../docs/nodes/parallel.md")]
     Parallel(Vec<Node>),
-    /// `race` — ticks all children every tick; the first to finish decides (Success or Failure),
-    /// the others are halted (bonsai `Race`).
+    #[doc = include_str!("../../docs/nodes/race.md")]
     Race(Vec<Node>),
-    /// `guard` — runs `child` only while `condition` holds; checked every tick before the child;
-    /// when it fails the child is halted → Failure.
+    #[doc = include_str!("../../docs/nodes/guard.md")]
     Guard {
         /// A condition leaf (or an `inverter` of one).
         condition: Box<Node>,
         /// The guarded node.
         child: Box<Node>,
     },
-    /// `retry` — re-runs a failing child, up to `attempts` runs in total; the next attempt
-    /// starts on the next tick.
+    #[doc = include_str!("../../docs/nodes/retry.md")]
     Retry {
         /// Total number of runs allowed (≥ 1).
         attempts: u32,
         /// The node to retry.
         child: Box<Node>,
     },
-    /// `repeat` — runs the child `times` times in a row while it succeeds (a failure fails the
-    /// repeat); the next run starts on the next tick.
+    #[doc = include_str!("../../docs/nodes/repeat.md")]
     Repeat {
         /// Number of successful runs required (≥ 1).
         times: u32,
         /// The node to repeat.
         child: Box<Node>,
     },
-    /// `timeout` — fails (halting the child) when the child has been running for `seconds` of
-    /// simulated time (bonsai `Timeout`).
+    #[doc = include_str!("../../docs/nodes/timeout.md")]
     Timeout {
         /// Simulated seconds (> 0).
         seconds: f64,
         /// The node to time-limit.
         child: Box<Node>,
     },
-    /// `inverter` — swaps Success and Failure.
+    #[doc = include_str!("../../docs/nodes/inverter.md")]
     Inverter(Box<Node>),
-    /// `force_success` — turns Failure into Success.
+    #[doc = include_str!("../../docs/nodes/force_success.md")]
     ForceSuccess(Box<Node>),
-    /// `force_failure` — turns Success into Failure.
+    #[doc = include_str!("../../docs/nodes/force_failure.md")]
     ForceFailure(Box<Node>),
-    /// `subtree` — a call of a named subtree, expanded in place (arguments substituted).
+    #[doc = include_str!("../../docs/nodes/subtree.md")]
     Subtree {
         /// The subtree's name (`ref:`).
         reference: String,

@@ -16,11 +16,11 @@ impl Tolerances {
     /// Largest distance of the cube centre from the line between the pad centres, metres.
     pub const GRASP_OFF_AXIS: f64 = 0.03;
     /// Gripper opening that counts as open, metres.
-    pub const OPEN_WIDTH: f64 = 0.07;
+    pub const OPEN_WIDTH: f64 = 0.08;
     /// Joint-space distance to home that counts as at home (Euclidean norm), radians.
     pub const HOME_TOLERANCE: f64 = 0.04;
     /// Cube bottom height above the table that still counts as resting on it, metres.
-    pub const ON_TABLE_HEIGHT: f64 = 0.005;
+    pub const ON_TABLE_HEIGHT: f64 = 0.01;
 }
 
 /// Both pads touch the cube and its centre lies between them: projected onto the pad-to-pad
