@@ -150,10 +150,7 @@ fn place_on_table_sets_the_cube_down_square_on_the_spot() {
             o.cube_yaw.to_degrees()
         );
         assert!(!r.checks.in_bowl);
-        assert!(
-            o.trace
-                .reached("cube_on_table[on the table?]", NodeStatus::Success)
-        );
+        assert!(o.trace.reached("cube_at[on the spot?]", NodeStatus::Success));
         let grasps = if fault.is_some() { 2 } else { 1 };
         assert_eq!(r.grasp_attempts, grasps, "{layout:?} {fault:?}");
     }

@@ -97,6 +97,13 @@ impl<'a> MacroDriver<'a> {
             ConditionLeaf::CubeLifted(c) => cond::cube_lifted(w, c.min_height),
             ConditionLeaf::CubeInBowl(c) => cond::cube_in_bowl(w, c.rest_speed),
             ConditionLeaf::CubeOnTable(c) => cond::cube_on_table(w, c.tolerance, c.rest_speed),
+            ConditionLeaf::CubeAt(c) => cond::cube_at(
+                w,
+                c.point,
+                c.tolerance,
+                cond::Tolerances::ON_TABLE_HEIGHT,
+                c.rest_speed,
+            ),
             ConditionLeaf::GripperOpen(c) => cond::gripper_open(w, c.min_width),
             ConditionLeaf::AtHome(c) => cond::at_home(w, c.tolerance),
         }

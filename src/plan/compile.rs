@@ -125,6 +125,12 @@ pub(crate) fn leaf_label(leaf: &Leaf) -> String {
         Leaf::Condition(c) => match c {
             ConditionLeaf::CubeLifted(p) => format!("cube_lifted ≥{} m", fmt_num(p.min_height)),
             ConditionLeaf::GripperOpen(p) => format!("gripper_open ≥{} m", fmt_num(p.min_width)),
+            ConditionLeaf::CubeAt(p) => format!(
+                "cube_at? [{}, {}] ±{} m",
+                fmt_num(p.point[0]),
+                fmt_num(p.point[1]),
+                fmt_num(p.tolerance)
+            ),
             other => format!("{}?", other.kind()),
         },
         Leaf::Wait(w) => format!("wait {} s", fmt_num(w.seconds)),

@@ -7,8 +7,8 @@ use serde::Serialize;
 use serde_json::{Map, Value, json};
 
 use super::leaves::{
-    AtHome, Carry, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, Grasp, GripperOpen, Home, MoveJoints,
-    Reach, Release, Wait,
+    AtHome, Carry, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, Grasp, GripperOpen, Home,
+    MoveJoints, Reach, Release, Wait,
 };
 
 /// One parameter of a node kind.
@@ -49,102 +49,45 @@ pub struct NodeDoc {
 /// text is the rustdoc of the node's variant or parameter struct (`#[doc = include_str!(…)]`).
 /// Each file is a one-line summary paragraph, optional details, a `Halt: …` paragraph and a
 /// ```` ```yaml ```` example; [`parse_node_doc`] reads them.
+macro_rules! node_doc {
+    ($kind:literal, $category:literal) => {
+        (
+            $kind,
+            $category,
+            include_str!(concat!("../../docs/nodes/", $kind, ".md")),
+        )
+    };
+}
+
 const NODE_DOCS: &[(&str, &str, &str)] = &[
-    (
-        "sequence",
-        "composite",
-        include_str!("../../docs/nodes/sequence.md"),
-    ),
-    (
-        "fallback",
-        "composite",
-        include_str!("../../docs/nodes/fallback.md"),
-    ),
-    (
-        "reactive_sequence",
-        "composite",
-        include_str!("../../docs/nodes/reactive_sequence.md"),
-    ),
-    (
-        "reactive_fallback",
-        "composite",
-        include_str!("../../docs/nodes/reactive_fallback.md"),
-    ),
-    (
-        "parallel",
-        "composite",
-        include_str!("../../docs/nodes/parallel.md"),
-    ),
-    ("race", "composite", include_str!("../../docs/nodes/race.md")),
-    ("guard", "decorator", include_str!("../../docs/nodes/guard.md")),
-    ("retry", "decorator", include_str!("../../docs/nodes/retry.md")),
-    ("repeat", "decorator", include_str!("../../docs/nodes/repeat.md")),
-    (
-        "timeout",
-        "decorator",
-        include_str!("../../docs/nodes/timeout.md"),
-    ),
-    (
-        "inverter",
-        "decorator",
-        include_str!("../../docs/nodes/inverter.md"),
-    ),
-    (
-        "force_success",
-        "decorator",
-        include_str!("../../docs/nodes/force_success.md"),
-    ),
-    (
-        "force_failure",
-        "decorator",
-        include_str!("../../docs/nodes/force_failure.md"),
-    ),
-    (
-        "subtree",
-        "decorator",
-        include_str!("../../docs/nodes/subtree.md"),
-    ),
-    ("reach", "action", include_str!("../../docs/nodes/reach.md")),
-    (
-        "move_joints",
-        "action",
-        include_str!("../../docs/nodes/move_joints.md"),
-    ),
-    ("home", "action", include_str!("../../docs/nodes/home.md")),
-    ("grasp", "action", include_str!("../../docs/nodes/grasp.md")),
-    ("carry", "action", include_str!("../../docs/nodes/carry.md")),
-    ("release", "action", include_str!("../../docs/nodes/release.md")),
-    ("wait", "runtime", include_str!("../../docs/nodes/wait.md")),
-    (
-        "cube_grasped",
-        "condition",
-        include_str!("../../docs/nodes/cube_grasped.md"),
-    ),
-    (
-        "cube_lifted",
-        "condition",
-        include_str!("../../docs/nodes/cube_lifted.md"),
-    ),
-    (
-        "cube_in_bowl",
-        "condition",
-        include_str!("../../docs/nodes/cube_in_bowl.md"),
-    ),
-    (
-        "cube_on_table",
-        "condition",
-        include_str!("../../docs/nodes/cube_on_table.md"),
-    ),
-    (
-        "gripper_open",
-        "condition",
-        include_str!("../../docs/nodes/gripper_open.md"),
-    ),
-    (
-        "at_home",
-        "condition",
-        include_str!("../../docs/nodes/at_home.md"),
-    ),
+    node_doc!("sequence", "composite"),
+    node_doc!("fallback", "composite"),
+    node_doc!("reactive_sequence", "composite"),
+    node_doc!("reactive_fallback", "composite"),
+    node_doc!("parallel", "composite"),
+    node_doc!("race", "composite"),
+    node_doc!("guard", "decorator"),
+    node_doc!("retry", "decorator"),
+    node_doc!("repeat", "decorator"),
+    node_doc!("timeout", "decorator"),
+    node_doc!("inverter", "decorator"),
+    node_doc!("force_success", "decorator"),
+    node_doc!("force_failure", "decorator"),
+    node_doc!("subtree", "decorator"),
+    node_doc!("reach", "action"),
+    node_doc!("move_joints", "action"),
+    node_doc!("home", "action"),
+    node_doc!("grasp", "action"),
+    node_doc!("carry", "action"),
+    node_doc!("release", "action"),
+    node_doc!("wait", "runtime"),
+    node_doc!("cube_grasped", "condition"),
+    node_doc!("cube_lifted", "condition"),
+    node_doc!("cube_in_bowl", "condition"),
+    node_doc!("cube_on_table", "condition"),
+    node_doc!("cube_at", "condition"),
+    node_doc!("gripper_open", "condition"),
+    node_doc!("at_home", "condition"),
 ];
 
 /// The parts of a node's documentation file: (summary, details, halt, example).
@@ -207,6 +150,7 @@ fn leaf_schemas(g: &mut SchemaGenerator) -> Vec<(&'static str, String)> {
         one::<CubeLifted>(g, "cube_lifted"),
         one::<CubeInBowl>(g, "cube_in_bowl"),
         one::<CubeOnTable>(g, "cube_on_table"),
+        one::<CubeAt>(g, "cube_at"),
         one::<GripperOpen>(g, "gripper_open"),
         one::<AtHome>(g, "at_home"),
     ]

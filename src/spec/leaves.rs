@@ -64,6 +64,9 @@ fn d_off_axis() -> f64 {
 fn d_rest_speed() -> f64 {
     Tolerances::REST_SPEED
 }
+fn d_point_tol() -> f64 {
+    Tolerances::AT_POINT
+}
 
 #[doc = include_str!("../../docs/nodes/reach.md")]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -275,6 +278,23 @@ impl Default for CubeOnTable {
     }
 }
 
+#[doc = include_str!("../../docs/nodes/cube_at.md")]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct CubeAt {
+    /// Where the cube's centre should rest, `[x, y]` on the table, world metres.
+    #[serde(deserialize_with = "units::vec2")]
+    pub point: [f64; 2],
+    /// Largest horizontal distance of the cube's centre from `point`, metres (≥ 0). Default 0.01.
+    #[serde(default = "d_point_tol", deserialize_with = "units::distance")]
+    #[schemars(range(min = 0.0))]
+    pub tolerance: f64,
+    /// Cube speed below which it counts as at rest, m/s (> 0). Default 0.05.
+    #[serde(default = "d_rest_speed", deserialize_with = "units::speed")]
+    #[schemars(range(min = 0.0))]
+    pub rest_speed: f64,
+}
+
 #[doc = include_str!("../../docs/nodes/gripper_open.md")]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -343,6 +363,8 @@ pub enum ConditionLeaf {
     CubeInBowl(CubeInBowl),
     /// See [`CubeOnTable`].
     CubeOnTable(CubeOnTable),
+    /// See [`CubeAt`].
+    CubeAt(CubeAt),
     /// See [`GripperOpen`].
     GripperOpen(GripperOpen),
     /// See [`AtHome`].
@@ -398,6 +420,7 @@ impl ConditionLeaf {
             ConditionLeaf::CubeLifted(_) => "cube_lifted",
             ConditionLeaf::CubeInBowl(_) => "cube_in_bowl",
             ConditionLeaf::CubeOnTable(_) => "cube_on_table",
+            ConditionLeaf::CubeAt(_) => "cube_at",
             ConditionLeaf::GripperOpen(_) => "gripper_open",
             ConditionLeaf::AtHome(_) => "at_home",
         }
@@ -441,6 +464,7 @@ pub const CONDITION_KINDS: &[&str] = &[
     "cube_lifted",
     "cube_in_bowl",
     "cube_on_table",
+    "cube_at",
     "gripper_open",
     "at_home",
 ];
@@ -462,6 +486,7 @@ pub fn parse_leaf(kind: &str, params: &super::value::Value) -> Option<Result<Lea
         "cube_lifted" => c(f(params).map(ConditionLeaf::CubeLifted)),
         "cube_in_bowl" => c(f(params).map(ConditionLeaf::CubeInBowl)),
         "cube_on_table" => c(f(params).map(ConditionLeaf::CubeOnTable)),
+        "cube_at" => c(f(params).map(ConditionLeaf::CubeAt)),
         "gripper_open" => c(f(params).map(ConditionLeaf::GripperOpen)),
         "at_home" => c(f(params).map(ConditionLeaf::AtHome)),
         _ => None,

@@ -24,8 +24,8 @@ pub mod value;
 pub use catalog::{NodeDoc, ParamDoc, catalog, json_schema};
 pub use diag::{Diagnostic, Issue, Loc, Sources};
 pub use leaves::{
-    ActionLeaf, AtHome, Carry, ConditionLeaf, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, Grasp,
-    GripperOpen, Home, Leaf, MoveJoints, Reach, Release, Wait,
+    ActionLeaf, AtHome, Carry, ConditionLeaf, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable,
+    Grasp, GripperOpen, Home, Leaf, MoveJoints, Reach, Release, Wait,
 };
 pub use load::{Spec, load_file, load_str};
 pub use node::{Node, NodeKind};

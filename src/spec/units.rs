@@ -106,6 +106,15 @@ pub fn vec3<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
     Ok(v)
 }
 
+/// A point on the table, `[x, y]` in world metres (finite).
+pub fn vec2<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    let v = <[f64; 2]>::deserialize(d)?;
+    for x in v {
+        finite::<D::Error>(x, "a coordinate (m)")?;
+    }
+    Ok(v)
+}
+
 /// Six joint angles in radians (each a number or `deg(..)`/`rad(..)`).
 pub fn joints6<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 6], D::Error> {
     let v = <[Angle; 6]>::deserialize(d)?;

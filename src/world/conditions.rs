@@ -21,6 +21,8 @@ impl Tolerances {
     pub const HOME_TOLERANCE: f64 = 0.04;
     /// Cube bottom height above the table that still counts as resting on it, metres.
     pub const ON_TABLE_HEIGHT: f64 = 0.01;
+    /// Horizontal distance of the cube's centre from a goal point that counts as there, metres.
+    pub const AT_POINT: f64 = 0.01;
 }
 
 /// Both pads touch the cube and its centre lies between them: projected onto the pad-to-pad
@@ -61,6 +63,13 @@ pub fn cube_on_table(w: &World, max_height: f64, rest_speed: f64) -> bool {
     let d = w.cube_pos - w.bowl_pos;
     let over_bowl = d.x.abs() < w.bowl.inner_half_width + 0.01 && d.y.abs() < w.bowl.inner_half_width + 0.01;
     w.cube_bottom() <= max_height && !over_bowl && w.cube_linvel.norm() < rest_speed
+}
+
+/// The cube rests on the table (as [`cube_on_table`] with `max_height`) with its centre within
+/// `tolerance` metres of `point` = (x, y), measured in the table plane.
+pub fn cube_at(w: &World, point: [f64; 2], tolerance: f64, max_height: f64, rest_speed: f64) -> bool {
+    let (dx, dy) = (w.cube_pos.x - point[0], w.cube_pos.y - point[1]);
+    cube_on_table(w, max_height, rest_speed) && dx.hypot(dy) <= tolerance
 }
 
 /// The gripper is open at least `min_width` metres.
@@ -199,6 +208,23 @@ mod tests {
         let mut sliding = resting();
         sliding.cube_linvel = Vector3::new(0.2, 0.0, 0.0);
         assert!(!cube_on_table(&sliding, 0.005, Tolerances::REST_SPEED));
+    }
+
+    #[test]
+    fn cube_at_is_resting_within_tolerance_of_the_point() {
+        let w = resting();
+        let (x, y) = (w.cube_pos.x, w.cube_pos.y);
+        let h = Tolerances::ON_TABLE_HEIGHT;
+        let v = Tolerances::REST_SPEED;
+        assert!(
+            cube_at(&w, [x + 0.006, y - 0.0079], 0.01, h, v),
+            "9.9 mm away, 10 mm allowed"
+        );
+        assert!(!cube_at(&w, [x + 0.006, y - 0.009], 0.01, h, v), "10.8 mm away");
+        assert!(
+            !cube_at(&held(), [x, y], 0.01, h, v),
+            "a lifted cube is not placed"
+        );
     }
 
     #[test]
