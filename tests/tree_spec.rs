@@ -361,3 +361,20 @@ fn condition_tolerances_are_overridable_and_checked() {
     let d = find(&diags, "speed");
     assert_eq!(at(d), (2, 30), "{d}");
 }
+
+#[test]
+fn out_of_range_numbers_are_located_errors() {
+    let yaml = "main:\n  sequence:\n    children:\n      - release: {width: 0.2}\n      - move_joints: {joints: [0, 0, 10, 0, 0, 0]}\n      - carry: {lift: 15}\n      - reach: {target: [45, 0, 10]}\n      - reach: {target: cube, offset: [0, 0, 12]}\n      - reach: {target: [0.4, 0, -0.1]}\n";
+    let diags = errors(yaml);
+    assert_eq!(diags.len(), 6, "one error per bad value, all at once");
+    assert_eq!(at(find(&diags, "gripper opening")), (4, 26));
+    assert!(find(&diags, "gripper opening").message.contains("0.08513"));
+    assert_eq!(at(find(&diags, "joint 3 (`elbow`)")), (5, 31));
+    assert_eq!(at(find(&diags, "a distance of 15 m")), (6, 23));
+    assert_eq!(at(find(&diags, "from the shoulder")), (7, 25));
+    assert_eq!(at(find(&diags, "an offset of 12.000 m")), (8, 39));
+    assert_eq!(at(find(&diags, "below the table top")), (9, 25));
+    for d in &diags {
+        assert!(d.to_string().contains("bad.yaml:"), "{d}");
+    }
+}

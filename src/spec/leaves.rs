@@ -129,8 +129,8 @@ impl Default for Home {
 #[serde(deny_unknown_fields)]
 pub struct Grasp {
     /// Close to this pad-to-pad width, metres (≥ 0). Absent: close until contact/stall.
-    #[serde(default, deserialize_with = "units::opt_distance")]
-    #[schemars(range(min = 0.0))]
+    #[serde(default, deserialize_with = "units::opt_opening")]
+    #[schemars(range(min = 0.0, max = units::MAX_OPENING))]
     pub width: Option<f64>,
     /// Give up after this many simulated seconds (> 0). Default 2.
     #[serde(default = "d_2", deserialize_with = "units::time_limit")]
@@ -156,11 +156,11 @@ pub struct Carry {
     pub to: Target,
     /// Height of the cube's bottom above the table during the transfer, metres (≥ 0). Default 0.20.
     #[serde(default = "d_lift", deserialize_with = "units::distance")]
-    #[schemars(range(min = 0.0))]
+    #[schemars(range(min = 0.0, max = units::MAX_REACH))]
     pub lift: f64,
     /// Height of the cube's bottom above the target when the carry ends, metres (≥ 0). Default 0.03.
     #[serde(default = "d_place_height", deserialize_with = "units::distance")]
-    #[schemars(range(min = 0.0))]
+    #[schemars(range(min = 0.0, max = units::MAX_REACH))]
     pub place_height: f64,
     /// Tool speed, m/s (> 0). Default 0.5.
     #[serde(default = "d_speed", deserialize_with = "units::speed")]
@@ -177,12 +177,12 @@ pub struct Carry {
 #[serde(deny_unknown_fields)]
 pub struct Release {
     /// Opening to go to, metres (pad face to pad face, 0 … 0.085). Default: fully open (≈ 0.085).
-    #[serde(default, deserialize_with = "units::opt_distance")]
-    #[schemars(range(min = 0.0))]
+    #[serde(default, deserialize_with = "units::opt_opening")]
+    #[schemars(range(min = 0.0, max = units::MAX_OPENING))]
     pub width: Option<f64>,
     /// Vertical retreat after opening, metres (≥ 0). Default 0.10.
     #[serde(default = "d_retreat", deserialize_with = "units::distance")]
-    #[schemars(range(min = 0.0))]
+    #[schemars(range(min = 0.0, max = units::MAX_REACH))]
     pub retreat: f64,
     /// Give up after this many simulated seconds (> 0). Default 3.
     #[serde(default = "d_3", deserialize_with = "units::time_limit")]
@@ -207,7 +207,7 @@ pub struct CubeGrasped {
     /// Largest distance of the cube's centre from the line between the pad centres, metres
     /// (≥ 0). Default 0.03.
     #[serde(default = "d_off_axis", deserialize_with = "units::distance")]
-    #[schemars(range(min = 0.0))]
+    #[schemars(range(min = 0.0, max = units::MAX_REACH))]
     pub off_axis: f64,
 }
 
@@ -225,7 +225,7 @@ impl Default for CubeGrasped {
 pub struct CubeLifted {
     /// Metres above the table (≥ 0). Default 0.03.
     #[serde(default = "d_min_height", deserialize_with = "units::distance")]
-    #[schemars(range(min = 0.0))]
+    #[schemars(range(min = 0.0, max = units::MAX_REACH))]
     pub min_height: f64,
 }
 
@@ -261,7 +261,7 @@ impl Default for CubeInBowl {
 pub struct CubeOnTable {
     /// Allowed height of the cube's bottom above the table top, metres (≥ 0). Default 0.01.
     #[serde(default = "d_table_tol", deserialize_with = "units::distance")]
-    #[schemars(range(min = 0.0))]
+    #[schemars(range(min = 0.0, max = units::MAX_REACH))]
     pub tolerance: f64,
     /// Cube speed below which it counts as at rest, m/s (> 0). Default 0.05.
     #[serde(default = "d_rest_speed", deserialize_with = "units::speed")]
@@ -287,7 +287,7 @@ pub struct CubeAt {
     pub point: [f64; 2],
     /// Largest horizontal distance of the cube's centre from `point`, metres (≥ 0). Default 0.01.
     #[serde(default = "d_point_tol", deserialize_with = "units::distance")]
-    #[schemars(range(min = 0.0))]
+    #[schemars(range(min = 0.0, max = units::MAX_REACH))]
     pub tolerance: f64,
     /// Cube speed below which it counts as at rest, m/s (> 0). Default 0.05.
     #[serde(default = "d_rest_speed", deserialize_with = "units::speed")]
@@ -300,8 +300,8 @@ pub struct CubeAt {
 #[serde(deny_unknown_fields)]
 pub struct GripperOpen {
     /// Metres (≥ 0). Default 0.08.
-    #[serde(default = "d_min_width", deserialize_with = "units::distance")]
-    #[schemars(range(min = 0.0))]
+    #[serde(default = "d_min_width", deserialize_with = "units::opening")]
+    #[schemars(range(min = 0.0, max = units::MAX_OPENING))]
     pub min_width: f64,
 }
 

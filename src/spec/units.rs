@@ -12,6 +12,31 @@ use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize};
 
 use super::suggest::did_you_mean;
+use crate::motion::kinematics::{
+    FOREARM, JOINT_LIMITS, LATERAL_OFFSET, SHOULDER_HEIGHT, TOOL_LENGTH, UPPER_ARM, WRIST_2_TO_3,
+};
+use crate::motion::{ARM_JOINTS, gripper};
+
+/// Upper bound on any length a tree names, metres (≈ 1.31): the UR5e's links laid end to end
+/// from the shoulder to the pinch point. No point farther than this from the shoulder can be
+/// reached, so a larger distance is a unit slip (centimetres for metres), reported before a
+/// simulation starts. Points inside it may still be unreachable; the IK says so with a reason.
+pub const MAX_REACH: f64 = UPPER_ARM + FOREARM + LATERAL_OFFSET + WRIST_2_TO_3 + TOOL_LENGTH;
+
+/// The 2F-85's full opening between the pad faces, metres (the calibration's open end).
+pub const MAX_OPENING: f64 = gripper::CALIBRATION[0].1;
+
+/// `Ok(length)` when `length` (metres) is at most [`MAX_REACH`]; otherwise an error that
+/// starts with `what` (e.g. "a distance of 5 m").
+fn within_reach<E: de::Error>(length: f64, what: impl FnOnce() -> String) -> Result<f64, E> {
+    if length > MAX_REACH {
+        return Err(E::custom(format!(
+            "{} exceeds the arm's full reach of {MAX_REACH:.2} m (lengths are in metres)",
+            what()
+        )));
+    }
+    Ok(length)
+}
 
 fn finite<E: de::Error>(x: f64, what: &str) -> Result<f64, E> {
     if x.is_finite() {
@@ -31,7 +56,7 @@ pub fn length<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     number(d, "a length (m)")
 }
 
-/// A finite, non-negative distance in metres.
+/// A finite, non-negative distance in metres, at most [`MAX_REACH`].
 pub fn distance<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     let x = number(d, "a distance (m)")?;
     if x < 0.0 {
@@ -39,18 +64,30 @@ pub fn distance<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
             "a distance (m) must be ≥ 0, found `{x}`"
         )));
     }
-    Ok(x)
+    within_reach(x, || format!("a distance of {x} m"))
 }
 
-/// An optional distance in metres (`~` or absent = `None`).
-pub fn opt_distance<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
-    struct Dist(f64);
-    impl<'de> Deserialize<'de> for Dist {
+/// An optional gripper opening between the pad faces, metres, 0 … [`MAX_OPENING`]
+/// (`~` or absent = `None`).
+pub fn opt_opening<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+    struct Opening(f64);
+    impl<'de> Deserialize<'de> for Opening {
         fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-            distance(d).map(Dist)
+            opening(d).map(Opening)
         }
     }
-    Ok(Option::<Dist>::deserialize(d)?.map(|x| x.0))
+    Ok(Option::<Opening>::deserialize(d)?.map(|x| x.0))
+}
+
+/// A gripper opening between the pad faces, metres, 0 … [`MAX_OPENING`].
+pub fn opening<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    let x = number(d, "a gripper opening (m)")?;
+    if !(0.0..=MAX_OPENING).contains(&x) {
+        return Err(de::Error::custom(format!(
+            "a gripper opening must be between 0 and {MAX_OPENING} m (the 2F-85 fully open), found `{x}`"
+        )));
+    }
+    Ok(x)
 }
 
 /// A finite, non-negative duration in (simulated) seconds.
@@ -103,6 +140,8 @@ pub fn vec3<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
     for x in v {
         finite::<D::Error>(x, "a coordinate (m)")?;
     }
+    let length = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    within_reach(length, || format!("an offset of {length:.3} m"))?;
     Ok(v)
 }
 
@@ -117,8 +156,17 @@ pub fn vec2<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
 
 /// Six joint angles in radians (each a number or `deg(..)`/`rad(..)`).
 pub fn joints6<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 6], D::Error> {
-    let v = <[Angle; 6]>::deserialize(d)?;
-    Ok(v.map(|a| a.0))
+    let v = <[Angle; 6]>::deserialize(d)?.map(|a| a.0);
+    for (i, (q, (lo, hi))) in v.iter().zip(JOINT_LIMITS).enumerate() {
+        if !(lo..=hi).contains(q) {
+            return Err(de::Error::custom(format!(
+                "joint {} (`{}`) must be within [{lo}, {hi}] rad, found `{q}`",
+                i + 1,
+                ARM_JOINTS[i]
+            )));
+        }
+    }
+    Ok(v)
 }
 
 /// Parse an angle written as text: `deg(90)`, `rad(1.57)`, `pi/2`, `deg(-45)`; plain numbers are
@@ -235,6 +283,19 @@ impl<'de> Visitor<'de> for TargetVisitor {
         if seq.next_element::<de::IgnoredAny>()?.is_some() {
             return Err(de::Error::invalid_length(4, &"a point [x, y, z] in metres"));
         }
+        if p[2] < 0.0 {
+            return Err(de::Error::custom(format!(
+                "the point [{}, {}, {}] is below the table top (z = 0 m)",
+                p[0], p[1], p[2]
+            )));
+        }
+        let from_shoulder = (p[0] * p[0] + p[1] * p[1] + (p[2] - SHOULDER_HEIGHT).powi(2)).sqrt();
+        within_reach(from_shoulder, || {
+            format!(
+                "the point [{}, {}, {}], {from_shoulder:.2} m from the shoulder,",
+                p[0], p[1], p[2]
+            )
+        })?;
         Ok(Target::Point(p))
     }
 }
