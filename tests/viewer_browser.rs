@@ -327,10 +327,11 @@ fn median(v: &[f64]) -> f64 {
 ///
 /// Runs are interleaved A B A B … (A: `NoObserver`, what `macrotree run` does without `--view`;
 /// B: `ViewObserver` streaming to a `LiveViewer` with the browser connected, what `--view`
-/// does), so drift in the machine's load hits both alike; it prints the median wall and
-/// sim-thread CPU time of each and their ratios. The browser stays open during the A runs too
-/// (idle: no frames arrive, the page does not redraw); a block of baseline runs before it is
-/// started is printed for reference. Nothing is asserted about time.
+/// does), so drift in the machine's load hits both alike, with 300 ms between runs so the
+/// browser has finished drawing what the previous run sent. It prints, for each, the median
+/// wall time, the sim thread's CPU time and its time runnable but waiting for a CPU, and the
+/// ratios; plus baselines with no Chromium running (before it starts, after it ends),
+/// Chromium's own CPU time and the load average. Nothing is asserted about time.
 #[test]
 #[ignore = "measurement: cargo test --release --test viewer_browser -- --ignored --nocapture measure_episode_overhead_with_one_browser"]
 fn measure_episode_overhead_with_one_browser() {
