@@ -5,14 +5,18 @@
 //! must run (`.ci/run` installs the `chromium` package).
 //!
 //! Set `MACROTREE_VIEWER_SCREENSHOT=path.png` to also save a screenshot of the live page (used
-//! for docs/images/viewer.png). `cargo test --test viewer_browser -- --ignored --nocapture`
-//! runs the overhead measurement.
+//! for docs/images/viewer.png). `cargo test --release --test viewer_browser -- --ignored
+//! --nocapture measure_episode_overhead_with_one_browser` runs the `--view` overhead
+//! measurement on the real flagship episode.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+use macrotree::episode::{EpisodeConfig, NoObserver, run_episode};
+use macrotree::plan::Plan;
 use macrotree::sim::{HOME_Q, Scene, Sim};
-use macrotree::viewer::{LiveViewer, Recorder, TreeNodeView, ViewerOptions, page};
+use macrotree::viewer::{LiveViewer, Recorder, TreeNodeView, ViewObserver, ViewerOptions, page};
 #[path = "support/browser.rs"]
 mod browser;
 use browser::*;
@@ -225,68 +229,131 @@ fn a_default_length_episode_replay_stays_under_15_mb() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// CPU time of the calling thread so far (Linux `schedstat`), seconds.
-fn thread_cpu() -> f64 {
+/// The calling thread's scheduler counters so far (Linux `/proc/thread-self/schedstat`): time on
+/// a CPU and time runnable but waiting for one, seconds.
+fn thread_sched() -> (f64, f64) {
     let stat = std::fs::read_to_string("/proc/thread-self/schedstat").unwrap_or_default();
-    stat.split_whitespace()
-        .next()
-        .and_then(|v| v.parse::<f64>().ok())
-        .unwrap_or(0.0)
-        / 1e9
+    let mut f = stat
+        .split_whitespace()
+        .map(|v| v.parse::<f64>().unwrap_or(0.0) / 1e9);
+    (f.next().unwrap_or(0.0), f.next().unwrap_or(0.0))
 }
 
-/// Runs an episode-like loop: `steps` physics steps, poses published at 30 Hz of sim time.
-/// Returns (wall seconds, sim-thread CPU seconds).
-fn episode(sim: &mut Sim, viewer: Option<&LiveViewer>, steps: usize) -> (f64, f64) {
-    sim.reset(&macrotree::sim::Layout::default());
+/// The 1-minute load average (`/proc/loadavg`).
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .unwrap_or_default()
+        .split_whitespace()
+        .take(3)
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// One run of the real flagship episode (default layout, not paced) on this thread, with or
+/// without the live viewer attached. Returns the sim thread's [`Times`] and the physics steps;
+/// they cover exactly `run_episode` (and the observer's construction), the calls `macrotree
+/// run` makes.
+fn flagship_episode(
+    scene: &Scene,
+    plan: &Arc<Plan>,
+    live: Option<LiveViewer>,
+) -> (Times, u64, Option<LiveViewer>) {
+    let config = EpisodeConfig::default();
+    let (cpu, queued) = thread_sched();
     let started = Instant::now();
-    let cpu = thread_cpu();
-    let mut next_publish = 0.0;
-    for i in 0..steps {
-        let t = sim.time();
-        let mut q = HOME_Q;
-        q[0] += 0.8 * (t * 1.5).sin();
-        q[2] += 0.4 * (t * 1.1).sin();
-        sim.set_arm_ctrl(&q);
-        sim.set_gripper_ctrl(if i % 1000 < 500 { 0.0 } else { 255.0 });
-        sim.step();
-        if let Some(v) = viewer
-            && sim.time() >= next_publish
-        {
-            next_publish += 1.0 / 30.0;
-            v.publish_poses(sim.data(), sim.time());
+    let (report, live) = match live {
+        None => (run_episode(scene, plan.clone(), &config, &mut NoObserver), None),
+        Some(live) => {
+            let mut view = ViewObserver::new(plan, Some(live), None, None);
+            let report = run_episode(scene, plan.clone(), &config, &mut view);
+            (report, view.finish().0)
+        }
+    };
+    let wall = started.elapsed().as_secs_f64();
+    let after = thread_sched();
+    assert!(report.success, "the flagship episode failed: {report:?}");
+    let times = Times {
+        wall,
+        cpu: after.0 - cpu,
+        queued: after.1 - queued,
+    };
+    (times, report.physics_steps, live)
+}
+
+/// What one episode cost the simulation thread, seconds.
+#[derive(Debug, Clone, Copy)]
+struct Times {
+    /// Wall-clock time.
+    wall: f64,
+    /// Time on a CPU.
+    cpu: f64,
+    /// Time runnable but waiting for a CPU (another thread or process had it).
+    queued: f64,
+}
+
+/// CPU time used so far by all processes of process group `pgid` (Chromium and its helpers),
+/// seconds (`/proc/*/stat` utime + stime, in clock ticks of 1/100 s).
+fn group_cpu(pgid: u32) -> f64 {
+    let mut ticks = 0u64;
+    for entry in std::fs::read_dir("/proc").into_iter().flatten().flatten() {
+        let Ok(stat) = std::fs::read_to_string(entry.path().join("stat")) else {
+            continue;
+        };
+        // Fields after the parenthesised command: state ppid pgrp … utime(14) stime(15).
+        let Some(rest) = stat.rfind(')').map(|i| &stat[i + 2..]) else {
+            continue;
+        };
+        let f: Vec<&str> = rest.split_whitespace().collect();
+        if f.len() > 12 && f[2].parse() == Ok(pgid) {
+            ticks += f[11].parse::<u64>().unwrap_or(0) + f[12].parse::<u64>().unwrap_or(0);
         }
     }
-    (started.elapsed().as_secs_f64(), thread_cpu() - cpu)
+    ticks as f64 / 100.0
 }
 
-/// Median wall and CPU seconds of `rounds` episodes.
-fn measure(sim: &mut Sim, viewer: Option<&LiveViewer>, steps: usize, rounds: usize) -> (f64, f64) {
-    let (mut wall, mut cpu): (Vec<f64>, Vec<f64>) = (0..rounds).map(|_| episode(sim, viewer, steps)).unzip();
-    let median = |v: &mut Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2]
-    };
-    (median(&mut wall), median(&mut cpu))
+fn median(v: &[f64]) -> f64 {
+    let mut v = v.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
 }
 
+/// The `--view` overhead on the real flagship episode (trees/cube_to_bowl.yaml, default
+/// layout, not paced) with one headless Chromium showing the live page.
+///
+/// Runs are interleaved A B A B … (A: `NoObserver`, what `macrotree run` does without `--view`;
+/// B: `ViewObserver` streaming to a `LiveViewer` with the browser connected, what `--view`
+/// does), so drift in the machine's load hits both alike, with 300 ms between runs so the
+/// browser has finished drawing what the previous run sent. It prints, for each, the median
+/// wall time, the sim thread's CPU time and its time runnable but waiting for a CPU, and the
+/// ratios; plus baselines with no Chromium running (before it starts, after it ends),
+/// Chromium's own CPU time and the load average. Nothing is asserted about time.
 #[test]
-#[ignore = "measurement: cargo test --release --test viewer_browser -- --ignored --nocapture"]
-fn measure_overhead_with_one_browser() {
+#[ignore = "measurement: cargo test --release --test viewer_browser -- --ignored --nocapture measure_episode_overhead_with_one_browser"]
+fn measure_episode_overhead_with_one_browser() {
     if !browser_available() {
         return;
     }
-    let scene = Scene::load().unwrap();
-    let mut sim = Sim::new(&scene);
-    // 60 s of sim time (30 000 steps), poses published at 30 Hz of sim time: 1800 frames.
-    let steps: usize = std::env::var("MACROTREE_OVERHEAD_STEPS")
+    let reps: usize = std::env::var("MACROTREE_OVERHEAD_REPS")
         .ok()
         .and_then(|s| s.parse().ok())
-        .unwrap_or(30_000);
-    let rounds = 7;
-    episode(&mut sim, None, steps); // warm-up
-    let base = measure(&mut sim, None, steps, rounds);
-    let viewer = LiveViewer::start(
+        .unwrap_or(21);
+    let scene = Scene::load().unwrap();
+    let plan =
+        Arc::new(macrotree::plan::load_plan(Path::new("trees/cube_to_bowl.yaml")).expect("flagship tree"));
+    let load_before = load_average();
+    for _ in 0..3 {
+        flagship_episode(&scene, &plan, None); // warm-up: caches, allocator, CPU frequency
+    }
+    let before: Vec<Times> = (0..reps)
+        .map(|_| flagship_episode(&scene, &plan, None).0)
+        .collect();
+
+    let live = LiveViewer::start(
         &scene.model,
         &ViewerOptions {
             port: 0,
@@ -294,36 +361,91 @@ fn measure_overhead_with_one_browser() {
         },
     )
     .unwrap();
-    let no_client = measure(&mut sim, Some(&viewer), steps, rounds);
-    let browser = Chromium::open(&viewer.url(), 1000, 600);
-    assert!(viewer.wait_for_clients(1, Duration::from_secs(60)));
-    viewer.capture_image(Duration::from_secs(120)).unwrap(); // the snapshot is loaded
-    let with_browser = measure(&mut sim, Some(&viewer), steps, rounds);
-    let stats = viewer.stats();
+    let browser = Chromium::open(&live.url(), 1000, 600);
+    assert!(
+        live.wait_for_clients(1, Duration::from_secs(60)),
+        "the page did not connect"
+    );
+    live.capture_image(Duration::from_secs(120)).unwrap(); // the snapshot is loaded and drawn
+    let mut live = Some(live);
+    for _ in 0..2 {
+        live = flagship_episode(&scene, &plan, live).2; // warm-up with the viewer
+    }
+    let pgid = browser.child.id();
+    std::thread::sleep(Duration::from_secs(2));
+    let idle_cpu = group_cpu(pgid);
+    std::thread::sleep(Duration::from_secs(2));
+    let idle_cpu = (group_cpu(pgid) - idle_cpu) / 2.0;
+    let browser_cpu = group_cpu(pgid);
+    let published_before = live.as_ref().unwrap().frames_published();
+    let (mut base, mut view) = (Vec::new(), Vec::new());
+    let mut steps = 0;
+    // Between runs the browser catches up with what it was sent (SwiftShader draws on these same
+    // cores), so that no run shares the machine with the previous run's rendering.
+    let settle = Duration::from_millis(300);
+    for _ in 0..reps {
+        std::thread::sleep(settle);
+        let (a, s, _) = flagship_episode(&scene, &plan, None);
+        std::thread::sleep(settle);
+        let (b, s2, l) = flagship_episode(&scene, &plan, live.take());
+        assert_eq!(s, s2, "the viewer changed the episode");
+        steps = s;
+        live = l;
+        base.push(a);
+        view.push(b);
+    }
+    let live = live.unwrap();
+    assert_eq!(live.client_count(), 1, "the browser left during the measurement");
+    let frames = (live.frames_published() - published_before) / reps as u64;
+    let browser_cpu = (group_cpu(pgid) - browser_cpu) / reps as f64;
+    let stats = live.stats();
     drop(browser);
-    drop(viewer);
+    drop(live);
     std::thread::sleep(Duration::from_millis(500));
-    let base2 = measure(&mut sim, None, steps, rounds);
-    let pct = |x: f64, b: f64| (x / b - 1.0) * 100.0;
-    let (bw, bc) = (base.0.min(base2.0), base.1.min(base2.1));
+    let after: Vec<Times> = (0..reps)
+        .map(|_| flagship_episode(&scene, &plan, None).0)
+        .collect();
+
+    let med = |v: &[Times], f: fn(&Times) -> f64| median(&v.iter().map(f).collect::<Vec<_>>());
+    let wall = |t: &Times| t.wall;
+    let cpu = |t: &Times| t.cpu;
+    let queued = |t: &Times| t.queued;
+    let line = |v: &[Times]| {
+        let walls: Vec<f64> = v.iter().map(|t| t.wall).collect();
+        format!(
+            "wall {:.4} s (min {:.4}, max {:.4}), sim-thread CPU {:.4} s, waiting for a CPU {:.4} s",
+            median(&walls),
+            walls.iter().copied().fold(f64::INFINITY, f64::min),
+            walls.iter().copied().fold(0.0, f64::max),
+            med(v, cpu),
+            med(v, queued),
+        )
+    };
+    let (bw, vw, bc, vc) = (
+        med(&base, wall),
+        med(&view, wall),
+        med(&base, cpu),
+        med(&view, cpu),
+    );
     eprintln!(
-        "{steps} steps ({:.0} s of sim time), poses published at 30 Hz of sim time, median of {rounds}:\n\
-         \x20 no viewer:            wall {:.3} s / {:.3} s (before / after), sim-thread CPU {:.3} s / {:.3} s\n\
-         \x20 viewer, no browser:   wall {:.3} s ({:+.1} %), sim-thread CPU {:.3} s ({:+.1} %)\n\
-         \x20 viewer + 1 browser:   wall {:.3} s ({:+.1} %), sim-thread CPU {:.3} s ({:+.1} %)\n\
-         \x20 {stats:?}",
-        steps as f64 * macrotree::sim::TIMESTEP,
-        base.0,
-        base2.0,
-        base.1,
-        base2.1,
-        no_client.0,
-        pct(no_client.0, bw),
-        no_client.1,
-        pct(no_client.1, bc),
-        with_browser.0,
-        pct(with_browser.0, bw),
-        with_browser.1,
-        pct(with_browser.1, bc),
+        "flagship episode (trees/cube_to_bowl.yaml, default layout, {steps} physics steps, not paced), \
+         medians of {reps} interleaved pairs:\n\
+         \x20 A without --view:          {}\n\
+         \x20 B --view + 1 browser:      {}\n\
+         \x20 overhead B/A:              wall {:+.1} % (ratio {:.3}), sim-thread CPU {:+.1} % (ratio {:.3})\n\
+         \x20 no Chromium running, before: {}\n\
+         \x20 no Chromium running, after:  {}\n\
+         \x20 Chromium CPU: {browser_cpu:.3} s per pair (idle: {idle_cpu:.3} s/s); {frames} pose frames published per episode\n\
+         \x20 {stats:?}\n\
+         \x20 load average before / after: {load_before} / {}",
+        line(&base),
+        line(&view),
+        (vw / bw - 1.0) * 100.0,
+        vw / bw,
+        (vc / bc - 1.0) * 100.0,
+        vc / bc,
+        line(&before),
+        line(&after),
+        load_average(),
     );
 }

@@ -13,7 +13,6 @@ mod run;
 mod schema;
 mod sweep;
 mod validate;
-mod view;
 
 use std::process::ExitCode;
 

@@ -6,11 +6,10 @@ use std::sync::Arc;
 use clap::Args;
 
 use super::args::{CubeArg, XyArg};
-use super::view::ViewObserver;
 use super::{CliError, load_plan_or_exit, load_scene_or_exit};
 use crate::episode::{EpisodeConfig, NoObserver, run_episode};
 use crate::sim::Layout;
-use crate::viewer::{LiveViewer, Recorder, ViewerOptions};
+use crate::viewer::{LiveViewer, Recorder, ViewObserver, ViewerOptions};
 
 /// Arguments of `run`.
 #[derive(Debug, Args)]

@@ -5,10 +5,12 @@
 //!   same port, from its own threads; the simulation thread only calls cheap, non-blocking
 //!   publish methods (latest pose wins per client).
 //! * [`Recorder`] samples an episode and writes one HTML file that plays offline.
+//! * [`ViewObserver`] attaches either or both to an episode ([`crate::episode::run_episode`]).
 //!
 //! Wire format: each server→browser binary frame is one msgpack map (a MeshCat command); the
 //! tree side panel uses JSON text frames. See `docs/viewer.md`.
 
+pub mod observer;
 pub mod page;
 pub mod panel;
 pub mod proto;
@@ -27,6 +29,7 @@ use mujoco_rs::wrappers::mj_model::traits::ModelType;
 use rmpv::Value;
 use tungstenite::Bytes;
 
+pub use observer::{PUBLISH_HZ, ViewObserver, tree_view};
 pub use panel::TreeNodeView;
 pub use record::Recorder;
 pub use scene::SceneLayout;

@@ -34,8 +34,10 @@ pub const MAX_CONNECTIONS: usize = 64;
 pub const WRITE_TIMEOUT: Duration = Duration::from_secs(30);
 /// How long a client thread sleeps when it has nothing to send (it then polls for input).
 const IDLE_POLL: Duration = Duration::from_millis(25);
-/// Pose batches are written to a client at most this often (40 Hz of wall time): a sim that
-/// runs faster than real time publishes more often, and the browser gets the latest pose only.
+/// Live updates (a pose batch, the sim time and the panel's statuses) are written to a client at
+/// most this often (40 Hz of wall time): a sim that runs faster than real time publishes more
+/// often, and the browser gets the latest state only (the panel's new events are all kept, up
+/// to [`super::panel::EVENT_HISTORY`]).
 pub const MIN_POSE_INTERVAL: Duration = Duration::from_millis(25);
 
 /// Counters of one connected client.
@@ -66,6 +68,9 @@ struct Outbox {
     /// Latest pose message per slot (body id); `None` once written.
     poses: Vec<Option<Bytes>>,
     poses_pending: bool,
+    /// When the client's thread may write its next live update; until then it sleeps (at most
+    /// until this instant) without being woken for live updates.
+    next_live_at: Option<Instant>,
     time: Option<f64>,
     tree_dirty: bool,
     status_dirty: bool,
@@ -79,6 +84,23 @@ pub(crate) struct Client {
     id: u64,
     out: Mutex<Outbox>,
     wake: Condvar,
+}
+
+impl Outbox {
+    /// Whether live updates (poses, time, panel status) wait for the client's next write. While
+    /// they do, its thread already sleeps only until that write is due, so a newer update needs
+    /// no wake-up.
+    fn live_pending(&self) -> bool {
+        self.poses_pending || self.time.is_some() || self.status_dirty
+    }
+
+    /// Whether a live update published now must wake the client's thread: only when nothing
+    /// was pending (else it is already due or timed) and the rate limit allows a write now
+    /// (else the thread wakes by itself when it does). Every wake-up is a context switch that
+    /// the simulation thread pays for on a busy machine.
+    fn live_needs_wake(&self) -> bool {
+        !self.live_pending() && self.next_live_at.is_none_or(|t| Instant::now() >= t)
+    }
 }
 
 impl Client {
@@ -153,6 +175,7 @@ impl Hub {
         }
         for c in &st.clients {
             let mut out = c.lock();
+            let wake = out.live_needs_wake();
             out.stats.frames_offered += 1;
             for (slot, _, msg) in &poses {
                 if out.poses.len() <= *slot {
@@ -163,20 +186,26 @@ impl Hub {
             out.poses_pending |= !poses.is_empty();
             out.time = Some(sim_time);
             drop(out);
-            c.wake.notify_all();
+            if wake {
+                c.wake.notify_all();
+            }
         }
     }
 
-    /// Marks the panel's tree (`tree = true`) or status as changed for every client.
+    /// Marks the panel's tree (`tree = true`, sent at once) or status (a live update, sent with
+    /// the next pose batch) as changed for every client.
     pub fn panel_changed(st: &HubState, tree: bool) {
         for c in &st.clients {
             let mut out = c.lock();
+            let wake = tree || out.live_needs_wake();
             if tree {
                 out.tree_dirty = true;
             }
             out.status_dirty = true;
             drop(out);
-            c.wake.notify_all();
+            if wake {
+                c.wake.notify_all();
+            }
         }
     }
 
@@ -514,10 +543,10 @@ struct Batch {
     closed: bool,
 }
 
-/// Takes what is due: structural messages and panel updates at once, poses at most every
-/// [`MIN_POSE_INTERVAL`] (the newer ones replace older ones meanwhile). Waits up to
-/// [`IDLE_POLL`] when nothing is due.
-fn take_batch(client: &Client, next_pose_at: &mut Instant) -> Batch {
+/// Takes what is due: structural messages and the panel's node list at once, live updates
+/// (poses, sim time, panel statuses) at most every [`MIN_POSE_INTERVAL`] (the newer ones
+/// replace older ones meanwhile). Waits up to [`IDLE_POLL`] when nothing is due.
+fn take_batch(client: &Client) -> Batch {
     let mut out = client.lock();
     let deadline = Instant::now() + IDLE_POLL;
     loop {
@@ -526,15 +555,16 @@ fn take_batch(client: &Client, next_pose_at: &mut Instant) -> Batch {
             || !out.after_poses.is_empty()
             || out.resync
             || out.tree_dirty
-            || out.status_dirty
             || out.closed;
-        let poses_due = (out.poses_pending || out.time.is_some()) && now >= *next_pose_at;
-        if other || poses_due || now >= deadline {
+        let live_allowed = out.next_live_at.is_none_or(|t| now >= t);
+        if other || (out.live_pending() && live_allowed) || now >= deadline {
             break;
         }
+        // Publishers do not wake a rate-limited thread (see `live_needs_wake`): sleep at most
+        // until the next live write is allowed, whether or not anything is pending yet.
         let mut wait = deadline - now;
-        if out.poses_pending || out.time.is_some() {
-            wait = wait.min(next_pose_at.saturating_duration_since(now));
+        if let Some(t) = out.next_live_at.filter(|_| !live_allowed) {
+            wait = wait.min(t - now);
         }
         out = client
             .wake
@@ -545,16 +575,21 @@ fn take_batch(client: &Client, next_pose_at: &mut Instant) -> Batch {
     let now = Instant::now();
     let mut poses = Vec::new();
     let mut time = None;
+    let mut status = false;
     let flush = !out.after_poses.is_empty();
-    if (now >= *next_pose_at || flush) && (out.poses_pending || out.time.is_some()) {
+    if (out.next_live_at.is_none_or(|t| now >= t) || flush) && out.live_pending() {
         if out.poses_pending {
             poses = out.poses.iter_mut().filter_map(Option::take).collect();
             out.stats.frames_sent += 1;
             out.poses_pending = false;
         }
         time = out.time.take();
-        *next_pose_at = now + MIN_POSE_INTERVAL;
+        status = std::mem::take(&mut out.status_dirty);
+        out.next_live_at = Some(now + MIN_POSE_INTERVAL);
     }
+    // A new node list goes with the statuses it resets.
+    let tree = std::mem::take(&mut out.tree_dirty);
+    status |= tree && std::mem::take(&mut out.status_dirty);
     out.queued_bytes = 0;
     Batch {
         queue: std::mem::take(&mut out.queue),
@@ -562,8 +597,8 @@ fn take_batch(client: &Client, next_pose_at: &mut Instant) -> Batch {
         after_poses: std::mem::take(&mut out.after_poses),
         time,
         resync: std::mem::take(&mut out.resync),
-        tree: std::mem::take(&mut out.tree_dirty),
-        status: std::mem::take(&mut out.status_dirty),
+        tree,
+        status,
         closed: out.closed,
     }
 }
@@ -587,9 +622,8 @@ fn ws_err(e: tungstenite::Error) -> io::Error {
 
 fn client_loop(ws: &mut WebSocket<TcpStream>, hub: &Hub, client: &Client) -> io::Result<()> {
     let mut events_seen = 0u64;
-    let mut next_pose_at = Instant::now();
     loop {
-        let mut batch = take_batch(client, &mut next_pose_at);
+        let mut batch = take_batch(client);
         if batch.closed || hub.shutdown.load(Ordering::SeqCst) {
             return Ok(());
         }

@@ -55,6 +55,12 @@ impl SceneTree {
 
     /// Stores a `set_transform` at `path` (latest wins).
     pub fn set_transform(&mut self, path: &str, msg: Bytes) {
+        // Keys are normalized, so an exact hit is the path's node (the per-frame case: no
+        // allocation).
+        if let Some(node) = self.nodes.get_mut(path) {
+            node.transform = Some(msg);
+            return;
+        }
         self.node(path).transform = Some(msg);
     }
 

@@ -1,18 +1,34 @@
-//! `run --view` and `run --record`: an [`EpisodeObserver`] that streams the episode to the live
-//! MeshCat page and/or records it into a self-contained HTML replay, with the tree's live status.
+//! [`ViewObserver`]: an [`EpisodeObserver`] that streams an episode to a [`LiveViewer`] and/or
+//! records it with a [`Recorder`], with the tree's live status beside the scene.
+//!
+//! This is what `macrotree run TREE --view` / `--record FILE.html` attaches to the episode; tests
+//! and other tools attach it the same way:
+//!
+//! ```no_run
+//! # use std::sync::Arc;
+//! # use macrotree::episode::{EpisodeConfig, run_episode};
+//! # use macrotree::viewer::{LiveViewer, ViewObserver, ViewerOptions};
+//! # fn demo(scene: &macrotree::sim::Scene, plan: Arc<macrotree::plan::Plan>) {
+//! let live = LiveViewer::start(&scene.model, &ViewerOptions::default()).unwrap();
+//! let mut view = ViewObserver::new(&plan, Some(live), None, None);
+//! let report = run_episode(scene, plan.clone(), &EpisodeConfig::default(), &mut view);
+//! let (live, _recorder) = view.finish();
+//! # }
+//! ```
 
 use std::time::{Duration, Instant};
 
+use super::{LiveViewer, Recorder, TreeNodeView};
 use crate::actions::Cell;
 use crate::episode::EpisodeObserver;
 use crate::plan::Plan;
 use crate::runtime::{Transition, TreeRunner};
-use crate::viewer::{LiveViewer, Recorder, TreeNodeView};
 
-/// Body poses are pushed at this rate of simulated time, Hz.
+/// Body poses are pushed at this rate of simulated time, Hz (every 1/60 s of sim time, not of
+/// wall time; the live viewer further limits what each browser gets to 40 Hz wall).
 pub const PUBLISH_HZ: f64 = 60.0;
 
-/// The tree's nodes as the viewer's side panel shows them.
+/// The tree's nodes as the viewer's side panel shows them (preorder, as in [`Plan::nodes`]).
 pub fn tree_view(plan: &Plan) -> Vec<TreeNodeView> {
     plan.nodes
         .iter()
@@ -32,19 +48,28 @@ fn event_json(t: &Transition) -> serde_json::Value {
     })
 }
 
-/// Streams and/or records an episode.
+/// Streams an episode to a live viewer and/or records it into a replay, optionally pacing the
+/// simulation to the wall clock.
+///
+/// After every control period it sends the tree's node statuses, retry attempts and new trace
+/// events whenever a node changed status (and at least every 1/[`PUBLISH_HZ`] s of sim time),
+/// and the body poses every 1/[`PUBLISH_HZ`] s of sim time. Publishing never blocks on a
+/// browser (see [`LiveViewer::publish_poses`]).
 pub struct ViewObserver {
     live: Option<LiveViewer>,
     recorder: Option<Recorder>,
+    /// Sim time of the next pose publish, seconds.
     next_publish: f64,
     /// Wall-clock pacing: simulated seconds per wall second (1.0 = real time), if any.
     speed: Option<f64>,
+    /// Wall-clock origin of the pacing.
     start: Instant,
 }
 
 impl ViewObserver {
     /// An observer publishing to `live` and/or recording into `recorder`, paced at `speed`× real
-    /// time when given.
+    /// time (simulated seconds per wall second) when given; `None` runs as fast as it can.
+    /// Sends the plan's node list to both at once.
     pub fn new(
         plan: &Plan,
         live: Option<LiveViewer>,
@@ -65,6 +90,11 @@ impl ViewObserver {
             speed,
             start: Instant::now(),
         }
+    }
+
+    /// The live viewer, if any (e.g. to capture an image or read its stats mid-run).
+    pub fn live(&self) -> Option<&LiveViewer> {
+        self.live.as_ref()
     }
 
     /// Ends the episode: returns the live viewer (to keep serving) and the recorder (to write).
