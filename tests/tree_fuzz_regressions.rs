@@ -17,7 +17,7 @@ fn repo_root() -> &'static Path {
 
 /// The files `fuzz/seed-corpus` copies into the corpus: every `.yaml` under trees/ and
 /// tests/fixtures/.
-fn seeds() -> Vec<PathBuf> {
+fn seed_files() -> Vec<PathBuf> {
     fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
         for e in std::fs::read_dir(dir).unwrap() {
             let p = e.unwrap().path();
@@ -43,9 +43,74 @@ fn assert_located(diags: &[Diagnostic], what: &str) {
     }
 }
 
+/// The other seeds of `fuzz/seed-corpus`: every ```yaml block of README.md and docs/*.md,
+/// wrapped into a tree when it has no `main:` (`main:` + the node, or a `sequence` of the listed
+/// nodes), as the script's awk does.
+fn doc_seeds() -> Vec<(String, String)> {
+    let mut docs = vec![repo_root().join("README.md")];
+    for e in std::fs::read_dir(repo_root().join("docs")).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "md") {
+            docs.push(p);
+        }
+    }
+    let mut out = Vec::new();
+    for doc in docs {
+        let text = std::fs::read_to_string(&doc).unwrap();
+        let stem = doc.file_stem().unwrap().to_string_lossy().into_owned();
+        let mut block: Option<Vec<&str>> = None;
+        for line in text.lines() {
+            match &mut block {
+                None if line.starts_with("```yaml") => block = Some(Vec::new()),
+                Some(lines) if line.starts_with("```") => {
+                    out.push((format!("{stem} example {}", out.len() + 1), wrap(lines)));
+                    block = None;
+                }
+                Some(lines) => lines.push(line),
+                None => {}
+            }
+        }
+    }
+    out
+}
+
+fn wrap(lines: &[&str]) -> String {
+    if lines.iter().any(|l| l.starts_with("main:")) {
+        return lines.iter().map(|l| format!("{l}\n")).collect();
+    }
+    let first = lines
+        .iter()
+        .find(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+    let (head, indent) = match first {
+        Some(l) if l.starts_with("- ") => ("main:\n  sequence:\n    children:\n", "      "),
+        _ => ("main:\n", "  "),
+    };
+    head.to_string() + &lines.iter().map(|l| format!("{indent}{l}\n")).collect::<String>()
+}
+
+#[test]
+fn every_doc_example_replays_through_the_fuzz_entry_point() {
+    let blocks = doc_seeds();
+    assert!(blocks.len() >= 20, "{} yaml blocks", blocks.len());
+    let mut ok = Vec::new();
+    for (name, text) in &blocks {
+        match entry::load_tree(text.as_bytes(), repo_root()) {
+            Ok(_) => ok.push(name.as_str()),
+            Err(d) => assert_located(&d, name),
+        }
+    }
+    // Most examples are complete nodes: wrapped, they compile and seed the fuzzer with every
+    // node kind.
+    assert!(
+        ok.len() >= blocks.len() / 2,
+        "only {ok:?} of {} compile",
+        blocks.len()
+    );
+}
+
 #[test]
 fn every_seed_replays_through_the_fuzz_entry_point() {
-    let seeds = seeds();
+    let seeds = seed_files();
     assert!(seeds.len() >= 10, "seeds: {seeds:?}");
     let mut ok = Vec::new();
     for p in &seeds {
