@@ -203,3 +203,11 @@ pub fn compile_str(src: &str, file_name: &str) -> Result<Plan, Vec<Diagnostic>> 
     let spec = spec::load_str(src, file_name)?;
     compile_spec(&spec)
 }
+
+/// Read, validate and compile a tree from raw bytes (a file's content), the way [`load_plan`]
+/// treats what it read: invalid UTF-8 is a located error. `file_name` plays the same role as in
+/// [`compile_str`]. This is the entry point of the loader's fuzz target (`fuzz/`).
+pub fn compile_bytes(bytes: &[u8], file_name: &str) -> Result<Plan, Vec<Diagnostic>> {
+    let spec = spec::load_bytes(bytes, file_name)?;
+    compile_spec(&spec)
+}

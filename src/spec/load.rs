@@ -1,6 +1,7 @@
 //! Loading tree files: read, follow `include:`, collect subtrees, expand `main:`.
 
 use std::collections::{HashMap, HashSet};
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use super::diag::{Diagnostic, FileId, Issue, Loc, Sources};
@@ -28,33 +29,16 @@ pub struct Spec {
 
 /// Load a tree file from disk (following includes relative to it).
 pub fn load_file(path: &Path) -> Result<Spec, Vec<Diagnostic>> {
-    let mut l = Loader::default();
     let name = path.display().to_string();
-    let text = match read_limited(path) {
-        Ok(t) => t,
+    match read_limited(path) {
+        Ok(bytes) => load_bytes_at(&bytes, name, path),
         Err((msg, help)) => {
+            let mut l = Loader::default();
             let id = l.sources.add(name, "");
             l.issues.push(Issue::new(Loc::file_start(id), msg).help(help));
-            return Err(l.sources.diagnostics(&l.issues));
+            Err(l.sources.diagnostics(&l.issues))
         }
-    };
-    let text = match String::from_utf8(text) {
-        Ok(t) => t,
-        Err(e) => {
-            let id = l
-                .sources
-                .add(name, String::from_utf8_lossy(e.as_bytes()).into_owned());
-            let issue = decode_utf8(e.as_bytes(), id)
-                .err()
-                .unwrap_or_else(|| Issue::new(Loc::file_start(id), "not UTF-8"));
-            l.issues.push(issue);
-            return Err(l.sources.diagnostics(&l.issues));
-        }
-    };
-    if let Ok(c) = path.canonicalize() {
-        l.loaded.insert(c);
     }
-    l.finish(&text, &name, path.parent())
 }
 
 /// Load a tree from text. `file_name` is used in diagnostics and, when it has a folder part,
@@ -68,6 +52,35 @@ pub fn load_str(text: &str, file_name: &str) -> Result<Spec, Vec<Diagnostic>> {
     l.finish(text, file_name, path.parent())
 }
 
+/// Load a tree from raw bytes (a file's content), exactly as [`load_file`] treats what it read:
+/// invalid UTF-8 is a located error, the rest is [`load_str`]. `file_name` plays the same role
+/// as in [`load_str`].
+pub fn load_bytes(bytes: &[u8], file_name: &str) -> Result<Spec, Vec<Diagnostic>> {
+    load_bytes_at(bytes, file_name.to_string(), Path::new(file_name))
+}
+
+fn load_bytes_at(bytes: &[u8], name: String, path: &Path) -> Result<Spec, Vec<Diagnostic>> {
+    let mut l = Loader::default();
+    let text = match std::str::from_utf8(bytes) {
+        Ok(t) => t,
+        Err(_) => {
+            let id = l.sources.add(name, String::from_utf8_lossy(bytes).into_owned());
+            let issue = decode_utf8(bytes, id)
+                .err()
+                .unwrap_or_else(|| Issue::new(Loc::file_start(id), "not UTF-8"));
+            l.issues.push(issue);
+            return Err(l.sources.diagnostics(&l.issues));
+        }
+    };
+    if let Ok(c) = path.canonicalize() {
+        l.loaded.insert(c);
+    }
+    l.finish(text, &name, path.parent())
+}
+
+/// Read a tree file of at most [`MAX_FILE_BYTES`]. Only regular files are read, and never more
+/// than the limit: a device (`/dev/zero`), a FIFO or a `/proc` file whose size is reported as 0
+/// would otherwise be read forever, or block.
 fn read_limited(path: &Path) -> Result<Vec<u8>, (String, String)> {
     let meta = std::fs::metadata(path).map_err(|e| {
         (
@@ -81,21 +94,37 @@ fn read_limited(path: &Path) -> Result<Vec<u8>, (String, String)> {
             "give the path of a `.yaml` file".to_string(),
         ));
     }
-    if meta.len() > MAX_FILE_BYTES as u64 {
+    if !meta.is_file() {
         return Err((
-            format!(
-                "file is too large: {} bytes (limit {MAX_FILE_BYTES} bytes)",
-                meta.len()
-            ),
-            "a behavior tree file is a few kilobytes; is this the right file?".to_string(),
+            format!("`{}` is not a regular file", path.display()),
+            "give the path of a `.yaml` file (devices, pipes and sockets are not read)".to_string(),
         ));
     }
-    std::fs::read(path).map_err(|e| {
+    let too_large = |size: String| {
+        (
+            format!("file is too large: {size} bytes (limit {MAX_FILE_BYTES} bytes)"),
+            "a behavior tree file is a few kilobytes; is this the right file?".to_string(),
+        )
+    };
+    if meta.len() > MAX_FILE_BYTES as u64 {
+        return Err(too_large(meta.len().to_string()));
+    }
+    let cannot = |e: std::io::Error| {
         (
             format!("cannot read `{}`: {e}", path.display()),
             "check the path and permissions".to_string(),
         )
-    })
+    };
+    let file = std::fs::File::open(path).map_err(cannot)?;
+    let mut bytes = Vec::new();
+    // One byte past the limit tells "too large" from "exactly at the limit".
+    file.take(MAX_FILE_BYTES as u64 + 1)
+        .read_to_end(&mut bytes)
+        .map_err(cannot)?;
+    if bytes.len() > MAX_FILE_BYTES {
+        return Err(too_large(format!("more than {MAX_FILE_BYTES}")));
+    }
+    Ok(bytes)
 }
 
 #[derive(Default)]

@@ -27,6 +27,6 @@ pub use leaves::{
     ActionLeaf, AtHome, Carry, ConditionLeaf, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable,
     Grasp, GripperOpen, Home, Leaf, MoveJoints, Reach, Release, Wait,
 };
-pub use load::{Spec, load_file, load_str};
+pub use load::{Spec, load_bytes, load_file, load_str};
 pub use node::{Node, NodeKind};
 pub use units::{PathKind, Target, Yaw};
