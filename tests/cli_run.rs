@@ -80,6 +80,42 @@ fn run_reports_task_failure_with_exit_1() {
 }
 
 #[test]
+fn goal_tree_lets_a_table_placement_succeed_and_bowl_does_not() {
+    // The same episode judged two ways: the tree places the cube on the table, so the default
+    // goal (cube in the bowl) fails it and `--goal tree` (the tree's own `cube_at`) passes it.
+    let judged = |goal: &str| {
+        let out = macrotree(&["run", "trees/place_on_table.yaml", "--goal", goal, "--json"]);
+        (out.status.code(), last_json_line(&out))
+    };
+    let (code, tree) = judged("tree");
+    assert_eq!(code, Some(0), "{tree}");
+    assert_eq!(tree["success"], true);
+    assert_eq!(tree["tree_status"], "success");
+    assert_eq!(tree["checks"]["in_bowl"], false);
+    let (code, bowl) = judged("bowl");
+    assert_eq!(code, Some(1), "{bowl}");
+    assert_eq!(bowl["success"], false);
+    assert_eq!(bowl["tree_status"], "success");
+    let reason = bowl["failure_reason"].as_str().unwrap_or_default();
+    assert!(reason.contains("not at rest in the bowl"), "reason: {reason}");
+    // Same physics either way: the goal only judges.
+    assert_eq!(tree["cube_final"], bowl["cube_final"]);
+    assert_eq!(tree["physics_steps"], bowl["physics_steps"]);
+}
+
+/// Regression: a tree that failed through a condition (no action failed) was reported with the
+/// bare reason "the tree failed"; the report now carries the root's reason.
+#[test]
+fn failure_reason_names_the_failed_condition_not_just_the_tree() {
+    let out = macrotree(&["run", "tests/fixtures/cli/carry_without_a_grasp.yaml", "--json"]);
+    assert_eq!(out.status.code(), Some(1));
+    let r = last_json_line(&out);
+    assert_eq!(r["tree_status"], "failure");
+    let reason = r["failure_reason"].as_str().unwrap_or_default();
+    assert_eq!(reason, "condition failed: cube_grasped: not satisfied");
+}
+
+#[test]
 fn invalid_tree_exits_2_with_a_located_message() {
     let out = macrotree(&["run", "tests/fixtures/cli/misspelled_param.yaml"]);
     assert_eq!(out.status.code(), Some(2));

@@ -7,7 +7,7 @@ use std::sync::{Arc, OnceLock};
 use clap::Parser;
 use macrotree::actions::{CONTROL_PERIOD, Cell};
 use macrotree::cli::{Cli, Command};
-use macrotree::episode::{NoObserver, run_episode};
+use macrotree::episode::{Goal, NoObserver, run_episode};
 use macrotree::faults::FaultKind;
 use macrotree::plan::Plan;
 use macrotree::sim::{Layout, Scene};
@@ -128,7 +128,7 @@ fn the_printed_command_reproduces_the_scenario_bit_for_bit() {
     for index in [1, 2] {
         let scenario = sample_scenario(77, index);
         let swept = run_scenario(&mut cell, &plan, &config, &scenario);
-        let cmd = swept.reproduce(TREE, config.max_sim_time);
+        let cmd = swept.reproduce(TREE, &config);
         let parsed = parse_run_command(&cmd);
         // Bit-exact: the same layout (floats compared with ==), seed, limits.
         assert_eq!(parsed, config.episode_config(&scenario), "{cmd}");
@@ -140,17 +140,21 @@ fn the_printed_command_reproduces_the_scenario_bit_for_bit() {
 }
 
 #[test]
-fn reproduction_commands_spell_the_fault_and_the_time_limit() {
+fn reproduction_commands_spell_the_fault_the_goal_and_the_time_limit() {
     let scenario = sample_scenario(3, 4);
     let config = SweepConfig {
         fault: Some(FaultKind::LateBowl),
+        goal: Goal::Tree,
         max_sim_time: 12.5,
         ..SweepConfig::default()
     };
     let mut cell = Cell::new(scene(), &Layout::default(), CONTROL_PERIOD);
     let r = run_scenario(&mut cell, &plan(), &config, &scenario);
-    let cmd = r.reproduce(TREE, config.max_sim_time);
-    assert!(cmd.ends_with(" --fault late_bowl --max-sim-time 12.5"), "{cmd}");
+    let cmd = r.reproduce(TREE, &config);
+    assert!(
+        cmd.ends_with(" --fault late_bowl --goal tree --max-sim-time 12.5"),
+        "{cmd}"
+    );
     let words: Vec<&str> = cmd.split_whitespace().collect();
     let Command::Run(args) = Cli::try_parse_from(words).expect("parses").command else {
         panic!("not a run command: {cmd}");
@@ -160,11 +164,11 @@ fn reproduction_commands_spell_the_fault_and_the_time_limit() {
     assert_eq!(parsed.layout, config.episode_config(&scenario).layout);
     assert_eq!(parsed.seed, scenario.seed);
     assert_eq!(parsed.max_sim_time, 12.5);
+    assert_eq!(parsed.goal, Goal::Tree);
 }
 
 /// `run --fault K` must inject K: the reproduction commands of faulted sweeps rely on it.
-/// Ignored until `EpisodeArgs::config` (src/cli/run.rs) copies `--fault` into the episode
-/// configuration; it currently drops it.
+/// (Regression: `EpisodeArgs::config` once dropped `--fault`.)
 #[test]
 fn run_fault_option_reaches_the_episode() {
     let cmd = sample_scenario(3, 4).layout;

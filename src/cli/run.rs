@@ -7,7 +7,7 @@ use clap::Args;
 
 use super::args::{CubeArg, XyArg};
 use super::{CliError, load_plan_or_exit, load_scene_or_exit};
-use crate::episode::{EpisodeConfig, NoObserver, run_episode};
+use crate::episode::{EpisodeConfig, Goal, NoObserver, run_episode};
 use crate::sim::Layout;
 use crate::viewer::{LiveViewer, Recorder, ViewObserver, ViewerOptions};
 
@@ -57,6 +57,10 @@ pub struct EpisodeArgs {
     /// Inject a fault through physics (see docs/faults.md).
     #[arg(long, value_enum)]
     pub fault: Option<crate::faults::FaultKind>,
+    /// Success means: `bowl` = the tree succeeded and the cube rests in the bowl; `tree` = the
+    /// tree succeeded (its own conditions check the task).
+    #[arg(long, value_enum, default_value_t = Goal::Bowl)]
+    pub goal: Goal,
 }
 
 impl EpisodeArgs {
@@ -81,6 +85,7 @@ impl EpisodeArgs {
             seed: self.seed,
             max_sim_time: self.max_sim_time,
             fault: self.fault,
+            goal: self.goal,
             ..EpisodeConfig::default()
         })
     }

@@ -11,6 +11,7 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use super::{CliError, load_plan_or_exit, load_scene_or_exit};
+use crate::episode::Goal;
 use crate::faults::FaultKind;
 use crate::sweep::{Shard, Summary, SweepConfig, run_sweep};
 
@@ -31,6 +32,10 @@ pub struct SweepArgs {
     /// Inject this fault through physics in every scenario (see docs/faults.md).
     #[arg(long, value_enum)]
     pub fault: Option<FaultKind>,
+    /// Success means: `bowl` = the tree succeeded and the cube rests in the bowl; `tree` = the
+    /// tree succeeded (its own conditions check the task).
+    #[arg(long, value_enum, default_value_t = Goal::Bowl)]
+    pub goal: Goal,
     /// Write one JSON line per scenario here, in scenario order.
     #[arg(long, value_name = "FILE.jsonl")]
     pub out: Option<PathBuf>,
@@ -66,6 +71,7 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
         seed: args.seed,
         jobs: args.jobs.map_or(0, |j| j as usize),
         fault: args.fault,
+        goal: args.goal,
         shard: args.shard,
         max_sim_time: args.max_sim_time,
     };

@@ -28,6 +28,30 @@ pub struct EpisodeConfig {
     pub control_period: f64,
     /// A fault to inject through physics, if any.
     pub fault: Option<crate::faults::FaultKind>,
+    /// What counts as success.
+    pub goal: Goal,
+}
+
+/// What counts as a successful episode (`run --goal`, `sweep --goal`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Goal {
+    /// The tree succeeded and the cube rests in the bowl (the cube-to-bowl task).
+    #[default]
+    Bowl,
+    /// The tree succeeded; the tree's own conditions define the task (e.g. `cube_at` for a
+    /// placement on the table).
+    Tree,
+}
+
+impl Goal {
+    /// The name used on the command line (`bowl`, `tree`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Goal::Bowl => "bowl",
+            Goal::Tree => "tree",
+        }
+    }
 }
 
 impl Default for EpisodeConfig {
@@ -38,6 +62,7 @@ impl Default for EpisodeConfig {
             max_sim_time: 60.0,
             control_period: crate::actions::CONTROL_PERIOD,
             fault: None,
+            goal: Goal::Bowl,
         }
     }
 }
@@ -96,7 +121,10 @@ pub fn run_in_cell(
     }
     let checks = driver.checks.clone();
     let counters = driver.counters;
-    let last_failure = driver.last_failure.clone();
+    // The root's reason tells the whole story ("all 3 attempts failed; last: …"); an action's
+    // own reason is the fallback.
+    let root_reason = runner.node_reasons().first().cloned().flatten();
+    let last_failure = root_reason.or_else(|| driver.last_failure.clone());
     cell.observers.truncate(observers_before);
     let world = cell.world().clone();
     EpisodeReport::new(

@@ -2,7 +2,7 @@
 
 use serde::Serialize;
 
-use super::EpisodeConfig;
+use super::{EpisodeConfig, Goal};
 use crate::actions::{Checks, LeafCounters};
 use crate::runtime::TreeStatus;
 use crate::world::World;
@@ -10,7 +10,8 @@ use crate::world::World;
 /// What happened in one episode. Lengths in metres, times in seconds.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EpisodeReport {
-    /// The tree succeeded and the cube rests in the bowl.
+    /// The episode met its [`Goal`]: by default the tree succeeded and the cube rests in the
+    /// bowl; with `Goal::Tree`, the tree succeeded.
     pub success: bool,
     /// Final status of the tree: "success", "failure", or "running" when the time limit hit.
     pub tree_status: &'static str,
@@ -66,7 +67,7 @@ impl EpisodeReport {
             TreeStatus::Failure => "failure",
             TreeStatus::Running => "running",
         };
-        let success = status == TreeStatus::Success && checks.in_bowl;
+        let success = status == TreeStatus::Success && (config.goal == Goal::Tree || checks.in_bowl);
         let failure_reason = if success {
             None
         } else if timed_out {

@@ -34,7 +34,7 @@ pub use layout::{Region, Scenario, ScenarioLayout, sample_scenario, sample_scena
 pub use summary::{Failure, Summary, percentile, wilson_interval};
 
 use crate::actions::{CONTROL_PERIOD, Cell, Checks};
-use crate::episode::{EpisodeConfig, EpisodeReport, NoObserver, run_in_cell};
+use crate::episode::{EpisodeConfig, EpisodeReport, Goal, NoObserver, run_in_cell};
 use crate::faults::FaultKind;
 use crate::plan::Plan;
 use crate::sim::{Layout, Scene};
@@ -86,6 +86,8 @@ pub struct SweepConfig {
     pub jobs: usize,
     /// A fault injected in every scenario.
     pub fault: Option<FaultKind>,
+    /// What counts as success.
+    pub goal: Goal,
     /// Only this shard's scenarios.
     pub shard: Option<Shard>,
     /// Per-episode simulated time limit, seconds.
@@ -99,6 +101,7 @@ impl Default for SweepConfig {
             seed: 0,
             jobs: 0,
             fault: None,
+            goal: Goal::Bowl,
             shard: None,
             max_sim_time: EpisodeConfig::default().max_sim_time,
         }
@@ -122,6 +125,7 @@ impl SweepConfig {
             max_sim_time: self.max_sim_time,
             control_period: CONTROL_PERIOD,
             fault: self.fault,
+            goal: self.goal,
         }
     }
 }
@@ -141,7 +145,8 @@ pub struct ScenarioResult {
     pub fault: Option<FaultKind>,
     /// The layout, exactly as sampled (and as `run --cube X,Y,YAW --bowl X,Y` takes it).
     pub layout: ScenarioLayout,
-    /// The tree succeeded and the cube rests in the bowl.
+    /// The episode met the sweep's goal (by default: the tree succeeded and the cube rests in
+    /// the bowl; see [`Goal`]).
     pub success: bool,
     /// Final status of the tree.
     pub tree_status: &'static str,
@@ -224,7 +229,7 @@ impl ScenarioResult {
 
     /// The `macrotree run …` command that reproduces this scenario bit for bit. Floats are
     /// printed with Rust's shortest round-trip formatting, so they parse back to the same bits.
-    pub fn reproduce(&self, tree: &str, max_sim_time: f64) -> String {
+    pub fn reproduce(&self, tree: &str, config: &SweepConfig) -> String {
         let l = &self.layout;
         let mut cmd = format!(
             "macrotree run {} --cube {},{},{} --bowl {},{} --seed {}",
@@ -239,8 +244,11 @@ impl ScenarioResult {
         if let Some(fault) = self.fault {
             cmd += &format!(" --fault {fault}");
         }
-        if max_sim_time != EpisodeConfig::default().max_sim_time {
-            cmd += &format!(" --max-sim-time {max_sim_time}");
+        if config.goal != Goal::default() {
+            cmd += &format!(" --goal {}", config.goal.name());
+        }
+        if config.max_sim_time != EpisodeConfig::default().max_sim_time {
+            cmd += &format!(" --max-sim-time {}", config.max_sim_time);
         }
         cmd
     }

@@ -7,6 +7,7 @@ use std::fmt::Write as _;
 use serde::Serialize;
 
 use super::{ScenarioResult, Shard, SweepConfig};
+use crate::episode::Goal;
 use crate::faults::FaultKind;
 
 /// z for a two-sided 95% interval.
@@ -40,6 +41,8 @@ pub struct Summary {
     pub seed: u64,
     /// The injected fault.
     pub fault: Option<FaultKind>,
+    /// What counted as success.
+    pub goal: Goal,
     /// The shard run, `K/M`, if any.
     pub shard: Option<String>,
     /// Worker threads.
@@ -93,13 +96,14 @@ impl Summary {
                 bowl: r.layout.bowl,
                 reason: r.failure_reason.clone().unwrap_or_else(|| "failed".into()),
                 grasp_attempts: r.grasp_attempts,
-                reproduce: r.reproduce(tree, config.max_sim_time),
+                reproduce: r.reproduce(tree, config),
             })
             .collect();
         Self {
             tree: tree.to_string(),
             seed: config.seed,
             fault: config.fault,
+            goal: config.goal,
             shard: config.shard.as_ref().map(Shard::to_string),
             jobs,
             scenarios: n,
@@ -130,7 +134,7 @@ impl Summary {
         let [lo, hi] = self.success_rate_ci95;
         let _ = writeln!(
             s,
-            "{} of {} scenarios succeeded: {:.2}% (95% CI {:.2}–{:.2}%), seed {}{}{}",
+            "{} of {} scenarios succeeded: {:.2}% (95% CI {:.2}–{:.2}%), seed {}{}{}{}",
             self.successes,
             self.scenarios,
             self.success_rate * 100.0,
@@ -138,6 +142,11 @@ impl Summary {
             hi * 100.0,
             self.seed,
             self.fault.map_or(String::new(), |f| format!(", fault {f}")),
+            if self.goal == Goal::default() {
+                String::new()
+            } else {
+                format!(", goal {}", self.goal.name())
+            },
             self.shard
                 .as_ref()
                 .map_or(String::new(), |k| format!(", shard {k}")),
