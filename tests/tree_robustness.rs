@@ -145,6 +145,15 @@ fn non_utf8_is_located() {
 }
 
 #[test]
+fn a_leaf_with_thousands_of_bad_keys_reports_a_capped_number() {
+    // Each reported error re-reads the leaf; the cap keeps this linear in the file size.
+    let keys: Vec<String> = (0..20_000).map(|i| format!("k{i}: 1")).collect();
+    let d = errors(&format!("main:\n  home: {{{}}}\n", keys.join(", ")));
+    assert_eq!(d.len(), macrotree::spec::expand::MAX_LEAF_ERRORS, "{}", d[0]);
+    assert!(d.iter().all(|e| e.message.starts_with("unknown parameter `k")));
+}
+
+#[test]
 fn fifty_megabyte_file_is_rejected_before_parsing() {
     let size = 50 * 1024 * 1024;
     let mut big = String::with_capacity(size + 32);

@@ -156,6 +156,42 @@ fn unknown_leaf_parameter_is_located_at_the_key() {
 }
 
 #[test]
+fn every_bad_parameter_of_one_leaf_is_reported_at_once() {
+    // Three mistakes in one `reach`, one in the next: four diagnostics, in source order, and no
+    // spurious "missing parameter `target`" for the misspelled target value.
+    let d = errors(
+        "main:\n  sequence:\n    children:\n      - reach: {target: cubee, ofset: [0, 0, 0.1], speed: .nan}\n      - grasp: {force: 1}\n",
+    );
+    let found: Vec<(u32, u32)> = d.iter().map(at).collect();
+    assert_eq!(found, [(4, 25), (4, 32), (4, 59), (5, 17)], "{d:?}");
+    find(&d, "unknown target `cubee`");
+    assert_eq!(
+        find(&d, "unknown parameter `ofset`").help.as_deref(),
+        Some("did you mean `offset`?")
+    );
+    find(&d, "must be a finite number");
+    find(&d, "unknown parameter `force`");
+    assert!(
+        !d.iter().any(|e| e.message.contains("missing parameter")),
+        "{d:?}"
+    );
+}
+
+#[test]
+fn a_missing_parameter_is_reported_with_the_bad_ones() {
+    let d = errors("main:\n  reach: {ofset: [0, 0, 0.1], sped: 1}\n");
+    let messages: Vec<&str> = d.iter().map(|e| e.message.as_str()).collect();
+    assert_eq!(
+        messages,
+        [
+            "missing parameter `target` in `reach`",
+            "unknown parameter `ofset` in `reach`",
+            "unknown parameter `sped` in `reach`",
+        ]
+    );
+}
+
+#[test]
 fn wrong_type_is_located_at_the_value() {
     let d = errors("main:\n  reach:\n    target: cube\n    speed: fast\n");
     let e = find(&d, "wrong type");

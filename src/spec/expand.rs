@@ -7,9 +7,10 @@
 
 use std::collections::HashMap;
 
+use super::de::DeError;
 use super::diag::{Issue, Loc, Sources};
 use super::file::{SubtreeDef, param_ref};
-use super::leaves::{ACTION_KINDS, CONDITION_KINDS, parse_leaf};
+use super::leaves::{ACTION_KINDS, CONDITION_KINDS, Leaf, parse_leaf};
 use super::node::{COMPOSITE_KINDS, DECORATOR_KINDS, Node, NodeKind};
 use super::suggest::did_you_mean;
 use super::value::{Value, ValueKind};
@@ -18,6 +19,8 @@ use super::value::{Value, ValueKind};
 pub const MAX_TREE_DEPTH: usize = 64;
 /// Most nodes accepted after subtree expansion.
 pub const MAX_TREE_NODES: usize = 5_000;
+/// Most errors reported for one leaf's parameters.
+pub const MAX_LEAF_ERRORS: usize = 16;
 /// Largest `attempts` / `times`.
 pub const MAX_COUNT: u32 = 1_000;
 
@@ -184,18 +187,20 @@ impl<'a> Expander<'a> {
             self.composite(k, loc, body, depth)?
         } else if DECORATOR_KINDS.contains(&k) {
             self.decorator(k, loc, body, depth)?
-        } else if let Some(parsed) = parse_leaf(k, &without_name(body)) {
+        } else if let Some(parsed) = parse_leaf_reporting_all(k, without_name(body)) {
             match parsed {
                 Ok(leaf) => NodeKind::Leaf(leaf),
-                Err(e) => {
-                    let mut issue = e.into_issue(body.loc, |l| self.sources.describe(l));
-                    issue.message = format!("{} in `{k}`", issue.message);
-                    if issue.help.is_none() {
-                        issue.help = Some(format!(
-                            "see `macrotree nodes {k}` (or docs/nodes/{k}.md) for its parameters and units"
-                        ));
+                Err(errors) => {
+                    for e in errors {
+                        let mut issue = e.into_issue(body.loc, |l| self.sources.describe(l));
+                        issue.message = format!("{} in `{k}`", issue.message);
+                        if issue.help.is_none() {
+                            issue.help = Some(format!(
+                                "see `macrotree nodes {k}` (or docs/nodes/{k}.md) for its parameters and units"
+                            ));
+                        }
+                        self.err(issue);
                     }
-                    self.err(issue);
                     return None;
                 }
             }
@@ -671,6 +676,62 @@ fn extra_example(kind: &str) -> &'static str {
 
 fn valid_name(s: &str) -> bool {
     !s.trim().is_empty() && s.chars().count() <= 80 && !s.contains(['/', '[', ']', '#', '\n', '\r'])
+}
+
+/// Reads leaf `kind` from `params` like [`parse_leaf`], but reports every bad parameter, not just
+/// the first: after an error located in one parameter (its key or anything in its value), that
+/// parameter is set aside and the rest read again. It stops at an error that no parameter
+/// explains (a missing parameter) or after [`MAX_LEAF_ERRORS`] (each retry re-reads the leaf, so
+/// the cap keeps a leaf with thousands of bad keys linear); a "missing" error for a parameter set
+/// aside, or for the one a misspelled key was suggested as, is not repeated. `None` if `kind` is not a leaf kind.
+fn parse_leaf_reporting_all(kind: &str, mut params: Value) -> Option<Result<Leaf, Vec<DeError>>> {
+    let mut errors = Vec::new();
+    let mut set_aside: Vec<String> = Vec::new();
+    loop {
+        let e = match parse_leaf(kind, &params)? {
+            Ok(leaf) if errors.is_empty() => return Some(Ok(leaf)),
+            Ok(_) => return Some(Err(errors)),
+            Err(e) => e,
+        };
+        // "Missing `target`" after `target: cubee` or `targt: cube` was set aside says nothing new.
+        let explained = |k: &String| {
+            e.message == format!("missing parameter `{k}`")
+                || e.message.strip_prefix("missing parameter `").is_some_and(|rest| {
+                    let missing = rest.trim_end_matches('`');
+                    did_you_mean(k, [missing]).is_some()
+                })
+        };
+        if set_aside.iter().any(explained) {
+            return Some(Err(errors));
+        }
+        let ValueKind::Map(entries) = &mut params.kind else {
+            errors.push(e);
+            return Some(Err(errors));
+        };
+        let culprit = e.loc.and_then(|loc| {
+            entries
+                .iter()
+                .position(|(k, v)| k.loc == loc || contains_loc(v, loc))
+        });
+        errors.push(e);
+        match culprit {
+            Some(i) if errors.len() < MAX_LEAF_ERRORS => {
+                let (key, _) = entries.remove(i);
+                set_aside.extend(key.as_str().map(str::to_string));
+            }
+            _ => return Some(Err(errors)),
+        }
+    }
+}
+
+/// Whether `loc` is the location of `v` or of a value inside it.
+fn contains_loc(v: &Value, loc: Loc) -> bool {
+    v.loc == loc
+        || match &v.kind {
+            ValueKind::Seq(items) => items.iter().any(|i| contains_loc(i, loc)),
+            ValueKind::Map(m) => m.iter().any(|(k, v)| k.loc == loc || contains_loc(v, loc)),
+            _ => false,
+        }
 }
 
 fn without_name(body: &Value) -> Value {
