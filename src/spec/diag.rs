@@ -65,8 +65,12 @@ pub struct Diagnostic {
     pub help: Option<String>,
     /// Extra context (e.g. where a `$param` value came from).
     pub note: Option<String>,
-    /// The source line the error points into, if known (without the line break).
+    /// The source line the error points into, if known (without the line break); a long line is
+    /// cut to a window around the column, with `…` where text was left out.
     pub source_line: Option<String>,
+    /// Where the caret starts in `source_line` (1-based, in characters): `column`, unless the
+    /// line was cut.
+    pub source_column: u32,
     /// Width of the caret underline in characters (at least 1).
     pub width: u32,
 }
@@ -90,7 +94,7 @@ impl fmt::Display for Diagnostic {
             writeln!(f)?;
             writeln!(f, "{pad} |")?;
             writeln!(f, "{} | {}", self.line, shown.trim_end())?;
-            let before = " ".repeat(self.column.saturating_sub(1) as usize);
+            let before = " ".repeat(self.source_column.saturating_sub(1) as usize);
             let carets = "^".repeat(self.width.max(1) as usize);
             write!(f, "{pad} | {before}{carets}")?;
             if let Some(label) = &self.label {
@@ -174,6 +178,36 @@ impl Issue {
 }
 
 /// Replace control characters (except tabs) so that a diagnostic never garbles a terminal.
+/// Characters of a source line shown under a diagnostic.
+const SHOWN_CHARS: usize = 160;
+/// Characters shown before the column when a long line is cut.
+const SHOWN_BEFORE: usize = 60;
+
+/// The part of `line` shown for a diagnostic at 1-based column `col`, and the caret's column in
+/// it: the whole line when short; otherwise a window that keeps the column in view, with `…` for
+/// what was left out (a 1 MB one-line file must not print 1 MB).
+fn source_window(line: &str, col: u32) -> (String, u32) {
+    let chars: Vec<char> = line.chars().collect();
+    let at = (col.max(1) - 1) as usize;
+    let start = if at < SHOWN_CHARS - 20 {
+        0
+    } else {
+        at - SHOWN_BEFORE
+    };
+    let start = start.min(chars.len());
+    let end = (start + SHOWN_CHARS).min(chars.len());
+    let mut shown = String::new();
+    if start > 0 {
+        shown.push('…');
+    }
+    shown.extend(&chars[start..end]);
+    if end < chars.len() {
+        shown.push('…');
+    }
+    let column = col.max(1) - start as u32 + u32::from(start > 0);
+    (sanitize(&shown), column)
+}
+
 fn sanitize(s: &str) -> String {
     s.chars()
         .map(|c| {
@@ -245,18 +279,22 @@ impl Sources {
     /// Turn an issue into a self-contained diagnostic.
     pub fn diagnostic(&self, issue: &Issue) -> Diagnostic {
         let file = self.get(issue.loc.file);
-        let source_line = file.and_then(|f| {
+        let window = file.and_then(|f| {
             if issue.loc.line == 0 {
                 return None;
             }
             f.text
                 .lines()
                 .nth(issue.loc.line as usize - 1)
-                .map(|l| sanitize(&l.chars().take(300).collect::<String>()))
+                .map(|l| source_window(l, issue.loc.col))
         });
+        let (source_line, source_column) = match window {
+            Some((line, column)) => (Some(line), column),
+            None => (None, issue.loc.col),
+        };
         let width = match &source_line {
             Some(l) => {
-                let avail = (l.chars().count() as u32 + 1).saturating_sub(issue.loc.col.max(1));
+                let avail = (l.chars().count() as u32 + 1).saturating_sub(source_column.max(1));
                 issue.loc.len.clamp(1, avail.max(1))
             }
             None => 1,
@@ -270,6 +308,7 @@ impl Sources {
             help: issue.help.as_deref().map(sanitize),
             note: issue.note.as_deref().map(sanitize),
             source_line,
+            source_column,
             width,
         }
     }
@@ -315,5 +354,40 @@ mod tests {
             text,
             "error: unknown node kind `sequnce`\n --> t.yaml:2:3\n  |\n2 |   sequnce: {}\n  |   ^^^^^^^ expected a node kind\n  = help: did you mean `sequence`?"
         );
+    }
+
+    #[test]
+    fn a_long_line_is_shown_as_a_window_around_the_column() {
+        // Regression: an error at column 300 000 of a one-line file printed 300 KB of spaces.
+        let line = format!("x: [{}bad]", "1, ".repeat(100_000));
+        let col = line.find("bad").unwrap() as u32 + 1;
+        let mut s = Sources::new();
+        let f = s.add("t.yaml", line.as_str());
+        let loc = Loc {
+            file: f,
+            line: 1,
+            col,
+            len: 3,
+        };
+        let d = s.diagnostic(&Issue::new(loc, "bad value"));
+        let shown = d.source_line.as_deref().unwrap();
+        assert!(
+            shown.starts_with('…') && shown.chars().count() <= SHOWN_CHARS + 2,
+            "{shown}"
+        );
+        // The caret still points at `bad`, and the location keeps the true column.
+        let caret_at: String = shown.chars().skip(d.source_column as usize - 1).take(3).collect();
+        assert_eq!(caret_at, "bad");
+        assert_eq!(d.column, col);
+        assert!(d.to_string().len() < 1_000, "{}", d.to_string().len());
+    }
+
+    #[test]
+    fn a_short_line_is_shown_whole() {
+        assert_eq!(source_window("main: {}", 7), ("main: {}".to_string(), 7));
+        let long = "a".repeat(500);
+        let (shown, column) = source_window(&long, 10);
+        assert_eq!(column, 10);
+        assert!(shown.ends_with('…') && shown.chars().count() == SHOWN_CHARS + 1);
     }
 }

@@ -313,6 +313,9 @@ fn yaml_error(e: &serde_saphyr::Error, file: FileId) -> Issue {
         .chars()
         .take(300)
         .collect();
+    if let Some((message, help)) = limit_message(e, &msg) {
+        return Issue::new(loc, message).help(help);
+    }
     let lower = msg.to_lowercase();
     let help = if lower.contains("budget")
         || lower.contains("alias")
@@ -324,6 +327,46 @@ fn yaml_error(e: &serde_saphyr::Error, file: FileId) -> Issue {
         "fix the YAML syntax here (indentation, a missing `:` or an unclosed bracket or quote)"
     };
     Issue::new(loc, format!("invalid YAML: {msg}")).help(help)
+}
+
+/// Our own words (message, help) for the parser's limits, whose own messages name internals.
+fn limit_message(e: &serde_saphyr::Error, raw: &str) -> Option<(String, &'static str)> {
+    use serde_saphyr::budget::BudgetBreach;
+    const SHALLOW: &str =
+        "tree files must stay small and shallow: nest nodes less deeply, or move parts into subtrees";
+    const ALIASES: &str =
+        "write the repeated part once as a subtree (`subtrees:`) instead of YAML anchors and aliases";
+    let mut inner = e;
+    while let serde_saphyr::Error::AliasError { error, .. } | serde_saphyr::Error::WithSnippet { error, .. } =
+        inner
+    {
+        inner = error;
+    }
+    if let serde_saphyr::Error::Budget { breach, .. } = inner {
+        return Some(match breach {
+            BudgetBreach::Depth { .. } => (
+                format!("the YAML is nested more than {MAX_YAML_DEPTH} levels deep"),
+                SHALLOW,
+            ),
+            BudgetBreach::Nodes { .. } | BudgetBreach::Events { .. } => (
+                format!("the YAML holds more than {MAX_YAML_NODES} values once aliases are expanded"),
+                "a tree needs far fewer: write a repeated part once as a subtree (`subtrees:`) instead of copies or YAML aliases",
+            ),
+            BudgetBreach::Aliases { aliases } => (format!("too many YAML aliases ({aliases})"), ALIASES),
+            BudgetBreach::Anchors { anchors } => (format!("too many YAML anchors ({anchors})"), ALIASES),
+            BudgetBreach::Documents { .. } => (
+                "a tree file holds one YAML document; this is the second (`---`)".to_string(),
+                "split the documents into separate files, or remove the `---` line",
+            ),
+            _ => return None,
+        });
+    }
+    raw.contains("recursion limit").then(|| {
+        (
+            "the YAML is nested too deeply for the parser (recursion limit)".to_string(),
+            SHALLOW,
+        )
+    })
 }
 
 /// Read raw bytes (e.g. a file's content) as UTF-8 tree text; invalid UTF-8 is an error located
