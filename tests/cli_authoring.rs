@@ -177,3 +177,47 @@ fn nodes_unknown_kind_suggests_the_nearest() {
     assert!(err.contains("unknown node kind `reac`"), "{err}");
     assert!(err.contains("did you mean `reach`?"), "{err}");
 }
+
+#[test]
+fn validate_json_gives_one_object_per_file_with_located_diagnostics() {
+    let bad = "tests/fixtures/cli/misspelled_param.yaml";
+    let out = macrotree(&["validate", "--format", "json", bad, "trees/cube_to_bowl.yaml"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let files: Vec<serde_json::Value> = stdout(&out)
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("each line is JSON"))
+        .collect();
+    assert_eq!(files.len(), 2);
+    assert_eq!(files[0]["file"], bad);
+    assert_eq!(files[0]["valid"], false);
+    let d = &files[0]["diagnostics"][0];
+    assert_eq!((d["line"].as_u64(), d["column"].as_u64()), (Some(4), Some(31)));
+    assert_eq!(d["end_column"], 36, "`ofset` is 5 characters: {d}");
+    assert_eq!(d["message"], "unknown parameter `ofset` in `reach`");
+    assert_eq!(d["help"], "did you mean `offset`?");
+    assert_eq!(files[1]["valid"], true);
+    assert_eq!(files[1]["diagnostics"].as_array().map(Vec::len), Some(0));
+    assert!(files[1]["nodes"].as_u64().unwrap_or(0) > 10);
+}
+
+#[test]
+fn validate_github_prints_one_annotation_per_error() {
+    let out = macrotree(&[
+        "validate",
+        "--format",
+        "github",
+        "tests/fixtures/cli/misspelled_param.yaml",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let text = stdout(&out);
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 1, "{text}");
+    assert!(
+        lines[0].starts_with(
+            "::error file=tests/fixtures/cli/misspelled_param.yaml,line=4,col=31,endColumn=35,title=macrotree::unknown parameter `ofset`"
+        ),
+        "{}",
+        lines[0]
+    );
+    assert!(lines[0].ends_with("%0Adid you mean `offset`?"), "{}", lines[0]);
+}

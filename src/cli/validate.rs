@@ -2,9 +2,10 @@
 
 use std::path::PathBuf;
 
-use clap::Args;
+use clap::{Args, ValueEnum};
 
 use super::CliError;
+use crate::spec::Diagnostic;
 
 /// Arguments of `validate`.
 #[derive(Debug, Args)]
@@ -12,23 +13,60 @@ pub struct ValidateArgs {
     /// Tree files (YAML).
     #[arg(required = true)]
     pub trees: Vec<PathBuf>,
+    /// How to print the result.
+    #[arg(long, value_enum, default_value_t = DiagnosticFormat::Human)]
+    pub format: DiagnosticFormat,
+}
+
+/// How `validate` prints its findings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum DiagnosticFormat {
+    /// rustc-style errors on stderr (source line, caret, help); "FILE: ok" on stdout.
+    Human,
+    /// One JSON object per file on stdout: `{file, valid, nodes, leaves, diagnostics: [...]}`,
+    /// each diagnostic with 1-based `line`, `column`, `end_column` (exclusive), `message`,
+    /// `label`, `help`, `note`. For editors and scripts.
+    Json,
+    /// GitHub Actions workflow commands on stdout (`::error file=…,line=…,col=…::…`), so that
+    /// a CI run annotates the offending lines of a pull request.
+    Github,
 }
 
 /// Runs `macrotree validate`: every error of every file, exit 2 if any.
 pub fn validate(args: ValidateArgs) -> Result<(), CliError> {
     let mut failed = 0;
     for tree in &args.trees {
-        match crate::plan::load_plan(tree) {
-            Ok(plan) => println!(
-                "{}: ok ({} nodes, {} leaves)",
-                tree.display(),
-                plan.nodes.len(),
-                plan.leaves.len()
-            ),
-            Err(diags) => {
-                failed += 1;
-                for d in &diags {
-                    eprintln!("{d}");
+        let result = crate::plan::load_plan(tree);
+        if result.is_err() {
+            failed += 1;
+        }
+        match args.format {
+            DiagnosticFormat::Human => match &result {
+                Ok(plan) => println!(
+                    "{}: ok ({} nodes, {} leaves)",
+                    tree.display(),
+                    plan.nodes.len(),
+                    plan.leaves.len()
+                ),
+                Err(diags) => diags.iter().for_each(|d| eprintln!("{d}")),
+            },
+            DiagnosticFormat::Json => {
+                let (nodes, leaves, diags) = match &result {
+                    Ok(plan) => (plan.nodes.len(), plan.leaves.len(), &[][..]),
+                    Err(diags) => (0, 0, &diags[..]),
+                };
+                let line = serde_json::json!({
+                    "file": tree.display().to_string(),
+                    "valid": result.is_ok(),
+                    "nodes": nodes,
+                    "leaves": leaves,
+                    "diagnostics": diags.iter().map(diagnostic_json).collect::<Vec<_>>(),
+                });
+                println!("{line}");
+            }
+            DiagnosticFormat::Github => {
+                if let Err(diags) = &result {
+                    diags.iter().for_each(|d| println!("{}", github_annotation(d)));
                 }
             }
         }
@@ -40,5 +78,74 @@ pub fn validate(args: ValidateArgs) -> Result<(), CliError> {
         )))
     } else {
         Ok(())
+    }
+}
+
+/// A diagnostic as JSON (`end_column` is exclusive, in characters).
+fn diagnostic_json(d: &Diagnostic) -> serde_json::Value {
+    serde_json::json!({
+        "file": d.file,
+        "line": d.line,
+        "column": d.column,
+        "end_column": d.column + d.width,
+        "severity": "error",
+        "message": d.message,
+        "label": d.label,
+        "help": d.help,
+        "note": d.note,
+    })
+}
+
+/// A diagnostic as a GitHub Actions `::error` workflow command (one line; `endColumn` is
+/// inclusive).
+pub fn github_annotation(d: &Diagnostic) -> String {
+    let mut text = d.message.clone();
+    for extra in [&d.label, &d.note, &d.help].into_iter().flatten() {
+        text += &format!("\n{extra}");
+    }
+    format!(
+        "::error file={},line={},col={},endColumn={},title=macrotree::{}",
+        escape_property(&d.file),
+        d.line,
+        d.column,
+        d.column + d.width.max(1) - 1,
+        escape_data(&text)
+    )
+}
+
+/// Escapes a workflow command's message (`%`, CR, LF).
+fn escape_data(s: &str) -> String {
+    s.replace('%', "%25").replace('\r', "%0D").replace('\n', "%0A")
+}
+
+/// Escapes a workflow command's property value (also `:` and `,`).
+fn escape_property(s: &str) -> String {
+    escape_data(s).replace(':', "%3A").replace(',', "%2C")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn github_annotations_escape_what_the_runner_would_split_on() {
+        let d = Diagnostic {
+            file: "trees/a,b:c.yaml".into(),
+            line: 4,
+            column: 17,
+            message: "unknown parameter `targt` in `reach` (100%)".into(),
+            label: Some("expected one of `target`, `offset`".into()),
+            help: Some("did you mean `target`?".into()),
+            note: None,
+            source_line: None,
+            source_column: 17,
+            width: 5,
+        };
+        assert_eq!(
+            github_annotation(&d),
+            "::error file=trees/a%2Cb%3Ac.yaml,line=4,col=17,endColumn=21,title=macrotree::\
+             unknown parameter `targt` in `reach` (100%25)%0Aexpected one of `target`, `offset`\
+             %0Adid you mean `target`?"
+        );
     }
 }
