@@ -1,4 +1,5 @@
-//! The committed JSON Schema must match the one generated from the Rust types.
+//! The committed JSON Schema must match the one generated from the Rust types, and it must agree
+//! with the loader: an editor using it shows no false errors on valid trees and flags mistakes.
 //!
 //! Regenerate after changing a node kind or parameter:
 //! `UPDATE_SCHEMA=1 cargo test --test tree_schema`
@@ -6,6 +7,40 @@
 use macrotree::spec::{catalog, json_schema};
 
 const PATH: &str = "schema/tree.schema.json";
+
+/// The subtrees the node examples call (`pick`, `place`, `wiggle`), and the example as `main`.
+fn example_tree(example: &str) -> String {
+    format!(
+        "subtrees:\n  pick: {{params: {{approach: 0.1}}, root: {{home: {{}}}}}}\n  place: {{root: {{home: {{}}}}}}\n  wiggle: {{root: {{home: {{}}}}}}\nmain:\n  {example}\n"
+    )
+}
+
+/// A JSON Schema validator for the committed schema (what an editor's YAML plugin loads).
+fn editor_validator() -> jsonschema::Validator {
+    let schema: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(PATH).unwrap()).unwrap();
+    jsonschema::validator_for(&schema).expect("the committed schema is a valid JSON Schema")
+}
+
+/// Schema errors of a YAML text, read as JSON data the way an editor plugin reads it.
+fn schema_errors(validator: &jsonschema::Validator, yaml: &str) -> Vec<String> {
+    let data: serde_json::Value = serde_saphyr::from_str(yaml).expect("YAML");
+    validator
+        .iter_errors(&data)
+        .map(|e| format!("{} at {}", e, e.instance_path()))
+        .collect()
+}
+
+/// Every `.yaml` under `trees/`.
+fn tree_files(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            tree_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "yaml") {
+            out.push(p);
+        }
+    }
+}
 
 #[test]
 fn committed_schema_is_up_to_date() {
@@ -56,10 +91,7 @@ fn catalog_documents_every_node() {
             d.kind
         );
         // Every example is a valid node.
-        let yaml = format!(
-            "subtrees:\n  pick: {{params: {{approach: 0.1}}, root: {{home: {{}}}}}}\n  place: {{root: {{home: {{}}}}}}\n  wiggle: {{root: {{home: {{}}}}}}\nmain:\n  {}\n",
-            d.example
-        );
+        let yaml = example_tree(d.example);
         if let Err(e) = macrotree::plan::compile_str(&yaml, "example.yaml") {
             panic!("example of `{}` does not compile: {}", d.kind, e[0]);
         }
@@ -94,4 +126,58 @@ fn node_doc_parts_are_read_from_the_markdown() {
     assert_eq!(details, "More about it.");
     assert_eq!(halt, "it stops");
     assert_eq!(example, "thing: {}");
+}
+
+#[test]
+fn the_schema_accepts_every_tree_and_node_example_the_loader_accepts() {
+    let validator = editor_validator();
+    let mut files = Vec::new();
+    tree_files(std::path::Path::new("trees"), &mut files);
+    assert!(files.len() >= 5);
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        let errors = schema_errors(&validator, &text);
+        assert!(errors.is_empty(), "{}: {errors:#?}", f.display());
+    }
+    for d in catalog() {
+        let errors = schema_errors(&validator, &example_tree(d.example));
+        assert!(errors.is_empty(), "example of `{}`: {errors:#?}", d.kind);
+    }
+}
+
+#[test]
+fn the_schema_flags_what_the_loader_rejects() {
+    let validator = editor_validator();
+    for (yaml, what) in [
+        ("main: {sequnce: {children: [home: {}]}}", "misspelled kind"),
+        (
+            "main: {reach: {target: cube, ofset: [0, 0, 0.1]}}",
+            "misspelled parameter",
+        ),
+        ("main: {reach: {offset: [0, 0, 0.1]}}", "missing parameter"),
+        ("main: {reach: {target: cube, speed: fast}}", "wrong type"),
+        (
+            "main: {release: {width: 0.2}}",
+            "opening beyond the 2F-85's 0.085 m",
+        ),
+        (
+            "main: {retry: {attempts: 0, child: {home: {}}}}",
+            "attempts below 1",
+        ),
+        ("main: {sequence: {children: []}}", "empty composite"),
+        (
+            "main: {guard: {condition: {cube_graspd: {}}, child: {home: {}}}}",
+            "unknown condition",
+        ),
+        ("mian: {home: {}}", "unknown top-level key"),
+    ] {
+        assert!(
+            macrotree::plan::compile_str(yaml, "t.yaml").is_err(),
+            "the loader accepts {what}: {yaml}"
+        );
+        assert!(
+            !schema_errors(&validator, yaml).is_empty(),
+            "the schema accepts {what}: {yaml}"
+        );
+    }
 }
