@@ -261,6 +261,8 @@ fn undefined_and_misplaced_params_are_errors() {
     assert_eq!(e.help.as_deref(), Some("did you mean `$approach`?"));
     let e = find(&d, "`$delay` is used outside a subtree");
     assert_eq!(at(e), (9, 25));
+    // Regression: the `$name` left in place was reported a second time, as a wrong type.
+    assert_eq!(d.len(), 2, "{d:#?}");
 }
 
 #[test]

@@ -46,6 +46,9 @@ pub struct Expander<'a> {
     too_many_reported: bool,
     /// How many times each subtree was called.
     pub calls: HashMap<String, usize>,
+    /// Where the loader already reported a problem (e.g. an undefined `$param`, left in place):
+    /// a leaf's error at the same place is not repeated.
+    pub reported: Vec<Loc>,
 }
 
 impl<'a> Expander<'a> {
@@ -59,6 +62,7 @@ impl<'a> Expander<'a> {
             nodes: 0,
             too_many_reported: false,
             calls: HashMap::new(),
+            reported: Vec::new(),
         }
     }
 
@@ -193,6 +197,13 @@ impl<'a> Expander<'a> {
                 Err(errors) => {
                     for e in errors {
                         let mut issue = e.into_issue(body.loc, |l| self.sources.describe(l));
+                        // A value already reported (an undefined `$param` left in place) needs
+                        // no second error for its type.
+                        if self.reported.contains(&issue.loc)
+                            || self.issues.iter().any(|i| i.loc == issue.loc)
+                        {
+                            continue;
+                        }
                         issue.message = format!("{} in `{k}`", issue.message);
                         if issue.help.is_none() {
                             issue.help = Some(format!(

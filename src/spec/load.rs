@@ -212,7 +212,9 @@ impl Loader {
             );
         }
 
+        let reported: Vec<Loc> = self.issues.iter().map(|i| i.loc).collect();
         let mut ex = Expander::new(&table, &self.sources);
+        ex.reported.clone_from(&reported);
         let root = ex.node(&main, 0);
         let called: HashSet<String> = ex.calls.keys().cloned().collect();
         self.issues.append(&mut ex.issues);
@@ -226,6 +228,7 @@ impl Loader {
                 continue;
             }
             let mut ex = Expander::new(&table, &self.sources);
+            ex.reported.clone_from(&reported);
             let call = super::value::Value::new(
                 super::value::ValueKind::Map(vec![(
                     super::value::Value::new(super::value::ValueKind::Str("subtree".into()), d.loc),
