@@ -192,6 +192,14 @@ fn a_missing_parameter_is_reported_with_the_bad_ones() {
 }
 
 #[test]
+fn a_duplicate_key_is_named_and_located_at_the_second() {
+    let d = errors("main:\n  sequence:\n    name: top\n    name: again\n    children: [home: {}]\n");
+    assert_eq!(d.len(), 1, "{d:?}");
+    assert_eq!(d[0].message, "`name` is given twice in this mapping");
+    assert_eq!(at(&d[0]), (4, 5));
+}
+
+#[test]
 fn wrong_type_is_located_at_the_value() {
     let d = errors("main:\n  reach:\n    target: cube\n    speed: fast\n");
     let e = find(&d, "wrong type");

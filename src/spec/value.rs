@@ -329,7 +329,8 @@ fn yaml_error(e: &serde_saphyr::Error, file: FileId) -> Issue {
     Issue::new(loc, format!("invalid YAML: {msg}")).help(help)
 }
 
-/// Our own words (message, help) for the parser's limits, whose own messages name internals.
+/// Our own words (message, help) for the parser's limits and duplicate keys, whose own messages
+/// name internals (`Nodes { nodes: 100001 }`, "set DuplicateKeyPolicy in Options").
 fn limit_message(e: &serde_saphyr::Error, raw: &str) -> Option<(String, &'static str)> {
     use serde_saphyr::budget::BudgetBreach;
     const SHALLOW: &str =
@@ -341,6 +342,15 @@ fn limit_message(e: &serde_saphyr::Error, raw: &str) -> Option<(String, &'static
         inner
     {
         inner = error;
+    }
+    if let serde_saphyr::Error::DuplicateMappingKey { key, .. } = inner {
+        return Some((
+            match key {
+                Some(k) => format!("`{k}` is given twice in this mapping"),
+                None => "a key is given twice in this mapping".to_string(),
+            },
+            "keep one of them: YAML keys must be unique, and a second one would silently win",
+        ));
     }
     if let serde_saphyr::Error::Budget { breach, .. } = inner {
         return Some(match breach {
