@@ -16,6 +16,9 @@ use super::diag::{Issue, Loc};
 use super::suggest::did_you_mean;
 use super::value::{Value, ValueKind};
 
+/// How a "missing parameter" message starts (the name and a backtick follow).
+const MISSING: &str = "missing parameter `";
+
 /// A typed-deserialization error: message plus (once known) the location of the value.
 #[derive(Debug, Clone)]
 pub struct DeError {
@@ -77,6 +80,11 @@ impl DeError {
     pub fn with_help(mut self, help: impl Into<String>) -> Self {
         self.help = Some(help.into());
         self
+    }
+
+    /// For a "missing parameter" error, the parameter's name.
+    pub fn missing_parameter(&self) -> Option<&str> {
+        self.message.strip_prefix(MISSING)?.strip_suffix('`')
     }
 }
 
@@ -147,7 +155,7 @@ impl de::Error for DeError {
     }
 
     fn missing_field(field: &'static str) -> Self {
-        Self::msg(format!("missing parameter `{field}`"))
+        Self::msg(format!("{MISSING}{field}`"))
             .with_label(format!("add `{field}: ...` here"))
             .with_help("see docs/tree_format.md for the node's parameters")
     }

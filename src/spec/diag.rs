@@ -177,7 +177,6 @@ impl Issue {
     }
 }
 
-/// Replace control characters (except tabs) so that a diagnostic never garbles a terminal.
 /// Characters of a source line shown under a diagnostic.
 const SHOWN_CHARS: usize = 160;
 /// Characters shown before the column when a long line is cut.
@@ -208,6 +207,7 @@ fn source_window(line: &str, col: u32) -> (String, u32) {
     (sanitize(&shown), column)
 }
 
+/// Replace control characters (except tabs) so that a diagnostic never garbles a terminal.
 fn sanitize(s: &str) -> String {
     s.chars()
         .map(|c| {

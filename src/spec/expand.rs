@@ -693,8 +693,9 @@ fn valid_name(s: &str) -> bool {
 /// the first: after an error located in one parameter (its key or anything in its value), that
 /// parameter is set aside and the rest read again. It stops at an error that no parameter
 /// explains (a missing parameter) or after [`MAX_LEAF_ERRORS`] (each retry re-reads the leaf, so
-/// the cap keeps a leaf with thousands of bad keys linear); a "missing" error for a parameter set
-/// aside, or for the one a misspelled key was suggested as, is not repeated. `None` if `kind` is not a leaf kind.
+/// the cap keeps a leaf with thousands of bad keys linear). A "missing" error for a parameter set
+/// aside, or for the one a misspelled key was suggested as, is not repeated. `None` if `kind` is
+/// not a leaf kind.
 fn parse_leaf_reporting_all(kind: &str, mut params: Value) -> Option<Result<Leaf, Vec<DeError>>> {
     let mut errors = Vec::new();
     let mut set_aside: Vec<String> = Vec::new();
@@ -705,14 +706,11 @@ fn parse_leaf_reporting_all(kind: &str, mut params: Value) -> Option<Result<Leaf
             Err(e) => e,
         };
         // "Missing `target`" after `target: cubee` or `targt: cube` was set aside says nothing new.
-        let explained = |k: &String| {
-            e.message == format!("missing parameter `{k}`")
-                || e.message.strip_prefix("missing parameter `").is_some_and(|rest| {
-                    let missing = rest.trim_end_matches('`');
-                    did_you_mean(k, [missing]).is_some()
-                })
-        };
-        if set_aside.iter().any(explained) {
+        if let Some(missing) = e.missing_parameter()
+            && set_aside
+                .iter()
+                .any(|k| k == missing || did_you_mean(k, [missing]).is_some())
+        {
             return Some(Err(errors));
         }
         let ValueKind::Map(entries) = &mut params.kind else {

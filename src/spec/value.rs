@@ -313,7 +313,7 @@ fn yaml_error(e: &serde_saphyr::Error, file: FileId) -> Issue {
         .chars()
         .take(300)
         .collect();
-    if let Some((message, help)) = limit_message(e, &msg) {
+    if let Some((message, help)) = plain_message(e, &msg) {
         return Issue::new(loc, message).help(help);
     }
     let lower = msg.to_lowercase();
@@ -331,7 +331,7 @@ fn yaml_error(e: &serde_saphyr::Error, file: FileId) -> Issue {
 
 /// Our own words (message, help) for the parser's limits and duplicate keys, whose own messages
 /// name internals (`Nodes { nodes: 100001 }`, "set DuplicateKeyPolicy in Options").
-fn limit_message(e: &serde_saphyr::Error, raw: &str) -> Option<(String, &'static str)> {
+fn plain_message(e: &serde_saphyr::Error, raw: &str) -> Option<(String, &'static str)> {
     use serde_saphyr::budget::BudgetBreach;
     const SHALLOW: &str =
         "tree files must stay small and shallow: nest nodes less deeply, or move parts into subtrees";
