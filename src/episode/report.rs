@@ -15,7 +15,8 @@ pub struct EpisodeReport {
     pub success: bool,
     /// Final status of the tree: "success", "failure", or "running" when the time limit hit.
     pub tree_status: &'static str,
-    /// Why it failed (the first failing leaf's reason, or the time limit), if it did.
+    /// Why it failed, if it did: the root node's reason (which names the failing leaf or
+    /// condition, e.g. "all 3 attempts failed; last: …"), the time limit, or a missed goal.
     pub failure_reason: Option<String>,
     /// Simulated time of the episode.
     pub sim_time_s: f64,
