@@ -420,6 +420,9 @@ fn out_of_range_numbers_are_located_errors() {
     assert_eq!(at(find(&diags, "from the shoulder")), (7, 25));
     assert_eq!(at(find(&diags, "an offset of 12.000 m")), (8, 39));
     assert_eq!(at(find(&diags, "below the table top")), (9, 25));
+    // A value written as a one-line list is underlined whole: `[0, 0, 12]`, `[0.4, 0, -0.1]`.
+    assert_eq!(find(&diags, "an offset of 12.000 m").width, 10);
+    assert_eq!(find(&diags, "below the table top").width, 14);
     for d in &diags {
         assert!(d.to_string().contains("bad.yaml:"), "{d}");
     }

@@ -142,7 +142,21 @@ fn loc_of(l: &serde_saphyr::Location) -> Loc {
 struct RawKind(ValueKind);
 
 fn spanned_to_value(s: Spanned<RawKind>) -> Value {
-    Value::new(s.value.0, loc_of(&s.referenced))
+    let mut loc = loc_of(&s.referenced);
+    // The parser spans a collection by its first character; one written on a single line
+    // (`offset: [0, 0, 0.1]`) is underlined whole, through its closing bracket.
+    let last = match &s.value.0 {
+        ValueKind::Seq(items) => items.last(),
+        ValueKind::Map(entries) => entries.last().map(|(_, v)| v),
+        _ => None,
+    };
+    if let Some(last) = last
+        && last.loc.line == loc.line
+        && last.loc.col > loc.col
+    {
+        loc.len = (last.loc.col + last.loc.len + 1).saturating_sub(loc.col);
+    }
+    Value::new(s.value.0, loc)
 }
 
 impl<'de> Deserialize<'de> for RawKind {
