@@ -154,7 +154,12 @@ fn spanned_to_value(s: Spanned<RawKind>) -> Value {
         && last.loc.line == loc.line
         && last.loc.col > loc.col
     {
-        loc.len = (last.loc.col + last.loc.len + 1).saturating_sub(loc.col);
+        loc.len = last
+            .loc
+            .col
+            .saturating_add(last.loc.len)
+            .saturating_add(1)
+            .saturating_sub(loc.col);
     }
     Value::new(s.value.0, loc)
 }
