@@ -3,6 +3,9 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+#[path = "support/files.rs"]
+mod files;
+
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
 fn macrotree(args: &[&str]) -> Output {
@@ -24,20 +27,7 @@ fn stderr(out: &Output) -> String {
 
 /// Every `.yaml` file under `trees/`, sorted.
 fn tree_files() -> Vec<PathBuf> {
-    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
-        for entry in std::fs::read_dir(dir).expect("trees/ is readable") {
-            let path = entry.expect("dir entry").path();
-            if path.is_dir() {
-                walk(&path, out);
-            } else if path.extension().is_some_and(|e| e == "yaml") {
-                out.push(path);
-            }
-        }
-    }
-    let mut files = vec![];
-    walk(&Path::new(ROOT).join("trees"), &mut files);
-    files.sort();
-    files
+    files::yaml_files(&Path::new(ROOT).join("trees"))
 }
 
 #[test]

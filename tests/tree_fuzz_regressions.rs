@@ -10,6 +10,8 @@ use macrotree::spec::Diagnostic;
 
 #[path = "../fuzz/entry.rs"]
 mod entry;
+#[path = "support/files.rs"]
+mod files;
 
 fn repo_root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -18,19 +20,8 @@ fn repo_root() -> &'static Path {
 /// The files `fuzz/seed-corpus` copies into the corpus: every `.yaml` under trees/ and
 /// tests/fixtures/.
 fn seed_files() -> Vec<PathBuf> {
-    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
-        for e in std::fs::read_dir(dir).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                walk(&p, out);
-            } else if p.extension().is_some_and(|x| x == "yaml") {
-                out.push(p);
-            }
-        }
-    }
-    let mut out = Vec::new();
-    walk(&repo_root().join("trees"), &mut out);
-    walk(&repo_root().join("tests/fixtures"), &mut out);
+    let mut out = files::yaml_files(&repo_root().join("trees"));
+    out.extend(files::yaml_files(&repo_root().join("tests/fixtures")));
     out.sort();
     out
 }

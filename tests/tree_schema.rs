@@ -6,6 +6,9 @@
 
 use macrotree::spec::{catalog, json_schema};
 
+#[path = "support/files.rs"]
+mod files;
+
 const PATH: &str = "schema/tree.schema.json";
 
 /// The subtrees the node examples call (`pick`, `place`, `wiggle`), and the example as `main`.
@@ -28,18 +31,6 @@ fn schema_errors(validator: &jsonschema::Validator, yaml: &str) -> Vec<String> {
         .iter_errors(&data)
         .map(|e| format!("{} at {}", e, e.instance_path()))
         .collect()
-}
-
-/// Every `.yaml` under `trees/`.
-fn tree_files(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
-    for e in std::fs::read_dir(dir).unwrap() {
-        let p = e.unwrap().path();
-        if p.is_dir() {
-            tree_files(&p, out);
-        } else if p.extension().is_some_and(|x| x == "yaml") {
-            out.push(p);
-        }
-    }
 }
 
 #[test]
@@ -131,8 +122,7 @@ fn node_doc_parts_are_read_from_the_markdown() {
 #[test]
 fn the_schema_accepts_every_tree_and_node_example_the_loader_accepts() {
     let validator = editor_validator();
-    let mut files = Vec::new();
-    tree_files(std::path::Path::new("trees"), &mut files);
+    let files = files::yaml_files(std::path::Path::new("trees"));
     assert!(files.len() >= 5);
     for f in &files {
         let text = std::fs::read_to_string(f).unwrap();
