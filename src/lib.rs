@@ -10,7 +10,8 @@
 //! | YAML tree → typed spec (with source spans) | [`spec`] | no |
 //! | spec → validated, compiled plan (a bonsai `Behavior`) | [`plan`] | no |
 //! | plan → running tree (ticks, halts, trace events) | [`runtime`] | no |
-//! | typed world snapshot and condition leaves | [`world`] | no |
+//! | scene files: named objects, placements, goal | [`scene`] | no |
+//! | typed world snapshot, condition leaves, goal, queries | [`world`] | no |
 //! | kinematics, IK, trajectories, gripper calibration | [`motion`] | no |
 //! | MuJoCo scene, stepping, world extraction | [`sim`] | yes |
 //! | macro-action leaves (reach, grasp, carry, …) | [`actions`] | through [`sim`] |
@@ -28,6 +29,7 @@ pub mod faults;
 pub mod motion;
 pub mod plan;
 pub mod runtime;
+pub mod scene;
 pub mod sim;
 pub mod spec;
 pub mod sweep;

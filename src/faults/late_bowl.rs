@@ -58,7 +58,8 @@ impl Fault for LateBowl {
     }
 
     fn before_step(&mut self, sim: &mut Sim) -> Option<String> {
-        let mocap = sim.scene().ids.bowl_mocap;
+        // A scene without a container has no bowl to move.
+        let mocap = sim.scene().ids.bowl.map(|b| b.mocap)?;
         match &mut self.state {
             State::Idle | State::Done => None,
             State::Armed { at } => {

@@ -3,10 +3,11 @@
 
 pub mod error;
 pub mod layout;
+pub mod mjcf;
 pub mod scene;
 pub mod simulator;
 
 pub use error::SimError;
 pub use layout::Layout;
-pub use scene::Scene;
+pub use scene::{ContainerIds, ObjectIds, Scene};
 pub use simulator::{HOME_Q, Sim, TIMESTEP};

@@ -8,7 +8,8 @@ use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 use super::layout::Layout;
 use super::scene::Scene;
-use crate::world::{BowlGeometry, World};
+use crate::scene::{Placement, Shape};
+use crate::world::{BowlGeometry, ObjectState, Part, World};
 
 pub use crate::motion::HOME_Q;
 
@@ -17,6 +18,10 @@ pub const PAD_HALF_THICKNESS: f64 = 0.004;
 
 /// Physics time step of the scene, seconds (set in assets/scene.xml).
 pub const TIMESTEP: f64 = 0.002;
+
+/// Where the legacy `bowl` fields of a [`World`] put the bowl when the scene has no container:
+/// far off the table, so nothing is ever in it or near it.
+const NO_BOWL: Vector3<f64> = Vector3::new(100.0, 100.0, 0.0);
 
 /// A running simulation of the task scene.
 pub struct Sim {
@@ -34,7 +39,8 @@ impl Sim {
             data,
             steps: 0,
         };
-        sim.reset(&Layout::default());
+        let placement = scene.default_placement();
+        sim.reset_placement(&placement);
         sim
     }
 
@@ -44,32 +50,61 @@ impl Sim {
     }
 
     /// Puts the arm at home with its servos holding home, the gripper open, the cube resting on
-    /// the table at the layout's pose and the bowl at its place; time and step count go to zero.
+    /// the table at the layout's pose and the bowl at its place; the scene's other objects at
+    /// their default poses ([`Scene::placement_from_layout`]); time and step count go to zero.
     pub fn reset(&mut self, layout: &Layout) {
-        let ids = self.scene.ids.clone();
+        let placement = self.scene.placement_from_layout(layout);
+        self.reset_placement(&placement);
+    }
+
+    /// Puts the arm at home with its servos holding home, the gripper open, every block resting
+    /// on the table and every container and obstacle at its pose in `placement` (one pose per
+    /// object, scene order); time, step count and MuJoCo's warning counters go to zero.
+    pub fn reset_placement(&mut self, placement: &Placement) {
         self.data.reset();
+        let scene = self.scene.clone();
         {
             let qpos = self.data.qpos_mut();
-            for (i, &a) in ids.arm_qpos.iter().enumerate() {
+            for (i, &a) in scene.ids.arm_qpos.iter().enumerate() {
                 qpos[a] = HOME_Q[i];
             }
-            let c = ids.cube_qpos;
-            let half_yaw = layout.cube_yaw / 2.0;
-            qpos[c..c + 7].copy_from_slice(&[
-                layout.cube_xy[0],
-                layout.cube_xy[1],
-                crate::world::CUBE_HALF,
-                half_yaw.cos(),
-                0.0,
-                0.0,
-                half_yaw.sin(),
-            ]);
+            for ((o, ids), p) in scene
+                .spec
+                .objects
+                .iter()
+                .zip(&scene.objects)
+                .zip(&placement.poses)
+            {
+                if let (Shape::Block { half, .. }, Some(c)) = (&o.shape, ids.qpos) {
+                    let h = p.yaw / 2.0;
+                    qpos[c..c + 7].copy_from_slice(&[p.x, p.y, *half, h.cos(), 0.0, 0.0, h.sin()]);
+                }
+            }
         }
-        self.data.mocap_pos_mut()[ids.bowl_mocap] = [layout.bowl_xy[0], layout.bowl_xy[1], 0.0];
+        for (ids, p) in scene.objects.iter().zip(&placement.poses) {
+            if let Some(m) = ids.mocap {
+                let h = p.yaw / 2.0;
+                self.data.mocap_pos_mut()[m] = [p.x, p.y, 0.0];
+                self.data.mocap_quat_mut()[m] = [h.cos(), 0.0, 0.0, h.sin()];
+            }
+        }
         self.set_arm_ctrl(&HOME_Q);
         self.set_gripper_ctrl(0.0);
         self.data.forward();
         self.steps = 0;
+    }
+
+    /// MuJoCo's instability warnings since the last reset (bad qpos, qvel or qacc: MuJoCo then
+    /// resets its state and the episode is no longer physics), as one sentence, or `None`.
+    pub fn instability(&self) -> Option<String> {
+        let w = &self.data.ffi().warning;
+        let kinds = [(3, "bad qpos"), (4, "bad qvel"), (5, "bad qacc")];
+        let found: Vec<String> = kinds
+            .iter()
+            .filter(|(k, _)| w[*k].number > 0)
+            .map(|(k, what)| format!("{what} ×{} (first at dof {})", w[*k].number, w[*k].lastinfo))
+            .collect();
+        (!found.is_empty()).then(|| format!("MuJoCo reported an unstable simulation: {}", found.join(", ")))
     }
 
     /// Commands the arm's position servos, radians.
@@ -156,6 +191,26 @@ impl Sim {
             .collect()
     }
 
+    /// The shape of the container the legacy name `bowl` stands for.
+    fn bowl_geometry(&self) -> BowlGeometry {
+        let spec = &self.scene.spec;
+        let c = spec
+            .legacy_bowl()
+            .or_else(|| spec.of_kind(crate::scene::ObjectKind::Container).next());
+        match c.map(|c| &spec.objects[c].shape) {
+            Some(Shape::Container {
+                inner_half,
+                wall_height,
+            }) => BowlGeometry {
+                inner_half_width: inner_half[0],
+                outer_half_width: inner_half[0] + crate::scene::CONTAINER_WALL,
+                rim_height: *wall_height,
+                floor_height: crate::scene::CONTAINER_FLOOR,
+            },
+            _ => BowlGeometry::NONE,
+        }
+    }
+
     /// Reads the current state into a [`World`] snapshot.
     pub fn observe(&self) -> World {
         let ids = &self.scene.ids;
@@ -177,17 +232,61 @@ impl Sim {
         let right_pad_pos = (v3(gx[ids.right_pads[0]]) + v3(gx[ids.right_pads[1]])) / 2.0;
         let mut left_pad_contact = false;
         let mut right_pad_contact = false;
+        let scene = &self.scene;
+        let mut objects: Vec<ObjectState> = scene
+            .objects
+            .iter()
+            .map(|o| match (o.qpos, o.dof, o.mocap) {
+                (Some(q), Some(v), _) => ObjectState {
+                    pos: Vector3::new(qpos[q], qpos[q + 1], qpos[q + 2]),
+                    quat: UnitQuaternion::from_quaternion(Quaternion::new(
+                        qpos[q + 3],
+                        qpos[q + 4],
+                        qpos[q + 5],
+                        qpos[q + 6],
+                    )),
+                    linvel: Vector3::new(qvel[v], qvel[v + 1], qvel[v + 2]),
+                    angvel: Vector3::new(qvel[v + 3], qvel[v + 4], qvel[v + 5]),
+                    left_pad_contact: false,
+                    right_pad_contact: false,
+                },
+                (_, _, Some(m)) => {
+                    let [w, x, y, z] = d.mocap_quat()[m];
+                    ObjectState {
+                        pos: v3(d.mocap_pos()[m]),
+                        quat: UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z)),
+                        linvel: Vector3::zeros(),
+                        angvel: Vector3::zeros(),
+                        left_pad_contact: false,
+                        right_pad_contact: false,
+                    }
+                }
+                _ => unreachable!("blocks have a free joint, the rest a mocap body"),
+            })
+            .collect();
+        let mut touches = Vec::new();
         for c in d.contact() {
             let (a, b) = (c.geom[0] as usize, c.geom[1] as usize);
-            let other = if a == ids.cube_geom {
-                b
-            } else if b == ids.cube_geom {
-                a
-            } else {
-                continue;
-            };
-            left_pad_contact |= ids.left_pads.contains(&other);
-            right_pad_contact |= ids.right_pads.contains(&other);
+            if a == ids.cube_geom || b == ids.cube_geom {
+                let other = if a == ids.cube_geom { b } else { a };
+                left_pad_contact |= ids.left_pads.contains(&other);
+                right_pad_contact |= ids.right_pads.contains(&other);
+            }
+            let (pa, pb) = (scene.geom_parts[a], scene.geom_parts[b]);
+            for (me, other) in [(pa, b), (pb, a)] {
+                if let Part::Object { index, .. } = me {
+                    objects[index].left_pad_contact |= ids.left_pads.contains(&other);
+                    objects[index].right_pad_contact |= ids.right_pads.contains(&other);
+                }
+            }
+            if pa != pb
+                && pa != Part::Table
+                && pb != Part::Table
+                && !(pa == Part::Robot && pb == Part::Robot)
+                && !touches.contains(&(pa, pb))
+            {
+                touches.push((pa, pb));
+            }
         }
         let c = ids.cube_qpos;
         let cube_quat = UnitQuaternion::from_quaternion(Quaternion::new(
@@ -203,7 +302,14 @@ impl Sim {
         let m = &site_xmat[ids.pinch_site * 9..ids.pinch_site * 9 + 9];
         let pinch_rot = Matrix3::from_row_slice(m);
         let sx = d.site_xpos();
-        let bowl = d.mocap_pos()[ids.bowl_mocap];
+        let (bowl_pos, bowl_target, bowl) = match ids.bowl {
+            Some(b) => (
+                v3(d.mocap_pos()[b.mocap]),
+                v3(sx[b.target_site]),
+                self.bowl_geometry(),
+            ),
+            None => (NO_BOWL, NO_BOWL, BowlGeometry::NONE),
+        };
         World {
             time: d.ffi().time,
             arm_q,
@@ -221,10 +327,13 @@ impl Sim {
             cube_quat,
             cube_linvel: Vector3::new(qvel[cd], qvel[cd + 1], qvel[cd + 2]),
             cube_angvel: Vector3::new(qvel[cd + 3], qvel[cd + 4], qvel[cd + 5]),
-            bowl_pos: v3(bowl),
-            bowl_target: v3(sx[ids.bowl_target_site]),
-            bowl: BowlGeometry::TRAY,
+            bowl_pos,
+            bowl_target,
+            bowl,
             home_q: HOME_Q,
+            scene: scene.spec.clone(),
+            objects,
+            touches,
         }
     }
 }

@@ -81,7 +81,7 @@ fn load_bytes_at(bytes: &[u8], name: String, path: &Path) -> Result<Spec, Vec<Di
 /// Read a tree file of at most [`MAX_FILE_BYTES`]. Only regular files are read, and never more
 /// than the limit: a device (`/dev/zero`), a FIFO or a `/proc` file whose size is reported as 0
 /// would otherwise be read forever, or block.
-fn read_limited(path: &Path) -> Result<Vec<u8>, (String, String)> {
+pub(crate) fn read_limited(path: &Path) -> Result<Vec<u8>, (String, String)> {
     let meta = std::fs::metadata(path).map_err(|e| {
         (
             format!("cannot read `{}`: {e}", path.display()),

@@ -95,11 +95,27 @@ pub fn at_home(w: &World, tolerance: f64) -> bool {
 /// Hand-built worlds for unit tests.
 #[cfg(test)]
 pub(crate) mod tests_support {
+    use std::sync::Arc;
+
     use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
-    use crate::world::{BowlGeometry, CUBE_HALF, World};
+    use crate::scene::SceneSpec;
+    use crate::world::{BowlGeometry, CUBE_HALF, ObjectState, World};
 
-    /// A cube resting on the table at (0.45, −0.18), open gripper far above it, bowl at (0.45, 0.08).
+    /// A still object at `pos`.
+    pub fn still(pos: Vector3<f64>) -> ObjectState {
+        ObjectState {
+            pos,
+            quat: UnitQuaternion::identity(),
+            linvel: Vector3::zeros(),
+            angvel: Vector3::zeros(),
+            left_pad_contact: false,
+            right_pad_contact: false,
+        }
+    }
+
+    /// A cube resting on the table at (0.45, −0.18), open gripper far above it, bowl at (0.45, 0.08)
+    /// (the built-in `cube_bowl` scene: `objects[0]` is the cube, `objects[1]` the bowl).
     pub fn resting() -> World {
         World {
             time: 0.0,
@@ -122,6 +138,12 @@ pub(crate) mod tests_support {
             bowl_target: Vector3::new(0.45, 0.08, 0.01),
             bowl: BowlGeometry::TRAY,
             home_q: [0.0; 6],
+            scene: Arc::new(SceneSpec::builtin()),
+            objects: vec![
+                still(Vector3::new(0.45, -0.18, CUBE_HALF)),
+                still(Vector3::new(0.45, 0.08, 0.0)),
+            ],
+            touches: Vec::new(),
         }
     }
 
@@ -134,6 +156,9 @@ pub(crate) mod tests_support {
         w.left_pad_contact = true;
         w.right_pad_contact = true;
         w.gripper_width = 2.0 * CUBE_HALF;
+        w.objects[0].pos = w.cube_pos;
+        w.objects[0].left_pad_contact = true;
+        w.objects[0].right_pad_contact = true;
         w
     }
 }

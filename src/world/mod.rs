@@ -3,6 +3,10 @@
 //! every control step, and tests build one by hand.
 
 pub mod conditions;
+pub mod goal;
+pub mod objects;
+pub mod query;
 pub mod snapshot;
 
+pub use objects::{ObjectState, Part, Piece, Touch};
 pub use snapshot::{BowlGeometry, CUBE_HALF, World};

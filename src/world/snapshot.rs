@@ -1,6 +1,11 @@
 //! [`World`]: everything the tree may know about the cell at one instant.
 
+use std::sync::Arc;
+
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+
+use super::objects::{ObjectState, Touch};
+use crate::scene::SceneSpec;
 
 /// Half of the cube's edge (the cube is 44 mm), metres.
 pub const CUBE_HALF: f64 = 0.022;
@@ -19,7 +24,15 @@ pub struct BowlGeometry {
 }
 
 impl BowlGeometry {
-    /// The tray in `assets/scene.xml`.
+    /// No bowl (a scene without a container): nothing fits in it.
+    pub const NONE: Self = Self {
+        inner_half_width: 0.0,
+        outer_half_width: 0.0,
+        rim_height: 0.0,
+        floor_height: 0.0,
+    };
+
+    /// The tray of the `cube_bowl` scene.
     pub const TRAY: Self = Self {
         inner_half_width: 0.075,
         outer_half_width: 0.085,
@@ -29,6 +42,11 @@ impl BowlGeometry {
 }
 
 /// A snapshot of the simulated cell, refreshed after every control step.
+///
+/// Every object of the scene is in [`objects`](Self::objects) (same order as the scene); the
+/// `cube_*` and `bowl_*` fields repeat the state of the objects the legacy names `cube` and `bowl`
+/// stand for ([`SceneSpec::legacy_cube`], [`SceneSpec::legacy_bowl`]), which the `cube_*`
+/// conditions and the reference tutorial's checks read.
 #[derive(Debug, Clone, PartialEq)]
 pub struct World {
     /// Simulated time, seconds.
@@ -71,6 +89,13 @@ pub struct World {
     pub bowl: BowlGeometry,
     /// The arm's home joint angles, radians.
     pub home_q: [f64; 6],
+    /// The scene: object names, shapes, colours and the goal.
+    pub scene: Arc<SceneSpec>,
+    /// Every object's state, in scene order.
+    pub objects: Vec<ObjectState>,
+    /// The contacts between distinct parts of the cell right now (robot–object, object–object),
+    /// table contacts excluded.
+    pub touches: Vec<Touch>,
 }
 
 impl World {

@@ -1,0 +1,802 @@
+//! Reading scene files: YAML → [`SceneSpec`], every problem located (file:line:column) with what
+//! was expected and what to do, exactly like tree files.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use schemars::JsonSchema;
+use serde::Deserialize;
+
+use super::color::Color;
+use super::goal::{Goal, GoalAtom};
+use super::sample::{Placement, sample_placement};
+use super::types::{ObjectKind, ObjectSpec, Pose, RandomPlacement, SceneSpec, Shape};
+use crate::spec::de::from_value;
+use crate::spec::diag::{Diagnostic, Issue, Loc, Sources};
+use crate::spec::suggest::did_you_mean;
+use crate::spec::units::Angle;
+use crate::spec::value::{Value, ValueKind, decode_utf8, parse_yaml};
+
+/// The built-in scene `cube_bowl` (the reference tutorial's cell), used when a tree names no
+/// scene. The same text as `scenes/cube_bowl.yaml`.
+pub const BUILTIN_CUBE_BOWL: &str = include_str!("../../scenes/cube_bowl.yaml");
+
+/// Most objects in one scene.
+pub const MAX_OBJECTS: usize = 16;
+
+/// Keys allowed at the top level of a scene file.
+const TOP_LEVEL_KEYS: &[&str] = &["description", "objects", "goal"];
+
+fn d_mass() -> f64 {
+    0.05
+}
+fn d_friction() -> f64 {
+    1.0
+}
+fn d_wall_height() -> f64 {
+    0.06
+}
+fn d_gray() -> Color {
+    Color::named("gray").expect("gray is in the palette")
+}
+fn d_orange() -> Color {
+    Color::named("orange").expect("orange is in the palette")
+}
+
+/// `block:` — a movable cube on a free joint.
+#[derive(Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BlockRaw {
+    /// Edge length, metres (0.02 … 0.07: the 2F-85 opens 0.085 m).
+    #[schemars(range(min = 0.02, max = 0.07))]
+    size: f64,
+    /// Mass, kg (0.005 … 0.5). Default 0.05.
+    #[serde(default = "d_mass")]
+    #[schemars(range(min = 0.005, max = 0.5))]
+    mass: f64,
+    /// Sliding friction coefficient (0.5 … 2: below 0.5 the 2F-85's pads cannot hold a block
+    /// through a fast carry). Default 1.0.
+    #[serde(default = "d_friction")]
+    #[schemars(range(min = 0.5, max = 2.0))]
+    friction: f64,
+    /// Colour name or `[r, g, b, a]`. Default orange.
+    #[serde(default = "d_orange")]
+    color: Color,
+}
+
+/// `container:` — an open box (tray or bin) fixed on the table.
+#[derive(Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ContainerRaw {
+    /// Free space inside the walls `[x, y]`, metres (each 0.06 … 0.40).
+    inner: [f64; 2],
+    /// Height of the rim above the table, metres (0.02 … 0.12). Default 0.06.
+    #[serde(default = "d_wall_height")]
+    #[schemars(range(min = 0.02, max = 0.12))]
+    wall_height: f64,
+    /// Colour name or `[r, g, b, a]`. Default gray.
+    #[serde(default = "d_gray")]
+    color: Color,
+}
+
+/// `obstacle:` — a fixed box on the table.
+#[derive(Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ObstacleRaw {
+    /// Size `[x, y, z]`, metres (x, y: 0.01 … 0.5; z: 0.01 … 0.3).
+    size: [f64; 3],
+    /// Colour name or `[r, g, b, a]`. Default gray.
+    #[serde(default = "d_gray")]
+    color: Color,
+}
+
+/// `random:` — where a sweep may place the object.
+#[derive(Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct RandomRaw {
+    /// Range of the centre x `[lo, hi]`, metres.
+    x: [f64; 2],
+    /// Range of the centre y `[lo, hi]`, metres.
+    y: [f64; 2],
+    /// Range of the yaw `[lo, hi]` (radians, or `deg(..)`). Absent: no yaw is drawn.
+    yaw: Option<[Angle; 2]>,
+    /// Smallest gap to every other object's footprint circle, metres (≥ 0). Default 0.01.
+    #[serde(default = "d_clearance")]
+    clearance: f64,
+}
+
+fn d_clearance() -> f64 {
+    0.01
+}
+
+/// One object of a scene file (`objects: {NAME: ...}`): exactly one of `block`, `container`,
+/// `obstacle`, and a `pose`, a `random` placement, or both.
+#[derive(Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectRaw {
+    /// A movable cube.
+    block: Option<BlockRaw>,
+    /// A tray or bin.
+    container: Option<ContainerRaw>,
+    /// A fixed box.
+    obstacle: Option<ObstacleRaw>,
+    /// Fixed pose `[x, y]` or `[x, y, yaw]` (metres; yaw in radians or `deg(..)`), used by
+    /// `macrotree run`.
+    pose: Option<Vec<Angle>>,
+    /// Randomization, used by sweeps.
+    random: Option<RandomRaw>,
+}
+
+/// `in:` goal.
+#[derive(Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct InRaw {
+    /// A block.
+    object: String,
+    /// A container.
+    container: String,
+}
+
+/// `on:` goal.
+#[derive(Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct OnRaw {
+    /// The block on top.
+    object: String,
+    /// The block under it.
+    support: String,
+}
+
+/// `all_in:` goal.
+#[derive(Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct AllInRaw {
+    /// The container every block must end in.
+    container: String,
+}
+
+/// `sorted_by_color:` goal (no parameters).
+#[derive(Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct NoParams {}
+
+/// One goal predicate (see `docs/scenes.md`).
+#[derive(Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum GoalRaw {
+    /// The block rests in the container.
+    In(InRaw),
+    /// The block rests on the other block.
+    On(OnRaw),
+    /// Every block rests in the container.
+    AllIn(AllInRaw),
+    /// `[top, …, bottom]`: each block rests on the next; the last stays on the table.
+    Stack(Vec<String>),
+    /// Every block rests in the container of its colour.
+    SortedByColor(NoParams),
+}
+
+/// The whole scene file, for the JSON Schema (`macrotree schema --scene`).
+#[derive(Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFileSchema {
+    /// One line on what the cell is.
+    pub description: Option<String>,
+    /// The objects by name (`[a-z][a-z0-9_]*`), in the order they are built.
+    pub objects: BTreeMap<String, ObjectRaw>,
+    /// Predicates that must hold when the episode ends.
+    #[serde(default)]
+    pub goal: Vec<GoalRaw>,
+}
+
+impl SceneSpec {
+    /// Read a scene from text. `file_name` names it in diagnostics; its stem is the scene's name.
+    #[allow(clippy::should_implement_trait)]
+    pub fn from_str(text: &str, file_name: &str) -> Result<SceneSpec, Vec<Diagnostic>> {
+        let mut sources = Sources::new();
+        let id = sources.add(file_name, text);
+        let mut issues = Vec::new();
+        let spec = match parse_yaml(text, id) {
+            Ok(v) => read_scene(&v, stem(file_name), &mut issues),
+            Err(issue) => {
+                issues.push(issue);
+                None
+            }
+        };
+        match spec {
+            Some(s) if issues.is_empty() => Ok(s),
+            _ => Err(sources.diagnostics(&issues)),
+        }
+    }
+
+    /// The built-in `cube_bowl` scene.
+    pub fn builtin() -> SceneSpec {
+        SceneSpec::from_str(BUILTIN_CUBE_BOWL, "cube_bowl.yaml").expect("the built-in scene is valid")
+    }
+}
+
+/// Read a scene file from disk (a regular file of at most 1 MiB).
+pub fn load_scene_file(path: &Path) -> Result<SceneSpec, Vec<Diagnostic>> {
+    let name = path.display().to_string();
+    let fail = |msg: String, help: String| {
+        let mut sources = Sources::new();
+        let id = sources.add(name.clone(), "");
+        Err(sources.diagnostics(&[Issue::new(Loc::file_start(id), msg).help(help)]))
+    };
+    let bytes = match crate::spec::load::read_limited(path) {
+        Ok(b) => b,
+        Err((msg, help)) => return fail(msg, help),
+    };
+    match std::str::from_utf8(&bytes) {
+        Ok(text) => SceneSpec::from_str(text, &name),
+        Err(_) => {
+            let mut sources = Sources::new();
+            let id = sources.add(name.clone(), String::from_utf8_lossy(&bytes).into_owned());
+            let issue = decode_utf8(&bytes, id)
+                .err()
+                .unwrap_or_else(|| Issue::new(Loc::file_start(id), "not UTF-8"));
+            Err(sources.diagnostics(&[issue]))
+        }
+    }
+}
+
+fn stem(file_name: &str) -> String {
+    Path::new(file_name)
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("scene")
+        .to_string()
+}
+
+/// True for object names: `[a-z][a-z0-9_]*`, at most 32 characters.
+pub fn is_object_name(s: &str) -> bool {
+    let mut c = s.chars();
+    matches!(c.next(), Some(f) if f.is_ascii_lowercase())
+        && c.all(|x| x.is_ascii_lowercase() || x.is_ascii_digit() || x == '_')
+        && s.len() <= 32
+}
+
+/// The location of the value at `path` under `v` (or `v`'s own when absent).
+fn loc_at(v: &Value, path: &[&str]) -> Loc {
+    let mut cur = v;
+    for k in path {
+        match cur.get(k) {
+            Some(next) => cur = next,
+            None => break,
+        }
+    }
+    cur.loc
+}
+
+fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneSpec> {
+    let Some(entries) = v.as_map() else {
+        issues.push(
+            Issue::new(
+                v.loc,
+                format!("a scene file must be a mapping, found {}", v.describe()),
+            )
+            .label("expected `objects:` (and optionally `description:` and `goal:`)"),
+        );
+        return None;
+    };
+    let mut description = None;
+    let mut objects_v = None;
+    let mut goal_v = None;
+    for (k, val) in entries {
+        match k.as_str() {
+            Some("description") => match val.as_str() {
+                Some(s) => description = Some(s.to_string()),
+                None => issues.push(
+                    Issue::new(
+                        val.loc,
+                        format!("`description` must be text, found {}", val.describe()),
+                    )
+                    .label("expected one line of text"),
+                ),
+            },
+            Some("objects") => objects_v = Some((k.loc, val)),
+            Some("goal") => goal_v = Some(val),
+            other => {
+                let other = other.unwrap_or("?");
+                issues.push(
+                    Issue::new(k.loc, format!("unknown top-level key `{other}` in a scene file"))
+                        .label("expected `description`, `objects` or `goal`")
+                        .maybe_help(did_you_mean(other, TOP_LEVEL_KEYS.iter().copied())),
+                )
+            }
+        }
+    }
+    let Some((objects_key, objects_v)) = objects_v else {
+        issues.push(
+            Issue::new(v.loc, "the scene has no `objects:`")
+                .label("expected `objects: {NAME: {block: {...}, pose: [x, y]}, ...}`")
+                .help("see docs/scenes.md for the object kinds"),
+        );
+        return None;
+    };
+    let objects = read_objects(objects_v, issues);
+    let scene = SceneSpec {
+        name,
+        description,
+        objects,
+        goal: Goal::default(),
+    };
+    let goal = match goal_v {
+        Some(g) => read_goal(g, &scene, issues),
+        None => Goal::default(),
+    };
+    let scene = SceneSpec { goal, ..scene };
+    if issues.is_empty() {
+        check_fixed_poses(&scene, objects_v, issues);
+    }
+    if issues.is_empty()
+        && scene.randomized()
+        && let Err(e) = sample_placement(&scene, 0, 0)
+    {
+        issues.push(
+            Issue::new(objects_key, format!("the randomization cannot be met: {e}"))
+                .help("widen the `random:` regions or lower the clearances"),
+        );
+    }
+    Some(scene)
+}
+
+fn read_objects(v: &Value, issues: &mut Vec<Issue>) -> Vec<ObjectSpec> {
+    let Some(entries) = v.as_map() else {
+        issues.push(
+            Issue::new(
+                v.loc,
+                format!(
+                    "`objects` must be a mapping of names to objects, found {}",
+                    v.describe()
+                ),
+            )
+            .label("expected `NAME: {block: {...}, pose: [x, y]}`"),
+        );
+        return Vec::new();
+    };
+    if entries.len() > MAX_OBJECTS {
+        issues.push(Issue::new(
+            v.loc,
+            format!(
+                "a scene has at most {MAX_OBJECTS} objects, this one has {}",
+                entries.len()
+            ),
+        ));
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    for (k, body) in entries {
+        let Some(name) = k.as_str().filter(|n| is_object_name(n)) else {
+            issues.push(
+                Issue::new(
+                    k.loc,
+                    format!("`{}` is not a valid object name", k.as_str().unwrap_or("?")),
+                )
+                .label("expected lower-case letters, digits and `_`, starting with a letter (at most 32)"),
+            );
+            continue;
+        };
+        if let Some(o) = read_object(name, body, issues) {
+            out.push(o);
+        }
+    }
+    out
+}
+
+/// Push an issue at `path` under `v` when `x` is outside `[lo, hi]`.
+fn check_range(
+    v: &Value,
+    path: &[&str],
+    x: f64,
+    lo: f64,
+    hi: f64,
+    what: &str,
+    issues: &mut Vec<Issue>,
+) -> bool {
+    if x.is_finite() && (lo..=hi).contains(&x) {
+        return true;
+    }
+    issues.push(
+        Issue::new(
+            loc_at(v, path),
+            format!("{what} must be within {lo} … {hi}, found {x}"),
+        )
+        .label(format!("expected {lo} … {hi}")),
+    );
+    false
+}
+
+fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<ObjectSpec> {
+    let raw: ObjectRaw = match from_value(body) {
+        Ok(r) => r,
+        Err(e) => {
+            let mut issue = e.into_issue(body.loc, |l| format!("{l:?}"));
+            issue.message = format!("{} in object `{name}`", issue.message);
+            issues.push(issue.help_or("see docs/scenes.md for what an object takes"));
+            return None;
+        }
+    };
+    let before = issues.len();
+    let kinds = [
+        raw.block.is_some(),
+        raw.container.is_some(),
+        raw.obstacle.is_some(),
+    ];
+    if kinds.iter().filter(|&&k| k).count() != 1 {
+        issues.push(
+            Issue::new(
+                body.loc,
+                format!("object `{name}` must be exactly one of `block`, `container`, `obstacle`"),
+            )
+            .label("expected e.g. `block: {size: 0.044, color: red}`"),
+        );
+        return None;
+    }
+    let (shape, color) = if let Some(b) = raw.block {
+        check_range(
+            body,
+            &["block", "size"],
+            b.size,
+            0.02,
+            0.07,
+            "a block's edge (m)",
+            issues,
+        );
+        check_range(
+            body,
+            &["block", "mass"],
+            b.mass,
+            0.005,
+            0.5,
+            "a block's mass (kg)",
+            issues,
+        );
+        check_range(
+            body,
+            &["block", "friction"],
+            b.friction,
+            0.5,
+            2.0,
+            "a block's friction",
+            issues,
+        );
+        (
+            Shape::Block {
+                half: b.size / 2.0,
+                mass: b.mass,
+                friction: b.friction,
+            },
+            b.color,
+        )
+    } else if let Some(c) = raw.container {
+        for (i, x) in c.inner.iter().enumerate() {
+            check_range(
+                body,
+                &["container", "inner"],
+                *x,
+                0.06,
+                0.40,
+                &format!("inner size {}", ["x", "y"][i]),
+                issues,
+            );
+        }
+        check_range(
+            body,
+            &["container", "wall_height"],
+            c.wall_height,
+            0.02,
+            0.12,
+            "a wall height (m)",
+            issues,
+        );
+        (
+            Shape::Container {
+                inner_half: [c.inner[0] / 2.0, c.inner[1] / 2.0],
+                wall_height: c.wall_height,
+            },
+            c.color,
+        )
+    } else {
+        let o = raw.obstacle.expect("one kind is set");
+        for (i, x) in o.size.iter().enumerate() {
+            let hi = if i == 2 { 0.3 } else { 0.5 };
+            check_range(
+                body,
+                &["obstacle", "size"],
+                *x,
+                0.01,
+                hi,
+                &format!("size {}", ["x", "y", "z"][i]),
+                issues,
+            );
+        }
+        (
+            Shape::Obstacle {
+                half: [o.size[0] / 2.0, o.size[1] / 2.0, o.size[2] / 2.0],
+            },
+            o.color,
+        )
+    };
+    let pose = match raw.pose {
+        None => None,
+        Some(p) if p.len() == 2 || p.len() == 3 => Some(Pose {
+            x: p[0].0,
+            y: p[1].0,
+            yaw: p.get(2).map_or(0.0, |a| a.0),
+        }),
+        Some(p) => {
+            issues.push(
+                Issue::new(
+                    loc_at(body, &["pose"]),
+                    format!("a pose has 2 or 3 numbers, found {}", p.len()),
+                )
+                .label("expected `[x, y]` or `[x, y, yaw]` (metres, radians or `deg(..)`)"),
+            );
+            None
+        }
+    };
+    let random = raw.random.map(|r| {
+        for (key, range) in [("x", r.x), ("y", r.y)] {
+            let ok = range.iter().all(|x| x.is_finite() && x.abs() <= 1.0) && range[0] <= range[1];
+            if !ok {
+                issues.push(
+                    Issue::new(
+                        loc_at(body, &["random", key]),
+                        format!("`{key}` must be a range [lo, hi] with lo ≤ hi, within ±1 m of the robot"),
+                    )
+                    .label("expected e.g. [0.30, 0.60] (metres)"),
+                );
+            }
+        }
+        if let Some([lo, hi]) = r.yaw
+            && !(lo.0 <= hi.0 && hi.0 - lo.0 <= std::f64::consts::TAU)
+        {
+            issues.push(
+                Issue::new(
+                    loc_at(body, &["random", "yaw"]),
+                    "`yaw` must be a range [lo, hi] with lo ≤ hi, at most one turn wide",
+                )
+                .label("expected e.g. [deg(-45), deg(45)]"),
+            );
+        }
+        check_range(
+            body,
+            &["random", "clearance"],
+            r.clearance,
+            0.0,
+            0.5,
+            "a clearance (m)",
+            issues,
+        );
+        RandomPlacement {
+            x: r.x,
+            y: r.y,
+            yaw: r.yaw.map(|[a, b]| [a.0, b.0]),
+            clearance: r.clearance,
+        }
+    });
+    if pose.is_none() && random.is_none() && issues.len() == before {
+        issues.push(
+            Issue::new(
+                body.loc,
+                format!("object `{name}` has neither `pose:` nor `random:`"),
+            )
+            .label("expected `pose: [x, y]` and/or `random: {x: [lo, hi], y: [lo, hi]}`"),
+        );
+    }
+    (issues.len() == before).then(|| ObjectSpec {
+        name: name.to_string(),
+        shape,
+        color,
+        pose,
+        random,
+    })
+}
+
+fn check_fixed_poses(scene: &SceneSpec, objects_v: &Value, issues: &mut Vec<Issue>) {
+    if !scene.fully_posed() {
+        // Mixed scenes are checked draw by draw when sampled; check each fixed pose alone.
+        for (i, o) in scene.objects.iter().enumerate() {
+            if let Some(p) = o.pose
+                && let Err(e) = Placement::check_one(scene, i, &p)
+            {
+                issues.push(Issue::new(loc_at(objects_v, &[&o.name, "pose"]), e.to_string()));
+            }
+        }
+        return;
+    }
+    let placement = Placement {
+        poses: scene
+            .objects
+            .iter()
+            .map(|o| o.pose.expect("fully posed"))
+            .collect(),
+    };
+    if let Err(e) = placement.check(scene) {
+        let at = e
+            .object()
+            .map_or(objects_v.loc, |n| loc_at(objects_v, &[n, "pose"]));
+        issues.push(
+            Issue::new(at, e.to_string())
+                .help("move the objects apart, onto the table and within the arm's reach"),
+        );
+    }
+}
+
+fn read_goal(v: &Value, scene: &SceneSpec, issues: &mut Vec<Issue>) -> Goal {
+    let Some(items) = v.as_seq() else {
+        issues.push(
+            Issue::new(
+                v.loc,
+                format!("`goal` must be a list of predicates, found {}", v.describe()),
+            )
+            .label("expected e.g. `- in: {object: red, container: red_bin}`"),
+        );
+        return Goal::default();
+    };
+    let mut atoms: Vec<(GoalAtom, Loc)> = Vec::new();
+    for item in items {
+        let raw: GoalRaw =
+            match from_value(item) {
+                Ok(r) => r,
+                Err(e) => {
+                    issues.push(e.into_issue(item.loc, |l| format!("{l:?}")).help_or(
+                        "a goal predicate is one of `in`, `on`, `all_in`, `stack`, `sorted_by_color`",
+                    ));
+                    continue;
+                }
+            };
+        let body = match &item.kind {
+            ValueKind::Map(e) if e.len() == 1 => &e[0].1,
+            _ => item,
+        };
+        let mut want = |name: &str, key: &str, kinds: &[ObjectKind]| -> bool {
+            let at = if key.is_empty() {
+                body.loc
+            } else {
+                loc_at(body, &[key])
+            };
+            match scene.object(name) {
+                Some(o) if kinds.contains(&o.kind()) => true,
+                Some(o) => {
+                    let expect: Vec<&str> = kinds.iter().map(|k| k.name()).collect();
+                    issues.push(
+                        Issue::new(
+                            at,
+                            format!("`{name}` is a {}, not a {}", o.kind(), expect.join(" or ")),
+                        )
+                        .label(format!("expected a {}", expect.join(" or "))),
+                    );
+                    false
+                }
+                None => {
+                    issues.push(
+                        Issue::new(at, format!("unknown object `{name}`"))
+                            .label("expected one of the scene's objects")
+                            .maybe_help(did_you_mean(name, scene.objects.iter().map(|o| o.name.as_str()))),
+                    );
+                    false
+                }
+            }
+        };
+        match raw {
+            GoalRaw::In(r) => {
+                if want(&r.object, "object", &[ObjectKind::Block])
+                    & want(&r.container, "container", &[ObjectKind::Container])
+                {
+                    atoms.push((
+                        GoalAtom::In {
+                            object: r.object,
+                            container: r.container,
+                        },
+                        item.loc,
+                    ));
+                }
+            }
+            GoalRaw::On(r) => {
+                if want(&r.object, "object", &[ObjectKind::Block])
+                    & want(&r.support, "support", &[ObjectKind::Block])
+                {
+                    atoms.push((
+                        GoalAtom::On {
+                            object: r.object,
+                            support: r.support,
+                        },
+                        item.loc,
+                    ));
+                }
+            }
+            GoalRaw::AllIn(r) => {
+                if want(&r.container, "container", &[ObjectKind::Container]) {
+                    for b in scene.of_kind(ObjectKind::Block) {
+                        let object = scene.objects[b].name.clone();
+                        atoms.push((
+                            GoalAtom::In {
+                                object,
+                                container: r.container.clone(),
+                            },
+                            item.loc,
+                        ));
+                    }
+                }
+            }
+            GoalRaw::Stack(names) => {
+                if names.len() < 2 {
+                    issues.push(
+                        Issue::new(body.loc, "a stack names at least two blocks, top first")
+                            .label("expected e.g. `[red, green, blue]` (red on green on blue)"),
+                    );
+                    continue;
+                }
+                // Every name is checked (and reported), not only up to the first bad one.
+                let checked: Vec<bool> = names.iter().map(|n| want(n, "", &[ObjectKind::Block])).collect();
+                let ok = checked.iter().all(|&b| b);
+                if ok {
+                    for pair in names.windows(2) {
+                        atoms.push((
+                            GoalAtom::On {
+                                object: pair[0].clone(),
+                                support: pair[1].clone(),
+                            },
+                            item.loc,
+                        ));
+                    }
+                }
+            }
+            GoalRaw::SortedByColor(NoParams {}) => {
+                for b in scene.of_kind(ObjectKind::Block) {
+                    let block = &scene.objects[b];
+                    let matching: Vec<&ObjectSpec> = scene
+                        .objects
+                        .iter()
+                        .filter(|o| {
+                            o.kind() == ObjectKind::Container
+                                && o.color.name.is_some()
+                                && o.color.name == block.color.name
+                        })
+                        .collect();
+                    if matching.len() == 1 {
+                        atoms.push((
+                            GoalAtom::In {
+                                object: block.name.clone(),
+                                container: matching[0].name.clone(),
+                            },
+                            item.loc,
+                        ));
+                    } else {
+                        issues.push(Issue::new(
+                            item.loc,
+                            format!(
+                                "`sorted_by_color` needs exactly one container of block `{}`'s colour ({}), found {}",
+                                block.name,
+                                block.color,
+                                matching.len()
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    // At most one predicate per block, and no block stacked on itself.
+    let mut seen: BTreeMap<String, Loc> = BTreeMap::new();
+    for (a, loc) in &atoms {
+        if a.object() == a.destination() {
+            issues.push(Issue::new(
+                *loc,
+                format!("`{}` cannot rest on itself", a.object()),
+            ));
+        }
+        if let Some(first) = seen.insert(a.object().to_string(), *loc) {
+            issues.push(
+                Issue::new(*loc, format!("block `{}` has two goals", a.object()))
+                    .note(format!("the first is at line {}", first.line))
+                    .help("give each block one destination"),
+            );
+        }
+    }
+    Goal {
+        atoms: atoms.into_iter().map(|(a, _)| a).collect(),
+    }
+}

@@ -1,0 +1,232 @@
+//! The scene's data: objects, their shapes, poses and randomization. Metres, kilograms, radians.
+
+use serde::Serialize;
+
+use super::color::Color;
+use super::goal::Goal;
+
+/// Thickness of a container's walls, metres.
+pub const CONTAINER_WALL: f64 = 0.01;
+/// Thickness of a container's floor, metres (its top surface is this high above the table).
+pub const CONTAINER_FLOOR: f64 = 0.01;
+/// Radius of the circle around the robot's base (at the world origin) that no object may
+/// overlap, metres (the UR5e base is 149 mm across; 5 cm margin).
+pub const ROBOT_BASE_RADIUS: f64 = 0.125;
+
+/// Horizontal distance from the robot's base within which a block can be picked from above and
+/// put down, metres: `[min, max]`. Closer than `min` the wrist folds onto the base; farther than
+/// `max` the arm cannot point the tool straight down at table height.
+pub fn reach_limits() -> [f64; 2] {
+    [0.22, 0.72]
+}
+
+/// What an object is for.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ObjectKind {
+    /// A movable cube on a free joint: picked, carried, stacked, put in containers.
+    Block,
+    /// A tray or bin with a floor and four walls; fixed to the table during an episode (its pose
+    /// comes from the layout).
+    Container,
+    /// A fixed box on the table that motions must clear.
+    Obstacle,
+}
+
+impl ObjectKind {
+    /// `block`, `container` or `obstacle`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ObjectKind::Block => "block",
+            ObjectKind::Container => "container",
+            ObjectKind::Obstacle => "obstacle",
+        }
+    }
+}
+
+impl std::fmt::Display for ObjectKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// An object's shape and physical parameters.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Shape {
+    /// A cube.
+    Block {
+        /// Half the edge, metres.
+        half: f64,
+        /// Mass, kg.
+        mass: f64,
+        /// Sliding friction coefficient against the pads and the table.
+        friction: f64,
+    },
+    /// An open box: floor [`CONTAINER_FLOOR`] thick, walls [`CONTAINER_WALL`] thick.
+    Container {
+        /// Half of the free space inside the walls along the container's x and y, metres.
+        inner_half: [f64; 2],
+        /// Height of the rim above the table, metres.
+        wall_height: f64,
+    },
+    /// A fixed box.
+    Obstacle {
+        /// Half extents along the obstacle's x, y, z, metres.
+        half: [f64; 3],
+    },
+}
+
+impl Shape {
+    /// The kind of object this shape makes.
+    pub fn kind(&self) -> ObjectKind {
+        match self {
+            Shape::Block { .. } => ObjectKind::Block,
+            Shape::Container { .. } => ObjectKind::Container,
+            Shape::Obstacle { .. } => ObjectKind::Obstacle,
+        }
+    }
+
+    /// Half extents of the footprint on the table, in the object's own frame, metres.
+    pub fn footprint_half(&self) -> [f64; 2] {
+        match self {
+            Shape::Block { half, .. } => [*half, *half],
+            Shape::Container { inner_half, .. } => {
+                [inner_half[0] + CONTAINER_WALL, inner_half[1] + CONTAINER_WALL]
+            }
+            Shape::Obstacle { half } => [half[0], half[1]],
+        }
+    }
+
+    /// Radius of the circle around the footprint (any yaw), metres.
+    pub fn footprint_radius(&self) -> f64 {
+        let [a, b] = self.footprint_half();
+        a.hypot(b)
+    }
+
+    /// Height of the object's top above its base, metres (a container's rim).
+    pub fn height(&self) -> f64 {
+        match self {
+            Shape::Block { half, .. } => 2.0 * half,
+            Shape::Container { wall_height, .. } => *wall_height,
+            Shape::Obstacle { half } => 2.0 * half[2],
+        }
+    }
+}
+
+/// A pose on the table: centre x, y (metres) and yaw about the vertical (radians).
+#[derive(Copy, Clone, Debug, PartialEq, Serialize, Default)]
+pub struct Pose {
+    /// Centre x, metres.
+    pub x: f64,
+    /// Centre y, metres.
+    pub y: f64,
+    /// Yaw about world z, radians.
+    pub yaw: f64,
+}
+
+impl Pose {
+    /// Horizontal distance between two poses' centres, metres.
+    pub fn distance(&self, other: &Pose) -> f64 {
+        (self.x - other.x).hypot(self.y - other.y)
+    }
+}
+
+/// Where a randomized object may start.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RandomPlacement {
+    /// Range of the centre x, metres (inclusive).
+    pub x: [f64; 2],
+    /// Range of the centre y, metres (inclusive).
+    pub y: [f64; 2],
+    /// Range of the yaw, radians (`[lo, hi)`); `None` keeps the fixed pose's yaw (or 0) and
+    /// draws nothing.
+    pub yaw: Option<[f64; 2]>,
+    /// Smallest gap between this object's footprint circle and any other object's, metres.
+    pub clearance: f64,
+}
+
+/// One object of the scene.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ObjectSpec {
+    /// The object's name (`[a-z][a-z0-9_]*`), used in trees and reports.
+    pub name: String,
+    /// Shape and physics.
+    pub shape: Shape,
+    /// Colour.
+    pub color: Color,
+    /// The pose `macrotree run` uses when no randomization is asked for.
+    pub pose: Option<Pose>,
+    /// The randomization sweeps draw from.
+    pub random: Option<RandomPlacement>,
+}
+
+impl ObjectSpec {
+    /// What the object is.
+    pub fn kind(&self) -> ObjectKind {
+        self.shape.kind()
+    }
+}
+
+/// A loaded, validated scene.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SceneSpec {
+    /// The scene's name (its file stem, e.g. `sort_three`).
+    pub name: String,
+    /// One line on what the cell is.
+    pub description: Option<String>,
+    /// The objects, in file order (which is also their order in the MuJoCo model and reports).
+    pub objects: Vec<ObjectSpec>,
+    /// The task's goal, evaluated when the episode ends.
+    pub goal: Goal,
+}
+
+impl SceneSpec {
+    /// Index of the object called `name`.
+    pub fn index_of(&self, name: &str) -> Option<usize> {
+        self.objects.iter().position(|o| o.name == name)
+    }
+
+    /// The object called `name`.
+    pub fn object(&self, name: &str) -> Option<&ObjectSpec> {
+        self.objects.iter().find(|o| o.name == name)
+    }
+
+    /// Indices of the objects of `kind`, in scene order.
+    pub fn of_kind(&self, kind: ObjectKind) -> impl Iterator<Item = usize> + '_ {
+        (0..self.objects.len()).filter(move |&i| self.objects[i].kind() == kind)
+    }
+
+    /// The object the legacy name `cube` stands for: the block called `cube`, else the scene's
+    /// only block.
+    pub fn legacy_cube(&self) -> Option<usize> {
+        self.legacy(ObjectKind::Block, "cube")
+    }
+
+    /// The object the legacy name `bowl` stands for: the container called `bowl`, else the
+    /// scene's only container.
+    pub fn legacy_bowl(&self) -> Option<usize> {
+        self.legacy(ObjectKind::Container, "bowl")
+    }
+
+    fn legacy(&self, kind: ObjectKind, name: &str) -> Option<usize> {
+        if let Some(i) = self.index_of(name).filter(|&i| self.objects[i].kind() == kind) {
+            return Some(i);
+        }
+        let mut of_kind = self.of_kind(kind);
+        match (of_kind.next(), of_kind.next()) {
+            (Some(i), None) => Some(i),
+            _ => None,
+        }
+    }
+
+    /// True when every object has a fixed pose (so `run` needs no sampling).
+    pub fn fully_posed(&self) -> bool {
+        self.objects.iter().all(|o| o.pose.is_some())
+    }
+
+    /// True when some object is randomized (so sweeps vary the layout).
+    pub fn randomized(&self) -> bool {
+        self.objects.iter().any(|o| o.random.is_some())
+    }
+}
