@@ -1,15 +1,16 @@
-//! `carry`: lift the held cube, transfer it above the goal on a straight line at a safe height,
-//! and lower it to the place height. Fails at once when the grasp is lost.
+//! `carry`: lift the held block, move it above the goal at a height that clears everything under
+//! its path, lower it onto the goal (a container's floor, the top of another block, or a point).
 
-use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
-use super::targets::resolve;
+use super::targets::{resolve, target_object};
 use crate::motion::{CartesianMove, MotionLimits, Trajectory};
+use crate::scene::ObjectKind;
 use crate::spec::Carry as CarrySpec;
-use crate::world::CUBE_HALF;
-use crate::world::conditions::{Tolerances, cube_grasped};
+use crate::world::World;
+use crate::world::conditions::Tolerances;
 
 /// Consecutive ticks without a grasp before the carry fails (filters single-step contact flicker).
 const LOST_TICKS: u32 = 3;
@@ -20,6 +21,13 @@ const GOAL_MOVED: f64 = 0.005;
 
 /// Re-plans of the transfer allowed in one carry.
 const MAX_REPLANS: u32 = 3;
+
+/// Gap kept between the carried block's bottom and the top of anything it passes over, metres.
+pub const CLEARANCE: f64 = 0.03;
+
+/// Reach of the closed fingers beyond the held block's faces, in the table plane, metres (the
+/// 2F-85's fingertips are about 2 cm wide and the pads 8 mm thick).
+pub const FINGER_MARGIN: f64 = 0.025;
 
 /// The carry's phases, in order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -45,13 +53,17 @@ impl Phase {
 /// lowering aim at where the goal is *now*, and a transfer whose goal moved meanwhile is re-planned.
 pub struct Carry {
     spec: CarrySpec,
-    /// Pinch position minus cube centre when the carry started (kept, so the cube goes where the
-    /// pinch is sent), metres.
-    pinch_from_cube: Vector3<f64>,
+    /// The held block (index into the world's objects).
+    held: usize,
+    /// Half the held block's edge, metres.
+    half: f64,
+    /// Pinch position minus block centre when the carry started (kept, so the block goes where
+    /// the pinch is sent), metres.
+    pinch_from_block: Vector3<f64>,
     /// Tool orientation kept during the carry.
     rotation: UnitQuaternion<f64>,
     phase: Phase,
-    /// Cube centre the current phase ends at, metres.
+    /// Block centre the current phase ends at, metres.
     phase_end: Vector3<f64>,
     replans: u32,
     goal_q: [f64; 6],
@@ -64,7 +76,9 @@ impl Carry {
     pub fn new(spec: CarrySpec) -> Self {
         Self {
             spec,
-            pinch_from_cube: Vector3::zeros(),
+            held: 0,
+            half: crate::world::CUBE_HALF,
+            pinch_from_block: Vector3::zeros(),
             rotation: UnitQuaternion::identity(),
             phase: Phase::Lift,
             phase_end: Vector3::zeros(),
@@ -75,20 +89,73 @@ impl Carry {
         }
     }
 
-    /// Height of the cube centre during the transfer, metres.
-    fn carry_z(&self) -> f64 {
-        self.spec.lift + CUBE_HALF
+    /// The object the carry goes to, if its target is one.
+    fn destination(&self, w: &World) -> Option<usize> {
+        target_object(&self.spec.to, w)
     }
 
-    /// Where the cube centre ends up when placed at the goal as it is now, metres.
-    fn place(&self, cell: &Cell) -> Vector3<f64> {
-        let goal = resolve(&self.spec.to, cell.world());
-        Vector3::new(goal.x, goal.y, goal.z + self.spec.place_height + CUBE_HALF)
+    /// Where the block's centre ends up when placed at the goal as it is now, metres: on a
+    /// container's floor, on top of a block, or at a point, `place_height` above it.
+    fn place(&self, w: &World) -> Result<Vector3<f64>, String> {
+        let goal = resolve(&self.spec.to, w)?;
+        let base = match self.destination(w) {
+            Some(d) if w.spec(d).kind() == ObjectKind::Block => w.top(d),
+            _ => goal.z,
+        };
+        Ok(Vector3::new(
+            goal.x,
+            goal.y,
+            base + self.spec.place_height + self.half,
+        ))
     }
 
-    /// Moves the cube centre to `cube_end` in a straight line: the phase `phase` starts.
-    fn start_phase(&mut self, cell: &mut Cell, phase: Phase, cube_end: Vector3<f64>) -> Result<(), String> {
-        let pose = Isometry3::from_parts(Translation3::from(cube_end + self.pinch_from_cube), self.rotation);
+    /// Height of the block's centre for a transfer from `from` to `to` (table plane), metres:
+    /// `lift` above the table, or higher when something under the path (any object but the held
+    /// block, the goal's own walls included) needs it to clear its top by [`CLEARANCE`].
+    fn transfer_z(&self, w: &World, from: Vector2<f64>, to: Vector2<f64>) -> f64 {
+        let mut z = self.spec.lift + self.half;
+        let reach = self.half * std::f64::consts::SQRT_2 + FINGER_MARGIN;
+        for j in 0..w.objects.len() {
+            if j == self.held {
+                continue;
+            }
+            let c = w.objects[j].pos.xy();
+            let near = segment_distance(c, from, to) <= w.spec(j).shape.footprint_radius() + reach;
+            if near {
+                z = z.max(w.top(j) + CLEARANCE + self.half);
+            }
+        }
+        z
+    }
+
+    /// Checks that the fingers can come down to `place` (block centre): no object other than the
+    /// goal stands within the fingers' reach of it higher than the block's bottom will be.
+    fn check_descent(&self, w: &World, place: &Vector3<f64>) -> Result<(), String> {
+        let dest = self.destination(w);
+        let bottom = place.z - self.half;
+        let reach = self.half * std::f64::consts::SQRT_2 + FINGER_MARGIN;
+        for j in 0..w.objects.len() {
+            if j == self.held || Some(j) == dest {
+                continue;
+            }
+            let gap = w.from_footprint(j, place).norm();
+            if gap < reach && w.top(j) > bottom {
+                return Err(format!(
+                    "no clear way down to ({:.3}, {:.3}): the fingers would hit {} ({:.0} mm away, its top at {:.3} m)",
+                    place.x,
+                    place.y,
+                    w.name(j),
+                    gap * 1e3,
+                    w.top(j)
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Moves the block centre to `end` in a straight line: the phase `phase` starts.
+    fn start_phase(&mut self, cell: &mut Cell, phase: Phase, end: Vector3<f64>) -> Result<(), String> {
+        let pose = Isometry3::from_parts(Translation3::from(end + self.pinch_from_block), self.rotation);
         let limits = MotionLimits {
             tool_speed: self.spec.speed,
             ..MotionLimits::default()
@@ -97,15 +164,18 @@ impl Carry {
             .map_err(|e| format!("unreachable carry path ({}): {e}", phase.name()))?;
         self.goal_q = mv.end();
         self.phase = phase;
-        self.phase_end = cube_end;
+        self.phase_end = end;
         cell.track(Box::new(mv));
         Ok(())
     }
 
     /// The current phase's motion has ended: start the next one (or re-plan the transfer).
     fn next_phase(&mut self, cell: &mut Cell) -> Result<(), String> {
-        let place = self.place(cell);
-        let above = Vector3::new(place.x, place.y, self.carry_z().max(place.z));
+        let w = cell.world();
+        let place = self.place(w)?;
+        let from = w.objects[self.held].pos.xy();
+        let above_z = self.transfer_z(w, from, place.xy()).max(place.z);
+        let above = Vector3::new(place.x, place.y, above_z);
         match self.phase {
             Phase::Lift => self.start_phase(cell, Phase::Transfer, above),
             Phase::Transfer if (above.xy() - self.phase_end.xy()).norm() > GOAL_MOVED => {
@@ -118,22 +188,42 @@ impl Carry {
                 tracing::debug!(target: "macrotree::actions", replans = self.replans, "carry: goal moved, re-planning the transfer");
                 self.start_phase(cell, Phase::Transfer, above)
             }
-            Phase::Transfer => self.start_phase(cell, Phase::Lower, place),
+            Phase::Transfer => {
+                self.check_descent(w, &place)?;
+                self.start_phase(cell, Phase::Lower, place)
+            }
             Phase::Lower => Ok(()),
         }
     }
 }
 
+/// Distance from `p` to the segment `a`–`b` in the table plane, metres.
+fn segment_distance(p: Vector2<f64>, a: Vector2<f64>, b: Vector2<f64>) -> f64 {
+    let ab = b - a;
+    let len2 = ab.norm_squared();
+    let t = if len2 < 1e-12 {
+        0.0
+    } else {
+        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
+    };
+    (p - (a + ab * t)).norm()
+}
+
 impl MacroAction for Carry {
     fn start(&mut self, cell: &mut Cell) -> Result<(), String> {
         let w = cell.world();
-        if !cube_grasped(w, Tolerances::GRASP_OFF_AXIS) {
-            return Err("carry needs the cube in the gripper, but it is not grasped".into());
-        }
-        // Keep the pinch where it holds the cube: move the pinch by as much as the cube should move.
-        self.pinch_from_cube = w.pinch_pos - w.cube_pos;
+        let Some(held) = w.held_block(Tolerances::GRASP_OFF_AXIS) else {
+            return Err("carry needs a block in the gripper, but none is grasped".into());
+        };
+        self.held = held;
+        self.half = w.half(held);
+        let pos = w.objects[held].pos;
+        // Keep the pinch where it holds the block: move the pinch by as much as the block should move.
+        self.pinch_from_block = w.pinch_pos - pos;
         self.rotation = UnitQuaternion::from_matrix(&w.pinch_rot);
-        let lift = Vector3::new(w.cube_pos.x, w.cube_pos.y, self.carry_z().max(w.cube_pos.z));
+        let place = self.place(w)?;
+        let lift_z = self.transfer_z(w, pos.xy(), place.xy()).max(pos.z);
+        let lift = Vector3::new(pos.x, pos.y, lift_z);
         self.replans = 0;
         self.lost = 0;
         self.start_phase(cell, Phase::Lift, lift)
@@ -141,15 +231,16 @@ impl MacroAction for Carry {
 
     fn update(&mut self, cell: &mut Cell) -> Progress {
         let w = cell.world();
-        if cube_grasped(w, Tolerances::GRASP_OFF_AXIS) {
+        if w.holds(self.held, Tolerances::GRASP_OFF_AXIS) {
             self.lost = 0;
         } else {
             self.lost += 1;
             if self.lost >= LOST_TICKS {
-                let c = w.cube_pos;
+                let c = w.objects[self.held].pos;
                 return Progress::Failed(format!(
-                    "grasp lost during {}: cube at ({:.3}, {:.3}, {:.3}) m",
+                    "grasp lost during {}: {} at ({:.3}, {:.3}, {:.3}) m",
                     self.phase.name(),
+                    w.name(self.held),
                     c.x,
                     c.y,
                     c.z
@@ -165,5 +256,18 @@ impl MacroAction for Carry {
             return Progress::Running;
         }
         self.arrival.progress(cell, &self.goal_q)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn distance_to_a_segment() {
+        let (a, b) = (Vector2::new(0.0, 0.0), Vector2::new(1.0, 0.0));
+        assert!((segment_distance(Vector2::new(0.5, 0.2), a, b) - 0.2).abs() < 1e-12);
+        assert!((segment_distance(Vector2::new(-0.3, 0.4), a, b) - 0.5).abs() < 1e-12);
+        assert!((segment_distance(Vector2::new(2.0, 0.0), a, a) - 2.0).abs() < 1e-12);
     }
 }

@@ -11,10 +11,14 @@ use super::joints::MoveJoints;
 use super::macro_action::{MacroAction, Progress};
 use super::reach::Reach;
 use super::release::Release;
+use super::targets::object_index;
 use crate::plan::LeafId;
-use crate::runtime::{LeafDriver, LeafOutcome};
-use crate::spec::{ActionLeaf, ConditionLeaf, Leaf};
+use crate::runtime::{LeafDriver, LeafOutcome, Selection};
+use crate::scene::ObjectKind;
+use crate::spec::{ActionLeaf, ConditionLeaf, Leaf, ObjectRef};
 use crate::world::conditions as cond;
+use crate::world::query::{self, Query};
+use crate::world::{Part, Piece, goal};
 
 /// A running macro action and when it must be done by.
 struct Active {
@@ -44,6 +48,17 @@ pub struct MacroDriver<'a> {
     pub counters: LeafCounters,
     /// The reason of the last action that failed.
     pub last_failure: Option<String>,
+    /// Contacts that should not happen, by name, in the order first seen.
+    pub collisions: Vec<Collision>,
+}
+
+/// A contact that should not happen (the fingers on a wall, the carried block on an obstacle).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Collision {
+    /// Simulated time it was first seen, seconds.
+    pub time: f64,
+    /// What hit what, e.g. `the fingers hit bowl wall`.
+    pub what: String,
 }
 
 impl<'a> MacroDriver<'a> {
@@ -55,6 +70,7 @@ impl<'a> MacroDriver<'a> {
             checks: ChecksRecorder::default(),
             counters: LeafCounters::default(),
             last_failure: None,
+            collisions: Vec::new(),
         }
     }
 
@@ -66,6 +82,7 @@ impl<'a> MacroDriver<'a> {
     /// Advances the physics by one control period and updates the checks.
     pub fn advance(&mut self) {
         self.cell.advance();
+        self.watch_contacts();
         let closed = self.cell.gripper_command() > 0.0;
         self.checks.on_tick(self.cell.world(), closed);
     }
@@ -90,9 +107,28 @@ impl<'a> MacroDriver<'a> {
         }
     }
 
-    fn condition(&self, leaf: &ConditionLeaf) -> bool {
+    fn condition(&self, leaf: &ConditionLeaf) -> Result<bool, String> {
         let w = self.cell.world();
-        match leaf {
+        let obj = |o: &ObjectRef| object_index(o, w);
+        Ok(match leaf {
+            ConditionLeaf::Grasped(c) => w.holds(obj(&c.object)?, c.off_axis),
+            ConditionLeaf::Lifted(c) => w.bottom(obj(&c.object)?) >= c.min_height,
+            ConditionLeaf::In(c) => goal::rests_in(w, obj(&c.object)?, obj(&c.container)?, c.rest_speed),
+            ConditionLeaf::On(c) => goal::rests_on(w, obj(&c.object)?, obj(&c.support)?, c.rest_speed),
+            ConditionLeaf::OnTable(c) => cond::on_table(w, obj(&c.object)?, c.tolerance, c.rest_speed),
+            ConditionLeaf::At(c) => {
+                let i = obj(&c.object)?;
+                let p = w.objects[i].pos;
+                let near = (p.x - c.point[0]).hypot(p.y - c.point[1]) <= c.tolerance;
+                let turned = c.yaw.is_none_or(|target| {
+                    crate::world::snapshot::fold_quarter_turn(w.yaw(i) - target.0).abs() <= c.yaw_tolerance
+                });
+                cond::on_table(w, i, cond::Tolerances::ON_TABLE_HEIGHT, c.rest_speed) && near && turned
+            }
+            ConditionLeaf::GoalMet(c) => match &c.object {
+                Some(o) => goal::done(w, obj(o)?),
+                None => goal::goal_holds(w),
+            },
             ConditionLeaf::CubeGrasped(c) => cond::cube_grasped(w, c.off_axis),
             ConditionLeaf::CubeLifted(c) => cond::cube_lifted(w, c.min_height),
             ConditionLeaf::CubeInBowl(c) => cond::cube_in_bowl(w, c.rest_speed),
@@ -106,6 +142,39 @@ impl<'a> MacroDriver<'a> {
             ),
             ConditionLeaf::GripperOpen(c) => cond::gripper_open(w, c.min_width),
             ConditionLeaf::AtHome(c) => cond::at_home(w, c.tolerance),
+        })
+    }
+
+    /// Notes contacts that should not happen: the fingers on a container or an obstacle, and the
+    /// held block on a wall or an obstacle. Each is logged and recorded once, by name.
+    fn watch_contacts(&mut self) {
+        let w = self.cell.world();
+        if w.touches.is_empty() {
+            return;
+        }
+        let held = w.held_block(cond::Tolerances::GRASP_OFF_AXIS);
+        for &(a, b) in &w.touches {
+            for (me, other) in [(a, b), (b, a)] {
+                let Part::Object { index, piece } = other else {
+                    continue;
+                };
+                let kind = w.spec(index).kind();
+                let fingers = me == Part::Fingers && kind != ObjectKind::Block;
+                let carried = matches!(me, Part::Object { index: h, .. } if Some(h) == held && h != index)
+                    && (piece == Piece::Wall || kind == ObjectKind::Obstacle);
+                if !(fingers || carried) {
+                    continue;
+                }
+                let who = match me {
+                    Part::Object { index: h, .. } => format!("the carried {}", w.name(h)),
+                    _ => "the fingers".to_string(),
+                };
+                let what = format!("{who} hit {}", w.describe(other));
+                if !self.collisions.iter().any(|c| c.what == what) {
+                    tracing::warn!(target: "macrotree::actions", sim_time = w.time, "collision: {what}");
+                    self.collisions.push(Collision { time: w.time, what });
+                }
+            }
         }
     }
 
@@ -131,15 +200,18 @@ impl LeafDriver for MacroDriver<'_> {
     fn tick(&mut self, id: LeafId, leaf: &Leaf, first: bool) -> LeafOutcome {
         let action = match leaf {
             Leaf::Condition(c) => {
-                return if self.condition(c) {
-                    LeafOutcome::Success
-                } else {
-                    LeafOutcome::Failure("not satisfied".into())
+                return match self.condition(c) {
+                    Ok(true) => LeafOutcome::Success,
+                    Ok(false) => LeafOutcome::Failure("not satisfied".into()),
+                    Err(e) => LeafOutcome::Failure(e),
                 };
             }
             Leaf::Action(a) => a,
-            Leaf::Wait(_) => {
-                return LeafOutcome::Failure("wait is handled by the runtime, not the driver".into());
+            Leaf::Wait(_) | Leaf::Select(_) => {
+                return LeafOutcome::Failure(format!(
+                    "`{}` is handled by the runtime, not the driver",
+                    leaf.kind()
+                ));
             }
         };
         if first || !self.active.contains_key(&id) {
@@ -168,6 +240,14 @@ impl LeafDriver for MacroDriver<'_> {
             progress = Progress::Failed(format!("timeout: not done after {:.2} s", active.timeout));
         }
         self.finish(id, leaf, progress)
+    }
+
+    fn select_object(&mut self, query: &Query) -> Result<Option<Selection>, String> {
+        let w = self.cell.world();
+        Ok(query::select(w, query).map(|i| Selection {
+            object: w.name(i).to_string(),
+            destination: goal::destination(w, i).map(|d| w.name(d).to_string()),
+        }))
     }
 
     fn halt(&mut self, id: LeafId, _leaf: &Leaf) {

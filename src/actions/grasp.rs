@@ -2,9 +2,10 @@
 
 use super::cell::Cell;
 use super::macro_action::{MacroAction, Progress};
+use super::targets::object_index;
 use crate::motion::gripper::{CLOSED_CTRL, ctrl_for_width};
 use crate::spec::Grasp as GraspSpec;
-use crate::world::conditions::{Tolerances, cube_grasped};
+use crate::world::conditions::Tolerances;
 
 /// Driver-joint speed below which the fingers count as stalled, rad/s.
 const STALL_SPEED: f64 = 0.02;
@@ -54,14 +55,31 @@ impl MacroAction for Grasp {
         if self.stalled < STALL_TICKS {
             return Progress::Running;
         }
-        if cube_grasped(w, Tolerances::GRASP_OFF_AXIS) {
+        let (held, what) = match &self.spec.object {
+            Some(o) => match object_index(o, w) {
+                Ok(i) => (w.holds(i, Tolerances::GRASP_OFF_AXIS), w.name(i).to_string()),
+                Err(e) => return Progress::Failed(e),
+            },
+            None => (
+                w.held_block(Tolerances::GRASP_OFF_AXIS).is_some(),
+                "a block".to_string(),
+            ),
+        };
+        if held {
             Progress::Done
         } else {
+            let touched: Vec<&str> = (0..w.objects.len())
+                .filter(|&i| !w.released(i))
+                .map(|i| w.name(i))
+                .collect();
             Progress::Failed(format!(
-                "grasp failed: fingers stopped at {:.1} mm without holding the cube (pad contacts: left {}, right {})",
+                "grasp failed: fingers stopped at {:.1} mm without holding {what} (pads touch: {})",
                 w.gripper_width * 1e3,
-                w.left_pad_contact,
-                w.right_pad_contact
+                if touched.is_empty() {
+                    "nothing".to_string()
+                } else {
+                    touched.join(", ")
+                }
             ))
         }
     }

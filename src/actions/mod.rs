@@ -18,6 +18,6 @@ mod targets;
 
 pub use cell::{CONTROL_PERIOD, Cell, StepObserver};
 pub use checks::{Checks, ChecksRecorder, pad_cube_distance};
-pub use driver::{LeafCounters, MacroDriver};
+pub use driver::{Collision, LeafCounters, MacroDriver};
 pub use macro_action::{Arrival, MacroAction, Progress};
-pub use targets::{resolve, tool_yaw};
+pub use targets::{object_index, object_point, resolve, target_block, target_object, tool_yaw};

@@ -4,7 +4,7 @@ use nalgebra::Vector3;
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
-use super::targets::{resolve, tool_yaw};
+use super::targets::{resolve, target_block, tool_yaw};
 use crate::motion::{CartesianMove, JointMove, MotionLimits, down_pose, ik_down};
 use crate::spec::{PathKind, Reach as ReachSpec, Target, Yaw};
 
@@ -30,11 +30,15 @@ impl MacroAction for Reach {
     fn start(&mut self, cell: &mut Cell) -> Result<(), String> {
         let w = cell.world();
         let offset = Vector3::from(self.spec.offset);
-        let position = resolve(&self.spec.target, w) + offset;
+        let position = resolve(&self.spec.target, w)? + offset;
         let current_yaw = tool_yaw(&w.pinch_rot);
         let (yaw, quarter) = match (&self.spec.yaw, &self.spec.target) {
             (Yaw::Object, Target::Cube) => grasp_yaw(w),
-            (Yaw::Object, _) | (Yaw::Keep, _) => (current_yaw, false),
+            (Yaw::Object, t) => match target_block(t, w) {
+                Some(b) => block_grasp_yaw(w, b),
+                None => (current_yaw, false),
+            },
+            (Yaw::Keep, _) => (current_yaw, false),
             (Yaw::Angle(a), _) => (*a, false),
         };
         let from = cell.arm_setpoint();
@@ -80,6 +84,31 @@ fn grasp_yaw(w: &crate::world::World) -> (f64, bool) {
     let toward_bowl = away.normalize();
     // At tool yaw ψ the pads separate along (cos ψ, sin ψ) in the table plane.
     let along = |psi: f64| (psi.cos() * toward_bowl.x + psi.sin() * toward_bowl.y).abs();
+    let other = yaw + std::f64::consts::FRAC_PI_2;
+    (if along(yaw) <= along(other) { yaw } else { other }, false)
+}
+
+/// Tool yaw for grasping block `b` (any scene) and whether its quarter turns are equivalent: as
+/// [`grasp_yaw`], with the nearest other object (container wall, obstacle or block) within
+/// [`BOWL_CLEARANCE`] of the block in place of the bowl.
+fn block_grasp_yaw(w: &crate::world::World, b: usize) -> (f64, bool) {
+    let yaw = w.yaw(b);
+    let p = w.objects[b].pos;
+    let nearest = (0..w.objects.len())
+        .filter(|&j| j != b)
+        .map(|j| {
+            // The offset from object j's footprint, turned back into the world frame.
+            let local = w.from_footprint(j, &p);
+            let (s, c) = crate::world::snapshot::yaw_of(&w.objects[j].quat).sin_cos();
+            nalgebra::Vector2::new(c * local.x - s * local.y, s * local.x + c * local.y)
+        })
+        .filter(|away| away.norm() > 0.0)
+        .min_by(|a, b| a.norm().total_cmp(&b.norm()));
+    let Some(away) = nearest.filter(|a| a.norm() < BOWL_CLEARANCE) else {
+        return (yaw, true);
+    };
+    let toward = away.normalize();
+    let along = |psi: f64| (psi.cos() * toward.x + psi.sin() * toward.y).abs();
     let other = yaw + std::f64::consts::FRAC_PI_2;
     (if along(yaw) <= along(other) { yaw } else { other }, false)
 }

@@ -3,16 +3,66 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+use crate::scene::ObjectKind;
+use crate::spec::ObjectRef;
 use crate::world::World;
 
-/// Where a named target is now, metres: the cube's centre, the bowl target (centre of the bowl
-/// floor's top surface), or a fixed point.
-pub fn resolve(target: &crate::spec::Target, w: &World) -> Vector3<f64> {
+/// Where a target is now, metres: a block's centre, the centre of a container floor's top
+/// surface (the legacy `bowl`: the bowl target), the centre of an obstacle's top, or a fixed
+/// point. Fails for a name the scene does not have (or a variable the runtime did not resolve).
+pub fn resolve(target: &crate::spec::Target, w: &World) -> Result<Vector3<f64>, String> {
     use crate::spec::Target;
     match target {
-        Target::Cube => w.cube_pos,
-        Target::Bowl => w.bowl_target,
-        Target::Point(p) => Vector3::new(p[0], p[1], p[2]),
+        Target::Cube => Ok(w.cube_pos),
+        Target::Bowl => Ok(w.bowl_target),
+        Target::Point(p) => Ok(Vector3::new(p[0], p[1], p[2])),
+        Target::Object(o) => {
+            let i = object_index(o, w)?;
+            Ok(object_point(w, i))
+        }
+    }
+}
+
+/// The point a motion aims at on object `i`: a block's centre, a container floor's top centre, an
+/// obstacle's top centre, metres.
+pub fn object_point(w: &World, i: usize) -> Vector3<f64> {
+    let p = w.objects[i].pos;
+    match w.spec(i).kind() {
+        ObjectKind::Block => p,
+        _ => Vector3::new(p.x, p.y, w.support_height(i)),
+    }
+}
+
+/// The index of the object `o` names.
+pub fn object_index(o: &ObjectRef, w: &World) -> Result<usize, String> {
+    match o {
+        ObjectRef::Name(n) => w
+            .index_of(n.as_str())
+            .ok_or_else(|| format!("scene `{}` has no object `{n}`", w.scene.name)),
+        ObjectRef::Var(v) => Err(format!("the variable `{{{v}}}` was not resolved")),
+    }
+}
+
+/// The block a target names, if it names one (the legacy `cube` is the scene's cube).
+pub fn target_block(target: &crate::spec::Target, w: &World) -> Option<usize> {
+    use crate::spec::Target;
+    match target {
+        Target::Cube => w.scene.legacy_cube(),
+        Target::Object(o) => object_index(o, w)
+            .ok()
+            .filter(|&i| w.spec(i).kind() == ObjectKind::Block),
+        _ => None,
+    }
+}
+
+/// The object a target names (the legacy names included), if any.
+pub fn target_object(target: &crate::spec::Target, w: &World) -> Option<usize> {
+    use crate::spec::Target;
+    match target {
+        Target::Cube => w.scene.legacy_cube(),
+        Target::Bowl => w.scene.legacy_bowl(),
+        Target::Object(o) => object_index(o, w).ok(),
+        Target::Point(_) => None,
     }
 }
 

@@ -8,9 +8,6 @@ use super::{Check, Internal, LeafId, LeafInfo, NodeInfo, Plan};
 use crate::spec::leaves::{ActionLeaf, ConditionLeaf};
 use crate::spec::{Diagnostic, Issue, Leaf, Node, NodeKind, Sources, Spec, Target, Yaw};
 
-/// Largest compiled behavior accepted (bonsai nodes, after retry/repeat copies).
-pub const MAX_BEHAVIOR_NODES: usize = 200_000;
-
 /// Validate and compile a loaded spec.
 pub fn compile_spec(spec: &Spec) -> Result<Plan, Vec<Diagnostic>> {
     let mut c = Compiler {
@@ -134,6 +131,7 @@ pub(crate) fn leaf_label(leaf: &Leaf) -> String {
             other => format!("{}?", other.kind()),
         },
         Leaf::Wait(w) => format!("wait {} s", fmt_num(w.seconds)),
+        Leaf::Select(sel) => format!("select {} → {{{}}}", sel.query().describe(), sel.var),
     }
 }
 
@@ -141,6 +139,15 @@ fn node_label(n: &Node) -> String {
     let base = match &n.kind {
         NodeKind::Retry { attempts, .. } => format!("retry ×{attempts}"),
         NodeKind::Repeat { times, .. } => format!("repeat ×{times}"),
+        NodeKind::ForEach {
+            select,
+            max_iterations,
+            ..
+        } => format!(
+            "for_each {} → {{{}}} (≤ {max_iterations})",
+            select.query().describe(),
+            select.var
+        ),
         NodeKind::Timeout { seconds, .. } => format!("timeout {} s", fmt_num(*seconds)),
         NodeKind::Subtree { reference, args, .. } => {
             if args.is_empty() {
@@ -274,20 +281,6 @@ impl Compiler<'_> {
         }
     }
 
-    fn too_big(&mut self, n: &Node, size: usize) {
-        self.issues.push(
-            Issue::new(
-                n.loc,
-                format!(
-                    "`{}` expands to {size} bonsai nodes (limit {MAX_BEHAVIOR_NODES})",
-                    n.kind.kind_name()
-                ),
-            )
-            .label("retry/repeat copy their child once per attempt")
-            .help("lower `attempts`/`times`, or move the retry closer to the leaves"),
-        );
-    }
-
     fn body(&mut self, n: &Node, idx: usize, path: &str) -> Behavior<LeafId> {
         let children = n.kind.children();
         let paths = child_paths(path, &children);
@@ -326,37 +319,56 @@ impl Compiler<'_> {
                 let x = self.wrapped(child, Some(idx), xp);
                 Behavior::Race(vec![c, x])
             }
-            NodeKind::Retry { attempts, child }
-            | NodeKind::Repeat {
-                times: attempts,
+            NodeKind::Retry { attempts, child } => {
+                let w = self.wrapped(child, Some(idx), paths.into_iter().next().unwrap_or_default());
+                let next = self.internal_leaf(Internal::Next {
+                    node: idx,
+                    limit: *attempts,
+                });
+                let exit = self.internal_leaf(Internal::Exit {
+                    node: idx,
+                    flagged_success: false,
+                });
+                // A child success fails the inverted body and ends the loop; the inverted loop
+                // then succeeds, and `exit` tells a success from attempts used up.
+                let body = vec![Behavior::Invert(Box::new(w)), next];
+                let looped = Behavior::While(Box::new(Behavior::WaitForever), body);
+                Behavior::Sequence(vec![Behavior::Invert(Box::new(looped)), exit])
+            }
+            NodeKind::Repeat { times, child } => {
+                let w = self.wrapped(child, Some(idx), paths.into_iter().next().unwrap_or_default());
+                let next = self.internal_leaf(Internal::Next {
+                    node: idx,
+                    limit: *times,
+                });
+                let exit = self.internal_leaf(Internal::Exit {
+                    node: idx,
+                    flagged_success: true,
+                });
+                let looped = Behavior::While(Box::new(Behavior::WaitForever), vec![w, next]);
+                Behavior::Select(vec![looped, exit])
+            }
+            NodeKind::ForEach {
+                select,
+                max_iterations,
                 child,
             } => {
+                let pick = self.internal_leaf(Internal::Pick {
+                    node: idx,
+                    select: select.clone(),
+                    limit: *max_iterations,
+                });
                 let w = self.wrapped(child, Some(idx), paths.into_iter().next().unwrap_or_default());
-                let size = behavior_size(&w).saturating_mul(*attempts as usize);
-                if size > MAX_BEHAVIOR_NODES {
-                    self.too_big(n, size);
-                    return Behavior::WaitForever;
-                }
-                let is_retry = matches!(n.kind, NodeKind::Retry { .. });
-                let mut copies = vec![w.clone()];
-                for k in 2..=*attempts {
-                    let y = self.internal_leaf(Internal::Yield {
-                        node: idx,
-                        iteration: k,
-                        of: *attempts,
-                    });
-                    if is_retry {
-                        copies.push(Behavior::Sequence(vec![y, w.clone()]));
-                    } else {
-                        copies.push(y);
-                        copies.push(w.clone());
-                    }
-                }
-                if is_retry {
-                    Behavior::Select(copies)
-                } else {
-                    Behavior::Sequence(copies)
-                }
+                let next = self.internal_leaf(Internal::Next {
+                    node: idx,
+                    limit: *max_iterations,
+                });
+                let exit = self.internal_leaf(Internal::Exit {
+                    node: idx,
+                    flagged_success: true,
+                });
+                let looped = Behavior::While(Box::new(Behavior::WaitForever), vec![pick, w, next]);
+                Behavior::Select(vec![looped, exit])
             }
             NodeKind::Timeout { seconds, child } => {
                 let w = self.wrapped(child, Some(idx), paths.into_iter().next().unwrap_or_default());

@@ -20,16 +20,22 @@
 //! | `race` | `Race` |
 //! | `reactive_sequence [c.., x]` / `guard {c, x}` | `Race([check(c).., W(x)])`, a check reports Running while its condition holds and Failure otherwise |
 //! | `reactive_fallback [c.., x]` | `Race([check(c).., W(x)])`, a check reports Running while its condition fails and Success otherwise |
-//! | `retry N` | `Select([W(x), Sequence([yield₂, W(x)]), …, Sequence([yield_N, W(x)])])` |
-//! | `repeat N` | `Sequence([W(x), yield₂, W(x), …, yield_N, W(x)])` |
+//! | `retry N` | `Sequence([Invert(While(WaitForever, [Invert(W(x)), next(N)])), exit])` |
+//! | `repeat N` | `Select([While(WaitForever, [W(x), next(N)]), exit])` |
+//! | `for_each {select, max_iterations: N}` | `Select([While(WaitForever, [pick(N), W(x), next]), exit])` |
 //! | `timeout S` | `Timeout(S, W(x))` |
 //! | `inverter` / `force_success` / `force_failure` | `Invert` / `AlwaysSucceed` / `Invert(AlwaysSucceed)` |
 //! | `subtree` | `W(body)` |
 //! | leaf | `Action(LeafId)` |
 //!
-//! A *yield* ([`Internal::Yield`]) is Running on the tick it is reached and Success on the next
-//! one, so each retry attempt / repeat iteration after the first starts on a fresh tick, after
-//! the world has been stepped and re-read. See `docs/tick_semantics.md`.
+//! Loops keep their counters in the runtime (BehaviorTree.CPP's way), not copies of the child:
+//! bonsai's `While` restarts its body with a fresh state each time round, `next`
+//! ([`Internal::Next`]) ends an iteration — Running on the tick it is reached and Success on the
+//! next one, so each retry attempt / repeat or for_each iteration after the first starts on a
+//! fresh tick, after the world has been stepped and re-read — and sets an exit flag when the
+//! count is used up; `exit` ([`Internal::Exit`]) turns the `While`'s end into the loop's
+//! outcome, and `pick` ([`Internal::Pick`]) selects the object of a `for_each` iteration. See
+//! `docs/tick_semantics.md`.
 
 #![warn(missing_docs)]
 
@@ -126,15 +132,37 @@ pub enum Internal {
         /// Which outcome.
         success: bool,
     },
-    /// Running on the tick it is first reached, Success (passing `dt` on) on the next tick:
-    /// starts iteration `iteration` (2-based) of the `retry`/`repeat` node `node` on a fresh tick.
-    Yield {
-        /// The retry / repeat node.
+    /// The end of one iteration of the loop node `node` (`retry`, `repeat`, `for_each`). While
+    /// iterations remain it is Running on the tick it is reached (the iteration counter goes up)
+    /// and Success on the next tick, so the next iteration starts on a fresh tick, after the
+    /// world has been stepped and re-read. When `retry`/`repeat` has used all `limit`
+    /// iterations it sets the loop's exit flag and fails, which ends the loop in the same tick.
+    Next {
+        /// The loop node.
         node: usize,
-        /// The attempt / iteration that starts after the yield (2, 3, …).
-        iteration: u32,
-        /// Total attempts / iterations of that node.
-        of: u32,
+        /// Attempts (`retry`), successful runs (`repeat`) or iterations (`for_each`) allowed.
+        limit: u32,
+    },
+    /// After the loop node `node`'s bonsai `While` ended: reads (and clears) the exit flag. With
+    /// the flag set it answers Success when `flagged_success`, Failure otherwise; without it, the
+    /// opposite.
+    Exit {
+        /// The loop node.
+        node: usize,
+        /// What a set flag means.
+        flagged_success: bool,
+    },
+    /// The start of an iteration of the `for_each` node `node`: selects the next object with
+    /// `query` (through the driver) and writes it to the blackboard. When nothing matches it
+    /// sets the exit flag and fails (the loop then succeeds); when something still matches after
+    /// `limit` iterations it fails (the loop fails).
+    Pick {
+        /// The `for_each` node.
+        node: usize,
+        /// What to select, and where to write it.
+        select: crate::spec::Select,
+        /// Iterations allowed.
+        limit: u32,
     },
 }
 

@@ -30,6 +30,7 @@
 
 #![warn(missing_docs)]
 
+pub mod blackboard;
 mod runner;
 pub mod scripted;
 
@@ -40,7 +41,18 @@ use serde::Serialize;
 use crate::plan::LeafId;
 use crate::spec::Leaf;
 
+pub use blackboard::Blackboard;
 pub use runner::TreeRunner;
+
+/// What a `select` (or a `for_each` iteration) found: an object's name and, when it has a goal
+/// in the scene, where the goal sends it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Selection {
+    /// The selected object.
+    pub object: String,
+    /// The container or block its goal names, if any.
+    pub destination: Option<String>,
+}
 
 /// What a driver answers for one tick of a leaf.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
@@ -67,6 +79,14 @@ pub trait LeafDriver {
     /// race lost, tree ended, or [`TreeRunner::halt_all`]). Stop its motion; the next tick of this
     /// leaf, if any, will have `first == true`.
     fn halt(&mut self, id: LeafId, leaf: &Leaf);
+    /// Answers a `select` query against the world: `Ok(None)` when no object matches. Drivers
+    /// that know no world cannot select (the default answer is an error).
+    fn select_object(&mut self, query: &crate::world::query::Query) -> Result<Option<Selection>, String> {
+        Err(format!(
+            "this driver cannot select objects (query: {})",
+            query.describe()
+        ))
+    }
 }
 
 /// Status of the whole tree after a tick.

@@ -5,9 +5,10 @@ use std::sync::Arc;
 use bonsai_bt::{BT, Event, Status, UpdateArgs};
 use tracing::Level;
 
+use super::blackboard::Blackboard;
 use super::{LeafDriver, LeafOutcome, NodeStatus, Transition, TreeStatus};
 use crate::plan::{Internal, LeafId, Plan};
-use crate::spec::Leaf;
+use crate::spec::{Leaf, Select};
 
 /// Pending transitions kept when nobody drains them; older ones are dropped (and counted).
 const MAX_PENDING_TRANSITIONS: usize = 100_000;
@@ -48,8 +49,12 @@ struct RunState {
     attempts: Vec<u32>,
     leaves: Vec<LeafRt>,
     yield_pending: Vec<bool>,
-    /// Yields that answered Running: (internal index, owning node, tick).
+    /// Loop ends (`next`) that answered Running: (internal index, owning node, tick).
     pending_yields: Vec<(usize, usize, u64)>,
+    /// Per loop node: the loop ended by its count or its query (see [`Internal::Exit`]).
+    exit_flags: Vec<bool>,
+    /// The blackboard: variables written by `select` and `for_each`.
+    vars: Blackboard,
     last_failure: Option<String>,
     transitions: Vec<Transition>,
     dropped: u64,
@@ -95,6 +100,8 @@ impl RunState {
             leaves: (0..plan.leaves.len()).map(|_| LeafRt::default()).collect(),
             yield_pending: vec![false; plan.internal.len()],
             pending_yields: Vec::new(),
+            exit_flags: vec![false; n],
+            vars: Blackboard::default(),
             last_failure: None,
             transitions: Vec::new(),
             dropped: 0,
@@ -186,7 +193,7 @@ impl RunState {
             }
             self.touched[a] = tick;
             if self.statuses[a] != NodeStatus::Running {
-                if matches!(plan.nodes[a].kind, "retry" | "repeat") {
+                if matches!(plan.nodes[a].kind, "retry" | "repeat" | "for_each") {
                     self.attempts[a] = 1;
                 }
                 self.set(plan, a, NodeStatus::Running, None);
@@ -197,7 +204,7 @@ impl RunState {
 
     fn on_leaf(&mut self, plan: &Plan, driver: &mut dyn LeafDriver, id: LeafId, dt: f64) -> (Status, f64) {
         if let Some(internal) = plan.internal(id) {
-            return self.on_internal(plan, id, internal, dt);
+            return self.on_internal(plan, driver, id, internal, dt);
         }
         let Some(info) = plan.leaf(id) else {
             return (Status::Failure, dt);
@@ -214,6 +221,7 @@ impl RunState {
             );
         }
         let (outcome, leftover) = match &info.kind {
+            Leaf::Select(sel) => (self.select(plan, node, driver, sel), dt),
             Leaf::Wait(w) => {
                 rt.elapsed += dt;
                 if rt.elapsed >= w.seconds {
@@ -224,7 +232,12 @@ impl RunState {
             }
             leaf => {
                 let span = rt.span.clone().unwrap_or_else(tracing::Span::none);
-                let out = span.in_scope(|| driver.tick(id, leaf, first));
+                let resolved = self.vars.resolve(leaf);
+                let out = match &resolved {
+                    Ok(std::borrow::Cow::Borrowed(l)) => span.in_scope(|| driver.tick(id, l, first)),
+                    Ok(std::borrow::Cow::Owned(l)) => span.in_scope(|| driver.tick(id, l, first)),
+                    Err(unset) => LeafOutcome::Failure(unset.clone()),
+                };
                 let out = match (leaf, out) {
                     (Leaf::Condition(c), LeafOutcome::Running) => {
                         tracing::warn!(target: "macrotree::tree", path = %info.path, "condition `{}` answered Running; conditions must answer at once, treating it as Failure", c.kind());
@@ -287,7 +300,14 @@ impl RunState {
         }
     }
 
-    fn on_internal(&mut self, plan: &Plan, id: LeafId, internal: &Internal, dt: f64) -> (Status, f64) {
+    fn on_internal(
+        &mut self,
+        plan: &Plan,
+        driver: &mut dyn LeafDriver,
+        id: LeafId,
+        internal: &Internal,
+        dt: f64,
+    ) -> (Status, f64) {
         match *internal {
             Internal::Probe { node, success } => {
                 if success {
@@ -300,49 +320,133 @@ impl RunState {
                     (Status::Failure, dt)
                 }
             }
-            Internal::Yield { node, iteration, of } => {
+            Internal::Next { node, limit } => {
                 let i = id.index();
                 self.touch(plan, node);
                 if self.yield_pending[i] {
                     self.yield_pending[i] = false;
                     self.pending_yields.retain(|(y, _, _)| *y != i);
+                    return (Status::Success, dt);
+                }
+                let info = &plan.nodes[node];
+                let done = self.attempts[node].max(1);
+                if info.kind != "for_each" && done >= limit {
+                    // Attempts (retry) or runs (repeat) used up: end the loop in this tick.
+                    self.exit_flags[node] = true;
+                    return (Status::Failure, dt);
+                }
+                self.yield_pending[i] = true;
+                self.pending_yields.push((i, node, self.tick));
+                let iteration = done + 1;
+                self.attempts[node] = iteration;
+                if info.kind == "retry" {
+                    tracing::info!(
+                        target: "macrotree::tree",
+                        tick = self.tick,
+                        sim_time = self.sim_time,
+                        path = %info.path,
+                        kind = info.kind,
+                        attempt = iteration,
+                        reason = self.last_failure.as_deref(),
+                        "{}: attempt {} of {} starts next tick",
+                        display_name(info),
+                        iteration,
+                        limit
+                    );
+                } else {
+                    tracing::debug!(
+                        target: "macrotree::tree",
+                        tick = self.tick,
+                        sim_time = self.sim_time,
+                        path = %info.path,
+                        kind = info.kind,
+                        iteration,
+                        "{}: iteration {} of {} starts next tick",
+                        display_name(info),
+                        iteration,
+                        limit
+                    );
+                }
+                (Status::Running, 0.0)
+            }
+            Internal::Exit {
+                node,
+                flagged_success,
+            } => {
+                let flagged = std::mem::take(&mut self.exit_flags[node]);
+                if flagged == flagged_success {
                     (Status::Success, dt)
                 } else {
-                    self.yield_pending[i] = true;
-                    self.pending_yields.push((i, node, self.tick));
-                    self.attempts[node] = iteration;
-                    let info = &plan.nodes[node];
-                    if info.kind == "retry" {
-                        tracing::info!(
-                            target: "macrotree::tree",
-                            tick = self.tick,
-                            sim_time = self.sim_time,
-                            path = %info.path,
-                            kind = info.kind,
-                            attempt = iteration,
-                            reason = self.last_failure.as_deref(),
-                            "{}: attempt {} of {} starts next tick",
-                            display_name(info),
-                            iteration,
-                            of
-                        );
-                    } else {
-                        tracing::debug!(
-                            target: "macrotree::tree",
-                            tick = self.tick,
-                            sim_time = self.sim_time,
-                            path = %info.path,
-                            kind = info.kind,
-                            iteration,
-                            "{}: iteration {} of {} starts next tick",
-                            display_name(info),
-                            iteration,
-                            of
-                        );
-                    }
-                    (Status::Running, 0.0)
+                    (Status::Failure, dt)
                 }
             }
+            Internal::Pick {
+                node,
+                ref select,
+                limit,
+            } => {
+                self.touch(plan, node);
+                let iteration = self.attempts[node].max(1);
+                let info = &plan.nodes[node];
+                match driver.select_object(&select.query()) {
+                    Ok(None) => {
+                        self.exit_flags[node] = true;
+                        tracing::debug!(target: "macrotree::tree", path = %info.path, "{}: no {} left", display_name(info), select.query().describe());
+                        (Status::Failure, dt)
+                    }
+                    Ok(Some(found)) if iteration > limit => {
+                        self.last_failure = Some(format!(
+                            "for_each: {} still matches ({}) after {limit} iteration(s) (max_iterations)",
+                            select.query().describe(),
+                            found.object
+                        ));
+                        (Status::Failure, dt)
+                    }
+                    Ok(Some(found)) => {
+                        self.write_selection(plan, node, select, found);
+                        (Status::Success, dt)
+                    }
+                    Err(reason) => {
+                        self.last_failure = Some(format!("for_each: {reason}"));
+                        (Status::Failure, dt)
+                    }
+                }
+            }
+        }
+    }
+
+    /// A `select` leaf: ask the driver, write the blackboard.
+    fn select(&mut self, plan: &Plan, node: usize, driver: &mut dyn LeafDriver, sel: &Select) -> LeafOutcome {
+        match driver.select_object(&sel.query()) {
+            Ok(Some(found)) => {
+                self.write_selection(plan, node, sel, found);
+                LeafOutcome::Success
+            }
+            Ok(None) => LeafOutcome::Failure(format!("no {} matches", sel.query().describe())),
+            Err(reason) => LeafOutcome::Failure(reason),
+        }
+    }
+
+    /// Writes a selection to the blackboard and logs each write as an event
+    /// (`{block} = "red"`, target `macrotree::blackboard`).
+    fn write_selection(&mut self, plan: &Plan, node: usize, sel: &Select, found: super::Selection) {
+        let info = &plan.nodes[node];
+        let mut writes = vec![(sel.var.clone(), Some(found.object))];
+        if let Some(g) = &sel.goal_var {
+            writes.push((g.clone(), found.destination));
+        }
+        for (var, value) in writes {
+            tracing::info!(
+                target: "macrotree::blackboard",
+                tick = self.tick,
+                sim_time = self.sim_time,
+                path = %info.path,
+                var = %var,
+                value = value.as_deref(),
+                "{{{var}}} = {}",
+                value.as_deref().map_or("(unset: no goal)".to_string(), |v| format!("\"{v}\""))
+            );
+            self.vars.set(&var, value);
         }
     }
 
@@ -545,6 +649,11 @@ impl TreeRunner {
     /// first run, then 1, 2, …
     pub fn attempt(&self, node: usize) -> u32 {
         self.st.attempts.get(node).copied().unwrap_or(0)
+    }
+
+    /// The blackboard (variables written by `select` and `for_each`).
+    pub fn blackboard(&self) -> &Blackboard {
+        &self.st.vars
     }
 
     /// Stop the tree now: halt every running leaf (calling [`LeafDriver::halt`]) and mark every

@@ -17,7 +17,7 @@
 
 use std::collections::{HashMap, VecDeque};
 
-use super::{LeafDriver, LeafOutcome};
+use super::{LeafDriver, LeafOutcome, Selection};
 use crate::plan::{LeafId, Plan};
 use crate::spec::Leaf;
 
@@ -54,6 +54,8 @@ struct Script {
 /// [`set_default`](Self::set_default)).
 #[derive(Clone, Debug)]
 pub struct ScriptedDriver {
+    /// Answers to `select` queries, in order; when empty, nothing matches.
+    pub selections: VecDeque<Selection>,
     paths: Vec<String>,
     scripts: HashMap<u32, Script>,
     default: LeafOutcome,
@@ -65,6 +67,7 @@ impl ScriptedDriver {
     /// A driver for `plan`'s leaves, every leaf answering Success.
     pub fn new(plan: &Plan) -> Self {
         Self {
+            selections: VecDeque::new(),
             paths: plan.leaves.iter().map(|l| l.path.clone()).collect(),
             scripts: HashMap::new(),
             default: LeafOutcome::Success,
@@ -200,5 +203,11 @@ impl LeafDriver for ScriptedDriver {
         self.scripts.entry(id.0).or_default().halts += 1;
         let path = self.path(id);
         self.log.push(Call::Halt { path });
+    }
+
+    /// Pops the next scripted answer of [`selections`](Self::selections) (none left: nothing
+    /// matches).
+    fn select_object(&mut self, _query: &crate::world::query::Query) -> Result<Option<Selection>, String> {
+        Ok(self.selections.pop_front())
     }
 }

@@ -24,7 +24,7 @@ mod types;
 
 pub use color::{COLOR_NAMES, Color};
 pub use goal::{Goal, GoalAtom};
-pub use load::{BUILTIN_CUBE_BOWL, SceneFileSchema, load_scene_file};
+pub use load::{BUILTIN_CUBE_BOWL, SceneFileSchema, is_object_name, load_scene_file};
 pub use sample::{MAX_DRAWS, Placement, PlacementError, sample_placement};
 pub use types::{
     CONTAINER_FLOOR, CONTAINER_WALL, ObjectKind, ObjectSpec, Pose, ROBOT_BASE_RADIUS, RandomPlacement,

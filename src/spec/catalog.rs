@@ -7,9 +7,10 @@ use serde::Serialize;
 use serde_json::{Map, Value, json};
 
 use super::leaves::{
-    AtHome, Carry, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, Grasp, GripperOpen, Home,
-    MoveJoints, Reach, Release, Wait,
+    At, AtHome, Carry, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, GoalMet, Grasp, Grasped,
+    GripperOpen, Home, In, Lifted, MoveJoints, On, OnTable, Reach, Release, Select, Wait,
 };
+use crate::world::query::Query;
 
 /// One parameter of a node kind.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -69,6 +70,7 @@ const NODE_DOCS: &[(&str, &str, &str)] = &[
     node_doc!("guard", "decorator"),
     node_doc!("retry", "decorator"),
     node_doc!("repeat", "decorator"),
+    node_doc!("for_each", "decorator"),
     node_doc!("timeout", "decorator"),
     node_doc!("inverter", "decorator"),
     node_doc!("force_success", "decorator"),
@@ -81,6 +83,14 @@ const NODE_DOCS: &[(&str, &str, &str)] = &[
     node_doc!("carry", "action"),
     node_doc!("release", "action"),
     node_doc!("wait", "runtime"),
+    node_doc!("select", "runtime"),
+    node_doc!("grasped", "condition"),
+    node_doc!("lifted", "condition"),
+    node_doc!("in", "condition"),
+    node_doc!("on", "condition"),
+    node_doc!("on_table", "condition"),
+    node_doc!("at", "condition"),
+    node_doc!("goal_met", "condition"),
     node_doc!("cube_grasped", "condition"),
     node_doc!("cube_lifted", "condition"),
     node_doc!("cube_in_bowl", "condition"),
@@ -146,6 +156,14 @@ fn leaf_schemas(g: &mut SchemaGenerator) -> Vec<(&'static str, String)> {
         one::<Carry>(g, "carry"),
         one::<Release>(g, "release"),
         one::<Wait>(g, "wait"),
+        one::<Select>(g, "select"),
+        one::<Grasped>(g, "grasped"),
+        one::<Lifted>(g, "lifted"),
+        one::<In>(g, "in"),
+        one::<On>(g, "on"),
+        one::<OnTable>(g, "on_table"),
+        one::<At>(g, "at"),
+        one::<GoalMet>(g, "goal_met"),
         one::<CubeGrasped>(g, "cube_grasped"),
         one::<CubeLifted>(g, "cube_lifted"),
         one::<CubeInBowl>(g, "cube_in_bowl"),
@@ -252,6 +270,19 @@ pub fn catalog() -> Vec<NodeDoc> {
                     ),
                     p("child", "node", true, None, "the node to repeat"),
                 ],
+                "for_each" => vec![
+                    p("as", "string", true, None, "the variable each selected object is written to; read it as `{name}`"),
+                    p("max_iterations", "integer", true, None, "most iterations, 1 to 1000"),
+                    p("child", "node", true, None, "the node run once per selected object"),
+                    p(
+                        "select",
+                        "Query",
+                        false,
+                        Some("{}"),
+                        "the query: `kind` (block), `color`, `where` (pending, done, on_table, free), `order` (nearest, name, scene)",
+                    ),
+                    p("goal_as", "string", false, None, "also write where the object's goal sends it"),
+                ],
                 "timeout" => vec![
                     p("seconds", "number", true, None, "simulated seconds (> 0)"),
                     p("child", "node", true, None, "the node to time-limit"),
@@ -324,6 +355,7 @@ fn templated(s: &Value) -> Value {
 pub fn json_schema() -> Value {
     let mut g = generator();
     let leaves = leaf_schemas(&mut g);
+    let _ = g.subschema_for::<Query>();
     let mut defs = g.take_definitions(true);
 
     defs.insert(
@@ -373,6 +405,14 @@ pub fn json_schema() -> Value {
                 "timeout" => body(
                     json!({"seconds": scalar(json!({"type": "number", "exclusiveMinimum": 0})), "child": node_ref}),
                     &["seconds", "child"],
+                ),
+                "for_each" => body(
+                    json!({"select": {"$ref": "#/$defs/Query"},
+                           "as": {"type": "string", "pattern": "^[A-Za-z_][A-Za-z0-9_]*$"},
+                           "goal_as": {"type": "string", "pattern": "^[A-Za-z_][A-Za-z0-9_]*$"},
+                           "max_iterations": scalar(json!({"type": "integer", "minimum": 1, "maximum": 1000})),
+                           "child": node_ref}),
+                    &["as", "max_iterations", "child"],
                 ),
                 "inverter" | "force_success" | "force_failure" => {
                     body(json!({"child": node_ref}), &["child"])
@@ -455,6 +495,10 @@ pub fn json_schema() -> Value {
         "description": "A behavior tree in YAML for the UR5e + Robotiq gripper. See docs/tree_format.md. Units: m, s, m/s, rad (or deg(..)).",
         "type": "object",
         "properties": {
+            "description": {"description": "What the tree does, one line (the task string of reports and datasets).",
+                            "type": "string"},
+            "scene": {"description": "The scene file the tree runs on by default, relative to this file (`--scene` overrides it). Without it: the built-in cube_bowl scene.",
+                      "type": "string"},
             "include": {"description": "Files with subtrees to load, relative to this file.",
                         "anyOf": [{"type": "string"}, {"type": "array", "items": {"type": "string"}}]},
             "subtrees": {

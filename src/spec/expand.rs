@@ -7,10 +7,11 @@
 
 use std::collections::HashMap;
 
+use super::check::{ObjectUse, Role, VarDef};
 use super::de::DeError;
 use super::diag::{Issue, Loc, Sources};
 use super::file::{SubtreeDef, param_ref};
-use super::leaves::{ACTION_KINDS, CONDITION_KINDS, Leaf, parse_leaf};
+use super::leaves::{ACTION_KINDS, CONDITION_KINDS, Leaf, Select, parse_leaf};
 use super::node::{COMPOSITE_KINDS, DECORATOR_KINDS, Node, NodeKind};
 use super::suggest::did_you_mean;
 use super::value::{Value, ValueKind};
@@ -49,6 +50,10 @@ pub struct Expander<'a> {
     /// Where the loader already reported a problem (e.g. an undefined `$param`, left in place):
     /// a leaf's error at the same place is not repeated.
     pub reported: Vec<Loc>,
+    /// Every object a leaf names or reads from the blackboard, located.
+    pub object_uses: Vec<ObjectUse>,
+    /// Every blackboard variable a `select` or `for_each` writes, located.
+    pub var_defs: Vec<VarDef>,
 }
 
 impl<'a> Expander<'a> {
@@ -63,6 +68,8 @@ impl<'a> Expander<'a> {
             too_many_reported: false,
             calls: HashMap::new(),
             reported: Vec::new(),
+            object_uses: Vec::new(),
+            var_defs: Vec::new(),
         }
     }
 
@@ -192,8 +199,19 @@ impl<'a> Expander<'a> {
         } else if DECORATOR_KINDS.contains(&k) {
             self.decorator(k, loc, body, depth)?
         } else if let Some(parsed) = parse_leaf_reporting_all(k, without_name(body)) {
+            self.record_objects(k, body);
             match parsed {
-                Ok(leaf) => NodeKind::Leaf(leaf),
+                Ok(leaf) => {
+                    if let Leaf::Select(s) = &leaf {
+                        let at = |key: &str| body.get(key).map_or(body.loc, |v| v.loc);
+                        self.var_defs.extend(VarDef::from_select(
+                            s,
+                            at("as"),
+                            body.get("goal_as").map(|v| v.loc),
+                        ));
+                    }
+                    NodeKind::Leaf(leaf)
+                }
                 Err(errors) => {
                     for e in errors {
                         let mut issue = e.into_issue(body.loc, |l| self.sources.describe(l));
@@ -235,6 +253,64 @@ impl<'a> Expander<'a> {
             name,
             loc,
         })
+    }
+
+    /// Notes where leaf `kind` names objects or variables (for the scene and blackboard checks),
+    /// even when the leaf has other errors, so that every mistake is reported at once.
+    fn record_objects(&mut self, kind: &str, body: &Value) {
+        if kind == "select" {
+            return;
+        }
+        for (key, role) in [
+            ("object", Role::Block),
+            ("container", Role::Container),
+            ("support", Role::Block),
+            ("target", Role::Any),
+            ("to", Role::Any),
+        ] {
+            let Some(v) = body.get(key) else { continue };
+            let reference = match &v.kind {
+                ValueKind::Str(s) if s == "cube" && key != "object" => Some(super::check::Named::LegacyCube),
+                ValueKind::Str(s) if s == "bowl" && key != "object" => Some(super::check::Named::LegacyBowl),
+                ValueKind::Str(s) => super::objects::ObjectRef::parse(s)
+                    .ok()
+                    .map(super::check::Named::Ref),
+                ValueKind::Map(m) if m.len() == 1 => m[0]
+                    .0
+                    .as_str()
+                    .and_then(super::objects::Ident::new)
+                    .map(|k| super::check::Named::Ref(super::objects::ObjectRef::Var(k))),
+                _ => None,
+            };
+            if let Some(reference) = reference {
+                self.object_uses.push(ObjectUse {
+                    reference,
+                    role,
+                    loc: v.loc,
+                    via: v.via,
+                    leaf: kind.to_string(),
+                });
+            }
+        }
+        // A `grasp` without `object:` and the `cube_*` conditions act on the legacy cube.
+        if kind.starts_with("cube_") {
+            self.object_uses.push(ObjectUse {
+                reference: super::check::Named::LegacyCube,
+                role: Role::Block,
+                loc: body.loc,
+                via: body.via,
+                leaf: kind.to_string(),
+            });
+        }
+        if kind == "cube_in_bowl" {
+            self.object_uses.push(ObjectUse {
+                reference: super::check::Named::LegacyBowl,
+                role: Role::Container,
+                loc: body.loc,
+                via: body.via,
+                leaf: kind.to_string(),
+            });
+        }
     }
 
     fn take_name(&mut self, body: &Value) -> Option<String> {
@@ -471,6 +547,21 @@ impl<'a> Expander<'a> {
                     child: child?,
                 })
             }
+            "for_each" => {
+                let f = self.fields(
+                    kind,
+                    body,
+                    &["select", "as", "goal_as", "max_iterations", "child"],
+                );
+                let max_iterations = self.count(kind, loc, &f, "max_iterations");
+                let child = self.child(kind, loc, &f, "child", depth);
+                let select = self.for_each_select(loc, &f);
+                Some(NodeKind::ForEach {
+                    select: select?,
+                    max_iterations: max_iterations?,
+                    child: child?,
+                })
+            }
             "timeout" => {
                 let f = self.fields(kind, body, &["seconds", "child"]);
                 let seconds = match f.get("seconds") {
@@ -506,6 +597,57 @@ impl<'a> Expander<'a> {
                 })
             }
             _ => self.subtree_call(loc, body, depth),
+        }
+    }
+
+    /// A `for_each`'s `select:` (the query), `as:` and `goal_as:` read as one [`Select`].
+    fn for_each_select(&mut self, loc: Loc, f: &HashMap<String, &Value>) -> Option<Select> {
+        let Some(var_v) = f.get("as") else {
+            self.err(
+                Issue::new(loc, "`for_each` needs `as:`")
+                    .label("expected `as: NAME`, the variable each selected object is written to")
+                    .help("read it in the child as `{NAME}`, e.g. `reach: {target: \"{block}\"}`"),
+            );
+            return None;
+        };
+        let mut entries = match f.get("select") {
+            None => Vec::new(),
+            Some(v) => match &v.kind {
+                ValueKind::Map(m) => m.clone(),
+                ValueKind::Null => Vec::new(),
+                _ => {
+                    self.err(
+                        Issue::new(
+                            v.loc,
+                            format!("`select` must be a query mapping, found {}", v.describe()),
+                        )
+                        .label("expected e.g. `{kind: block, where: [pending], order: nearest}`"),
+                    );
+                    return None;
+                }
+            },
+        };
+        let key = |k: &str| Value::new(ValueKind::Str(k.into()), loc);
+        entries.push((key("as"), (*var_v).clone()));
+        if let Some(g) = f.get("goal_as") {
+            entries.push((key("goal_as"), (*g).clone()));
+        }
+        let v = Value::new(ValueKind::Map(entries), loc);
+        match super::de::from_value::<Select>(&v) {
+            Ok(s) => {
+                self.var_defs.extend(VarDef::from_select(
+                    &s,
+                    var_v.loc,
+                    f.get("goal_as").map(|g| g.loc),
+                ));
+                Some(s)
+            }
+            Err(e) => {
+                let mut issue = e.into_issue(loc, |l| self.sources.describe(l));
+                issue.message = format!("{} in `for_each`", issue.message);
+                self.err(issue);
+                None
+            }
         }
     }
 

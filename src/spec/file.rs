@@ -5,7 +5,7 @@ use super::suggest::did_you_mean;
 use super::value::{Value, ValueKind};
 
 /// Keys allowed at the top level of a tree file.
-pub const TOP_LEVEL_KEYS: &[&str] = &["include", "subtrees", "main"];
+pub const TOP_LEVEL_KEYS: &[&str] = &["description", "scene", "include", "subtrees", "main"];
 /// Keys allowed in a subtree definition.
 pub const SUBTREE_KEYS: &[&str] = &["params", "root", "description"];
 
@@ -55,6 +55,10 @@ pub struct TreeFile {
     pub main: Option<Value>,
     /// Where `main:` is written.
     pub main_key: Option<Loc>,
+    /// `scene:`: the default scene file (relative to this file) and where it is written.
+    pub scene: Option<(String, Loc)>,
+    /// `description:`: what the tree does, one line (the task string of datasets and reports).
+    pub description: Option<String>,
 }
 
 /// True for names usable as subtree and parameter names: `[A-Za-z_][A-Za-z0-9_]*`.
@@ -93,11 +97,24 @@ pub fn parse_tree_file(v: &Value, issues: &mut Vec<Issue>) -> Option<TreeFile> {
                 out.main = Some(val.clone());
                 out.main_key = Some(k.loc);
             }
+            Some(key @ ("scene" | "description")) => match val.as_str() {
+                Some(s) if key == "scene" => out.scene = Some((s.to_string(), val.loc)),
+                Some(s) => out.description = Some(s.to_string()),
+                None => issues.push(
+                    Issue::new(val.loc, format!("`{key}` must be text, found {}", val.describe())).label(
+                        if key == "scene" {
+                            "expected a scene file path, relative to this file (e.g. `../scenes/sort_three.yaml`)"
+                        } else {
+                            "expected one line of text"
+                        },
+                    ),
+                ),
+            },
             Some(other) => issues.push(
                 Issue::new(k.loc, format!("unknown top-level key `{other}`"))
-                    .label("expected `include`, `subtrees` or `main`")
+                    .label("expected `description`, `scene`, `include`, `subtrees` or `main`")
                     .maybe_help(did_you_mean(other, TOP_LEVEL_KEYS.iter().copied()))
-                    .help_or("remove it; a tree file has only `include:`, `subtrees:` and `main:`"),
+                    .help_or("remove it; a tree file has only `description:`, `scene:`, `include:`, `subtrees:` and `main:`"),
             ),
             None => issues.push(
                 Issue::new(

@@ -9,8 +9,10 @@ use serde::{Deserialize, Serialize};
 
 use schemars::JsonSchema;
 
-use super::units::{self, PathKind, Target, Yaw};
+use super::objects::{ObjectRef, opt_var_name, var_name};
+use super::units::{self, Angle, PathKind, Target, Yaw};
 use crate::world::conditions::Tolerances;
+use crate::world::query::{Filter, KindFilter, Order, Query};
 
 fn d_zero3() -> [f64; 3] {
     [0.0, 0.0, 0.0]
@@ -72,7 +74,8 @@ fn d_point_tol() -> f64 {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Reach {
-    /// What to reach: `cube`, `bowl` or `[x, y, z]` (world metres).
+    /// What to reach: an object (`red`, `cube`, `bowl`), a variable `{block}`, or `[x, y, z]`
+    /// (world metres).
     pub target: Target,
     /// Offset of the tool centre point from the target, world frame, metres. Default `[0, 0, 0]`.
     #[serde(default = "d_zero3", deserialize_with = "units::vec3")]
@@ -128,6 +131,9 @@ impl Default for Home {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Grasp {
+    /// The block that must end up held (a name or `{var}`). Absent: any block between the pads.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub object: Option<ObjectRef>,
     /// Close to this pad-to-pad width, metres (≥ 0). Absent: close until contact/stall.
     #[serde(default, deserialize_with = "units::opt_opening")]
     #[schemars(range(min = 0.0, max = units::MAX_OPENING))]
@@ -141,6 +147,7 @@ pub struct Grasp {
 impl Default for Grasp {
     fn default() -> Self {
         Self {
+            object: None,
             width: None,
             timeout: 2.0,
         }
@@ -151,7 +158,8 @@ impl Default for Grasp {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Carry {
-    /// Where to: `cube`, `bowl` or `[x, y, z]` (world metres). Default `bowl`.
+    /// Where to: an object (a container: onto its floor; a block: on top of it, for stacking),
+    /// a variable `{dest}`, or `[x, y, z]` (world metres). Default `bowl`.
     #[serde(default = "d_bowl")]
     pub to: Target,
     /// Height of the cube's bottom above the table during the transfer, metres (≥ 0). Default 0.20.
@@ -332,6 +340,155 @@ impl Default for AtHome {
     }
 }
 
+fn d_yaw_tol() -> f64 {
+    3f64.to_radians()
+}
+
+#[doc = include_str!("../../docs/nodes/grasped.md")]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Grasped {
+    /// The block (a name or `{var}`).
+    pub object: ObjectRef,
+    /// Largest distance of the block's centre from the line between the pad centres, metres
+    /// (≥ 0). Default 0.03.
+    #[serde(default = "d_off_axis", deserialize_with = "units::distance")]
+    #[schemars(range(min = 0.0, max = units::MAX_REACH))]
+    pub off_axis: f64,
+}
+
+#[doc = include_str!("../../docs/nodes/lifted.md")]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Lifted {
+    /// The block (a name or `{var}`).
+    pub object: ObjectRef,
+    /// Height of the block's lowest point above the table, metres (≥ 0). Default 0.03.
+    #[serde(default = "d_min_height", deserialize_with = "units::distance")]
+    #[schemars(range(min = 0.0, max = units::MAX_REACH))]
+    pub min_height: f64,
+}
+
+#[doc = include_str!("../../docs/nodes/in.md")]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct In {
+    /// The block (a name or `{var}`).
+    pub object: ObjectRef,
+    /// The container (a name or `{var}`).
+    pub container: ObjectRef,
+    /// Speed below which the block counts as at rest, m/s (> 0). Default 0.05.
+    #[serde(default = "d_rest_speed", deserialize_with = "units::speed")]
+    #[schemars(range(min = 0.0))]
+    pub rest_speed: f64,
+}
+
+#[doc = include_str!("../../docs/nodes/on.md")]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct On {
+    /// The block on top (a name or `{var}`).
+    pub object: ObjectRef,
+    /// The block under it (a name or `{var}`).
+    pub support: ObjectRef,
+    /// Speed below which the block counts as at rest, m/s (> 0). Default 0.05.
+    #[serde(default = "d_rest_speed", deserialize_with = "units::speed")]
+    #[schemars(range(min = 0.0))]
+    pub rest_speed: f64,
+}
+
+#[doc = include_str!("../../docs/nodes/on_table.md")]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct OnTable {
+    /// The block (a name or `{var}`).
+    pub object: ObjectRef,
+    /// Allowed height of the block's bottom above the table top, metres (≥ 0). Default 0.01.
+    #[serde(default = "d_table_tol", deserialize_with = "units::distance")]
+    #[schemars(range(min = 0.0, max = units::MAX_REACH))]
+    pub tolerance: f64,
+    /// Speed below which the block counts as at rest, m/s (> 0). Default 0.05.
+    #[serde(default = "d_rest_speed", deserialize_with = "units::speed")]
+    #[schemars(range(min = 0.0))]
+    pub rest_speed: f64,
+}
+
+#[doc = include_str!("../../docs/nodes/at.md")]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct At {
+    /// The block (a name or `{var}`).
+    pub object: ObjectRef,
+    /// Where its centre should rest, `[x, y]` on the table, world metres.
+    #[serde(deserialize_with = "units::vec2")]
+    pub point: [f64; 2],
+    /// Largest horizontal distance of its centre from `point`, metres (≥ 0). Default 0.01.
+    #[serde(default = "d_point_tol", deserialize_with = "units::distance")]
+    #[schemars(range(min = 0.0, max = units::MAX_REACH))]
+    pub tolerance: f64,
+    /// The yaw its faces should have (radians or `deg(..)`, compared modulo 90°). Absent: any.
+    #[serde(default)]
+    pub yaw: Option<Angle>,
+    /// Largest yaw error when `yaw` is given, radians (or `deg(..)`). Default 3°.
+    #[serde(default = "d_yaw_tol", deserialize_with = "units::angle_tolerance")]
+    #[schemars(with = "units::Angle")]
+    pub yaw_tolerance: f64,
+    /// Speed below which the block counts as at rest, m/s (> 0). Default 0.05.
+    #[serde(default = "d_rest_speed", deserialize_with = "units::speed")]
+    #[schemars(range(min = 0.0))]
+    pub rest_speed: f64,
+}
+
+#[doc = include_str!("../../docs/nodes/goal_met.md")]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema, Default)]
+#[serde(deny_unknown_fields)]
+pub struct GoalMet {
+    /// Only this block's goal predicate (a name or `{var}`). Absent: the whole goal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub object: Option<ObjectRef>,
+}
+
+#[doc = include_str!("../../docs/nodes/select.md")]
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Select {
+    /// The variable the selected object's name is written to (`block` → read it as `{block}`).
+    #[serde(rename = "as", deserialize_with = "var_name")]
+    pub var: String,
+    /// Also write where the object's goal sends it (a container or a block) to this variable.
+    #[serde(
+        default,
+        rename = "goal_as",
+        deserialize_with = "opt_var_name",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub goal_var: Option<String>,
+    /// `block` (default), `container` or `obstacle`.
+    #[serde(default)]
+    pub kind: KindFilter,
+    /// Only objects of this colour name (`red`, …).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub color: Option<String>,
+    /// Conditions every selected object meets: `pending`, `done`, `on_table`, `free`.
+    #[serde(default, rename = "where", skip_serializing_if = "Vec::is_empty")]
+    pub filters: Vec<Filter>,
+    /// Which match is taken: `nearest` (default) to the gripper, first by `name`, or in `scene` order.
+    #[serde(default)]
+    pub order: Order,
+}
+
+impl Select {
+    /// The query part.
+    pub fn query(&self) -> Query {
+        Query {
+            kind: self.kind,
+            color: self.color.clone(),
+            filters: self.filters.clone(),
+            order: self.order,
+        }
+    }
+}
+
 /// A macro action, executed over several ticks by the driver.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -369,6 +526,20 @@ pub enum ConditionLeaf {
     GripperOpen(GripperOpen),
     /// See [`AtHome`].
     AtHome(AtHome),
+    /// See [`Grasped`].
+    Grasped(Grasped),
+    /// See [`Lifted`].
+    Lifted(Lifted),
+    /// See [`In`].
+    In(In),
+    /// See [`On`].
+    On(On),
+    /// See [`OnTable`].
+    OnTable(OnTable),
+    /// See [`At`].
+    At(At),
+    /// See [`GoalMet`].
+    GoalMet(GoalMet),
 }
 
 /// A leaf of the tree, with all parameters resolved.
@@ -384,6 +555,9 @@ pub enum Leaf {
     Condition(ConditionLeaf),
     /// `wait: {seconds}` (runtime-internal).
     Wait(Wait),
+    /// `select: {as, …}`: picks an object through the driver and writes the blackboard
+    /// (runtime-internal).
+    Select(Select),
 }
 
 impl ActionLeaf {
@@ -423,6 +597,13 @@ impl ConditionLeaf {
             ConditionLeaf::CubeAt(_) => "cube_at",
             ConditionLeaf::GripperOpen(_) => "gripper_open",
             ConditionLeaf::AtHome(_) => "at_home",
+            ConditionLeaf::Grasped(_) => "grasped",
+            ConditionLeaf::Lifted(_) => "lifted",
+            ConditionLeaf::In(_) => "in",
+            ConditionLeaf::On(_) => "on",
+            ConditionLeaf::OnTable(_) => "on_table",
+            ConditionLeaf::At(_) => "at",
+            ConditionLeaf::GoalMet(_) => "goal_met",
         }
     }
 }
@@ -434,6 +615,68 @@ impl Leaf {
             Leaf::Action(a) => a.kind(),
             Leaf::Condition(c) => c.kind(),
             Leaf::Wait(_) => "wait",
+            Leaf::Select(_) => "select",
+        }
+    }
+
+    /// Every object reference of the leaf (targets, `object:`, `container:`, `support:`), mutably.
+    fn refs_mut(&mut self) -> Vec<&mut ObjectRef> {
+        fn target(t: &mut Target) -> Option<&mut ObjectRef> {
+            match t {
+                Target::Object(o) => Some(o),
+                _ => None,
+            }
+        }
+        match self {
+            Leaf::Action(ActionLeaf::Reach(r)) => target(&mut r.target).into_iter().collect(),
+            Leaf::Action(ActionLeaf::Carry(c)) => target(&mut c.to).into_iter().collect(),
+            Leaf::Action(ActionLeaf::Grasp(g)) => g.object.iter_mut().collect(),
+            Leaf::Condition(c) => match c {
+                ConditionLeaf::Grasped(p) => vec![&mut p.object],
+                ConditionLeaf::Lifted(p) => vec![&mut p.object],
+                ConditionLeaf::In(p) => vec![&mut p.object, &mut p.container],
+                ConditionLeaf::On(p) => vec![&mut p.object, &mut p.support],
+                ConditionLeaf::OnTable(p) => vec![&mut p.object],
+                ConditionLeaf::At(p) => vec![&mut p.object],
+                ConditionLeaf::GoalMet(p) => p.object.iter_mut().collect(),
+                _ => vec![],
+            },
+            _ => vec![],
+        }
+    }
+
+    /// Every object reference of the leaf.
+    pub fn object_refs(&self) -> Vec<ObjectRef> {
+        self.clone().refs_mut().into_iter().map(|r| *r).collect()
+    }
+
+    /// The leaf with object references replaced where `f` answers `Some`; `None` when nothing
+    /// was replaced (the leaf is not cloned then unless it has references).
+    pub fn map_objects(&self, f: &mut dyn FnMut(&ObjectRef) -> Option<ObjectRef>) -> Option<Leaf> {
+        if !self.has_vars() {
+            return None;
+        }
+        let mut out = self.clone();
+        let mut changed = false;
+        for r in out.refs_mut() {
+            if let Some(new) = f(r) {
+                *r = new;
+                changed = true;
+            }
+        }
+        changed.then_some(out)
+    }
+
+    /// True when the leaf reads a blackboard variable.
+    pub fn has_vars(&self) -> bool {
+        let var = |t: &Target| matches!(t, Target::Object(ObjectRef::Var(_)));
+        let ovar = |o: &ObjectRef| matches!(o, ObjectRef::Var(_));
+        match self {
+            Leaf::Action(ActionLeaf::Reach(r)) => var(&r.target),
+            Leaf::Action(ActionLeaf::Carry(c)) => var(&c.to),
+            Leaf::Action(ActionLeaf::Grasp(g)) => g.object.as_ref().is_some_and(ovar),
+            Leaf::Condition(_) => self.clone().refs_mut().into_iter().any(|o| ovar(o)),
+            _ => false,
         }
     }
 
@@ -460,6 +703,13 @@ impl Leaf {
 pub const ACTION_KINDS: &[&str] = &["reach", "move_joints", "home", "grasp", "carry", "release"];
 /// Kinds of condition leaves, in documentation order.
 pub const CONDITION_KINDS: &[&str] = &[
+    "grasped",
+    "lifted",
+    "in",
+    "on",
+    "on_table",
+    "at",
+    "goal_met",
     "cube_grasped",
     "cube_lifted",
     "cube_in_bowl",
@@ -482,6 +732,14 @@ pub fn parse_leaf(kind: &str, params: &super::value::Value) -> Option<Result<Lea
         "carry" => a(f(params).map(ActionLeaf::Carry)),
         "release" => a(f(params).map(ActionLeaf::Release)),
         "wait" => Some(f(params).map(Leaf::Wait)),
+        "select" => Some(f(params).map(Leaf::Select)),
+        "grasped" => c(f(params).map(ConditionLeaf::Grasped)),
+        "lifted" => c(f(params).map(ConditionLeaf::Lifted)),
+        "in" => c(f(params).map(ConditionLeaf::In)),
+        "on" => c(f(params).map(ConditionLeaf::On)),
+        "on_table" => c(f(params).map(ConditionLeaf::OnTable)),
+        "at" => c(f(params).map(ConditionLeaf::At)),
+        "goal_met" => c(f(params).map(ConditionLeaf::GoalMet)),
         "cube_grasped" => c(f(params).map(ConditionLeaf::CubeGrasped)),
         "cube_lifted" => c(f(params).map(ConditionLeaf::CubeLifted)),
         "cube_in_bowl" => c(f(params).map(ConditionLeaf::CubeInBowl)),

@@ -3,6 +3,7 @@
 use std::collections::{HashMap, HashSet};
 use std::io::Read;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use super::diag::{Diagnostic, FileId, Issue, Loc, Sources};
 use super::expand::{Expander, undefined_params};
@@ -10,6 +11,7 @@ use super::file::{SubtreeDef, TreeFile, parse_tree_file};
 use super::node::Node;
 use super::suggest::closest;
 use super::value::{MAX_FILE_BYTES, decode_utf8, parse_yaml};
+use crate::scene::SceneSpec;
 
 /// Deepest chain of includes.
 pub const MAX_INCLUDE_DEPTH: usize = 16;
@@ -25,13 +27,32 @@ pub struct Spec {
     pub sources: Sources,
     /// Every subtree definition found (main file and includes), in load order.
     pub subtrees: Vec<SubtreeDef>,
+    /// The main file's `scene:` (path as written, relative to the main file) and its location.
+    pub scene: Option<(String, Loc)>,
+    /// The scene the tree's object names were checked against (the `--scene` override, the
+    /// tree's `scene:`, or the built-in `cube_bowl`): the scene it runs on.
+    pub scene_spec: Arc<SceneSpec>,
+    /// The main file's `description:`.
+    pub description: Option<String>,
+    /// Every object a leaf names or reads from the blackboard (checked against a scene by
+    /// [`super::check::check_scene`]).
+    pub object_uses: Vec<super::check::ObjectUse>,
+    /// Every blackboard variable a `select` or `for_each` writes.
+    pub var_defs: Vec<super::check::VarDef>,
 }
 
-/// Load a tree file from disk (following includes relative to it).
+/// Load a tree file from disk (following includes relative to it), checking the objects it
+/// names against its `scene:` (or the built-in `cube_bowl` scene when it names none).
 pub fn load_file(path: &Path) -> Result<Spec, Vec<Diagnostic>> {
+    load_file_with(path, None)
+}
+
+/// Load a tree file from disk like [`load_file`], checking the objects it names against `scene`
+/// when given (a `--scene` override) instead of the tree's own `scene:`.
+pub fn load_file_with(path: &Path, scene: Option<Arc<SceneSpec>>) -> Result<Spec, Vec<Diagnostic>> {
     let name = path.display().to_string();
     match read_limited(path) {
-        Ok(bytes) => load_bytes_at(&bytes, name, path),
+        Ok(bytes) => load_bytes_at(&bytes, name, path, scene),
         Err((msg, help)) => {
             let mut l = Loader::default();
             let id = l.sources.add(name, "");
@@ -56,11 +77,19 @@ pub fn load_str(text: &str, file_name: &str) -> Result<Spec, Vec<Diagnostic>> {
 /// invalid UTF-8 is a located error, the rest is [`load_str`]. `file_name` plays the same role
 /// as in [`load_str`].
 pub fn load_bytes(bytes: &[u8], file_name: &str) -> Result<Spec, Vec<Diagnostic>> {
-    load_bytes_at(bytes, file_name.to_string(), Path::new(file_name))
+    load_bytes_at(bytes, file_name.to_string(), Path::new(file_name), None)
 }
 
-fn load_bytes_at(bytes: &[u8], name: String, path: &Path) -> Result<Spec, Vec<Diagnostic>> {
-    let mut l = Loader::default();
+fn load_bytes_at(
+    bytes: &[u8],
+    name: String,
+    path: &Path,
+    scene: Option<Arc<SceneSpec>>,
+) -> Result<Spec, Vec<Diagnostic>> {
+    let mut l = Loader {
+        scene_override: scene,
+        ..Loader::default()
+    };
     let text = match std::str::from_utf8(bytes) {
         Ok(t) => t,
         Err(_) => {
@@ -133,6 +162,16 @@ struct Loader {
     issues: Vec<Issue>,
     loaded: HashSet<PathBuf>,
     defs: Vec<SubtreeDef>,
+    /// The scene to check object names against instead of the tree's own.
+    scene_override: Option<Arc<SceneSpec>>,
+    /// Diagnostics of a scene file the tree names (reported with the tree's).
+    scene_diagnostics: Vec<Diagnostic>,
+}
+
+/// The built-in `cube_bowl` scene, parsed once.
+pub fn builtin_scene() -> Arc<SceneSpec> {
+    static BUILTIN: std::sync::OnceLock<Arc<SceneSpec>> = std::sync::OnceLock::new();
+    BUILTIN.get_or_init(|| Arc::new(SceneSpec::builtin())).clone()
 }
 
 impl Loader {
@@ -218,6 +257,19 @@ impl Loader {
         let root = ex.node(&main, 0);
         let called: HashSet<String> = ex.calls.keys().cloned().collect();
         self.issues.append(&mut ex.issues);
+        let object_uses = std::mem::take(&mut ex.object_uses);
+        let var_defs = std::mem::take(&mut ex.var_defs);
+        let scene = self.scene_for(&root_file, base);
+        {
+            let sources = &self.sources;
+            let mut found = super::check::check_vars(&object_uses, &var_defs, |l| sources.describe(l));
+            if let Some(scene) = &scene {
+                found.extend(super::check::check_scene(&object_uses, scene, |l| {
+                    sources.describe(l)
+                }));
+            }
+            self.issues.append(&mut found);
+        }
 
         // Check unused subtrees that can be expanded with defaults alone.
         let mut names: Vec<&String> = table.keys().collect();
@@ -251,13 +303,51 @@ impl Loader {
                 root,
                 sources: self.sources,
                 subtrees: self.defs,
+                scene: root_file.scene.clone(),
+                scene_spec: scene.unwrap_or_else(builtin_scene),
+                description: root_file.description.clone(),
+                object_uses,
+                var_defs,
             }),
             _ => {
                 if self.issues.is_empty() {
                     self.issues
                         .push(Issue::new(Loc::file_start(id), "the tree could not be read"));
                 }
-                Err(self.sources.diagnostics(&self.issues))
+                let mut diags = self.sources.diagnostics(&self.issues);
+                diags.append(&mut self.scene_diagnostics);
+                Err(diags)
+            }
+        }
+    }
+
+    /// The scene object names are checked against: the override, the tree's `scene:` (relative
+    /// to the tree's folder), or the built-in scene. `None` when the named scene file is broken
+    /// (its diagnostics are kept, and an issue points at `scene:`).
+    fn scene_for(&mut self, file: &TreeFile, base: Option<&Path>) -> Option<Arc<SceneSpec>> {
+        if let Some(s) = &self.scene_override {
+            return Some(s.clone());
+        }
+        let Some((rel, loc)) = &file.scene else {
+            return Some(builtin_scene());
+        };
+        let path = match base {
+            Some(b) if !Path::new(rel).is_absolute() => b.join(rel),
+            _ => PathBuf::from(rel),
+        };
+        match crate::scene::load_scene_file(&path) {
+            Ok(s) => Some(Arc::new(s)),
+            Err(diags) => {
+                self.issues.push(
+                    Issue::new(
+                        *loc,
+                        format!("the scene `{rel}` is invalid ({} error(s), below)", diags.len()),
+                    )
+                    .label("the scene file named here")
+                    .help("fix the scene file, or give another with `--scene FILE`"),
+                );
+                self.scene_diagnostics = diags;
+                None
             }
         }
     }

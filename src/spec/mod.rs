@@ -10,6 +10,7 @@
 #![warn(missing_docs)]
 
 pub mod catalog;
+pub mod check;
 pub mod de;
 pub mod diag;
 pub mod expand;
@@ -17,6 +18,7 @@ pub mod file;
 pub mod leaves;
 pub mod load;
 pub mod node;
+pub mod objects;
 pub mod suggest;
 pub mod units;
 pub mod value;
@@ -24,9 +26,11 @@ pub mod value;
 pub use catalog::{NodeDoc, ParamDoc, catalog, json_schema};
 pub use diag::{Diagnostic, Issue, Loc, Sources};
 pub use leaves::{
-    ActionLeaf, AtHome, Carry, ConditionLeaf, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable,
-    Grasp, GripperOpen, Home, Leaf, MoveJoints, Reach, Release, Wait,
+    ActionLeaf, At, AtHome, Carry, ConditionLeaf, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable,
+    GoalMet, Grasp, Grasped, GripperOpen, Home, In, Leaf, Lifted, MoveJoints, On, OnTable, Reach, Release,
+    Select, Wait,
 };
 pub use load::{Spec, load_bytes, load_file, load_str};
 pub use node::{Node, NodeKind};
+pub use objects::ObjectRef;
 pub use units::{PathKind, Target, Yaw};

@@ -51,6 +51,15 @@ pub enum NodeKind {
         /// The node to repeat.
         child: Box<Node>,
     },
+    #[doc = include_str!("../../docs/nodes/for_each.md")]
+    ForEach {
+        /// What each iteration selects, and the variables it writes.
+        select: super::leaves::Select,
+        /// Most iterations (≥ 1); more matches after that fail the loop.
+        max_iterations: u32,
+        /// The node run once per selected object.
+        child: Box<Node>,
+    },
     #[doc = include_str!("../../docs/nodes/timeout.md")]
     Timeout {
         /// Simulated seconds (> 0).
@@ -92,6 +101,7 @@ pub const DECORATOR_KINDS: &[&str] = &[
     "guard",
     "retry",
     "repeat",
+    "for_each",
     "timeout",
     "inverter",
     "force_success",
@@ -112,6 +122,7 @@ impl NodeKind {
             NodeKind::Guard { .. } => "guard",
             NodeKind::Retry { .. } => "retry",
             NodeKind::Repeat { .. } => "repeat",
+            NodeKind::ForEach { .. } => "for_each",
             NodeKind::Timeout { .. } => "timeout",
             NodeKind::Inverter(_) => "inverter",
             NodeKind::ForceSuccess(_) => "force_success",
@@ -133,6 +144,7 @@ impl NodeKind {
             NodeKind::Guard { condition, child } => vec![condition, child],
             NodeKind::Retry { child, .. }
             | NodeKind::Repeat { child, .. }
+            | NodeKind::ForEach { child, .. }
             | NodeKind::Timeout { child, .. }
             | NodeKind::Inverter(child)
             | NodeKind::ForceSuccess(child)

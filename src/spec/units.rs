@@ -238,39 +238,42 @@ impl JsonSchema for Angle {
 
 /// Where a motion goes: one of the scene's objects, or a fixed point.
 ///
-/// YAML: `cube`, `bowl`, or `[x, y, z]` in world metres.
+/// YAML: an object's name (`red`, `bin`), a blackboard variable (`{block}`), or `[x, y, z]` in
+/// world metres. `cube` and `bowl` are the legacy names of the `cube_bowl` scene: the block called
+/// `cube` (else the scene's only block) and the container called `bowl` (else its only container).
 #[derive(Copy, Clone, Debug, PartialEq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Target {
-    /// The cube's current pose.
+    /// The legacy `cube`: its current pose.
     Cube,
-    /// The bowl's current pose.
+    /// The legacy `bowl`: its current pose.
     Bowl,
+    /// A scene object (by name or blackboard variable): its current pose.
+    Object(super::objects::ObjectRef),
     /// A fixed point in the world frame, metres.
     Point([f64; 3]),
 }
-
-const TARGET_NAMES: &[&str] = &["cube", "bowl"];
 
 struct TargetVisitor;
 
 impl<'de> Visitor<'de> for TargetVisitor {
     type Value = Target;
     fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        f.write_str("`cube`, `bowl` or a point `[x, y, z]` in metres")
+        f.write_str(
+            "an object (`red`, `cube`, `bowl`), a variable (`{block}`) or a point `[x, y, z]` in metres",
+        )
     }
     fn visit_str<E: de::Error>(self, v: &str) -> Result<Target, E> {
         match v {
             "cube" => Ok(Target::Cube),
             "bowl" => Ok(Target::Bowl),
-            _ => {
-                let mut msg = format!("unknown target `{v}`: expected `cube`, `bowl` or `[x, y, z]`");
-                if let Some(h) = did_you_mean(v, TARGET_NAMES.iter().copied()) {
-                    msg.push_str(&format!(" ({h})"));
-                }
-                Err(E::custom(msg))
-            }
+            _ => super::objects::ObjectRef::parse(v)
+                .map(Target::Object)
+                .map_err(|e| E::custom(format!("{e}; a target is an object, a variable or `[x, y, z]`"))),
         }
+    }
+    fn visit_map<A: de::MapAccess<'de>>(self, map: A) -> Result<Target, A::Error> {
+        super::objects::var_from_map(map).map(Target::Object)
     }
     fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Target, A::Error> {
         let mut p = [0.0; 3];
@@ -312,9 +315,10 @@ impl JsonSchema for Target {
     }
     fn json_schema(_: &mut SchemaGenerator) -> Schema {
         json_schema!({
-            "description": "`cube`, `bowl`, or a fixed point `[x, y, z]` in world metres.",
+            "description": "An object of the scene (`red`; `cube` and `bowl` name the scene's only block and container), a blackboard variable (`{block}`), or a fixed point `[x, y, z]` in world metres.",
             "anyOf": [
-                {"type": "string", "enum": ["cube", "bowl"]},
+                {"type": "string", "pattern": "^([a-z][a-z0-9_]*|\\{\\s*[A-Za-z_][A-Za-z0-9_]*\\s*\\})$"},
+                {"type": "object", "minProperties": 1, "maxProperties": 1, "additionalProperties": {"type": "null"}},
                 {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3}
             ]
         })
@@ -326,6 +330,7 @@ impl fmt::Display for Target {
         match self {
             Target::Cube => f.write_str("cube"),
             Target::Bowl => f.write_str("bowl"),
+            Target::Object(o) => write!(f, "{o}"),
             Target::Point([x, y, z]) => write!(f, "[{x}, {y}, {z}]"),
         }
     }

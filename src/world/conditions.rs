@@ -72,6 +72,17 @@ pub fn cube_at(w: &World, point: [f64; 2], tolerance: f64, max_height: f64, rest
     cube_on_table(w, max_height, rest_speed) && dx.hypot(dy) <= tolerance
 }
 
+/// Block `i` rests on the table: its bottom within `max_height` metres of the table top, not over
+/// any container's footprint (1 cm margin), at rest (speed below `rest_speed`, m/s).
+pub fn on_table(w: &World, i: usize, max_height: f64, rest_speed: f64) -> bool {
+    let p = w.objects[i].pos;
+    let over_container = w
+        .scene
+        .of_kind(crate::scene::ObjectKind::Container)
+        .any(|c| w.from_footprint(c, &p).norm() < 0.01);
+    w.bottom(i) <= max_height && !over_container && w.at_rest(i, rest_speed)
+}
+
 /// The gripper is open at least `min_width` metres.
 pub fn gripper_open(w: &World, min_width: f64) -> bool {
     w.gripper_width >= min_width

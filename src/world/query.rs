@@ -61,7 +61,7 @@ pub enum Order {
 }
 
 /// Which object to pick. YAML: `{kind: block, color: red, where: [pending], order: nearest}`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema, Default)]
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema, Default)]
 #[serde(deny_unknown_fields)]
 pub struct Query {
     /// `block` (default), `container` or `obstacle`.
