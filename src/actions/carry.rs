@@ -98,15 +98,63 @@ impl Carry {
     /// container's floor, on top of a block, or at a point, `place_height` above it.
     fn place(&self, w: &World) -> Result<Vector3<f64>, String> {
         let goal = resolve(&self.spec.to, w)?;
-        let base = match self.destination(w) {
+        let dest = self.destination(w);
+        let base = match dest {
             Some(d) if w.spec(d).kind() == ObjectKind::Block => w.top(d),
             _ => goal.z,
         };
+        let spot = match dest {
+            Some(c) if w.spec(c).kind() == ObjectKind::Container => self.free_spot(w, c),
+            _ => goal.xy(),
+        };
         Ok(Vector3::new(
-            goal.x,
-            goal.y,
+            spot.x,
+            spot.y,
             base + self.spec.place_height + self.half,
         ))
+    }
+
+    /// Where in container `c` to set the block down: of a 5 × 5 grid over the part of its floor
+    /// the fingers can reach, the point farthest from the blocks already in it (the centre when
+    /// it is empty; ties go to the point nearest the centre), world frame, metres.
+    fn free_spot(&self, w: &World, c: usize) -> Vector2<f64> {
+        let centre = w.objects[c].pos.xy();
+        let crate::scene::Shape::Container { inner_half, .. } = w.spec(c).shape else {
+            return centre;
+        };
+        let inside: Vec<Vector2<f64>> = (0..w.objects.len())
+            .filter(|&j| j != self.held && w.spec(j).kind() == ObjectKind::Block && w.inside(j, c))
+            .map(|j| w.objects[j].pos.xy())
+            .collect();
+        if inside.is_empty() {
+            return centre;
+        }
+        let usable = inner_half.map(|h| (h - self.half - FINGER_MARGIN).max(0.0));
+        let (s, co) = crate::world::snapshot::yaw_of(&w.objects[c].quat).sin_cos();
+        let mut candidates: Vec<Vector2<f64>> = Vec::with_capacity(25);
+        for i in -2..=2 {
+            for k in -2..=2 {
+                let (lx, ly) = (usable[0] * i as f64 / 2.0, usable[1] * k as f64 / 2.0);
+                candidates.push(centre + Vector2::new(co * lx - s * ly, s * lx + co * ly));
+            }
+        }
+        candidates.sort_by(|a, b| (a - centre).norm().total_cmp(&(b - centre).norm()));
+        let clearance = |p: &Vector2<f64>| {
+            inside
+                .iter()
+                .map(|q| (p - q).norm())
+                .fold(f64::INFINITY, f64::min)
+        };
+        let mut best = candidates[0];
+        let mut best_clearance = clearance(&best);
+        for p in &candidates[1..] {
+            let d = clearance(p);
+            if d > best_clearance + 1e-9 {
+                best = *p;
+                best_clearance = d;
+            }
+        }
+        best
     }
 
     /// Height of the block's centre for a transfer from `from` to `to` (table plane), metres:

@@ -67,6 +67,14 @@ impl Cell {
         self.world = self.sim.observe();
     }
 
+    /// Back to home, gripper open, every object where `placement` puts it, time zero.
+    pub fn reset_placement(&mut self, placement: &crate::scene::Placement) {
+        self.sim.reset_placement(placement);
+        self.arm = ArmPlan::Hold(crate::sim::HOME_Q);
+        self.gripper_ctrl = 0.0;
+        self.world = self.sim.observe();
+    }
+
     /// Tells the observers that a macro action of `kind` starts.
     pub fn notify_action_start(&mut self, kind: &str) {
         for obs in &mut self.observers {

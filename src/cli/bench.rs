@@ -12,7 +12,7 @@ use clap::Args;
 use serde::Serialize;
 
 use super::run::EpisodeArgs;
-use super::{CliError, load_plan_or_exit, load_scene_or_exit};
+use super::{CliError, load_task};
 use crate::actions::{Cell, StepObserver};
 use crate::episode::{NoObserver, run_in_cell};
 use crate::sim::{Scene, Sim};
@@ -71,9 +71,14 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 /// Runs `macrotree bench`.
 pub fn bench(args: BenchArgs) -> Result<(), CliError> {
-    let config = args.episode.config()?;
-    let plan = Arc::new(load_plan_or_exit(&args.tree)?);
-    let scene = load_scene_or_exit()?;
+    args.episode.config()?;
+    let (plan, scene) = load_task(&args.tree, args.episode.scene.as_deref())?;
+    let plan = Arc::new(plan);
+    let config = args.episode.config_on(&scene)?;
+    let placement = config
+        .placement
+        .clone()
+        .unwrap_or_else(|| scene.placement_from_layout(&config.layout));
     let repeat = args.repeat.max(1);
     let mut episode_times = Vec::new();
     let mut replay_times = Vec::new();
@@ -88,7 +93,7 @@ pub fn bench(args: BenchArgs) -> Result<(), CliError> {
         let report = run_in_cell(&mut cell, plan.clone(), &config, &mut NoObserver);
         episode_times.push(t.elapsed().as_secs_f64());
         let controls = controls.lock().expect("recorder lock").clone();
-        replay_times.push(replay(&scene, &config.layout, &controls));
+        replay_times.push(replay(&scene, &placement, &controls));
         last = Some(report);
     }
     let report = last.expect("repeat >= 1");
@@ -124,9 +129,9 @@ pub fn bench(args: BenchArgs) -> Result<(), CliError> {
 }
 
 /// Wall time of stepping a fresh simulation through `controls` (nu values per step), seconds.
-fn replay(scene: &Scene, layout: &crate::sim::Layout, controls: &[f64]) -> f64 {
+fn replay(scene: &Scene, placement: &crate::scene::Placement, controls: &[f64]) -> f64 {
     let mut sim = Sim::new(scene);
-    sim.reset(layout);
+    sim.reset_placement(placement);
     let nu = sim.ctrl().len();
     let t = Instant::now();
     for ctrl in controls.chunks_exact(nu) {

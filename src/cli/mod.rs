@@ -102,9 +102,40 @@ fn load_plan_or_exit(path: &std::path::Path) -> Result<crate::plan::Plan, CliErr
     })
 }
 
-/// Loads the scene, or returns a bad-input error that says how to get the models.
-fn load_scene_or_exit() -> Result<crate::sim::Scene, CliError> {
-    crate::sim::Scene::load().map_err(|e| CliError::Input(format!("error: {e}")))
+/// Loads a tree for the scene it runs on — `scene_file` (a `--scene` override) when given, else
+/// the tree's own `scene:` or the built-in scene — and compiles that scene with the robot.
+/// Diagnostics of either file are a bad-input error.
+fn load_task(
+    tree: &std::path::Path,
+    scene_file: Option<&std::path::Path>,
+) -> Result<(crate::plan::Plan, crate::sim::Scene), CliError> {
+    let plan = match scene_file {
+        Some(path) => {
+            let scene = crate::scene::load_scene_file(path).map_err(|diags| {
+                let text: Vec<String> = diags.iter().map(|d| d.to_string()).collect();
+                CliError::Input(format!(
+                    "{}\nerror: {} is invalid ({} error(s))",
+                    text.join("\n"),
+                    path.display(),
+                    diags.len()
+                ))
+            })?;
+            crate::plan::load_plan_for(tree, Some(std::sync::Arc::new(scene))).map_err(|diags| {
+                let text: Vec<String> = diags.iter().map(|d| d.to_string()).collect();
+                CliError::Input(format!(
+                    "{}\nerror: {} is invalid for scene {} ({} error(s))",
+                    text.join("\n"),
+                    tree.display(),
+                    path.display(),
+                    diags.len()
+                ))
+            })?
+        }
+        None => load_plan_or_exit(tree)?,
+    };
+    let scene =
+        crate::sim::Scene::load_spec(&plan.scene).map_err(|e| CliError::Input(format!("error: {e}")))?;
+    Ok((plan, scene))
 }
 
 /// Writes `text` to `out`, or to stdout when `out` is `None`. A closed stdout pipe (`| head`)

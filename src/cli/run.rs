@@ -6,9 +6,9 @@ use std::sync::Arc;
 use clap::Args;
 
 use super::args::{CubeArg, XyArg};
-use super::{CliError, load_plan_or_exit, load_scene_or_exit};
+use super::{CliError, load_task};
 use crate::episode::{EpisodeConfig, Goal, NoObserver, run_episode};
-use crate::sim::Layout;
+use crate::sim::{Layout, Scene};
 use crate::viewer::{LiveViewer, Recorder, ViewObserver, ViewerOptions};
 
 /// Arguments of `run`.
@@ -42,6 +42,16 @@ pub struct RunArgs {
 /// Layout and limits shared by `run` and `bench`.
 #[derive(Debug, Args)]
 pub struct EpisodeArgs {
+    /// Run on this scene file instead of the tree's own `scene:` (or the built-in cube_bowl).
+    #[arg(long, value_name = "FILE.yaml")]
+    pub scene: Option<PathBuf>,
+    /// Start from scenario K of a sweep (the same layout and episode seed as `sweep --seed S`
+    /// gives scenario K); see --sweep-seed.
+    #[arg(long, value_name = "K", conflicts_with_all = ["cube", "bowl", "seed"])]
+    pub scenario: Option<u64>,
+    /// The sweep seed S of --scenario.
+    #[arg(long, value_name = "S", default_value_t = 0, requires = "scenario")]
+    pub sweep_seed: u64,
     /// Cube centre and yaw: X,Y[,YAW_DEG] (metres, degrees). Default 0.45,-0.18,0.
     #[arg(long, value_name = "X,Y[,YAW_DEG]", allow_hyphen_values = true)]
     pub cube: Option<CubeArg>,
@@ -57,9 +67,10 @@ pub struct EpisodeArgs {
     /// Inject a fault through physics (see docs/faults.md).
     #[arg(long, value_enum)]
     pub fault: Option<crate::faults::FaultKind>,
-    /// Success means: `bowl` = the tree succeeded and the cube rests in the bowl; `tree` = the
-    /// tree succeeded (its own conditions check the task).
-    #[arg(long, value_enum, default_value_t = Goal::Bowl)]
+    /// Success means: `scene` = the tree succeeded and the scene's goal holds; `bowl` = the tree
+    /// succeeded and the cube rests in the bowl; `tree` = the tree succeeded (its own
+    /// conditions check the task).
+    #[arg(long, value_enum, default_value_t = Goal::Scene)]
     pub goal: Goal,
 }
 
@@ -82,6 +93,7 @@ impl EpisodeArgs {
         }
         Ok(EpisodeConfig {
             layout,
+            placement: None,
             seed: self.seed,
             max_sim_time: self.max_sim_time,
             fault: self.fault,
@@ -91,12 +103,64 @@ impl EpisodeArgs {
     }
 }
 
+impl EpisodeArgs {
+    /// The episode configuration on `scene`: [`config`](Self::config) with every object placed —
+    /// `--scenario K` draws the sweep's scenario K, `--cube`/`--bowl` move the scene's cube and
+    /// bowl, otherwise the scene's poses (or, for a randomized scene without them, scenario 0 of
+    /// seed 0). The placement is checked (on the table, clear of the robot's base and of each
+    /// other, blocks within reach) before anything is simulated.
+    pub fn config_on(&self, scene: &Scene) -> Result<EpisodeConfig, CliError> {
+        let mut config = self.config()?;
+        let placement = if let Some(k) = self.scenario {
+            let sweep = crate::sweep::SweepConfig {
+                seed: self.sweep_seed,
+                ..crate::sweep::SweepConfig::default()
+            };
+            let s = sweep.scene_scenario(scene, k).map_err(|e| {
+                CliError::Input(format!("error: scenario {k} of seed {}: {e}", self.sweep_seed))
+            })?;
+            config.seed = s.seed;
+            if let Some(l) = s.layout {
+                config.layout = l.to_layout();
+            }
+            s.placement
+        } else {
+            if (self.cube.is_some() && scene.spec.legacy_cube().is_none())
+                || (self.bowl.is_some() && scene.spec.legacy_bowl().is_none())
+            {
+                return Err(CliError::Input(format!(
+                    "error: --cube/--bowl place the scene's only block and container, but scene `{}` has {} blocks and {} containers; use --scenario K to draw a layout",
+                    scene.spec.name,
+                    scene.spec.of_kind(crate::scene::ObjectKind::Block).count(),
+                    scene.spec.of_kind(crate::scene::ObjectKind::Container).count()
+                )));
+            }
+            scene.placement_from_layout(&config.layout)
+        };
+        placement.check(&scene.spec).map_err(|e| {
+            CliError::Input(format!(
+                "error: the layout is not allowed: {e}\n  help: objects stand on the table (|x|, |y| ≤ 1 m), clear of the robot's base (within {} m of the origin) and of each other; blocks {:.2} … {:.2} m from the base",
+                crate::scene::ROBOT_BASE_RADIUS,
+                crate::scene::reach_limits()[0],
+                crate::scene::reach_limits()[1]
+            ))
+        })?;
+        // The built-in scene's legacy layout stays the episode's description (bit-identical
+        // to earlier releases); any other placement is given whole.
+        if *scene.spec != *crate::spec::load::builtin_scene() {
+            config.placement = Some(placement);
+        }
+        Ok(config)
+    }
+}
+
 /// Runs `macrotree run`.
 pub fn run(args: RunArgs) -> Result<(), CliError> {
-    let config = args.episode.config()?;
-    let plan = Arc::new(load_plan_or_exit(&args.tree)?);
-    let scene = load_scene_or_exit()?;
-    tracing::info!(tree = %args.tree.display(), cube = ?config.layout.cube_xy, bowl = ?config.layout.bowl_xy, seed = config.seed, "episode start");
+    args.episode.config()?;
+    let (plan, scene) = load_task(&args.tree, args.episode.scene.as_deref())?;
+    let plan = Arc::new(plan);
+    let config = args.episode.config_on(&scene)?;
+    tracing::info!(tree = %args.tree.display(), scene = %scene.spec.name, seed = config.seed, "episode start");
     let speed = match (args.realtime, args.speed) {
         (true, _) => Some(1.0),
         (false, Some(x)) if x.is_finite() && x > 0.0 => Some(x),
@@ -158,10 +222,20 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
 
 fn finish_report(report: &crate::episode::EpisodeReport, json: bool) {
     if report.success {
+        let what = if report.goal.is_empty() {
+            "the tree succeeded".to_string()
+        } else {
+            report
+                .goal
+                .iter()
+                .map(|g| g.predicate.clone())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
         tracing::info!(
             sim_time_s = report.sim_time_s,
             grasp_attempts = report.grasp_attempts,
-            "episode succeeded: the cube is in the bowl"
+            "episode succeeded: {what}"
         );
     } else {
         tracing::warn!(
@@ -188,6 +262,23 @@ fn print_summary(r: &crate::episode::EpisodeReport) {
     );
     if let Some(reason) = &r.failure_reason {
         println!("  reason: {reason}");
+    }
+    for o in &r.objects {
+        let [x, y, z, yaw] = o.end;
+        println!(
+            "  {} {}: final ({x:.3}, {y:.3}, {z:.3}) m, yaw {yaw:.1}°",
+            o.kind, o.name
+        );
+    }
+    for g in &r.goal {
+        println!(
+            "  goal: {} {}",
+            g.predicate,
+            if g.holds { "holds" } else { "does NOT hold" }
+        );
+    }
+    for c in &r.collisions {
+        println!("  collision at {:.2} s: {}", c.time, c.what);
     }
     println!(
         "  cube final ({:.3}, {:.3}, {:.3}) m, bowl target ({:.3}, {:.3}, {:.3}) m",

@@ -10,7 +10,7 @@ use std::sync::Arc;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use super::{CliError, load_plan_or_exit, load_scene_or_exit};
+use super::{CliError, load_task};
 use crate::episode::Goal;
 use crate::faults::FaultKind;
 use crate::sweep::{Shard, Summary, SweepConfig, run_sweep};
@@ -20,6 +20,9 @@ use crate::sweep::{Shard, Summary, SweepConfig, run_sweep};
 pub struct SweepArgs {
     /// The tree file (YAML).
     pub tree: PathBuf,
+    /// Sweep this scene file instead of the tree's own `scene:` (or the built-in cube_bowl).
+    #[arg(long, value_name = "FILE.yaml")]
+    pub scene: Option<PathBuf>,
     /// Number of scenarios (indices 0..N); with --shard, only this shard's share of them runs.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
     pub scenarios: u64,
@@ -32,9 +35,9 @@ pub struct SweepArgs {
     /// Inject this fault through physics in every scenario (see docs/faults.md).
     #[arg(long, value_enum)]
     pub fault: Option<FaultKind>,
-    /// Success means: `bowl` = the tree succeeded and the cube rests in the bowl; `tree` = the
-    /// tree succeeded (its own conditions check the task).
-    #[arg(long, value_enum, default_value_t = Goal::Bowl)]
+    /// Success means: `scene` = the tree succeeded and the scene's goal holds; `bowl` = the tree
+    /// succeeded and the cube rests in the bowl; `tree` = the tree succeeded.
+    #[arg(long, value_enum, default_value_t = Goal::Scene)]
     pub goal: Goal,
     /// Write one JSON line per scenario here, in scenario order.
     #[arg(long, value_name = "FILE.jsonl")]
@@ -58,8 +61,8 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
             args.max_sim_time
         )));
     }
-    let plan = Arc::new(load_plan_or_exit(&args.tree)?);
-    let scene = load_scene_or_exit()?;
+    let (plan, scene) = load_task(&args.tree, args.scene.as_deref())?;
+    let plan = Arc::new(plan);
     let mut out = match &args.out {
         Some(path) => Some(BufWriter::new(File::create(path).map_err(|e| {
             CliError::Input(format!("error: cannot write {}: {e}", path.display()))
@@ -74,6 +77,7 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
         goal: args.goal,
         shard: args.shard,
         max_sim_time: args.max_sim_time,
+        scene_file: args.scene.as_ref().map(|p| p.display().to_string()),
     };
     let total = config.indices().len() as u64;
     let bar = if std::io::stderr().is_terminal() {

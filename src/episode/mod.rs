@@ -7,18 +7,23 @@ mod report;
 use std::sync::Arc;
 use std::time::Instant;
 
-pub use report::EpisodeReport;
+pub use report::{EpisodeReport, ObjectReport};
 
 use crate::actions::{Cell, MacroDriver};
 use crate::plan::Plan;
 use crate::runtime::{TreeRunner, TreeStatus};
+use crate::scene::Placement;
 use crate::sim::{Layout, Scene};
 
 /// How to run an episode.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EpisodeConfig {
-    /// Where the cube and the bowl start.
+    /// Where the cube and the bowl start (the scene's other objects at their default poses),
+    /// unless [`placement`](Self::placement) is given.
     pub layout: Layout,
+    /// Where every object of the scene starts (one pose per object, scene order); overrides
+    /// [`layout`](Self::layout).
+    pub placement: Option<Placement>,
     /// Seed for everything random in the episode (fault timing and magnitude). The same tree,
     /// layout and seed give a bit-identical result.
     pub seed: u64,
@@ -36,8 +41,11 @@ pub struct EpisodeConfig {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Goal {
-    /// The tree succeeded and the cube rests in the bowl (the cube-to-bowl task).
+    /// The tree succeeded and the scene's goal holds (for the `cube_bowl` scene: the cube rests
+    /// in the bowl). A tree that succeeds without doing the job is caught.
     #[default]
+    Scene,
+    /// The tree succeeded and the legacy cube rests in the legacy bowl (the cube-to-bowl task).
     Bowl,
     /// The tree succeeded; the tree's own conditions define the task (e.g. `cube_at` for a
     /// placement on the table).
@@ -48,6 +56,7 @@ impl Goal {
     /// The name used on the command line (`bowl`, `tree`).
     pub fn name(self) -> &'static str {
         match self {
+            Goal::Scene => "scene",
             Goal::Bowl => "bowl",
             Goal::Tree => "tree",
         }
@@ -58,13 +67,44 @@ impl Default for EpisodeConfig {
     fn default() -> Self {
         Self {
             layout: Layout::default(),
+            placement: None,
             seed: 0,
             max_sim_time: 60.0,
             control_period: crate::actions::CONTROL_PERIOD,
             fault: None,
-            goal: Goal::Bowl,
+            goal: Goal::Scene,
         }
     }
+}
+
+/// A stable name for the kind of a failure reason, for grouping failures across a sweep:
+/// `time_limit`, `unstable`, `goal_not_met`, `grasp_lost`, `grasp_failed`, `unreachable`,
+/// `blocked` (no clear way), `timeout` (a leaf's own limit), `halted`, `condition_false`,
+/// `layout`, `panicked`, or `other`.
+pub fn failure_kind(reason: &str) -> &'static str {
+    const KINDS: &[(&str, &str)] = &[
+        ("time limit", "time_limit"),
+        ("MuJoCo reported an unstable", "unstable"),
+        ("goal does not hold", "goal_not_met"),
+        ("not at rest in the bowl", "goal_not_met"),
+        ("grasp lost", "grasp_lost"),
+        ("grasp failed", "grasp_failed"),
+        ("unreachable", "unreachable"),
+        ("no clear way", "blocked"),
+        ("timeout", "timeout"),
+        ("expired", "timeout"),
+        ("preempted", "halted"),
+        ("not satisfied", "condition_false"),
+        ("layout:", "layout"),
+        ("panicked", "panicked"),
+    ];
+    // The innermost reason ("all 3 attempts failed; last: …") decides.
+    let inner = reason.rsplit("last: ").next().unwrap_or(reason);
+    KINDS
+        .iter()
+        .find(|(needle, _)| inner.contains(needle))
+        .or_else(|| KINDS.iter().find(|(needle, _)| reason.contains(needle)))
+        .map_or("other", |(_, kind)| kind)
 }
 
 /// Called after every control period (viewer, recorder, progress).
@@ -96,7 +136,11 @@ pub fn run_in_cell(
     observer: &mut dyn EpisodeObserver,
 ) -> EpisodeReport {
     let wall = Instant::now();
-    cell.reset(&config.layout);
+    match &config.placement {
+        Some(p) => cell.reset_placement(p),
+        None => cell.reset(&config.layout),
+    }
+    let initial = cell.world().clone();
     let observers_before = cell.observers.len();
     if let Some(kind) = config.fault {
         cell.observers.push(crate::faults::injector(kind, config.seed));
@@ -106,6 +150,7 @@ pub fn run_in_cell(
     let mut driver = MacroDriver::new(cell);
     let mut status = TreeStatus::Running;
     let mut timed_out = false;
+    let mut unstable = None;
     while status == TreeStatus::Running {
         let now = driver.cell().world().time;
         if now >= config.max_sim_time {
@@ -115,19 +160,29 @@ pub fn run_in_cell(
         status = runner.tick(now, dt, &mut driver);
         driver.advance();
         observer.on_tick(driver.cell(), &mut runner);
+        // MuJoCo resets an unstable simulation and carries on: the episode is no longer physics.
+        if let Some(why) = driver.cell().sim().instability() {
+            tracing::error!(target: "macrotree::episode", "{why}");
+            unstable = Some(why);
+            break;
+        }
     }
-    if timed_out {
+    if timed_out || unstable.is_some() {
         runner.halt_all(&mut driver);
     }
     let checks = driver.checks.clone();
     let counters = driver.counters;
+    let collisions = std::mem::take(&mut driver.collisions);
     // The root's reason tells the whole story ("all 3 attempts failed; last: …"); an action's
     // own reason is the fallback.
     let root_reason = runner.node_reasons().first().cloned().flatten();
-    let last_failure = root_reason.or_else(|| driver.last_failure.clone());
+    let last_failure = unstable
+        .clone()
+        .or(root_reason)
+        .or_else(|| driver.last_failure.clone());
     cell.observers.truncate(observers_before);
     let world = cell.world().clone();
-    EpisodeReport::new(
+    let mut report = EpisodeReport::new(
         status,
         timed_out,
         config,
@@ -137,5 +192,10 @@ pub fn run_in_cell(
         cell.sim().steps(),
         wall.elapsed().as_secs_f64(),
         last_failure,
-    )
+    );
+    report.add_scene(&initial, &world, collisions, unstable);
+    if !report.success {
+        report.failed_node = runner.last_failed_path();
+    }
+    report
 }

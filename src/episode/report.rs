@@ -3,9 +3,11 @@
 use serde::Serialize;
 
 use super::{EpisodeConfig, Goal};
-use crate::actions::{Checks, LeafCounters};
+use crate::actions::{Checks, Collision, LeafCounters};
 use crate::runtime::TreeStatus;
+use crate::scene::ObjectKind;
 use crate::world::World;
+use crate::world::goal::{GoalValue, evaluate, goal_holds};
 
 /// What happened in one episode. Lengths in metres, times in seconds.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -38,6 +40,36 @@ pub struct EpisodeReport {
     pub layout: LayoutJson,
     /// The seed.
     pub seed: u64,
+    /// The scene's name.
+    pub scene: String,
+    /// Every object's initial and final pose, in scene order.
+    pub objects: Vec<ObjectReport>,
+    /// Every goal predicate's value at the end, in the scene's order.
+    pub goal: Vec<GoalValue>,
+    /// Contacts that should not happen (the fingers on a wall, …), in the order first seen.
+    pub collisions: Vec<Collision>,
+    /// The path of the last leaf (or check) that failed, when the episode failed.
+    pub failed_node: Option<String>,
+}
+
+/// One object's initial and final pose: `[x, y, z, yaw]` in metres and degrees (a block's yaw
+/// is of its side faces, in [−45°, 45°)).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ObjectReport {
+    /// The object's name.
+    pub name: String,
+    /// What it is.
+    pub kind: ObjectKind,
+    /// Pose when the episode started.
+    pub initial: [f64; 4],
+    /// Pose when it ended.
+    #[serde(rename = "final")]
+    pub end: [f64; 4],
+}
+
+fn pose(w: &World, i: usize) -> [f64; 4] {
+    let p = w.objects[i].pos;
+    [p.x, p.y, p.z, w.yaw(i).to_degrees()]
 }
 
 /// A layout as JSON.
@@ -68,7 +100,12 @@ impl EpisodeReport {
             TreeStatus::Failure => "failure",
             TreeStatus::Running => "running",
         };
-        let success = status == TreeStatus::Success && (config.goal == Goal::Tree || checks.in_bowl);
+        let goal_ok = match config.goal {
+            Goal::Scene => goal_holds(world),
+            Goal::Bowl => checks.in_bowl,
+            Goal::Tree => true,
+        };
+        let success = status == TreeStatus::Success && goal_ok;
         let failure_reason = if success {
             None
         } else if timed_out {
@@ -76,8 +113,18 @@ impl EpisodeReport {
                 "time limit: the tree was still running after {:.1} s of simulated time",
                 config.max_sim_time
             ))
-        } else if status == TreeStatus::Success {
+        } else if status == TreeStatus::Success && config.goal == Goal::Bowl {
             Some("the tree succeeded but the cube is not at rest in the bowl".into())
+        } else if status == TreeStatus::Success {
+            let missed: Vec<String> = evaluate(world)
+                .into_iter()
+                .filter(|g| !g.holds)
+                .map(|g| g.predicate)
+                .collect();
+            Some(format!(
+                "the tree succeeded but the scene's goal does not hold: not {}",
+                missed.join(", not ")
+            ))
         } else {
             Some(tree_failure.unwrap_or_else(|| "the tree failed".into()))
         };
@@ -99,6 +146,35 @@ impl EpisodeReport {
                 bowl: l.bowl_xy,
             },
             seed: config.seed,
+            scene: world.scene.name.clone(),
+            objects: Vec::new(),
+            goal: evaluate(world),
+            collisions: Vec::new(),
+            failed_node: None,
+        }
+    }
+
+    /// Adds every object's initial (`start`) and final (`end`) pose and the collisions seen; an
+    /// unstable simulation is a failure whatever the tree said.
+    pub fn add_scene(
+        &mut self,
+        start: &World,
+        end: &World,
+        collisions: Vec<Collision>,
+        unstable: Option<String>,
+    ) {
+        self.objects = (0..end.objects.len())
+            .map(|i| ObjectReport {
+                name: end.name(i).to_string(),
+                kind: end.spec(i).kind(),
+                initial: pose(start, i),
+                end: pose(end, i),
+            })
+            .collect();
+        self.collisions = collisions;
+        if let Some(why) = unstable {
+            self.success = false;
+            self.failure_reason = Some(why);
         }
     }
 }

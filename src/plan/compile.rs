@@ -27,6 +27,8 @@ pub fn compile_spec(spec: &Spec) -> Result<Plan, Vec<Diagnostic>> {
         nodes: c.nodes,
         internal: c.internal,
         file: spec.sources.name(0).to_string(),
+        description: spec.description.clone(),
+        scene: spec.scene_spec.clone(),
     })
 }
 

@@ -179,6 +179,10 @@ pub struct Plan {
     pub internal: Vec<Internal>,
     /// The main file's name.
     pub file: String,
+    /// The tree's `description:`, if any.
+    pub description: Option<String>,
+    /// The scene the tree's object names were checked against, which it runs on.
+    pub scene: std::sync::Arc<crate::scene::SceneSpec>,
 }
 
 impl Plan {
@@ -219,9 +223,20 @@ impl Plan {
     }
 }
 
-/// Read, validate and compile a tree file (following its `include:`s).
+/// Read, validate and compile a tree file (following its `include:`s), for its own `scene:` (or
+/// the built-in scene).
 pub fn load_plan(path: &Path) -> Result<Plan, Vec<Diagnostic>> {
     let spec = spec::load_file(path)?;
+    compile_spec(&spec)
+}
+
+/// Read, validate and compile a tree file for `scene` (a `--scene` override) when given,
+/// else for the tree's own `scene:` (or the built-in scene).
+pub fn load_plan_for(
+    path: &Path,
+    scene: Option<std::sync::Arc<crate::scene::SceneSpec>>,
+) -> Result<Plan, Vec<Diagnostic>> {
+    let spec = spec::load::load_file_with(path, scene)?;
     compile_spec(&spec)
 }
 

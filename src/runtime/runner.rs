@@ -56,6 +56,8 @@ struct RunState {
     /// The blackboard: variables written by `select` and `for_each`.
     vars: Blackboard,
     last_failure: Option<String>,
+    /// The node of the last leaf that failed.
+    last_failed_node: Option<usize>,
     transitions: Vec<Transition>,
     dropped: u64,
     tick: u64,
@@ -103,6 +105,7 @@ impl RunState {
             exit_flags: vec![false; n],
             vars: Blackboard::default(),
             last_failure: None,
+            last_failed_node: None,
             transitions: Vec::new(),
             dropped: 0,
             tick: 0,
@@ -266,6 +269,7 @@ impl RunState {
                 rt.span = None;
                 let reason = format!("{}: {reason}", info.kind.kind());
                 self.last_failure = Some(reason.clone());
+                self.last_failed_node = Some(node);
                 self.set(plan, node, NodeStatus::Failure, Some(reason));
                 false
             }
@@ -649,6 +653,11 @@ impl TreeRunner {
     /// first run, then 1, 2, …
     pub fn attempt(&self, node: usize) -> u32 {
         self.st.attempts.get(node).copied().unwrap_or(0)
+    }
+
+    /// The path of the last leaf that failed (since the last reset).
+    pub fn last_failed_path(&self) -> Option<String> {
+        self.st.last_failed_node.map(|n| self.plan.nodes[n].path.clone())
     }
 
     /// The blackboard (variables written by `select` and `for_each`).

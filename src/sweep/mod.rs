@@ -31,13 +31,15 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 pub use layout::{Region, Scenario, ScenarioLayout, sample_scenario, sample_scenario_in};
-pub use summary::{Failure, Summary, percentile, wilson_interval};
+pub use summary::{Failure, FailureGroup, Summary, percentile, wilson_interval};
 
-use crate::actions::{CONTROL_PERIOD, Cell, Checks};
-use crate::episode::{EpisodeConfig, EpisodeReport, Goal, NoObserver, run_in_cell};
+use crate::actions::{CONTROL_PERIOD, Cell, Checks, Collision};
+use crate::episode::{EpisodeConfig, EpisodeReport, Goal, NoObserver, ObjectReport, run_in_cell};
 use crate::faults::FaultKind;
 use crate::plan::Plan;
+use crate::scene::{Placement, PlacementError, sample_placement};
 use crate::sim::{Layout, Scene};
+use crate::world::goal::GoalValue;
 
 /// `--shard K/M`: the scenarios whose index is ≡ K (mod M), `0 ≤ K < M`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -92,6 +94,8 @@ pub struct SweepConfig {
     pub shard: Option<Shard>,
     /// Per-episode simulated time limit, seconds.
     pub max_sim_time: f64,
+    /// The `--scene` file the sweep was given, if any (printed in reproduction commands).
+    pub scene_file: Option<String>,
 }
 
 impl Default for SweepConfig {
@@ -104,6 +108,7 @@ impl Default for SweepConfig {
             goal: Goal::Bowl,
             shard: None,
             max_sim_time: EpisodeConfig::default().max_sim_time,
+            scene_file: None,
         }
     }
 }
@@ -116,11 +121,58 @@ impl SweepConfig {
             .collect()
     }
 
+    /// Scenario `index` of this sweep on `scene`. The built-in `cube_bowl` scene keeps the
+    /// documented task-region sampler ([`sample_scenario`]), so its sweeps and reproduction
+    /// commands (`--cube … --bowl …`) are those of earlier releases; every other scene draws its
+    /// own randomization ([`crate::scene::sample_placement`]).
+    pub fn scene_scenario(&self, scene: &Scene, index: u64) -> Result<SceneScenario, PlacementError> {
+        if *scene.spec == *crate::spec::load::builtin_scene() {
+            let s = sample_scenario(self.seed, index);
+            return Ok(SceneScenario {
+                sweep_seed: s.sweep_seed,
+                index,
+                seed: s.seed,
+                placement: scene.placement_from_layout(&s.layout.to_layout()),
+                layout: Some(s.layout),
+            });
+        }
+        let (seed, placement) = sample_placement(&scene.spec, self.seed, index)?;
+        Ok(SceneScenario {
+            sweep_seed: self.seed,
+            index,
+            seed,
+            placement,
+            layout: None,
+        })
+    }
+
+    /// The episode configuration of a scenario of any scene (see [`Self::scene_scenario`]).
+    pub fn scene_episode_config(&self, scenario: &SceneScenario) -> EpisodeConfig {
+        match &scenario.layout {
+            Some(l) => self.episode_config(&Scenario {
+                sweep_seed: scenario.sweep_seed,
+                index: scenario.index,
+                seed: scenario.seed,
+                layout: *l,
+            }),
+            None => EpisodeConfig {
+                placement: Some(scenario.placement.clone()),
+                seed: scenario.seed,
+                max_sim_time: self.max_sim_time,
+                control_period: CONTROL_PERIOD,
+                fault: self.fault,
+                goal: self.goal,
+                ..EpisodeConfig::default()
+            },
+        }
+    }
+
     /// The episode configuration of `scenario`: exactly what `macrotree run` builds from the
     /// reproduction command [`ScenarioResult::reproduce`] prints.
     pub fn episode_config(&self, scenario: &Scenario) -> EpisodeConfig {
         EpisodeConfig {
             layout: scenario.layout.to_layout(),
+            placement: None,
             seed: scenario.seed,
             max_sim_time: self.max_sim_time,
             control_period: CONTROL_PERIOD,
@@ -128,6 +180,21 @@ impl SweepConfig {
             goal: self.goal,
         }
     }
+}
+
+/// A scenario of a sweep on any scene: the episode seed and every object's starting pose.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SceneScenario {
+    /// The sweep seed `S`.
+    pub sweep_seed: u64,
+    /// The scenario index `k`.
+    pub index: u64,
+    /// The episode seed (fault timing and magnitude).
+    pub seed: u64,
+    /// Every object's starting pose, scene order.
+    pub placement: Placement,
+    /// The legacy cube/bowl layout, for the built-in scene.
+    pub layout: Option<ScenarioLayout>,
 }
 
 /// One line of the sweep's JSONL: the scenario and its episode's outcome (the fields of
@@ -143,8 +210,10 @@ pub struct ScenarioResult {
     pub seed: u64,
     /// The injected fault.
     pub fault: Option<FaultKind>,
-    /// The layout, exactly as sampled (and as `run --cube X,Y,YAW --bowl X,Y` takes it).
-    pub layout: ScenarioLayout,
+    /// The layout of the built-in scene, exactly as sampled (and as `run --cube X,Y,YAW --bowl
+    /// X,Y` takes it); other scenes list every object in `objects`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub layout: Option<ScenarioLayout>,
     /// The episode met the sweep's goal (by default: the tree succeeded and the cube rests in
     /// the bowl; see [`Goal`]).
     pub success: bool,
@@ -166,20 +235,63 @@ pub struct ScenarioResult {
     pub bowl_target: [f64; 3],
     /// The reference tutorial's checks.
     pub checks: Checks,
+    /// The scene's name.
+    pub scene: String,
+    /// Every object's initial and final pose, `[x, y, z, yaw°]`.
+    pub objects: Vec<ObjectReport>,
+    /// Every goal predicate's value at the end.
+    pub goal: Vec<GoalValue>,
+    /// Contacts that should not happen, by name.
+    pub collisions: Vec<Collision>,
+    /// The path of the node whose failure ended the episode, if one did.
+    pub failed_node: Option<String>,
+    /// A stable name for the kind of failure (`timeout`, `grasp_lost`, …), for grouping.
+    pub failure_kind: Option<&'static str>,
     /// Wall-clock time of the episode, seconds (not written to the JSONL).
     #[serde(skip)]
     pub wall_time_s: f64,
 }
 
 impl ScenarioResult {
-    /// The result of `scenario` from its episode report.
+    /// The result of `scenario` (of the built-in scene) from its episode report.
     pub fn new(scenario: &Scenario, fault: Option<FaultKind>, r: EpisodeReport) -> Self {
-        Self {
-            index: scenario.index,
-            sweep_seed: scenario.sweep_seed,
-            seed: scenario.seed,
+        Self::of(
+            scenario.index,
+            scenario.sweep_seed,
+            scenario.seed,
+            Some(scenario.layout),
             fault,
-            layout: scenario.layout,
+            r,
+        )
+    }
+
+    /// The result of a scenario of any scene from its episode report.
+    pub fn of_scene(scenario: &SceneScenario, fault: Option<FaultKind>, r: EpisodeReport) -> Self {
+        Self::of(
+            scenario.index,
+            scenario.sweep_seed,
+            scenario.seed,
+            scenario.layout,
+            fault,
+            r,
+        )
+    }
+
+    fn of(
+        index: u64,
+        sweep_seed: u64,
+        seed: u64,
+        layout: Option<ScenarioLayout>,
+        fault: Option<FaultKind>,
+        r: EpisodeReport,
+    ) -> Self {
+        let failure_kind = r.failure_reason.as_deref().map(crate::episode::failure_kind);
+        Self {
+            index,
+            sweep_seed,
+            seed,
+            fault,
+            layout,
             success: r.success,
             tree_status: r.tree_status,
             failure_reason: r.failure_reason,
@@ -190,21 +302,36 @@ impl ScenarioResult {
             cube_final: r.cube_final,
             bowl_target: r.bowl_target,
             checks: r.checks,
+            scene: r.scene,
+            objects: r.objects,
+            goal: r.goal,
+            collisions: r.collisions,
+            failure_kind,
+            failed_node: r.failed_node,
             wall_time_s: r.wall_time_s,
         }
     }
 
-    /// A result for an episode that panicked.
-    fn panicked(scenario: &Scenario, fault: Option<FaultKind>, message: String) -> Self {
+    /// A result for an episode that could not run (it panicked, or its layout could not be
+    /// drawn).
+    fn not_run(
+        index: u64,
+        sweep_seed: u64,
+        seed: u64,
+        layout: Option<ScenarioLayout>,
+        fault: Option<FaultKind>,
+        reason: String,
+    ) -> Self {
         Self {
-            index: scenario.index,
-            sweep_seed: scenario.sweep_seed,
-            seed: scenario.seed,
+            index,
+            sweep_seed,
+            seed,
             fault,
-            layout: scenario.layout,
+            layout,
             success: false,
             tree_status: "failure",
-            failure_reason: Some(format!("panicked: {message}")),
+            failure_kind: Some(crate::episode::failure_kind(&reason)),
+            failure_reason: Some(reason),
             sim_time_s: 0.0,
             grasp_attempts: 0,
             halts: 0,
@@ -218,6 +345,11 @@ impl ScenarioResult {
                 home_error: f64::NAN,
                 in_bowl: false,
             },
+            scene: String::new(),
+            objects: Vec::new(),
+            goal: Vec::new(),
+            collisions: Vec::new(),
+            failed_node: None,
             wall_time_s: 0.0,
         }
     }
@@ -230,17 +362,27 @@ impl ScenarioResult {
     /// The `macrotree run …` command that reproduces this scenario bit for bit. Floats are
     /// printed with Rust's shortest round-trip formatting, so they parse back to the same bits.
     pub fn reproduce(&self, tree: &str, config: &SweepConfig) -> String {
-        let l = &self.layout;
-        let mut cmd = format!(
-            "macrotree run {} --cube {},{},{} --bowl {},{} --seed {}",
-            shell_quote(tree),
-            l.cube[0],
-            l.cube[1],
-            l.cube[2],
-            l.bowl[0],
-            l.bowl[1],
-            self.seed
-        );
+        let mut cmd = match &self.layout {
+            Some(l) => format!(
+                "macrotree run {} --cube {},{},{} --bowl {},{} --seed {}",
+                shell_quote(tree),
+                l.cube[0],
+                l.cube[1],
+                l.cube[2],
+                l.bowl[0],
+                l.bowl[1],
+                self.seed
+            ),
+            None => format!(
+                "macrotree run {} --sweep-seed {} --scenario {}",
+                shell_quote(tree),
+                self.sweep_seed,
+                self.index
+            ),
+        };
+        if let Some(scene) = &config.scene_file {
+            cmd += &format!(" --scene {}", shell_quote(scene));
+        }
         if let Some(fault) = self.fault {
             cmd += &format!(" --fault {fault}");
         }
@@ -266,7 +408,7 @@ fn shell_quote(s: &str) -> String {
     }
 }
 
-/// Runs scenario `scenario` of `config` in `cell` (reset first).
+/// Runs scenario `scenario` (of the built-in scene) of `config` in `cell` (reset first).
 pub fn run_scenario(
     cell: &mut Cell,
     plan: &Arc<Plan>,
@@ -276,6 +418,23 @@ pub fn run_scenario(
     let episode = config.episode_config(scenario);
     let report = run_in_cell(cell, plan.clone(), &episode, &mut NoObserver);
     ScenarioResult::new(scenario, config.fault, report)
+}
+
+/// Runs scenario `index` of `config` on the cell's scene (reset first).
+pub fn run_scene_scenario(
+    cell: &mut Cell,
+    plan: &Arc<Plan>,
+    config: &SweepConfig,
+    index: u64,
+) -> ScenarioResult {
+    match config.scene_scenario(cell.sim().scene(), index) {
+        Ok(scenario) => {
+            let episode = config.scene_episode_config(&scenario);
+            let report = run_in_cell(cell, plan.clone(), &episode, &mut NoObserver);
+            ScenarioResult::of_scene(&scenario, config.fault, report)
+        }
+        Err(e) => ScenarioResult::not_run(index, config.seed, 0, None, config.fault, format!("layout: {e}")),
+    }
 }
 
 /// The outcome of a sweep.
@@ -316,12 +475,19 @@ pub fn run_sweep(
                 indices.iter().copied().enumerate().par_bridge().for_each_init(
                     new_cell,
                     |cell, (pos, index)| {
-                        let scenario = sample_scenario(config.seed, index);
                         let outcome =
-                            catch_unwind(AssertUnwindSafe(|| run_scenario(cell, plan, config, &scenario)));
+                            catch_unwind(AssertUnwindSafe(|| run_scene_scenario(cell, plan, config, index)));
                         let result = outcome.unwrap_or_else(|payload| {
                             *cell = new_cell();
-                            ScenarioResult::panicked(&scenario, config.fault, panic_message(&*payload))
+                            let s = config.scene_scenario(scene, index).ok();
+                            ScenarioResult::not_run(
+                                index,
+                                config.seed,
+                                s.as_ref().map_or(0, |s| s.seed),
+                                s.and_then(|s| s.layout),
+                                config.fault,
+                                format!("panicked: {}", panic_message(&*payload)),
+                            )
                         });
                         // The receiver lives until every result is in.
                         let _ = tx.send((pos, result));

@@ -20,10 +20,16 @@ pub struct Failure {
     pub index: u64,
     /// Episode seed.
     pub seed: u64,
-    /// Cube x, y (metres), yaw (degrees).
-    pub cube: [f64; 3],
-    /// Bowl x, y (metres).
-    pub bowl: [f64; 2],
+    /// Cube x, y (metres), yaw (degrees): the built-in scene's layout.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cube: Option<[f64; 3]>,
+    /// Bowl x, y (metres): the built-in scene's layout.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bowl: Option<[f64; 2]>,
+    /// The node whose failure ended the episode.
+    pub node: Option<String>,
+    /// The kind of failure (`timeout`, `grasp_lost`, …).
+    pub kind: Option<&'static str>,
     /// Why it failed.
     pub reason: String,
     /// Grasp attempts made.
@@ -67,6 +73,21 @@ pub struct Summary {
     pub scenarios_per_minute: f64,
     /// Every failing scenario, by index.
     pub failures: Vec<Failure>,
+    /// Failures grouped by (node path, failure kind), most frequent first.
+    pub failure_groups: Vec<FailureGroup>,
+}
+
+/// Failures that share the node that failed and the kind of failure.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FailureGroup {
+    /// The node path (`-` when no node failed, e.g. the time limit or a missed goal).
+    pub node: String,
+    /// The kind of failure.
+    pub kind: String,
+    /// How many scenarios.
+    pub count: u64,
+    /// The scenario indices, ascending.
+    pub indices: Vec<u64>,
 }
 
 impl Summary {
@@ -92,13 +113,33 @@ impl Summary {
             .map(|r| Failure {
                 index: r.index,
                 seed: r.seed,
-                cube: r.layout.cube,
-                bowl: r.layout.bowl,
+                cube: r.layout.map(|l| l.cube),
+                bowl: r.layout.map(|l| l.bowl),
+                node: r.failed_node.clone(),
+                kind: r.failure_kind,
                 reason: r.failure_reason.clone().unwrap_or_else(|| "failed".into()),
                 grasp_attempts: r.grasp_attempts,
                 reproduce: r.reproduce(tree, config),
             })
+            .collect::<Vec<Failure>>();
+        let mut groups: BTreeMap<(String, String), Vec<u64>> = BTreeMap::new();
+        for f in &failures {
+            let key = (
+                f.node.clone().unwrap_or_else(|| "-".into()),
+                f.kind.unwrap_or("other").to_string(),
+            );
+            groups.entry(key).or_default().push(f.index);
+        }
+        let mut failure_groups: Vec<FailureGroup> = groups
+            .into_iter()
+            .map(|((node, kind), indices)| FailureGroup {
+                node,
+                kind,
+                count: indices.len() as u64,
+                indices,
+            })
             .collect();
+        failure_groups.sort_by(|a, b| b.count.cmp(&a.count));
         Self {
             tree: tree.to_string(),
             seed: config.seed,
@@ -120,6 +161,7 @@ impl Summary {
                 0.0
             },
             failures,
+            failure_groups,
         }
     }
 
@@ -167,6 +209,12 @@ impl Summary {
             "  wall time {:.1} s on {} job(s): {:.0} scenarios/minute",
             self.wall_time_s, self.jobs, self.scenarios_per_minute
         );
+        if !self.failure_groups.is_empty() {
+            let _ = writeln!(s, "  failures by node and kind:");
+            for g in &self.failure_groups {
+                let _ = writeln!(s, "    {:>5}  {}  {}", g.count, g.kind, g.node);
+            }
+        }
         if !self.failures.is_empty() {
             let _ = writeln!(s, "  failures ({}):", self.failures.len());
             for f in &self.failures {
