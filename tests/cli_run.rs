@@ -65,8 +65,8 @@ fn run_default_layout_succeeds_with_a_json_report() {
 
 #[test]
 fn run_reports_task_failure_with_exit_1() {
-    // The cube far outside the reach of the arm: the reach fails with a reason.
-    let out = macrotree(&["run", "trees/cube_to_bowl.yaml", "--cube", "1.5,0.0", "--json"]);
+    // One simulated second is too short for the task: the episode fails with a reason.
+    let out = macrotree(&["run", "trees/cube_to_bowl.yaml", "--max-sim-time", "1", "--json"]);
     assert_eq!(
         out.status.code(),
         Some(1),
@@ -76,7 +76,30 @@ fn run_reports_task_failure_with_exit_1() {
     let r = last_json_line(&out);
     assert_eq!(r["success"], false);
     let reason = r["failure_reason"].as_str().unwrap_or_default();
-    assert!(reason.contains("unreachable"), "reason: {reason}");
+    assert!(reason.contains("time limit"), "reason: {reason}");
+}
+
+/// Regression (hardening, bad numbers): a cube out of the arm's reach, inside the robot's base or
+/// off the table used to run (and a cube at 1e10 m "succeeded"); it is refused before anything is
+/// simulated, with what is allowed.
+#[test]
+fn run_refuses_layouts_outside_the_cell_with_exit_2() {
+    for (cube, why) in [
+        ("1.5,0.0", "off the table"),
+        ("0.9,0.0", "from the robot's base"),
+        ("0.05,0", "overlaps the robot's base"),
+        ("1.1e10,0", "off the table"),
+    ] {
+        let out = macrotree(&["run", "trees/cube_to_bowl.yaml", "--cube", cube, "--json"]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "--cube {cube}: {stderr}");
+        assert!(stderr.contains(why) && stderr.contains("help:"), "--cube {cube}: {stderr}");
+        assert!(out.stdout.is_empty(), "--cube {cube}: nothing simulated");
+    }
+    // The cube on top of the bowl overlaps it.
+    let out = macrotree(&["run", "trees/cube_to_bowl.yaml", "--cube", "0.45,0.08", "--json"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("apart"));
 }
 
 #[test]
