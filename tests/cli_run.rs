@@ -93,7 +93,10 @@ fn run_refuses_layouts_outside_the_cell_with_exit_2() {
         let out = macrotree(&["run", "trees/cube_to_bowl.yaml", "--cube", cube, "--json"]);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "--cube {cube}: {stderr}");
-        assert!(stderr.contains(why) && stderr.contains("help:"), "--cube {cube}: {stderr}");
+        assert!(
+            stderr.contains(why) && stderr.contains("help:"),
+            "--cube {cube}: {stderr}"
+        );
         assert!(out.stdout.is_empty(), "--cube {cube}: nothing simulated");
     }
     // The cube on top of the bowl overlaps it.

@@ -277,9 +277,12 @@ fn color_rule_geom_rgba_overrides_material_unless_default() {
     let scene = Scene::load().unwrap();
     let m = &scene.model;
     let geom = |name: &str| m.name_to_id(MjtObjBase::mjOBJ_GEOM, name).unwrap();
-    // The cube has the default rgba and material "cube": material colour.
-    assert_eq!(scene::geom_rgba(m, geom("cube")), [0.95, 0.35, 0.15, 1.0]);
-    assert_eq!(scene::geom_rgba(m, geom("bowl_bottom")), [0.25, 0.65, 0.55, 1.0]);
+    // The scene's objects carry their colour as geom rgba (no material): geom colour.
+    assert_eq!(scene::geom_rgba(m, geom("obj/cube")), [0.95, 0.35, 0.15, 1.0]);
+    assert_eq!(
+        scene::geom_rgba(m, geom("obj/bowl/floor")),
+        [0.25, 0.65, 0.55, 1.0]
+    );
     // The pads have their own rgba and no material: geom colour.
     assert_eq!(
         scene::geom_rgba(m, geom("gripper/right_pad1")),
@@ -341,8 +344,8 @@ fn the_task_scene_draws_visual_geoms_only_from_compiled_meshes() {
         }
     }
     for name in [
-        "/mujoco/cube/cube",
-        "/mujoco/bowl/bowl_bottom",
+        "/mujoco/obj/cube/obj/cube",
+        "/mujoco/obj/bowl/obj/bowl/floor",
         "/mujoco/world/floor",
     ] {
         assert!(layout.geoms.iter().any(|g| g.path == name), "{name}");

@@ -1,4 +1,5 @@
-//! `macrotree validate TREE...`: parse and check trees without simulating.
+//! `macrotree validate FILE...`: parse and check trees and scene files without simulating. A
+//! file whose top level has `objects:` and no `main:` is read as a scene.
 
 use std::path::PathBuf;
 
@@ -10,9 +11,12 @@ use crate::spec::Diagnostic;
 /// Arguments of `validate`.
 #[derive(Debug, Args)]
 pub struct ValidateArgs {
-    /// Tree files (YAML).
+    /// Tree or scene files (YAML).
     #[arg(required = true)]
     pub trees: Vec<PathBuf>,
+    /// Check the trees' object names against this scene instead of each tree's own `scene:`.
+    #[arg(long, value_name = "FILE.yaml")]
+    pub scene: Option<PathBuf>,
     /// How to print the result.
     #[arg(long, value_enum, default_value_t = DiagnosticFormat::Human)]
     pub format: DiagnosticFormat,
@@ -35,24 +39,35 @@ pub enum DiagnosticFormat {
 /// Runs `macrotree validate`: every error of every file, exit 2 if any.
 pub fn validate(args: ValidateArgs) -> Result<(), CliError> {
     let mut failed = 0;
+    let override_scene = match &args.scene {
+        Some(path) => Some(std::sync::Arc::new(crate::scene::load_scene_file(path).map_err(
+            |diags| {
+                diags.iter().for_each(|d| eprintln!("{d}"));
+                CliError::Input(format!("error: the scene {} is invalid", path.display()))
+            },
+        )?)),
+        None => None,
+    };
     for tree in &args.trees {
-        let result = crate::plan::load_plan(tree);
+        let result = if is_scene_file(tree) {
+            crate::scene::load_scene_file(tree).map(|s| (s.objects.len(), s.goal.atoms.len()))
+        } else {
+            crate::plan::load_plan_for(tree, override_scene.clone()).map(|p| (p.nodes.len(), p.leaves.len()))
+        };
         if result.is_err() {
             failed += 1;
         }
         match args.format {
             DiagnosticFormat::Human => match &result {
-                Ok(plan) => println!(
-                    "{}: ok ({} nodes, {} leaves)",
-                    tree.display(),
-                    plan.nodes.len(),
-                    plan.leaves.len()
-                ),
+                Ok((a, b)) if is_scene_file(tree) => {
+                    println!("{}: ok (scene: {a} objects, {b} goal predicates)", tree.display())
+                }
+                Ok((nodes, leaves)) => println!("{}: ok ({nodes} nodes, {leaves} leaves)", tree.display()),
                 Err(diags) => diags.iter().for_each(|d| eprintln!("{d}")),
             },
             DiagnosticFormat::Json => {
                 let (nodes, leaves, diags) = match &result {
-                    Ok(plan) => (plan.nodes.len(), plan.leaves.len(), &[][..]),
+                    Ok((a, b)) => (*a, *b, &[][..]),
                     Err(diags) => (0, 0, &diags[..]),
                 };
                 let line = serde_json::json!({
@@ -78,6 +93,21 @@ pub fn validate(args: ValidateArgs) -> Result<(), CliError> {
         )))
     } else {
         Ok(())
+    }
+}
+
+/// True for a scene file: a YAML mapping with `objects:` and without `main:` (read cheaply: a
+/// file that cannot be read is left to the tree loader, which reports why).
+fn is_scene_file(path: &std::path::Path) -> bool {
+    let Ok(bytes) = crate::spec::load::read_limited(path) else {
+        return false;
+    };
+    let Ok(text) = std::str::from_utf8(&bytes) else {
+        return false;
+    };
+    match crate::spec::value::parse_yaml(text, 0) {
+        Ok(v) => v.get("objects").is_some() && v.get("main").is_none(),
+        Err(_) => false,
     }
 }
 

@@ -187,7 +187,9 @@ pub fn check_scene(uses: &[ObjectUse], scene: &SceneSpec, describe: impl Fn(Loc)
             Named::Ref(ObjectRef::Name(n)) => match scene.object(n.as_str()) {
                 None => {
                     let what = if u.role == Role::Any { "target" } else { "object" };
-                    Issue::new(u.loc, format!("unknown {what} `{n}` in `{}`", u.leaf))
+                    let hint = did_you_mean(n.as_str(), names.iter().copied())
+                        .map_or(String::new(), |h| format!(" ({h})"));
+                    Issue::new(u.loc, format!("unknown {what} `{n}` in `{}`{hint}", u.leaf))
                         .label(format!(
                             "expected an object of scene `{}` ({}), a variable `{{name}}`{}",
                             scene.name,
@@ -198,7 +200,7 @@ pub fn check_scene(uses: &[ObjectUse], scene: &SceneSpec, describe: impl Fn(Loc)
                                 ""
                             }
                         ))
-                        .maybe_help(did_you_mean(n.as_str(), names.iter().copied()))
+                        .help("name an object of the scene, or run the tree on another scene with `--scene FILE`")
                 }
                 Some(o) if !u.role.accepts(o.kind()) => Issue::new(
                     u.loc,

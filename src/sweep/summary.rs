@@ -139,7 +139,7 @@ impl Summary {
                 indices,
             })
             .collect();
-        failure_groups.sort_by(|a, b| b.count.cmp(&a.count));
+        failure_groups.sort_by_key(|g| std::cmp::Reverse(g.count));
         Self {
             tree: tree.to_string(),
             seed: config.seed,
