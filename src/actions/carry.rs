@@ -6,7 +6,7 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
 use super::targets::{resolve, target_object};
-use crate::motion::{CartesianMove, MotionLimits, Trajectory};
+use crate::motion::{CartesianMove, JointMove, MotionLimits, Trajectory};
 use crate::scene::ObjectKind;
 use crate::spec::Carry as CarrySpec;
 use crate::world::World;
@@ -28,6 +28,10 @@ pub const CLEARANCE: f64 = 0.03;
 /// Reach of the closed fingers beyond the held block's faces, in the table plane, metres (the
 /// 2F-85's fingertips are about 2 cm wide and the pads 8 mm thick).
 pub const FINGER_MARGIN: f64 = 0.025;
+
+/// Radius around a set-down block's centre that the fingers sweep when they open to release it
+/// (up to 6 cm apart, plus pads and fingertips), metres.
+pub const RELEASE_REACH: f64 = 0.05;
 
 /// The carry's phases, in order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -129,7 +133,9 @@ impl Carry {
         if inside.is_empty() {
             return centre;
         }
-        let usable = inner_half.map(|h| (h - self.half - FINGER_MARGIN).max(0.0));
+        // The opening fingers may point any way: keep their whole sweep inside the walls.
+        let reach = (self.half * std::f64::consts::SQRT_2).max(RELEASE_REACH) + 0.005;
+        let usable = inner_half.map(|h| (h - reach).max(0.0));
         let (s, co) = crate::world::snapshot::yaw_of(&w.objects[c].quat).sin_cos();
         let mut candidates: Vec<Vector2<f64>> = Vec::with_capacity(25);
         for i in -2..=2 {
@@ -208,12 +214,26 @@ impl Carry {
             tool_speed: self.spec.speed,
             ..MotionLimits::default()
         };
-        let mv = CartesianMove::new(cell.arm_setpoint(), pose, &limits)
-            .map_err(|e| format!("unreachable carry path ({}): {e}", phase.name()))?;
-        self.goal_q = mv.end();
+        let from = cell.arm_setpoint();
+        match CartesianMove::new(from, pose, &limits) {
+            Ok(mv) => {
+                self.goal_q = mv.end();
+                cell.track(Box::new(mv));
+            }
+            // The transfer runs at a height that clears everything: when its straight line
+            // crosses a wrist singularity or a branch flip, a joint move to the same pose does.
+            Err(line) if phase == Phase::Transfer => {
+                let goal = crate::motion::ik(&pose, &from).map_err(|e| {
+                    format!("unreachable carry path ({}): {line}; and by a joint move: {e}", phase.name())
+                })?;
+                tracing::debug!(target: "macrotree::actions", "carry: straight transfer impossible ({line}); joint move instead");
+                self.goal_q = goal;
+                cell.track(Box::new(JointMove::new(from, goal, &limits)));
+            }
+            Err(e) => return Err(format!("unreachable carry path ({}): {e}", phase.name())),
+        }
         self.phase = phase;
         self.phase_end = end;
-        cell.track(Box::new(mv));
         Ok(())
     }
 

@@ -171,7 +171,7 @@ impl<'a> MacroDriver<'a> {
                 };
                 let what = format!("{who} hit {}", w.describe(other));
                 if !self.collisions.iter().any(|c| c.what == what) {
-                    tracing::warn!(target: "macrotree::actions", sim_time = w.time, "collision: {what}");
+                    tracing::info!(target: "macrotree::actions", sim_time = w.time, "collision: {what}");
                     self.collisions.push(Collision { time: w.time, what });
                 }
             }

@@ -11,10 +11,19 @@ use crate::spec::Release as ReleaseSpec;
 /// How close the opening must come to its target, metres.
 const WIDTH_TOLERANCE: f64 = 0.002;
 
+/// Driver-joint speed below which the fingers count as stopped, rad/s.
+const STALL_SPEED: f64 = 0.02;
+/// Consecutive stopped ticks (after [`MIN_OPEN_TIME`]) before an opening counts as blocked.
+const STALL_TICKS: u32 = 10;
+/// Time the fingers get to start moving before a stop counts, seconds.
+const MIN_OPEN_TIME: f64 = 0.2;
+
 /// Executes a [`ReleaseSpec`].
 pub struct Release {
     spec: ReleaseSpec,
     target_width: f64,
+    t0: f64,
+    stalled: u32,
     retreating: bool,
     goal_q: [f64; 6],
     arrival: Arrival,
@@ -26,6 +35,8 @@ impl Release {
         Self {
             spec,
             target_width: 0.0,
+            t0: 0.0,
+            stalled: 0,
             retreating: false,
             goal_q: [0.0; 6],
             arrival: Arrival::default(),
@@ -43,13 +54,24 @@ impl MacroAction for Release {
         cell.set_gripper(ctrl);
         self.target_width = width;
         self.retreating = false;
+        self.t0 = cell.world().time;
+        self.stalled = 0;
         Ok(())
     }
 
     fn update(&mut self, cell: &mut Cell) -> Progress {
         if !self.retreating {
-            if (cell.world().gripper_width - self.target_width).abs() > WIDTH_TOLERANCE {
-                return Progress::Running;
+            let w = cell.world();
+            if (w.gripper_width - self.target_width).abs() > WIDTH_TOLERANCE {
+                // Fingers stopped short of the opening (against a wall or a neighbour): once no
+                // block is held any more the release has done its job, so retreat anyway.
+                let stopped = w.time - self.t0 >= MIN_OPEN_TIME && w.gripper_speed.abs() < STALL_SPEED;
+                self.stalled = if stopped { self.stalled + 1 } else { 0 };
+                let held = w.held_block(crate::world::conditions::Tolerances::GRASP_OFF_AXIS);
+                if self.stalled < STALL_TICKS || held.is_some() {
+                    return Progress::Running;
+                }
+                tracing::debug!(target: "macrotree::actions", width = w.gripper_width, "release: the fingers stopped at {:.1} mm of {:.1} mm (blocked); retreating", w.gripper_width * 1e3, self.target_width * 1e3);
             }
             if self.spec.retreat == 0.0 {
                 return Progress::Done;

@@ -91,6 +91,7 @@ pub fn failure_kind(reason: &str) -> &'static str {
         ("grasp failed", "grasp_failed"),
         ("unreachable", "unreachable"),
         ("no clear way", "blocked"),
+        ("blocked:", "blocked"),
         ("timeout", "timeout"),
         ("expired", "timeout"),
         ("preempted", "halted"),

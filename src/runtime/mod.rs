@@ -44,6 +44,21 @@ use crate::spec::Leaf;
 pub use blackboard::Blackboard;
 pub use runner::TreeRunner;
 
+/// One blackboard write, as logged (also a `tracing` event, target `macrotree::blackboard`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BlackboardWrite {
+    /// Tick number.
+    pub tick: u64,
+    /// Simulated time of that tick, seconds.
+    pub sim_time: f64,
+    /// The node that wrote (a `select` or a `for_each`).
+    pub path: String,
+    /// The variable.
+    pub var: String,
+    /// The value written (`None`: unset, e.g. a `goal_as` for an object without a goal).
+    pub value: Option<String>,
+}
+
 /// What a `select` (or a `for_each` iteration) found: an object's name and, when it has a goal
 /// in the scene, where the goal sends it.
 #[derive(Clone, Debug, PartialEq, Eq)]

@@ -58,6 +58,8 @@ struct RunState {
     last_failure: Option<String>,
     /// The node of the last leaf that failed.
     last_failed_node: Option<usize>,
+    /// Blackboard writes since the last drain (bounded like the transitions).
+    writes: Vec<super::BlackboardWrite>,
     transitions: Vec<Transition>,
     dropped: u64,
     tick: u64,
@@ -106,6 +108,7 @@ impl RunState {
             vars: Blackboard::default(),
             last_failure: None,
             last_failed_node: None,
+            writes: Vec::new(),
             transitions: Vec::new(),
             dropped: 0,
             tick: 0,
@@ -450,6 +453,16 @@ impl RunState {
                 "{{{var}}} = {}",
                 value.as_deref().map_or("(unset: no goal)".to_string(), |v| format!("\"{v}\""))
             );
+            if self.writes.len() >= MAX_PENDING_TRANSITIONS {
+                self.writes.remove(0);
+            }
+            self.writes.push(super::BlackboardWrite {
+                tick: self.tick,
+                sim_time: self.sim_time,
+                path: info.path.clone(),
+                var: var.clone(),
+                value: value.clone(),
+            });
             self.vars.set(&var, value);
         }
     }
@@ -653,6 +666,11 @@ impl TreeRunner {
     /// first run, then 1, 2, …
     pub fn attempt(&self, node: usize) -> u32 {
         self.st.attempts.get(node).copied().unwrap_or(0)
+    }
+
+    /// Blackboard writes since the last drain, in the order they happened.
+    pub fn drain_blackboard_writes(&mut self) -> Vec<super::BlackboardWrite> {
+        std::mem::take(&mut self.st.writes)
     }
 
     /// The path of the last leaf that failed (since the last reset).

@@ -30,6 +30,8 @@ pub struct Failure {
     pub node: Option<String>,
     /// The kind of failure (`timeout`, `grasp_lost`, …).
     pub kind: Option<&'static str>,
+    /// Contacts that should not happen, by name (`the fingers hit bin wall`).
+    pub collisions: Vec<String>,
     /// Why it failed.
     pub reason: String,
     /// Grasp attempts made.
@@ -117,6 +119,7 @@ impl Summary {
                 bowl: r.layout.map(|l| l.bowl),
                 node: r.failed_node.clone(),
                 kind: r.failure_kind,
+                collisions: r.collisions.iter().map(|c| c.what.clone()).collect(),
                 reason: r.failure_reason.clone().unwrap_or_else(|| "failed".into()),
                 grasp_attempts: r.grasp_attempts,
                 reproduce: r.reproduce(tree, config),
@@ -219,6 +222,9 @@ impl Summary {
             let _ = writeln!(s, "  failures ({}):", self.failures.len());
             for f in &self.failures {
                 let _ = writeln!(s, "    #{}: {}", f.index, f.reason);
+                if !f.collisions.is_empty() {
+                    let _ = writeln!(s, "      collisions: {}", f.collisions.join("; "));
+                }
                 let _ = writeln!(s, "      {}", f.reproduce);
             }
         }

@@ -107,9 +107,14 @@ impl EpisodeObserver for ViewObserver {
     fn on_tick(&mut self, cell: &Cell, runner: &mut TreeRunner) {
         let time = cell.world().time;
         let transitions = runner.drain_transitions();
-        if !transitions.is_empty() || time >= self.next_publish {
+        let writes = runner.drain_blackboard_writes();
+        if !transitions.is_empty() || !writes.is_empty() || time >= self.next_publish {
             let statuses: Vec<&'static str> = runner.node_statuses().iter().map(|s| s.as_str()).collect();
-            let events: Vec<serde_json::Value> = transitions.iter().map(event_json).collect();
+            let mut events: Vec<serde_json::Value> = transitions.iter().map(event_json).collect();
+            // Blackboard writes (`{block} = "red"`) are events of their own.
+            events.extend(writes.iter().map(|w| {
+                serde_json::json!({"t": w.sim_time, "path": w.path, "kind": "blackboard", "var": w.var, "value": w.value})
+            }));
             if let Some(live) = &self.live {
                 let attempts = (0..statuses.len()).map(|i| runner.attempt(i)).collect();
                 live.publish_tree_status_with_attempts(statuses.clone(), attempts, events.clone());
