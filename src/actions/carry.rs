@@ -224,7 +224,10 @@ impl Carry {
             // crosses a wrist singularity or a branch flip, a joint move to the same pose does.
             Err(line) if phase == Phase::Transfer => {
                 let goal = crate::motion::ik(&pose, &from).map_err(|e| {
-                    format!("unreachable carry path ({}): {line}; and by a joint move: {e}", phase.name())
+                    format!(
+                        "unreachable carry path ({}): {line}; and by a joint move: {e}",
+                        phase.name()
+                    )
                 })?;
                 tracing::debug!(target: "macrotree::actions", "carry: straight transfer impossible ({line}); joint move instead");
                 self.goal_q = goal;

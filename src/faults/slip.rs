@@ -13,11 +13,11 @@
 use nalgebra::Vector3;
 use rand_chacha::ChaCha8Rng;
 
-use super::push::cube_pos;
 use super::{Fault, uniform};
 use crate::motion::gripper::ctrl_for_width;
 use crate::sim::Sim;
-use crate::world::{CUBE_HALF, World};
+use crate::world::World;
+use crate::world::conditions::Tolerances;
 
 /// How far the pads relax beyond the cube's width, metres.
 const RELAX: f64 = 0.008;
@@ -35,11 +35,16 @@ const HEIGHT: [f64; 2] = [0.03, 0.10];
 enum State {
     /// Waiting for the first carry.
     Idle,
-    /// The first carry started with the cube at height `from`; waiting for it to rise by
-    /// `height`.
-    Armed { from: f64 },
-    /// The grip is relaxed since `t0`, and the jolt acts for the first [`JOLT`] seconds.
-    Slipping { t0: f64, force: Vector3<f64> },
+    /// The first carry started with block `block` (the one it carries) at height `from`;
+    /// waiting for it to rise by `height`.
+    Armed { block: usize, from: f64 },
+    /// The grip is relaxed since `t0`, and the jolt acts on `block` for the first [`JOLT`]
+    /// seconds.
+    Slipping {
+        block: usize,
+        t0: f64,
+        force: Vector3<f64>,
+    },
     /// Fired (once per episode).
     Done,
 }
@@ -62,44 +67,61 @@ impl Slip {
     }
 }
 
+/// Block `i`'s centre, world frame, metres (read from its free joint).
+fn block_pos(sim: &Sim, i: usize) -> Vector3<f64> {
+    let q = sim.scene().objects[i].qpos.unwrap_or_default();
+    let qpos = sim.data().qpos();
+    Vector3::new(qpos[q], qpos[q + 1], qpos[q + 2])
+}
+
 impl Fault for Slip {
     fn on_action_start(&mut self, kind: &str, world: &World) {
-        if kind == "carry" && matches!(self.state, State::Idle) {
+        if kind == "carry"
+            && matches!(self.state, State::Idle)
+            && let Some(block) = world.held_block(Tolerances::GRASP_OFF_AXIS)
+        {
             self.state = State::Armed {
-                from: world.cube_pos.z,
+                block,
+                from: world.objects[block].pos.z,
             };
         }
     }
 
     fn before_step(&mut self, sim: &mut Sim) -> Option<String> {
-        let body = sim.scene().ids.cube_body;
         let mut fired = None;
-        if let State::Armed { from } = self.state
-            && cube_pos(sim).z >= from + self.height
+        if let State::Armed { block, from } = self.state
+            && block_pos(sim, block).z >= from + self.height
         {
             let side = Vector3::new(self.side_angle.cos(), self.side_angle.sin(), 0.0) * SIDE_FORCE;
             let force = side - Vector3::z() * DOWN_FORCE;
-            let c = cube_pos(sim);
+            let c = block_pos(sim, block);
             fired = Some(format!(
-                "{:.0} mm up, the grip relaxes for {:.0} ms and a {:.1} N jolt pushes the cube at ({:.3}, {:.3}, {:.3}) m out of the pads",
+                "{:.0} mm up, the grip relaxes for {:.0} ms and a {:.1} N jolt pushes {} at ({:.3}, {:.3}, {:.3}) m out of the pads",
                 self.height * 1e3,
                 WINDOW * 1e3,
                 force.norm(),
+                sim.scene().spec.objects[block].name,
                 c.x,
                 c.y,
                 c.z
             ));
             self.state = State::Slipping {
+                block,
                 t0: sim.time(),
                 force,
             };
         }
-        if let State::Slipping { t0, force } = self.state {
+        if let State::Slipping { block, t0, force } = self.state {
             let t = sim.time() - t0;
             let jolt = if t < JOLT { force } else { Vector3::zeros() };
+            let body = sim.scene().objects[block].body;
             sim.data_mut().xfrc_applied_mut()[body] = [jolt.x, jolt.y, jolt.z, 0.0, 0.0, 0.0];
+            let edge = match sim.scene().spec.objects[block].shape {
+                crate::scene::Shape::Block { half, .. } => 2.0 * half,
+                _ => 0.0,
+            };
             if t < WINDOW {
-                sim.set_gripper_ctrl(ctrl_for_width(2.0 * CUBE_HALF + RELAX));
+                sim.set_gripper_ctrl(ctrl_for_width(edge + RELAX));
             } else {
                 self.state = State::Done;
             }
