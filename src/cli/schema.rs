@@ -25,5 +25,5 @@ pub fn schema_text() -> String {
 
 /// Runs `macrotree schema`.
 pub fn schema(args: SchemaArgs) -> Result<(), CliError> {
-    write_output(args.out.as_deref(), &schema_text())
+    write_output(args.out.as_deref(), &[], &schema_text())
 }

@@ -4,9 +4,10 @@ use std::collections::{HashMap, HashSet};
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
+use super::confine::{IncludeScope, parse_top_level};
 use super::diag::{Diagnostic, FileId, Issue, Loc, Sources};
 use super::expand::{Expander, undefined_params};
-use super::file::{SubtreeDef, TreeFile, parse_tree_file};
+use super::file::{SubtreeDef, TreeFile};
 use super::node::Node;
 use super::suggest::closest;
 use super::value::{MAX_FILE_BYTES, decode_utf8, parse_yaml};
@@ -25,6 +26,8 @@ pub struct Spec {
     pub sources: Sources,
     /// Every subtree definition found (main file and includes), in load order.
     pub subtrees: Vec<SubtreeDef>,
+    /// The canonical paths of the files read from disk (main file and includes), sorted.
+    pub files: Vec<PathBuf>,
 }
 
 /// Load a tree file from disk (following includes relative to it).
@@ -133,14 +136,16 @@ struct Loader {
     issues: Vec<Issue>,
     loaded: HashSet<PathBuf>,
     defs: Vec<SubtreeDef>,
+    scope: IncludeScope,
 }
 
 impl Loader {
     fn finish(mut self, text: &str, name: &str, base: Option<&Path>) -> Result<Spec, Vec<Diagnostic>> {
+        self.scope = IncludeScope::for_base(base);
         let id = self.sources.add(name, text);
-        let root_file = match parse_yaml(text, id).map(|v| parse_tree_file(&v, &mut self.issues)) {
-            Ok(Some(f)) => f,
-            Ok(None) => return Err(self.sources.diagnostics(&self.issues)),
+        let (root_file, is_tree) = match parse_yaml(text, id).map(|v| parse_top_level(&v, &mut self.issues)) {
+            Ok((Some(f), is_tree)) => (f, is_tree),
+            Ok((None, _)) => return Err(self.sources.diagnostics(&self.issues)),
             Err(issue) => {
                 self.issues.push(issue);
                 return Err(self.sources.diagnostics(&self.issues));
@@ -150,8 +155,13 @@ impl Loader {
         let main = match (&root_file.main, root_file.main_key) {
             (Some(m), _) => m.clone(),
             _ => {
+                // In a file that is not a tree, point at the one line already shown.
+                let at = match self.issues.iter().find(|i| i.loc.file == id) {
+                    Some(first) if !is_tree => first.loc,
+                    _ => Loc::file_start(id),
+                };
                 self.issues.push(
-                    Issue::new(Loc::file_start(id), "the file has no `main:` tree")
+                    Issue::new(at, "the file has no `main:` tree")
                         .label("expected `main: <node>`")
                         .help("add `main:` with the root node; files that only define subtrees are included with `include:`"),
                 );
@@ -247,11 +257,16 @@ impl Loader {
         }
 
         match root {
-            Some(root) if self.issues.is_empty() => Ok(Spec {
-                root,
-                sources: self.sources,
-                subtrees: self.defs,
-            }),
+            Some(root) if self.issues.is_empty() => {
+                let mut files: Vec<PathBuf> = self.loaded.into_iter().collect();
+                files.sort();
+                Ok(Spec {
+                    root,
+                    sources: self.sources,
+                    subtrees: self.defs,
+                    files,
+                })
+            }
             _ => {
                 if self.issues.is_empty() {
                     self.issues
@@ -288,6 +303,10 @@ impl Loader {
                 );
                 continue;
             }
+            if let Err(issue) = self.scope.check_spelling(base, rel, inc.loc) {
+                self.issues.push(issue);
+                continue;
+            }
             let canon = match path.canonicalize() {
                 Ok(c) => c,
                 Err(e) => {
@@ -299,6 +318,10 @@ impl Loader {
                     continue;
                 }
             };
+            if let Err(issue) = self.scope.check_resolved(&canon, rel, inc.loc) {
+                self.issues.push(issue);
+                continue;
+            }
             if !self.loaded.insert(canon) {
                 continue; // already loaded (diamond or cycle): its subtrees are known
             }
@@ -329,7 +352,7 @@ impl Loader {
             match parse_yaml(&text, id) {
                 Ok(v) => {
                     // A library's own `main:` is ignored (it can be a demo of its subtrees).
-                    if let Some(f) = parse_tree_file(&v, &mut self.issues) {
+                    if let (Some(f), _) = parse_top_level(&v, &mut self.issues) {
                         self.collect(&f, path.parent(), depth + 1);
                     }
                 }

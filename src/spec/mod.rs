@@ -10,6 +10,7 @@
 #![warn(missing_docs)]
 
 pub mod catalog;
+mod confine;
 pub mod de;
 pub mod diag;
 pub mod expand;
@@ -22,6 +23,7 @@ pub mod units;
 pub mod value;
 
 pub use catalog::{NodeDoc, ParamDoc, catalog, json_schema};
+pub use confine::{includes_anywhere, set_includes_anywhere};
 pub use diag::{Diagnostic, Issue, Loc, Sources};
 pub use leaves::{
     ActionLeaf, AtHome, Carry, ConditionLeaf, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable,
