@@ -11,35 +11,30 @@ pub const MAX_SPEED: f64 = 1000.0;
 /// tree's ~1000 scenarios per minute. Split bigger studies by `--seed`.
 pub const MAX_SCENARIOS: u64 = 10_000_000;
 
-fn number(s: &str) -> Result<f64, String> {
+/// `s` as a number accepted by `ok`, or an error that gives the `range`.
+fn number_in(s: &str, ok: impl Fn(f64) -> bool, range: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
-        _ => Err(format!("{s:?} is not a finite number")),
+        Ok(v) if v.is_finite() && ok(v) => Ok(v),
+        _ => Err(format!("must be {range}, got {s}")),
     }
 }
 
 /// `--max-sim-time S`: 0 < S ≤ [`MAX_SIM_TIME_S`].
 pub fn max_sim_time(s: &str) -> Result<f64, String> {
-    let v = number(s)?;
-    if v > 0.0 && v <= MAX_SIM_TIME_S {
-        Ok(v)
-    } else {
-        Err(format!(
-            "must be more than 0 and at most {MAX_SIM_TIME_S} seconds of simulated time, got {v}"
-        ))
-    }
+    number_in(
+        s,
+        |v| v > 0.0 && v <= MAX_SIM_TIME_S,
+        &format!("more than 0 and at most {MAX_SIM_TIME_S} seconds of simulated time"),
+    )
 }
 
 /// `--speed X`: [`MIN_SPEED`] ≤ X ≤ [`MAX_SPEED`].
 pub fn speed(s: &str) -> Result<f64, String> {
-    let v = number(s)?;
-    if (MIN_SPEED..=MAX_SPEED).contains(&v) {
-        Ok(v)
-    } else {
-        Err(format!(
-            "must be between {MIN_SPEED} and {MAX_SPEED} times real time, got {v}"
-        ))
-    }
+    number_in(
+        s,
+        |v| (MIN_SPEED..=MAX_SPEED).contains(&v),
+        &format!("between {MIN_SPEED} and {MAX_SPEED} times real time"),
+    )
 }
 
 /// `--scenarios N`: 1 ≤ N ≤ [`MAX_SCENARIOS`].
