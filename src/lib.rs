@@ -17,6 +17,7 @@
 //! | macro-action leaves (reach, grasp, carry, …) | [`actions`] | through [`sim`] |
 //! | one episode: tree + cell → report | [`episode`] | yes |
 //! | command-line interface | [`cli`] | yes |
+//! | safe output files (every file the CLI writes) | [`output`] | no |
 //!
 //! Units everywhere: metres, radians, seconds, unless a name says otherwise.
 
@@ -27,6 +28,7 @@ pub mod cli;
 pub mod episode;
 pub mod faults;
 pub mod motion;
+pub mod output;
 pub mod plan;
 pub mod runtime;
 pub mod scene;

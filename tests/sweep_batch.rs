@@ -31,7 +31,11 @@ fn sweep(config: &SweepConfig) -> Vec<ScenarioResult> {
     let mut streamed = Vec::new();
     let run = run_sweep(scene(), &plan(), config, |r| streamed.push(r.index)).expect("thread pool");
     let indices: Vec<u64> = run.results.iter().map(|r| r.index).collect();
-    assert_eq!(indices, config.indices(), "results come in scenario order");
+    assert_eq!(
+        indices,
+        config.indices().collect::<Vec<_>>(),
+        "results come in scenario order"
+    );
     assert_eq!(streamed, indices, "results are streamed in scenario order");
     run.results
 }

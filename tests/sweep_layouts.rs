@@ -110,7 +110,7 @@ fn shards_partition_the_scenarios() {
             })
             .collect();
         union.sort_unstable();
-        assert_eq!(union, full.indices(), "M = {m}");
+        assert_eq!(union, full.indices().collect::<Vec<_>>(), "M = {m}");
     }
     assert!("3/2".parse::<Shard>().is_err());
     assert!("2/2".parse::<Shard>().is_err());

@@ -138,12 +138,21 @@ fn fuzz_entry_reports_bad_utf8_located() {
     assert!(d[0].file.ends_with("fuzz_input.yaml"), "{}", d[0].file);
 }
 
+/// The include tests below pin what the loader does with files outside the tree's folder when
+/// includes may read anywhere (`--allow-include-outside`); by default such includes are refused
+/// before they are opened (tests/include_confinement.rs). The setting is process-wide, and no
+/// test in this file depends on the default.
+fn allow_includes_anywhere() {
+    macrotree::spec::set_includes_anywhere(true);
+}
+
 /// Bug (found reviewing what the fuzz target can reach): `include:` of a device was read to its
 /// end. `/dev/zero` reports size 0, so the size check passed and the loader read until it ran out
 /// of memory.
 #[cfg(unix)]
 #[test]
 fn include_of_dev_zero_is_rejected_not_read() {
+    allow_includes_anywhere();
     let d = compile_bytes(b"include: [/dev/zero]\nmain: {home: {}}\n", "t.yaml").unwrap_err();
     assert_eq!(d.len(), 1, "{d:?}");
     assert_eq!(d[0].message, "`/dev/zero` is not a regular file");
@@ -154,6 +163,7 @@ fn include_of_dev_zero_is_rejected_not_read() {
 #[cfg(unix)]
 #[test]
 fn include_of_a_fifo_does_not_block() {
+    allow_includes_anywhere();
     let dir = std::env::temp_dir().join(format!("macrotree-fuzz-fifo-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let fifo = dir.join("pipe.yaml");
@@ -175,6 +185,7 @@ fn include_of_a_fifo_does_not_block() {
 #[cfg(target_os = "linux")]
 #[test]
 fn include_of_an_endless_proc_file_stops_at_the_size_limit() {
+    allow_includes_anywhere();
     let pagemap = Path::new("/proc/self/pagemap");
     assert!(pagemap.is_file(), "/proc/self/pagemap is missing");
     let d = compile_bytes(b"include: [/proc/self/pagemap]\nmain: {home: {}}\n", "t.yaml").unwrap_err();

@@ -93,9 +93,9 @@ fn missing_include_is_located_at_the_include_entry() {
 fn duplicate_subtree_across_files_is_an_error() {
     let d = load_plan(Path::new("tests/fixtures/trees/bad/dup_subtree.yaml")).unwrap_err();
     let e = find(&d, "defined twice");
-    assert!(e.file.ends_with("lib/pick_place.yaml"), "{e}");
-    assert_eq!(at(e), (4, 3));
-    assert!(e.note.as_deref().unwrap().contains("dup.yaml:2:3"));
+    assert!(e.file.ends_with("bad/lib/dup.yaml"), "{e}");
+    assert_eq!(at(e), (2, 3));
+    assert!(e.note.as_deref().unwrap().contains("dup_subtree.yaml:4:3"), "{e}");
 }
 
 #[test]

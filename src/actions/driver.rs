@@ -53,7 +53,7 @@ pub struct MacroDriver<'a> {
 }
 
 /// A contact that should not happen (the fingers on a wall, the carried block on an obstacle).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Collision {
     /// Simulated time it was first seen, seconds.
     pub time: f64,

@@ -37,5 +37,9 @@ pub fn graph(args: GraphArgs) -> Result<(), CliError> {
         GraphFormat::Dot => crate::plan::to_dot(&plan),
         GraphFormat::Mermaid => crate::plan::to_mermaid(&plan),
     };
-    write_output(args.out.as_deref(), &text)
+    write_output(
+        args.out.as_deref(),
+        &super::outputs::tree_inputs(&args.tree),
+        &text,
+    )
 }

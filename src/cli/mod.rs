@@ -7,11 +7,14 @@
 mod args;
 mod bench;
 mod graph;
+mod limits;
 mod logging;
 mod nodes;
+mod outputs;
 mod run;
 mod schema;
 mod sweep;
+mod sweep_out;
 mod validate;
 
 use std::process::ExitCode;
@@ -30,6 +33,9 @@ pub struct Cli {
     /// Log format on stderr.
     #[arg(long, value_enum, default_value_t = logging::LogFormat::Pretty, global = true)]
     pub log_format: logging::LogFormat,
+    /// Let `include:` read files outside the main tree file's folder (see docs/security.md).
+    #[arg(long, global = true)]
+    pub allow_include_outside: bool,
     /// The command.
     #[command(subcommand)]
     pub command: Command,
@@ -68,6 +74,7 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let quiet = matches!(cli.command, Command::Bench(_) | Command::Sweep(_));
     logging::init(cli.verbose, cli.log_format, quiet);
+    crate::spec::set_includes_anywhere(cli.allow_include_outside);
     let result = match cli.command {
         Command::Run(args) => run::run(args),
         Command::Validate(args) => validate::validate(args),
@@ -138,9 +145,14 @@ fn load_task(
     Ok((plan, scene))
 }
 
-/// Writes `text` to `out`, or to stdout when `out` is `None`. A closed stdout pipe (`| head`)
-/// ends the output quietly; a file that cannot be written is bad input (exit 2).
-fn write_output(out: Option<&std::path::Path>, text: &str) -> Result<(), CliError> {
+/// Writes `text` to `out` (safely, see [`crate::output`]; `inputs` are the files the command
+/// read, which are never overwritten), or to stdout when `out` is `None`. A closed stdout pipe
+/// (`| head`) ends the output quietly; a file that cannot be written is bad input (exit 2).
+fn write_output(
+    out: Option<&std::path::Path>,
+    inputs: &[std::path::PathBuf],
+    text: &str,
+) -> Result<(), CliError> {
     use std::io::Write as _;
     match out {
         None => match std::io::stdout().lock().write_all(text.as_bytes()) {
@@ -149,7 +161,8 @@ fn write_output(out: Option<&std::path::Path>, text: &str) -> Result<(), CliErro
             }
             _ => Ok(()),
         },
-        Some(path) => std::fs::write(path, text)
-            .map_err(|e| CliError::Input(format!("error: cannot write {}: {e}", path.display()))),
+        Some(path) => outputs::check_output(path, inputs)?
+            .write_all(text.as_bytes())
+            .map_err(outputs::output_error),
     }
 }

@@ -44,7 +44,7 @@ pub fn nodes(args: NodesArgs) -> Result<(), CliError> {
     } else {
         render(&shown)
     };
-    write_output(None, &text)
+    write_output(None, &[], &text)
 }
 
 /// Plain-text catalog: kinds grouped by category, each with its summary, parameters, halt

@@ -32,9 +32,10 @@ pub struct RunArgs {
     #[arg(long, conflicts_with = "speed")]
     pub realtime: bool,
     /// Pace the simulation at X times real time.
-    #[arg(long, value_name = "X")]
+    #[arg(long, value_name = "X", value_parser = super::limits::speed)]
     pub speed: Option<f64>,
-    /// Write the episode as one self-contained HTML replay (plays offline).
+    /// Write the episode as one self-contained HTML replay (plays offline); a regular file or a
+    /// new path, never the tree itself (see docs/security.md).
     #[arg(long, value_name = "FILE.html")]
     pub record: Option<PathBuf>,
 }
@@ -61,8 +62,8 @@ pub struct EpisodeArgs {
     /// Seed for fault timing and magnitude.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Stop the episode (as a failure) after this much simulated time, seconds.
-    #[arg(long, default_value_t = 60.0, value_name = "S")]
+    /// Stop the episode (as a failure) after this much simulated time, seconds (at most 3600).
+    #[arg(long, default_value_t = 60.0, value_name = "S", value_parser = super::limits::max_sim_time)]
     pub max_sim_time: f64,
     /// Inject a fault through physics (see docs/faults.md).
     #[arg(long, value_enum)]
@@ -160,6 +161,11 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
     let (plan, scene) = load_task(&args.tree, args.episode.scene.as_deref())?;
     let plan = Arc::new(plan);
     let config = args.episode.config_on(&scene)?;
+    let mut inputs = super::outputs::tree_inputs(&args.tree);
+    inputs.extend(args.episode.scene.clone());
+    let record_out = (args.record.as_deref())
+        .map(|p| super::outputs::check_output(p, &inputs))
+        .transpose()?;
     tracing::info!(tree = %args.tree.display(), scene = %scene.spec.name, seed = config.seed, "episode start");
     let speed = match (args.realtime, args.speed) {
         (true, _) => Some(1.0),
@@ -197,10 +203,10 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
         let mut view = ViewObserver::new(&plan, live, recorder, speed);
         let report = run_episode(&scene, plan.clone(), &config, &mut view);
         let (live, recorder) = view.finish();
-        if let (Some(rec), Some(path)) = (recorder, &args.record) {
-            rec.write(path)
-                .map_err(|e| CliError::Input(format!("error: cannot write {}: {e}", path.display())))?;
-            eprintln!("replay written to {}", path.display());
+        if let (Some(rec), Some(out)) = (recorder, &record_out) {
+            rec.write_to(out)
+                .map_err(|e| CliError::Input(format!("error: {e}")))?;
+            eprintln!("replay written to {}", out.path().display());
         }
         finish_report(&report, args.json);
         if let Some(live) = live {

@@ -48,5 +48,5 @@ pub fn schema(args: SchemaArgs) -> Result<(), CliError> {
     } else {
         schema_text()
     };
-    write_output(args.out.as_deref(), &text)
+    write_output(args.out.as_deref(), &[], &text)
 }

@@ -2,8 +2,8 @@
 //!
 //! Exit codes: 0 when every scenario succeeded, 1 when any failed, 2 on bad input.
 
-use std::fs::File;
-use std::io::{BufWriter, IsTerminal, Write};
+use std::io::IsTerminal;
+use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -13,7 +13,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use super::{CliError, load_task};
 use crate::episode::Goal;
 use crate::faults::FaultKind;
-use crate::sweep::{Shard, Summary, SweepConfig, run_sweep};
+use crate::sweep::{Shard, Summary, SweepConfig, run_sweep_from};
 
 /// Arguments of `sweep`.
 #[derive(Debug, Args)]
@@ -23,8 +23,9 @@ pub struct SweepArgs {
     /// Sweep this scene file instead of the tree's own `scene:` (or the built-in cube_bowl).
     #[arg(long, value_name = "FILE.yaml")]
     pub scene: Option<PathBuf>,
-    /// Number of scenarios (indices 0..N); with --shard, only this shard's share of them runs.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    /// Number of scenarios (indices 0..N, N ≤ 10 000 000); with --shard, only this shard's share
+    /// of them runs.
+    #[arg(long, value_name = "N", value_parser = super::limits::scenarios)]
     pub scenarios: u64,
     /// Sweep seed: scenario k of seed S is the same layout and episode seed everywhere.
     #[arg(long, default_value_t = 0, value_name = "S")]
@@ -39,17 +40,21 @@ pub struct SweepArgs {
     /// succeeded and the cube rests in the bowl; `tree` = the tree succeeded.
     #[arg(long, value_enum, default_value_t = Goal::Scene)]
     pub goal: Goal,
-    /// Write one JSON line per scenario here, in scenario order.
+    /// Write one JSON line per scenario here, in scenario order (a regular file or a new path).
     #[arg(long, value_name = "FILE.jsonl")]
     pub out: Option<PathBuf>,
+    /// Keep the complete results already in --out (from an interrupted run of this same sweep)
+    /// and run only the missing scenarios.
+    #[arg(long, requires = "out")]
+    pub resume: bool,
     /// Print the summary as one JSON object on the last line of stdout.
     #[arg(long)]
     pub json: bool,
     /// Run only the scenarios with index ≡ K (mod M), 0 ≤ K < M.
     #[arg(long, value_name = "K/M")]
     pub shard: Option<Shard>,
-    /// Stop each episode (as a failure) after this much simulated time, seconds.
-    #[arg(long, default_value_t = 60.0, value_name = "S")]
+    /// Stop each episode (as a failure) after this much simulated time, seconds (at most 3600).
+    #[arg(long, default_value_t = 60.0, value_name = "S", value_parser = super::limits::max_sim_time)]
     pub max_sim_time: f64,
 }
 
@@ -63,12 +68,6 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
     }
     let (plan, scene) = load_task(&args.tree, args.scene.as_deref())?;
     let plan = Arc::new(plan);
-    let mut out = match &args.out {
-        Some(path) => Some(BufWriter::new(File::create(path).map_err(|e| {
-            CliError::Input(format!("error: cannot write {}: {e}", path.display()))
-        })?)),
-        None => None,
-    };
     let config = SweepConfig {
         scenarios: args.scenarios,
         seed: args.seed,
@@ -80,6 +79,26 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
         scene_file: args.scene.as_ref().map(|p| p.display().to_string()),
     };
     let total = config.indices().len() as u64;
+    if total == 0 {
+        return Err(CliError::Input(format!(
+            "error: shard {} of {} scenario(s) is empty (no index below {} is {} mod {}); \
+             use more --scenarios or fewer shards",
+            args.shard.map_or(String::new(), |s| s.to_string()),
+            config.scenarios,
+            config.scenarios,
+            args.shard.map_or(0, |s| s.index),
+            args.shard.map_or(1, |s| s.count),
+        )));
+    }
+    let (mut out, resumed) = match &args.out {
+        Some(path) => {
+            let (file, resumed) =
+                super::sweep_out::open(path, args.resume, &args.tree, &config, &scene, &plan)?;
+            (Some(file), resumed)
+        }
+        None => (None, Default::default()),
+    };
+    let done = resumed.results.len() as u64;
     let bar = if std::io::stderr().is_terminal() {
         ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
     } else {
@@ -96,30 +115,39 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
             )
             .progress_chars("=> "),
     );
+    bar.set_position(done);
     let mut failures = 0u64;
     let mut write_error = None;
-    let run = run_sweep(&scene, &plan, &config, |r| {
-        if let (Some(w), None) = (out.as_mut(), &write_error)
-            && let Err(e) = writeln!(w, "{}", r.to_jsonl()).and_then(|()| w.flush())
+    let run = run_sweep_from(&scene, &plan, &config, done, |r| {
+        if let Some(w) = out.as_mut()
+            && let Err(e) = w.write_line(&r.to_jsonl())
         {
             write_error = Some(e);
+            return ControlFlow::Break(());
         }
         if !r.success {
             failures += 1;
             bar.set_message(format!("{failures} failed"));
         }
         bar.inc(1);
+        ControlFlow::Continue(())
     })
     .map_err(|e| CliError::Input(format!("error: cannot start {} worker threads: {e}", config.jobs)))?;
     bar.finish_and_clear();
-    if let (Some(e), Some(path)) = (write_error, &args.out) {
+    if let (Some(e), Some(w)) = (write_error, &out) {
         return Err(CliError::Input(format!(
-            "error: writing {} failed: {e}",
-            path.display()
+            "error: {e}\nthe sweep stopped: the file keeps its {} complete line(s) of {total}; fix \
+             the problem and add --resume to run the rest",
+            done + w.lines()
         )));
     }
+    if let Some(w) = out {
+        w.finish().map_err(super::outputs::output_error)?;
+    }
+    let mut results = resumed.results;
+    results.extend(run.results);
     let tree = args.tree.display().to_string();
-    let summary = Summary::new(&tree, &config, &run.results, run.wall_time_s, run.jobs);
+    let summary = Summary::new(&tree, &config, &results, run.wall_time_s, run.jobs);
     print!("{}", summary.to_text());
     if args.json {
         println!("{}", serde_json::to_string(&summary).expect("summary serializes"));

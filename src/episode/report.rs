@@ -54,7 +54,7 @@ pub struct EpisodeReport {
 
 /// One object's initial and final pose: `[x, y, z, yaw]` in metres and degrees (a block's yaw
 /// is of its side faces, in [−45°, 45°)).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct ObjectReport {
     /// The object's name.
     pub name: String,

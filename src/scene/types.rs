@@ -21,7 +21,7 @@ pub fn reach_limits() -> [f64; 2] {
 }
 
 /// What an object is for.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, Serialize)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ObjectKind {
     /// A movable cube on a free joint: picked, carried, stacked, put in containers.

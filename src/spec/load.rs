@@ -5,9 +5,10 @@ use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use super::confine::{IncludeScope, parse_top_level};
 use super::diag::{Diagnostic, FileId, Issue, Loc, Sources};
 use super::expand::{Expander, undefined_params};
-use super::file::{SubtreeDef, TreeFile, parse_tree_file};
+use super::file::{SubtreeDef, TreeFile};
 use super::node::Node;
 use super::suggest::closest;
 use super::value::{MAX_FILE_BYTES, decode_utf8, parse_yaml};
@@ -39,6 +40,8 @@ pub struct Spec {
     pub object_uses: Vec<super::check::ObjectUse>,
     /// Every blackboard variable a `select` or `for_each` writes.
     pub var_defs: Vec<super::check::VarDef>,
+    /// The canonical paths of the files read from disk (main file and includes), sorted.
+    pub files: Vec<PathBuf>,
 }
 
 /// Load a tree file from disk (following includes relative to it), checking the objects it
@@ -166,6 +169,7 @@ struct Loader {
     scene_override: Option<Arc<SceneSpec>>,
     /// Diagnostics of a scene file the tree names (reported with the tree's).
     scene_diagnostics: Vec<Diagnostic>,
+    scope: IncludeScope,
 }
 
 /// The built-in `cube_bowl` scene, parsed once.
@@ -176,10 +180,11 @@ pub fn builtin_scene() -> Arc<SceneSpec> {
 
 impl Loader {
     fn finish(mut self, text: &str, name: &str, base: Option<&Path>) -> Result<Spec, Vec<Diagnostic>> {
+        self.scope = IncludeScope::for_base(base);
         let id = self.sources.add(name, text);
-        let root_file = match parse_yaml(text, id).map(|v| parse_tree_file(&v, &mut self.issues)) {
-            Ok(Some(f)) => f,
-            Ok(None) => return Err(self.sources.diagnostics(&self.issues)),
+        let (root_file, is_tree) = match parse_yaml(text, id).map(|v| parse_top_level(&v, &mut self.issues)) {
+            Ok((Some(f), is_tree)) => (f, is_tree),
+            Ok((None, _)) => return Err(self.sources.diagnostics(&self.issues)),
             Err(issue) => {
                 self.issues.push(issue);
                 return Err(self.sources.diagnostics(&self.issues));
@@ -189,8 +194,13 @@ impl Loader {
         let main = match (&root_file.main, root_file.main_key) {
             (Some(m), _) => m.clone(),
             _ => {
+                // In a file that is not a tree, point at the one line already shown.
+                let at = match self.issues.iter().find(|i| i.loc.file == id) {
+                    Some(first) if !is_tree => first.loc,
+                    _ => Loc::file_start(id),
+                };
                 self.issues.push(
-                    Issue::new(Loc::file_start(id), "the file has no `main:` tree")
+                    Issue::new(at, "the file has no `main:` tree")
                         .label("expected `main: <node>`")
                         .help("add `main:` with the root node; files that only define subtrees are included with `include:`"),
                 );
@@ -299,16 +309,21 @@ impl Loader {
         }
 
         match root {
-            Some(root) if self.issues.is_empty() => Ok(Spec {
-                root,
-                sources: self.sources,
-                subtrees: self.defs,
-                scene: root_file.scene.clone(),
-                scene_spec: scene.unwrap_or_else(builtin_scene),
-                description: root_file.description.clone(),
-                object_uses,
-                var_defs,
-            }),
+            Some(root) if self.issues.is_empty() => {
+                let mut files: Vec<PathBuf> = self.loaded.into_iter().collect();
+                files.sort();
+                Ok(Spec {
+                    root,
+                    sources: self.sources,
+                    subtrees: self.defs,
+                    scene: root_file.scene.clone(),
+                    scene_spec: scene.unwrap_or_else(builtin_scene),
+                    description: root_file.description.clone(),
+                    object_uses,
+                    var_defs,
+                    files,
+                })
+            }
             _ => {
                 if self.issues.is_empty() {
                     self.issues
@@ -378,6 +393,10 @@ impl Loader {
                 );
                 continue;
             }
+            if let Err(issue) = self.scope.check_spelling(base, rel, inc.loc) {
+                self.issues.push(issue);
+                continue;
+            }
             let canon = match path.canonicalize() {
                 Ok(c) => c,
                 Err(e) => {
@@ -389,6 +408,10 @@ impl Loader {
                     continue;
                 }
             };
+            if let Err(issue) = self.scope.check_resolved(&canon, rel, inc.loc) {
+                self.issues.push(issue);
+                continue;
+            }
             if !self.loaded.insert(canon) {
                 continue; // already loaded (diamond or cycle): its subtrees are known
             }
@@ -419,7 +442,7 @@ impl Loader {
             match parse_yaml(&text, id) {
                 Ok(v) => {
                     // A library's own `main:` is ignored (it can be a demo of its subtrees).
-                    if let Some(f) = parse_tree_file(&v, &mut self.issues) {
+                    if let (Some(f), _) = parse_top_level(&v, &mut self.issues) {
                         self.collect(&f, path.parent(), depth + 1);
                     }
                 }

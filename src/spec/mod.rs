@@ -11,6 +11,7 @@
 
 pub mod catalog;
 pub mod check;
+mod confine;
 pub mod de;
 pub mod diag;
 pub mod expand;
@@ -24,6 +25,7 @@ pub mod units;
 pub mod value;
 
 pub use catalog::{NodeDoc, ParamDoc, catalog, json_schema};
+pub use confine::{includes_anywhere, set_includes_anywhere};
 pub use diag::{Diagnostic, Issue, Loc, Sources};
 pub use leaves::{
     ActionLeaf, At, AtHome, Carry, ConditionLeaf, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable,

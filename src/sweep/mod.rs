@@ -17,19 +17,24 @@
 //! println!("{} of {} succeeded", run.results.iter().filter(|r| r.success).count(), run.results.len());
 //! ```
 
+mod indices;
 pub mod layout;
+pub mod resume;
 mod summary;
 
 use std::collections::BTreeMap;
+use std::ops::ControlFlow;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::str::FromStr;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 use std::time::Instant;
 
 use rayon::prelude::*;
 use serde::Serialize;
 
+pub use indices::ScenarioIndices;
 pub use layout::{Region, Scenario, ScenarioLayout, sample_scenario, sample_scenario_in};
 pub use summary::{Failure, FailureGroup, Summary, percentile, wilson_interval};
 
@@ -114,11 +119,9 @@ impl Default for SweepConfig {
 }
 
 impl SweepConfig {
-    /// The scenario indices this sweep runs, ascending.
-    pub fn indices(&self) -> Vec<u64> {
-        (0..self.scenarios)
-            .filter(|&i| self.shard.is_none_or(|s| s.contains(i)))
-            .collect()
+    /// The scenario indices this sweep runs, ascending (computed, never listed).
+    pub fn indices(&self) -> ScenarioIndices {
+        ScenarioIndices::new(self.scenarios, self.shard)
     }
 
     /// Scenario `index` of this sweep on `scene`. The built-in `cube_bowl` scene keeps the
@@ -457,50 +460,73 @@ pub fn run_sweep(
     config: &SweepConfig,
     mut on_result: impl FnMut(&ScenarioResult),
 ) -> Result<SweepRun, rayon::ThreadPoolBuildError> {
+    run_sweep_from(scene, plan, config, 0, |r| {
+        on_result(r);
+        ControlFlow::Continue(())
+    })
+}
+
+/// [`run_sweep`] without the first `skip` scenarios of the sweep (those already done, see
+/// [`resume`]), stopping as soon as `on_result` breaks: no scenario starts after that, the ones
+/// already running are finished and dropped, and `results` ends with the one that broke.
+pub fn run_sweep_from(
+    scene: &Scene,
+    plan: &Arc<Plan>,
+    config: &SweepConfig,
+    skip: u64,
+    mut on_result: impl FnMut(&ScenarioResult) -> ControlFlow<()>,
+) -> Result<SweepRun, rayon::ThreadPoolBuildError> {
     let wall = Instant::now();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(config.jobs)
         .thread_name(|i| format!("sweep-{i}"))
         .build()?;
     let jobs = pool.current_num_threads();
-    let indices = config.indices();
-    let mut results = Vec::with_capacity(indices.len());
+    let indices = config.indices().skip_first(skip);
+    // Memory grows with the results, not with the size of the sweep.
+    let mut results = Vec::with_capacity(indices.len().min(4096));
     let (tx, rx) = mpsc::channel::<(usize, ScenarioResult)>();
+    let stop = AtomicBool::new(false);
     std::thread::scope(|s| {
-        let indices = &indices;
+        let stop = &stop;
         s.spawn(move || {
             let new_cell = || Cell::new(scene, &Layout::default(), CONTROL_PERIOD);
             pool.install(|| {
                 // par_bridge hands out scenarios in index order, so results arrive nearly in order.
-                indices.iter().copied().enumerate().par_bridge().for_each_init(
-                    new_cell,
-                    |cell, (pos, index)| {
-                        let outcome =
-                            catch_unwind(AssertUnwindSafe(|| run_scene_scenario(cell, plan, config, index)));
-                        let result = outcome.unwrap_or_else(|payload| {
-                            *cell = new_cell();
-                            let s = config.scene_scenario(scene, index).ok();
-                            ScenarioResult::not_run(
-                                index,
-                                config.seed,
-                                s.as_ref().map_or(0, |s| s.seed),
-                                s.and_then(|s| s.layout),
-                                config.fault,
-                                format!("panicked: {}", panic_message(&*payload)),
-                            )
-                        });
-                        // The receiver lives until every result is in.
-                        let _ = tx.send((pos, result));
-                    },
-                );
+                let todo = indices.take_while(|_| !stop.load(Ordering::Relaxed)).enumerate();
+                todo.par_bridge().for_each_init(new_cell, |cell, (pos, index)| {
+                    let outcome =
+                        catch_unwind(AssertUnwindSafe(|| run_scene_scenario(cell, plan, config, index)));
+                    let result = outcome.unwrap_or_else(|payload| {
+                        *cell = new_cell();
+                        let s = config.scene_scenario(scene, index).ok();
+                        ScenarioResult::not_run(
+                            index,
+                            config.seed,
+                            s.as_ref().map_or(0, |s| s.seed),
+                            s.and_then(|s| s.layout),
+                            config.fault,
+                            format!("panicked: {}", panic_message(&*payload)),
+                        )
+                    });
+                    // The receiver lives until every result is in.
+                    let _ = tx.send((pos, result));
+                });
             });
         });
         let mut pending = BTreeMap::new();
         for (pos, result) in rx {
+            if stop.load(Ordering::Relaxed) {
+                continue; // draining the scenarios that were running
+            }
             pending.insert(pos, result);
             while let Some(result) = pending.remove(&results.len()) {
-                on_result(&result);
+                let flow = on_result(&result);
                 results.push(result);
+                if flow.is_break() {
+                    stop.store(true, Ordering::Relaxed);
+                    break;
+                }
             }
         }
     });
@@ -547,7 +573,7 @@ mod tests {
             })
             .collect();
         union.sort();
-        assert_eq!(union, all.indices());
+        assert_eq!(union, all.indices().collect::<Vec<_>>());
     }
 
     #[test]

@@ -14,6 +14,7 @@ use super::panel::TreeNodeView;
 use super::proto::{self, map, s};
 use super::scene::SceneLayout;
 use super::{initial_tree, page};
+use crate::output::OutputFile;
 
 /// Default sampling rate of a recording, frames per second of sim time.
 pub const DEFAULT_FPS: f64 = 30.0;
@@ -234,16 +235,18 @@ impl Recorder {
         page::standalone_html(bundle, &self.commands(), Some(&self.meta()))
     }
 
-    /// Writes the replay HTML to `path` (atomically: a temporary file, then a rename). Fails
-    /// with `NotFound` and a message naming tools/bootstrap when the viewer bundle is missing.
+    /// Writes the replay HTML to `path` (checked, then written safely and atomically, see
+    /// [`crate::output`]). Fails with `NotFound` and a message naming tools/bootstrap when the
+    /// viewer bundle is missing; any other error's message is complete (it names the file).
     pub fn write(&self, path: &Path) -> std::io::Result<()> {
+        self.write_to(&OutputFile::check(path, &[]).map_err(std::io::Error::other)?)
+    }
+
+    /// Writes the replay HTML to an output checked earlier, like [`write`](Self::write).
+    pub fn write_to(&self, out: &OutputFile) -> std::io::Result<()> {
         let bundle = page::load_bundle()
             .map_err(|p| std::io::Error::new(std::io::ErrorKind::NotFound, page::bundle_help(&p)))?;
-        let html = self.html(&bundle);
-        let mut tmp = path.as_os_str().to_owned();
-        tmp.push(".tmp");
-        let tmp = std::path::PathBuf::from(tmp);
-        std::fs::write(&tmp, html)?;
-        std::fs::rename(&tmp, path)
+        out.write_all(self.html(&bundle).as_bytes())
+            .map_err(std::io::Error::other)
     }
 }

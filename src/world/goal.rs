@@ -51,7 +51,7 @@ pub fn goal_holds(w: &World) -> bool {
 }
 
 /// One predicate's value, as reports carry it.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, serde::Deserialize)]
 pub struct GoalValue {
     /// The predicate, e.g. `red in red_bin`.
     pub predicate: String,

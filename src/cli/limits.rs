@@ -1,0 +1,72 @@
+//! Bounds of the numeric options, as `clap` value parsers: a value out of range is a usage error
+//! (exit 2) that names the range, before anything runs.
+
+/// Largest `--max-sim-time`, seconds of simulated time (one hour; the flagship task takes ~6 s).
+pub const MAX_SIM_TIME_S: f64 = 3600.0;
+/// Slowest `--speed` (a hundredth of real time).
+pub const MIN_SPEED: f64 = 0.01;
+/// Fastest `--speed` (a thousand times real time; faster than the simulation runs anyway).
+pub const MAX_SPEED: f64 = 1000.0;
+/// Most scenarios in one sweep (before sharding): about a week of one core at the flagship
+/// tree's ~1000 scenarios per minute. Split bigger studies by `--seed`.
+pub const MAX_SCENARIOS: u64 = 10_000_000;
+
+/// `s` as a number accepted by `ok`, or an error that gives the `range`.
+fn number_in(s: &str, ok: impl Fn(f64) -> bool, range: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && ok(v) => Ok(v),
+        _ => Err(format!("must be {range}, got {s}")),
+    }
+}
+
+/// `--max-sim-time S`: 0 < S ≤ [`MAX_SIM_TIME_S`].
+pub fn max_sim_time(s: &str) -> Result<f64, String> {
+    number_in(
+        s,
+        |v| v > 0.0 && v <= MAX_SIM_TIME_S,
+        &format!("more than 0 and at most {MAX_SIM_TIME_S} seconds of simulated time"),
+    )
+}
+
+/// `--speed X`: [`MIN_SPEED`] ≤ X ≤ [`MAX_SPEED`].
+pub fn speed(s: &str) -> Result<f64, String> {
+    number_in(
+        s,
+        |v| (MIN_SPEED..=MAX_SPEED).contains(&v),
+        &format!("between {MIN_SPEED} and {MAX_SPEED} times real time"),
+    )
+}
+
+/// `--scenarios N`: 1 ≤ N ≤ [`MAX_SCENARIOS`].
+pub fn scenarios(s: &str) -> Result<u64, String> {
+    match s.trim().parse::<u64>() {
+        Ok(n) if (1..=MAX_SCENARIOS).contains(&n) => Ok(n),
+        Ok(n) => Err(format!(
+            "must be between 1 and {MAX_SCENARIOS}, got {n} (split a bigger study into sweeps with different --seed)"
+        )),
+        Err(_) => Err(format!(
+            "{s:?} is not a whole number of scenarios between 1 and {MAX_SCENARIOS}"
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bounds() {
+        assert_eq!(speed("2"), Ok(2.0));
+        for bad in ["1e-22", "1e-18", "0", "-1", "1001", "inf", "NaN", "x"] {
+            assert!(speed(bad).is_err(), "{bad}");
+        }
+        assert_eq!(max_sim_time("3600"), Ok(3600.0));
+        for bad in ["0", "3600.5", "1e300", "nan"] {
+            assert!(max_sim_time(bad).is_err(), "{bad}");
+        }
+        assert_eq!(scenarios("10000000"), Ok(10_000_000));
+        for bad in ["0", "10000001", "18446744073709551615", "-1", "1e3"] {
+            assert!(scenarios(bad).is_err(), "{bad}");
+        }
+    }
+}

@@ -1,0 +1,166 @@
+//! What `include:` may read, and how much of a file that is not a tree a diagnostic may show.
+//!
+//! An include must resolve (after `..` and symbolic links are resolved) to a file inside the
+//! folder of the main tree file or one of its subfolders — the *tree folder*. Anything else
+//! (`/etc/shadow`, `/proc/self/environ`, `../../secret.yaml`, a link pointing out of the folder)
+//! is refused before it is opened, unless [`set_includes_anywhere`] allowed it for the whole
+//! process (the command line's `--allow-include-outside`).
+//!
+//! A file that is not a tree (not a mapping, or a mapping without any of `include:`,
+//! `subtrees:` and `main:`) gets one diagnostic, which shows at most the one line it points at.
+
+use std::path::{Component, Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use super::diag::{Issue, Loc};
+use super::file::{TOP_LEVEL_KEYS, TreeFile, parse_tree_file};
+use super::value::{Value, ValueKind};
+
+static ANYWHERE: AtomicBool = AtomicBool::new(false);
+
+/// Lets `include:` read files outside the tree folder (`true`) or not (`false`, the default),
+/// for every tree loaded afterwards in this process.
+pub fn set_includes_anywhere(allow: bool) {
+    ANYWHERE.store(allow, Ordering::Relaxed);
+}
+
+/// Whether `include:` may read files outside the tree folder (see [`set_includes_anywhere`]).
+pub fn includes_anywhere() -> bool {
+    ANYWHERE.load(Ordering::Relaxed)
+}
+
+/// The folder includes are confined to, fixed when a tree starts loading.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct IncludeScope {
+    /// The canonical tree folder; `None` when includes may read anywhere, or when the folder
+    /// cannot be resolved (then every include is refused).
+    root: Option<PathBuf>,
+    anywhere: bool,
+}
+
+impl IncludeScope {
+    /// The scope of a main file whose folder is `base` (`None` or empty: the current folder).
+    pub(crate) fn for_base(base: Option<&Path>) -> Self {
+        let dir = match base {
+            Some(b) if !b.as_os_str().is_empty() => b,
+            _ => Path::new("."),
+        };
+        Self {
+            root: dir.canonicalize().ok(),
+            anywhere: includes_anywhere(),
+        }
+    }
+
+    /// Checks `written` (the include as written, in a file whose folder is `base`) by its
+    /// spelling alone, before anything outside the tree folder is touched.
+    pub(crate) fn check_spelling(&self, base: Option<&Path>, written: &Path, loc: Loc) -> Result<(), Issue> {
+        if self.anywhere {
+            return Ok(());
+        }
+        let base = match base {
+            Some(b) if !b.as_os_str().is_empty() => b,
+            _ => Path::new("."),
+        };
+        match base.canonicalize() {
+            Ok(b) => self.check_resolved(&lexical(&b.join(written)), written, loc),
+            Err(_) => Ok(()), // the resolved path is checked once it exists
+        }
+    }
+
+    /// Checks the canonical path `resolved` of the include written `written`.
+    pub(crate) fn check_resolved(&self, resolved: &Path, written: &Path, loc: Loc) -> Result<(), Issue> {
+        if self.anywhere {
+            return Ok(());
+        }
+        match &self.root {
+            Some(root) if resolved.starts_with(root) => Ok(()),
+            root => Err(Issue::new(
+                loc,
+                format!("`{}` is outside the tree's folder", written.display()),
+            )
+            .label(match root {
+                Some(r) => format!("includes may only read files under `{}`", r.display()),
+                None => "the tree's folder cannot be resolved".to_string(),
+            })
+            .help(
+                "move the library into the main tree file's folder (or a subfolder), or pass \
+                 --allow-include-outside to read it anyway",
+            )),
+        }
+    }
+}
+
+/// `path` with `.` and `..` resolved by spelling alone (no file system access).
+fn lexical(path: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for c in path.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                out.pop();
+            }
+            other => out.push(other),
+        }
+    }
+    out
+}
+
+/// Reads the top level of a file like [`parse_tree_file`], and returns whether it is a tree.
+/// A file that is not a tree leaves only one issue in `issues` (the first one found in it), so
+/// that no more than one of its lines is ever shown.
+pub(crate) fn parse_top_level(v: &Value, issues: &mut Vec<Issue>) -> (Option<TreeFile>, bool) {
+    let mut found = Vec::new();
+    let file = parse_tree_file(v, &mut found);
+    let is_tree = v.as_map().is_some_and(|entries| {
+        entries
+            .iter()
+            .any(|(k, _)| k.as_str().is_some_and(|k| TOP_LEVEL_KEYS.contains(&k)))
+    });
+    if !is_tree {
+        found.sort_by_key(|i| (i.loc.line, i.loc.col));
+        found.truncate(1);
+        if let Some(issue) = found.first_mut()
+            && !matches!(v.kind, ValueKind::Map(_))
+        {
+            // The value's description could quote text beyond its first line.
+            issue.message = format!("a tree file must be a mapping, found {}", kind_of(v));
+        }
+    }
+    issues.append(&mut found);
+    (file, is_tree)
+}
+
+/// What `v` is, without its content.
+fn kind_of(v: &Value) -> &'static str {
+    match v.kind {
+        ValueKind::Null => "nothing (an empty document)",
+        ValueKind::Bool(_) => "a boolean",
+        ValueKind::Int(_) | ValueKind::Float(_) => "a number",
+        ValueKind::Str(_) => "text",
+        ValueKind::Seq(_) => "a list",
+        ValueKind::Map(_) => "a mapping",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lexical_resolution() {
+        assert_eq!(lexical(Path::new("/a/b/../../../etc/x")), Path::new("/etc/x"));
+        assert_eq!(lexical(Path::new("/a/./b/c/../d")), Path::new("/a/b/d"));
+    }
+
+    #[test]
+    fn a_scope_without_a_root_refuses_everything() {
+        let scope = IncludeScope {
+            root: None,
+            anywhere: false,
+        };
+        let e = scope
+            .check_resolved(Path::new("/x/y.yaml"), Path::new("y.yaml"), Loc::default())
+            .unwrap_err();
+        assert!(e.message.contains("outside"), "{}", e.message);
+    }
+}

@@ -1,0 +1,316 @@
+//! `sweep --resume`: continue an interrupted sweep from the results already in its JSONL file.
+//!
+//! A sweep writes its lines in scenario order, each whole, so an interrupted sweep leaves a
+//! prefix of the complete file, possibly followed by one truncated line. [`read_existing`] keeps
+//! the complete lines and drops the truncated tail; the sweep then runs only the scenarios after
+//! them ([`super::run_sweep_from`]), so the final file is byte-identical to that of an
+//! uninterrupted run, and so is the summary (but for the wall time).
+//!
+//! The file carries no header; the lines themselves show that they belong to this sweep:
+//!
+//! - line `n` is scenario `n` of this sweep's (shard's) indices: the scenario count and the
+//!   shard match;
+//! - its `sweep_seed`, `fault`, episode `seed` and `layout` are those of that scenario of this
+//!   sweep seed ([`super::sample_scenario`]): the seed matches;
+//! - its `success` agrees with its `tree_status` and `checks.in_bowl` under this `--goal`;
+//! - it is exactly what this version writes for the result it holds (no unknown or reordered
+//!   fields);
+//! - and [`spot_check`] runs the last kept scenario again and compares the line byte for byte:
+//!   episodes are deterministic, so a different tree, goal or time limit shows up there.
+
+use std::fmt;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use serde_json::Value;
+
+use super::{ScenarioResult, SweepConfig, run_scene_scenario};
+use crate::actions::{CONTROL_PERIOD, Cell, Checks};
+use crate::episode::Goal;
+use crate::faults::FaultKind;
+use crate::plan::Plan;
+use crate::sim::{Layout, Scene};
+
+/// The complete results found in an existing output file.
+#[derive(Debug, Clone, Default)]
+pub struct Resumed {
+    /// The bytes of the complete lines kept, as they are in the file.
+    pub kept: Vec<u8>,
+    /// Their results, in order (scenario positions `0..results.len()` of the sweep).
+    pub results: Vec<ScenarioResult>,
+    /// Bytes of a truncated last line that were dropped (0 when the file ended with a newline).
+    pub dropped_bytes: usize,
+}
+
+/// Why an existing file cannot be resumed. `Display` says what and what to do.
+#[derive(Debug)]
+pub enum ResumeError {
+    /// The file could not be read.
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
+    /// A complete line is not a result of this sweep.
+    Foreign {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number.
+        line: u64,
+        /// Why.
+        reason: String,
+    },
+}
+
+impl fmt::Display for ResumeError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Read { path, source } => write!(f, "cannot resume from {}: {source}", path.display()),
+            Self::Foreign { path, line, reason } => write!(
+                f,
+                "cannot resume from {}: line {line} is not a result of this sweep ({reason}); \
+                 resume with the same tree, --scenarios, --seed, --fault, --goal, --shard and \
+                 --max-sim-time, or run without --resume to start over",
+                path.display()
+            ),
+        }
+    }
+}
+
+impl std::error::Error for ResumeError {}
+
+/// Reads the results of `config` already in `path` (see the [module docs](self)). A missing
+/// file has none.
+pub fn read_existing(path: &Path, scene: &Scene, config: &SweepConfig) -> Result<Resumed, ResumeError> {
+    let read_error = |source| ResumeError::Read {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut bytes = Vec::new();
+    match std::fs::File::open(path) {
+        Ok(mut f) => {
+            if !f.metadata().map_err(read_error)?.is_file() {
+                return Err(read_error(std::io::Error::other("not a regular file")));
+            }
+            f.read_to_end(&mut bytes).map_err(read_error)?;
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Resumed::default()),
+        Err(e) => return Err(read_error(e)),
+    }
+    let complete = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    let dropped_bytes = bytes.len() - complete;
+    bytes.truncate(complete);
+    let indices = config.indices();
+    let mut results = Vec::new();
+    let lines = bytes.strip_suffix(b"\n").map(|b| b.split(|&c| c == b'\n'));
+    for (n, line) in lines.into_iter().flatten().enumerate() {
+        let foreign = |reason: String| ResumeError::Foreign {
+            path: path.to_path_buf(),
+            line: n as u64 + 1,
+            reason,
+        };
+        let line = std::str::from_utf8(line).map_err(|_| foreign("not UTF-8".into()))?;
+        let Some(index) = indices.get(n as u64) else {
+            return Err(foreign(format!(
+                "this sweep has only {} scenario(s)",
+                indices.count_left()
+            )));
+        };
+        let result = parse_line(line).map_err(foreign)?;
+        check_result(&result, line, index, scene, config).map_err(foreign)?;
+        results.push(result);
+    }
+    Ok(Resumed {
+        kept: bytes,
+        results,
+        dropped_bytes,
+    })
+}
+
+/// Runs the last kept scenario again with this tree and configuration and checks that it gives
+/// the same line: the check for what the lines do not carry (tree, goal, time limit).
+pub fn spot_check(
+    scene: &Scene,
+    plan: &Arc<Plan>,
+    config: &SweepConfig,
+    resumed: &Resumed,
+) -> Result<(), String> {
+    let Some(last) = resumed.results.last() else {
+        return Ok(());
+    };
+    let mut cell = Cell::new(scene, &Layout::default(), CONTROL_PERIOD);
+    let again = run_scene_scenario(&mut cell, plan, config, last.index);
+    if again.to_jsonl() == last.to_jsonl() {
+        Ok(())
+    } else {
+        Err(format!(
+            "scenario {} gives a different result with this tree and options than the one in the \
+             file (a different tree, --goal or --max-sim-time?)",
+            last.index
+        ))
+    }
+}
+
+/// Checks that `r` (read from `line`) is scenario `index` of `config`, exactly as written.
+fn check_result(
+    r: &ScenarioResult,
+    line: &str,
+    index: u64,
+    scene: &Scene,
+    config: &SweepConfig,
+) -> Result<(), String> {
+    if r.index != index {
+        return Err(format!(
+            "it holds scenario {}, expected scenario {index}",
+            r.index
+        ));
+    }
+    if r.sweep_seed != config.seed {
+        return Err(format!("sweep seed {}, not {}", r.sweep_seed, config.seed));
+    }
+    if r.fault != config.fault {
+        let name = |f: Option<FaultKind>| f.map_or("none", FaultKind::name);
+        return Err(format!("fault {}, not {}", name(r.fault), name(config.fault)));
+    }
+    let s = config
+        .scene_scenario(scene, index)
+        .map_err(|e| format!("scenario {index} cannot be drawn: {e}"))?;
+    let initial: Vec<[f64; 3]> = r
+        .objects
+        .iter()
+        .map(|o| [o.initial[0], o.initial[1], o.initial[3]])
+        .collect();
+    let drawn: Vec<[f64; 3]> = s
+        .placement
+        .poses
+        .iter()
+        .map(|p| [p.x, p.y, p.yaw.to_degrees()])
+        .collect();
+    let same_objects = initial.len() == drawn.len()
+        && initial
+            .iter()
+            .zip(&drawn)
+            .all(|(a, b)| (a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9);
+    if r.seed != s.seed || r.layout != s.layout || !same_objects || r.scene != scene.spec.name {
+        return Err("its scene, layout or episode seed is not that of this sweep seed".into());
+    }
+    let goal_ok = match config.goal {
+        Goal::Scene => r.goal.iter().all(|g| g.holds),
+        Goal::Bowl => r.checks.in_bowl,
+        Goal::Tree => true,
+    };
+    let met = r.tree_status == "success" && goal_ok;
+    if r.success != met {
+        return Err(format!(
+            "its success does not follow from --goal {}",
+            config.goal.name()
+        ));
+    }
+    if r.to_jsonl() != line {
+        return Err("it is not exactly what this version writes".into());
+    }
+    Ok(())
+}
+
+/// Reads one JSONL line back into the result it was written from.
+pub fn parse_line(line: &str) -> Result<ScenarioResult, String> {
+    let v: Value = serde_json::from_str(line).map_err(|e| format!("not JSON: {e}"))?;
+    let field = |k: &str| v.get(k).ok_or_else(|| format!("no `{k}`"));
+    let u64_of = |k: &str| field(k)?.as_u64().ok_or_else(|| format!("`{k}` is not a count"));
+    let u32_of = |k: &str| u32::try_from(u64_of(k)?).map_err(|_| format!("`{k}` is too large"));
+    let checks = field("checks")?;
+    let parsed = |k: &str| -> Result<Value, String> { Ok(field(k)?.clone()) };
+    let failure_reason = match field("failure_reason")? {
+        Value::Null => None,
+        r => Some(r.as_str().ok_or("`failure_reason` is not text")?.to_string()),
+    };
+    let status = field("tree_status")?.as_str().unwrap_or_default();
+    let fault = match field("fault")? {
+        Value::Null => None,
+        f => Some(
+            FaultKind::ALL
+                .into_iter()
+                .find(|k| f.as_str() == Some(k.name()))
+                .ok_or("unknown `fault`")?,
+        ),
+    };
+    Ok(ScenarioResult {
+        index: u64_of("index")?,
+        sweep_seed: u64_of("sweep_seed")?,
+        seed: u64_of("seed")?,
+        fault,
+        layout: match v.get("layout") {
+            None => None,
+            Some(layout) => Some(super::ScenarioLayout {
+                cube: floats(layout.get("cube"), "layout.cube")?,
+                bowl: floats(layout.get("bowl"), "layout.bowl")?,
+            }),
+        },
+        success: field("success")?.as_bool().ok_or("`success` is not a boolean")?,
+        tree_status: ["success", "failure", "running"]
+            .into_iter()
+            .find(|s| *s == status)
+            .ok_or("unknown `tree_status`")?,
+        failure_kind: failure_reason.as_deref().map(crate::episode::failure_kind),
+        failure_reason,
+        sim_time_s: float(field("sim_time_s")?, "sim_time_s")?,
+        grasp_attempts: u32_of("grasp_attempts")?,
+        halts: u32_of("halts")?,
+        physics_steps: u64_of("physics_steps")?,
+        cube_final: floats(v.get("cube_final"), "cube_final")?,
+        bowl_target: floats(v.get("bowl_target"), "bowl_target")?,
+        checks: Checks {
+            grasp_distance: match checks.get("grasp_distance") {
+                Some(Value::Null) => None,
+                d => Some(float(
+                    d.ok_or("no `checks.grasp_distance`")?,
+                    "checks.grasp_distance",
+                )?),
+            },
+            cube_motion_while_closed: float_at(checks, "cube_motion_while_closed")?,
+            cube_lift_while_closed: float_at(checks, "cube_lift_while_closed")?,
+            home_error: float_at(checks, "home_error")?,
+            in_bowl: checks
+                .get("in_bowl")
+                .and_then(Value::as_bool)
+                .ok_or("`checks.in_bowl` is not a boolean")?,
+        },
+        scene: field("scene")?.as_str().ok_or("`scene` is not text")?.to_string(),
+        objects: serde_json::from_value(parsed("objects")?).map_err(|e| format!("`objects`: {e}"))?,
+        goal: serde_json::from_value(parsed("goal")?).map_err(|e| format!("`goal`: {e}"))?,
+        collisions: serde_json::from_value(parsed("collisions")?)
+            .map_err(|e| format!("`collisions`: {e}"))?,
+        failed_node: serde_json::from_value(parsed("failed_node")?)
+            .map_err(|e| format!("`failed_node`: {e}"))?,
+        wall_time_s: 0.0,
+    })
+}
+
+/// A number; `null` stands for NaN (which JSON cannot spell).
+fn float(v: &Value, name: &str) -> Result<f64, String> {
+    match v {
+        Value::Null => Ok(f64::NAN),
+        v => v.as_f64().ok_or_else(|| format!("`{name}` is not a number")),
+    }
+}
+
+fn float_at(v: &Value, key: &str) -> Result<f64, String> {
+    float(
+        v.get(key).ok_or_else(|| format!("no `checks.{key}`"))?,
+        &format!("checks.{key}"),
+    )
+}
+
+fn floats<const N: usize>(v: Option<&Value>, name: &str) -> Result<[f64; N], String> {
+    let items = v
+        .and_then(Value::as_array)
+        .filter(|a| a.len() == N)
+        .ok_or_else(|| format!("`{name}` is not a list of {N} numbers"))?;
+    let mut out = [0.0; N];
+    for (o, x) in out.iter_mut().zip(items) {
+        *o = float(x, name)?;
+    }
+    Ok(out)
+}
