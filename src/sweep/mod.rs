@@ -110,7 +110,7 @@ impl Default for SweepConfig {
             seed: 0,
             jobs: 0,
             fault: None,
-            goal: Goal::Bowl,
+            goal: Goal::default(),
             shard: None,
             max_sim_time: EpisodeConfig::default().max_sim_time,
             scene_file: None,

@@ -1,0 +1,175 @@
+//! The multi-object tasks on physics: the three shipped trees on their scenes, the goal judged
+//! independently of the tree, motions that name what is in their way, faults on the handled block.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use macrotree::episode::{EpisodeConfig, EpisodeReport, NoObserver, run_episode};
+use macrotree::plan::load_plan;
+use macrotree::sim::{Scene, Sim};
+use macrotree::sweep::SweepConfig;
+
+const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+
+/// Scenario `k` of sweep seed `s` of `tree` on its own scene, as `run --scenario k --sweep-seed s`.
+fn run_scenario(tree: &str, s: u64, k: u64, fault: Option<macrotree::faults::FaultKind>) -> EpisodeReport {
+    let plan = Arc::new(load_plan(&Path::new(ROOT).join(tree)).unwrap_or_else(|d| panic!("{}", d[0])));
+    let scene = Scene::load_spec(&plan.scene).expect("scene compiles");
+    let sweep = SweepConfig {
+        seed: s,
+        fault,
+        ..SweepConfig::default()
+    };
+    let scenario = sweep.scene_scenario(&scene, k).expect("a placement");
+    run_episode(
+        &scene,
+        plan,
+        &sweep.scene_episode_config(&scenario),
+        &mut NoObserver,
+    )
+}
+
+fn assert_done(r: &EpisodeReport, what: &str) {
+    assert!(r.success, "{what}: {:?}", r.failure_reason);
+    assert!(
+        !r.goal.is_empty() && r.goal.iter().all(|g| g.holds),
+        "{what}: {:?}",
+        r.goal
+    );
+}
+
+#[test]
+fn sort_by_color_puts_every_block_in_the_bin_of_its_colour() {
+    for k in [0, 1] {
+        let r = run_scenario("trees/sort_by_color.yaml", 0, k, None);
+        assert_done(&r, "sort");
+        // Independently of the predicate code: each block's final centre lies inside the walls
+        // (12 cm inner, so within 6 cm in x and y) of the bin of its colour, on its floor.
+        for colour in ["red", "green", "blue"] {
+            let block = r.objects.iter().find(|o| o.name == colour).unwrap();
+            let bin = r
+                .objects
+                .iter()
+                .find(|o| o.name == format!("{colour}_bin"))
+                .unwrap();
+            let (dx, dy) = (block.end[0] - bin.end[0], block.end[1] - bin.end[1]);
+            assert!(dx.abs() < 0.06 && dy.abs() < 0.06, "{colour}: {dx:.3}, {dy:.3}");
+            assert!(
+                (block.end[2] - (0.01 + 0.022)).abs() < 0.003,
+                "{colour} rests on the floor: z {}",
+                block.end[2]
+            );
+        }
+        assert!(r.sim_time_s < 3.0 * 6.0, "{} s for three blocks", r.sim_time_s);
+    }
+}
+
+#[test]
+fn stack_three_builds_the_tower() {
+    let r = run_scenario("trees/stack_three.yaml", 0, 3, None);
+    assert_done(&r, "stack");
+    let z = |n: &str| r.objects.iter().find(|o| o.name == n).unwrap().end;
+    let (red, green, blue) = (z("red"), z("green"), z("blue"));
+    // 44 mm blocks: centres at 22, 66, 110 mm, each within half a block of the one below.
+    for (top, below, height) in [(red, green, 0.110), (green, blue, 0.066)] {
+        assert!((top[2] - height).abs() < 0.005, "height {} vs {height}", top[2]);
+        assert!((top[0] - below[0]).abs() < 0.027 && (top[1] - below[1]).abs() < 0.027);
+    }
+    assert!((blue[2] - 0.022).abs() < 0.003, "the base stays on the table");
+}
+
+#[test]
+fn clear_table_puts_every_block_in_the_bin() {
+    let r = run_scenario("trees/clear_table.yaml", 0, 0, None);
+    assert_done(&r, "clear");
+    let bin = r.objects.iter().find(|o| o.name == "bin").unwrap().end;
+    for o in r.objects.iter().filter(|o| o.name != "bin") {
+        assert!(
+            (o.end[0] - bin[0]).abs() < 0.14 && (o.end[1] - bin[1]).abs() < 0.14,
+            "{}",
+            o.name
+        );
+    }
+}
+
+#[test]
+fn a_slip_hits_the_carried_block_and_the_task_still_finishes() {
+    let r = run_scenario(
+        "trees/sort_by_color.yaml",
+        0,
+        0,
+        Some(macrotree::faults::FaultKind::Slip),
+    );
+    assert_done(&r, "sort with a slip");
+    assert!(
+        r.grasp_attempts >= 4,
+        "one block was grasped twice: {}",
+        r.grasp_attempts
+    );
+}
+
+/// A tree that does nothing succeeds as a tree, but the episode fails: the scene's goal decides.
+#[test]
+fn a_tree_that_succeeds_without_doing_the_job_is_caught() {
+    let dir = tempdir("goal");
+    let tree = dir.join("idle.yaml");
+    std::fs::write(
+        &tree,
+        format!("scene: {ROOT}/scenes/sort_three.yaml\nmain: {{home: {{}}}}\n"),
+    )
+    .unwrap();
+    let plan = Arc::new(load_plan(&tree).unwrap_or_else(|d| panic!("{}", d[0])));
+    let scene = Scene::load_spec(&plan.scene).unwrap();
+    let r = run_episode(&scene, plan, &EpisodeConfig::default(), &mut NoObserver);
+    assert_eq!(r.tree_status, "success");
+    assert!(!r.success);
+    let reason = r.failure_reason.unwrap();
+    assert!(
+        reason.contains("the scene's goal does not hold: not red in red_bin"),
+        "{reason}"
+    );
+}
+
+/// A carry whose set-down spot is beside the bowl fails before lowering, naming the bowl.
+#[test]
+fn a_carry_that_would_lower_the_fingers_onto_the_bowl_names_it() {
+    let dir = tempdir("descent");
+    let tree = dir.join("beside.yaml");
+    std::fs::write(
+        &tree,
+        "main:\n  sequence:\n    children:\n      - release: {width: 0.065, retreat: 0}\n      - reach: {target: cube, offset: [0, 0, 0.12]}\n      - reach: {target: cube, path: cartesian}\n      - grasp: {}\n      - carry: {to: [0.45, -0.02, 0.0], lift: 0.15}\n",
+    )
+    .unwrap();
+    let plan = Arc::new(load_plan(&tree).unwrap());
+    let scene = Scene::load().unwrap();
+    let r = run_episode(&scene, plan, &EpisodeConfig::default(), &mut NoObserver);
+    let reason = r.failure_reason.unwrap_or_default();
+    assert!(
+        reason.contains("no clear way down") && reason.contains("would hit bowl"),
+        "{reason}"
+    );
+    assert_eq!(r.failed_node.as_deref(), Some("main/sequence/carry"));
+}
+
+/// MuJoCo resets a simulation whose state blows up and carries on; the episode must not.
+#[test]
+fn a_mujoco_instability_is_reported() {
+    let scene = Scene::load().unwrap();
+    let mut sim = Sim::new(&scene);
+    assert_eq!(sim.instability(), None);
+    sim.data_mut().qpos_mut()[0] = f64::NAN;
+    sim.step();
+    let why = sim.instability().expect("a warning");
+    assert!(why.contains("bad qpos"), "{why}");
+    sim.reset(&macrotree::sim::Layout::default());
+    assert_eq!(sim.instability(), None, "a reset clears the warnings");
+}
+
+fn tempdir(name: &str) -> std::path::PathBuf {
+    let dir = Path::new(ROOT)
+        .join("target")
+        .join(format!("multi_object_{name}"))
+        .join("t");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
