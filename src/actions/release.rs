@@ -63,12 +63,13 @@ impl MacroAction for Release {
         if !self.retreating {
             let w = cell.world();
             if (w.gripper_width - self.target_width).abs() > WIDTH_TOLERANCE {
-                // Fingers stopped short of the opening (against a wall or a neighbour): once no
-                // block is held any more the release has done its job, so retreat anyway.
+                // Fingers stopped short of the opening (against a wall): once no pad touches a
+                // block any more the release has done its job, so retreat anyway.
                 let stopped = w.time - self.t0 >= MIN_OPEN_TIME && w.gripper_speed.abs() < STALL_SPEED;
                 self.stalled = if stopped { self.stalled + 1 } else { 0 };
-                let held = w.held_block(crate::world::conditions::Tolerances::GRASP_OFF_AXIS);
-                if self.stalled < STALL_TICKS || held.is_some() {
+                // A pad still on a block (wedged against a neighbour) would lift it out again.
+                let touching = (0..w.objects.len()).any(|i| !w.released(i));
+                if self.stalled < STALL_TICKS || touching {
                     return Progress::Running;
                 }
                 tracing::debug!(target: "macrotree::actions", width = w.gripper_width, "release: the fingers stopped at {:.1} mm of {:.1} mm (blocked); retreating", w.gripper_width * 1e3, self.target_width * 1e3);
