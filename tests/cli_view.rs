@@ -3,7 +3,8 @@
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::{TcpListener, TcpStream};
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, Command, Output, Stdio};
+use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 #[path = "support/browser.rs"]
@@ -24,6 +25,71 @@ impl Drop for Killed {
     }
 }
 
+/// A child's stderr, read line by line on a thread so that every wait has a deadline even when
+/// the child prints nothing.
+struct StderrLines(mpsc::Receiver<String>);
+
+impl StderrLines {
+    fn of(child: &mut Child) -> Self {
+        let stderr = child.stderr.take().expect("stderr is piped");
+        let (tx, rx) = mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(stderr).lines() {
+                let Ok(line) = line else { break };
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        Self(rx)
+    }
+
+    /// The next line, or `None` at the end of the output; panics at `deadline`.
+    fn next_by(&self, deadline: Instant, what: &str) -> Option<String> {
+        let left = deadline.saturating_duration_since(Instant::now());
+        match self.0.recv_timeout(left) {
+            Ok(line) => Some(line),
+            Err(mpsc::RecvTimeoutError::Disconnected) => None,
+            Err(mpsc::RecvTimeoutError::Timeout) => panic!("timed out waiting for {what}"),
+        }
+    }
+}
+
+/// Runs `cmd` to completion like [`Command::output`], but kills it and panics after `timeout`.
+fn output_within(mut cmd: Command, timeout: Duration) -> Output {
+    let mut child = cmd
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start macrotree");
+    let pipe = |mut r: Box<dyn Read + Send>| {
+        std::thread::spawn(move || {
+            let mut buf = Vec::new();
+            let _ = r.read_to_end(&mut buf);
+            buf
+        })
+    };
+    let stdout = pipe(Box::new(child.stdout.take().unwrap()));
+    let stderr = pipe(Box::new(child.stderr.take().unwrap()));
+    let mut child = Killed(child);
+    let deadline = Instant::now() + timeout;
+    let status = loop {
+        if let Some(status) = child.0.try_wait().expect("wait for macrotree") {
+            break status;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "macrotree did not finish within {timeout:?}"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    Output {
+        status,
+        stdout: stdout.join().unwrap(),
+        stderr: stderr.join().unwrap(),
+    }
+}
+
 fn http_get(addr: &str, path: &str) -> String {
     let mut s = TcpStream::connect(addr).expect("connect to the live view");
     s.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
@@ -37,8 +103,14 @@ fn http_get(addr: &str, path: &str) -> String {
     String::from_utf8_lossy(&body).into_owned()
 }
 
-/// Starts `run TREE --view --port 0 EXTRA…`; returns the server and its `host:port`.
-fn start_view(extra: &[&str]) -> (Killed, BufReader<std::process::ChildStderr>, String) {
+/// The `host:port` of the live view in a line of `run --view`'s output.
+fn view_addr(line: &str) -> Option<String> {
+    let i = line.find("http://127.0.0.1:")?;
+    Some(line[i + 7..].split(['/', ' ']).next()?.to_string())
+}
+
+/// Starts `run TREE --view --port 0 EXTRA…`; returns the server, its output and its `host:port`.
+fn start_view(extra: &[&str]) -> (Killed, StderrLines, String) {
     let mut child = macrotree()
         .args(["run", "trees/cube_to_bowl.yaml", "--view", "--port", "0"])
         .args(extra)
@@ -46,18 +118,15 @@ fn start_view(extra: &[&str]) -> (Killed, BufReader<std::process::ChildStderr>, 
         .stderr(Stdio::piped())
         .spawn()
         .expect("start macrotree");
-    let mut stderr = BufReader::new(child.stderr.take().unwrap());
+    let lines = StderrLines::of(&mut child);
     let child = Killed(child);
-    let mut line = String::new();
+    let deadline = Instant::now() + Duration::from_secs(60);
     loop {
-        line.clear();
-        assert!(
-            stderr.read_line(&mut line).unwrap() > 0,
-            "macrotree ended without printing the URL"
-        );
-        if let Some(i) = line.find("http://127.0.0.1:") {
-            let addr = line[i + 7..].split(['/', ' ', '\n']).next().unwrap().to_string();
-            return (child, stderr, addr);
+        let line = lines
+            .next_by(deadline, "the live view URL")
+            .expect("macrotree ended without printing the URL");
+        if let Some(addr) = view_addr(&line) {
+            return (child, lines, addr);
         }
     }
 }
@@ -68,7 +137,7 @@ fn live_page_of_a_real_episode_shows_the_robot_and_the_tree_in_a_browser() {
         return;
     }
     // A slowed-down episode, so the browser joins while it runs.
-    let (_server, _stderr, addr) = start_view(&["--speed", "0.5"]);
+    let (_server, _lines, addr) = start_view(&["--speed", "0.5"]);
     let chromium = browser::Chromium::open(&format!("http://{addr}/"), 1000, 600);
     let mut dt = chromium.devtools();
     let deadline = Instant::now() + Duration::from_secs(60);
@@ -105,32 +174,11 @@ fn live_page_of_a_real_episode_shows_the_robot_and_the_tree_in_a_browser() {
 
 #[test]
 fn view_serves_the_page_and_keeps_serving_after_the_episode() {
-    let mut child = macrotree()
-        .args(["run", "trees/cube_to_bowl.yaml", "--view", "--port", "0"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start macrotree");
-    let stderr = child.stderr.take().unwrap();
-    let child = Killed(child);
-    let mut lines = BufReader::new(stderr).lines();
-    let mut url = None;
-    let mut over = false;
-    let deadline = Instant::now() + Duration::from_secs(60);
-    // The URL comes first; "episode over; still serving" after the episode.
-    while let Some(Ok(line)) = lines.next() {
-        if url.is_none()
-            && let Some(i) = line.find("http://127.0.0.1:")
-        {
-            url = Some(line[i + 7..].split(['/', ' ']).next().unwrap().to_string());
-        }
-        if line.contains("still serving") {
-            over = true;
-            break;
-        }
-        assert!(Instant::now() < deadline, "no end of episode");
-    }
-    let addr = url.expect("the live view URL is printed");
+    let (child, lines, addr) = start_view(&[]);
+    // "episode over; still serving" comes after the episode.
+    let deadline = Instant::now() + Duration::from_secs(120);
+    let over = std::iter::from_fn(|| lines.next_by(deadline, "the end of the episode"))
+        .any(|line| line.contains("still serving"));
     assert!(over, "the episode did not finish");
     let page = http_get(&addr, "/");
     assert!(
@@ -148,10 +196,9 @@ fn view_serves_the_page_and_keeps_serving_after_the_episode() {
 fn a_taken_port_exits_2_and_says_what_to_do() {
     let blocker = TcpListener::bind("127.0.0.1:0").unwrap();
     let port = blocker.local_addr().unwrap().port().to_string();
-    let out = macrotree()
-        .args(["run", "trees/cube_to_bowl.yaml", "--view", "--port", &port])
-        .output()
-        .unwrap();
+    let mut cmd = macrotree();
+    cmd.args(["run", "trees/cube_to_bowl.yaml", "--view", "--port", &port]);
+    let out = output_within(cmd, Duration::from_secs(60));
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("--port"), "{stderr}");
@@ -163,15 +210,14 @@ fn record_writes_a_self_contained_replay() {
     let dir = std::env::temp_dir().join(format!("macrotree-record-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("episode.html");
-    let out = macrotree()
-        .args([
-            "run",
-            "trees/cube_to_bowl.yaml",
-            "--record",
-            file.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let mut cmd = macrotree();
+    cmd.args([
+        "run",
+        "trees/cube_to_bowl.yaml",
+        "--record",
+        file.to_str().unwrap(),
+    ]);
+    let out = output_within(cmd, Duration::from_secs(180));
     assert_eq!(
         out.status.code(),
         Some(0),

@@ -1,8 +1,8 @@
 //! Real-browser tests: headless Debian Chromium opens the live page and a recorded replay.
 //!
 //! The tests start Chromium themselves (fresh profile, its own process group) and kill it when
-//! done. They skip only when `/usr/bin/chromium` is absent **and** `CI` is unset; in CI they
-//! must run (`.ci/run` installs the `chromium` package).
+//! done. A missing `/usr/bin/chromium` (or viewer bundle) fails them, unless
+//! `MACROTREE_SKIP_BROWSER_TESTS=1` asks to skip them (`.ci/run` installs the `chromium` package).
 //!
 //! Set `MACROTREE_VIEWER_SCREENSHOT=path.png` to also save a screenshot of the live page (used
 //! for docs/images/viewer.png). `cargo test --release --test viewer_browser -- --ignored
@@ -35,6 +35,16 @@ fn demo_tree() -> Vec<TreeNodeView> {
         n("root/1/0", "grasp", "grasp_cube", Some(2)),
         n("root/2", "carry", "carry_to_bowl", Some(0)),
     ]
+}
+
+/// Issue 13, item 14: a machine without Chromium must not pass the browser tests silently.
+#[test]
+fn a_missing_browser_fails_unless_skipping_is_asked_for() {
+    let nowhere = Path::new("/nonexistent/macrotree-test/chromium");
+    let why = browser_check(nowhere, false).expect_err("a missing browser must fail the test");
+    assert!(why.contains(nowhere.to_str().unwrap()), "{why}");
+    assert!(why.contains(SKIP_ENV), "the message names the opt-out: {why}");
+    assert_eq!(browser_check(nowhere, true), Ok(false), "opted out: skip");
 }
 
 #[test]
