@@ -17,6 +17,7 @@ use macrotree::episode::{EpisodeConfig, NoObserver, run_episode};
 use macrotree::plan::Plan;
 use macrotree::sim::{HOME_Q, Scene, Sim};
 use macrotree::viewer::{LiveViewer, Recorder, TreeNodeView, ViewObserver, ViewerOptions, page};
+use mujoco_rs::prelude::*;
 #[path = "support/browser.rs"]
 mod browser;
 use browser::*;
@@ -221,6 +222,152 @@ fn recorded_replay_plays_offline_and_animates() {
         .filter(|(a, b)| a.abs_diff(**b) > 30)
         .count();
     assert!(diff > 1000, "the replay did not animate: {diff} bytes differ");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Names that would change a page if they reached its markup: each sets `window.__pwned` or
+/// breaks the script that starts the replay (no `-->`: it would end the comment state that
+/// `<!--<script>` opens).
+const HOSTILE: [&str; 5] = [
+    "<!--<script>",
+    "</script><script>window.__pwned = 1</script>",
+    "</SCRIPT ><img src=x onerror=\"window.__pwned = 2\">",
+    "a\u{2028}b\u{2029}c",
+    "&lt;b&gt; & <b>bold</b>",
+];
+
+/// A falling box whose body and geom carry hostile MuJoCo names (path segments replace `/` and
+/// whitespace, so markup in a body name has no attributes; it must still not become markup).
+fn hostile_model() -> MjModel {
+    MjModel::from_xml_string(
+        r#"<mujoco><worldbody>
+             <body name="&lt;i&gt;hostile_body" pos="0.3 0 0.3">
+               <freejoint/>
+               <geom name="&lt;!--&lt;script&gt;" type="box" size="0.05 0.05 0.05" rgba="1 0 0 1"/>
+             </body>
+           </worldbody></mujoco>"#,
+    )
+    .expect("the hostile test model compiles")
+}
+
+fn hostile_tree() -> Vec<TreeNodeView> {
+    HOSTILE
+        .iter()
+        .enumerate()
+        .map(|(i, name)| TreeNodeView {
+            path: format!("root/{name}"),
+            kind: (*name).into(),
+            name: (*name).into(),
+            parent: (i > 0).then_some(0),
+        })
+        .collect()
+}
+
+/// The panel's node names and event texts, and whether anything set `window.__pwned`.
+const PANEL_TEXT: &str = "JSON.stringify({\
+    names: Array.from(document.querySelectorAll('#tree .node .name')).map(e => e.textContent),\
+    events: Array.from(document.querySelectorAll('#events li')).map(e => e.textContent),\
+    conn: document.querySelector('#conn').textContent,\
+    pwned: window.__pwned === undefined ? null : window.__pwned,\
+    italics: document.querySelectorAll('i').length,\
+    time: document.querySelector('#replay-time').textContent,\
+    body: document.body.textContent})";
+
+fn panel(dt: &mut Devtools) -> serde_json::Value {
+    serde_json::from_str(dt.eval(PANEL_TEXT).as_str().unwrap_or("null")).unwrap_or_default()
+}
+
+/// Issue 13, item 9: tree, event and scene names that look like markup show as text, in the
+/// live page and in a replay, and the replay still starts.
+#[test]
+fn hostile_names_show_as_text_in_the_live_page_and_the_replay() {
+    if !browser_available() {
+        return;
+    }
+    let model = hostile_model();
+    let mut data = model.make_data();
+    data.forward();
+    let statuses = vec!["running"; HOSTILE.len()];
+    let events: Vec<serde_json::Value> = HOSTILE.iter().map(|&e| e.into()).collect();
+    let names: Vec<&str> = HOSTILE.to_vec();
+    let mut expected_events = names.clone();
+    expected_events.reverse(); // newest first
+
+    // Live: the names arrive as JSON text frames and the scene over the websocket.
+    let viewer = LiveViewer::start(
+        &model,
+        &ViewerOptions {
+            port: 0,
+            ..ViewerOptions::default()
+        },
+    )
+    .unwrap();
+    viewer.set_tree(hostile_tree());
+    viewer.publish_poses(&data, 0.0);
+    viewer.publish_tree_status(statuses.clone(), events.clone());
+    let browser = Chromium::open(&viewer.url(), 800, 500);
+    assert!(
+        viewer.wait_for_clients(1, Duration::from_secs(60)),
+        "the page did not connect"
+    );
+    // The capture round trip means the whole scene was handled by the page.
+    viewer.capture_image(Duration::from_secs(120)).expect("capture");
+    let mut dt = browser.devtools();
+    let live = dt.wait_until(PANEL_TEXT, Duration::from_secs(30), |v| {
+        serde_json::from_str::<serde_json::Value>(v.as_str().unwrap_or("null"))
+            .is_ok_and(|p| p["conn"] == "live" && p["names"].as_array().is_some_and(|n| n.len() == 5))
+    });
+    let live: serde_json::Value = serde_json::from_str(live.as_str().unwrap()).unwrap();
+    assert_eq!(live["names"], serde_json::json!(names), "{live}");
+    assert_eq!(live["events"], serde_json::json!(expected_events), "{live}");
+    // MeshCat's controls list the scene's names as text.
+    assert_eq!(live["italics"], 0, "the body's name became markup");
+    let body = live["body"].as_str().unwrap();
+    assert!(body.contains("<i>hostile_body<!--<script>"), "{body}");
+    std::thread::sleep(Duration::from_millis(500)); // an injected onerror would have fired
+    assert_eq!(
+        panel(&mut dt)["pwned"],
+        serde_json::Value::Null,
+        "the live page ran injected code"
+    );
+    drop(viewer);
+
+    // Replay: the names are embedded in the page itself.
+    let dir = temp_dir("hostile");
+    let mut rec = Recorder::new(&model);
+    rec.set_tree(hostile_tree());
+    rec.frame(&data, data.time());
+    rec.tree_status(0.0, statuses, events);
+    for _ in 0..300 {
+        data.step();
+        rec.frame(&data, data.time());
+    }
+    let html = dir.join("hostile.html");
+    rec.write(&html).unwrap();
+    dt.call(
+        "Page.navigate",
+        serde_json::json!({ "url": format!("file://{}", html.display()) }),
+    );
+    // Started: the page fed the scene and its time label runs against the clip's duration.
+    let replay = dt.wait_until(PANEL_TEXT, Duration::from_secs(60), |v| {
+        serde_json::from_str::<serde_json::Value>(v.as_str().unwrap_or("null")).is_ok_and(|p| {
+            p["conn"] == "replay"
+                && p["time"]
+                    .as_str()
+                    .is_some_and(|t| t.contains(" / ") && !t.ends_with("/ 0.00 s"))
+        })
+    });
+    let replay: serde_json::Value = serde_json::from_str(replay.as_str().unwrap()).unwrap();
+    assert_eq!(replay["names"], serde_json::json!(names), "{replay}");
+    assert_eq!(replay["events"], serde_json::json!(expected_events), "{replay}");
+    assert_eq!(replay["italics"], 0, "the body's name became markup");
+    std::thread::sleep(Duration::from_millis(500));
+    assert_eq!(
+        panel(&mut dt)["pwned"],
+        serde_json::Value::Null,
+        "the replay ran injected code"
+    );
+    drop(browser);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

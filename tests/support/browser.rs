@@ -194,6 +194,25 @@ impl Devtools {
         r["result"]["value"].clone()
     }
 
+    /// Evaluates `js` every 100 ms until `done` accepts its value; panics with the last value
+    /// after `timeout`.
+    pub fn wait_until(
+        &mut self,
+        js: &str,
+        timeout: Duration,
+        done: impl Fn(&serde_json::Value) -> bool,
+    ) -> serde_json::Value {
+        let deadline = Instant::now() + timeout;
+        loop {
+            let v = self.eval(js);
+            if done(&v) {
+                return v;
+            }
+            assert!(Instant::now() < deadline, "after {timeout:?}, {js} is {v}");
+            std::thread::sleep(Duration::from_millis(100));
+        }
+    }
+
     pub fn screenshot(&mut self) -> Vec<u8> {
         use base64::Engine as _;
         let r = self.call("Page.captureScreenshot", serde_json::json!({ "format": "png" }));
