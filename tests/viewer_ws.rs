@@ -31,11 +31,21 @@ fn start(scene: &Scene) -> Option<LiveViewer> {
     }
 }
 
+/// Connects as the live page does: from the server's own origin.
 fn connect(addr: SocketAddr) -> Client {
     let stream = TcpStream::connect(addr).unwrap();
     stream.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
-    let (ws, _) = tungstenite::client(format!("ws://{addr}/"), stream).unwrap();
+    let (ws, _) = tungstenite::client(page_request(addr), stream).unwrap();
     ws
+}
+
+/// A websocket request to `addr` with the `Origin` the live page sends.
+fn page_request(addr: SocketAddr) -> tungstenite::handshake::client::Request {
+    use tungstenite::client::IntoClientRequest as _;
+    let mut req = format!("ws://{addr}/").into_client_request().unwrap();
+    req.headers_mut()
+        .insert("Origin", format!("http://{addr}").parse().unwrap());
+    req
 }
 
 /// A decoded server message.
