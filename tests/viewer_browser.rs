@@ -94,7 +94,12 @@ fn live_page_renders_the_scene_and_the_tree_panel() {
         img.height
     );
     let with_scene = classify(&img);
-    eprintln!("live capture {}x{}: {with_scene:?}", img.width, img.height);
+    eprintln!(
+        "live capture {}x{} ({} bytes of PNG): {with_scene:?}",
+        img.width,
+        img.height,
+        png.len()
+    );
     assert_scene_visible(with_scene, "live page");
 
     // The panel shows the tree with statuses and attempts, and the events.
