@@ -230,6 +230,110 @@ fn recorded_replay_plays_offline_and_animates() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Serves `html` for `/` (404 for anything else) on a free local port until the returned flag
+/// is set; returns the port.
+fn serve_page(html: String) -> (u16, Arc<std::sync::atomic::AtomicBool>) {
+    use std::io::{Read, Write};
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    listener.set_nonblocking(true).unwrap();
+    let port = listener.local_addr().unwrap().port();
+    let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let stopped = stop.clone();
+    std::thread::spawn(move || {
+        while !stopped.load(std::sync::atomic::Ordering::SeqCst) {
+            let Ok((mut s, _)) = listener.accept() else {
+                std::thread::sleep(Duration::from_millis(20));
+                continue;
+            };
+            let _ = s.set_nonblocking(false);
+            let _ = s.set_read_timeout(Some(Duration::from_secs(5)));
+            let mut head = Vec::new();
+            let mut buf = [0u8; 1024];
+            while !head.windows(4).any(|w| w == b"\r\n\r\n") {
+                match s.read(&mut buf) {
+                    Ok(n) if n > 0 => head.extend_from_slice(&buf[..n]),
+                    _ => break,
+                }
+            }
+            let (status, body) = if head.starts_with(b"GET / ") {
+                ("200 OK", html.as_str())
+            } else {
+                ("404 Not Found", "")
+            };
+            let _ = write!(
+                s,
+                "HTTP/1.1 {status}\r\nContent-Type: text/html\r\nContent-Length: {}\r\nConnection: close\r\n\r\n{body}",
+                body.len()
+            );
+        }
+    });
+    (port, stop)
+}
+
+/// Issue 13, item 5: a page of another local origin (any site the user visits could do the
+/// same) cannot open the viewer's websocket, by IP or by name; the viewer's own page can.
+#[test]
+fn a_page_from_another_local_port_cannot_open_the_websocket() {
+    if !browser_available() {
+        return;
+    }
+    let scene = Scene::load().unwrap();
+    let viewer = LiveViewer::start(
+        &scene.model,
+        &ViewerOptions {
+            port: 0,
+            ..ViewerOptions::default()
+        },
+    )
+    .unwrap();
+    let port = viewer.local_addr().port();
+    let attacker = format!(
+        r#"<!DOCTYPE html><title>another page</title><script>
+        window.results = {{}};
+        function attempt(name, url) {{
+          results[name] = "pending";
+          var ws = new WebSocket(url);
+          ws.onopen = function () {{ results[name] = "open"; }};
+          ws.onmessage = function () {{ results[name] = "message"; }};
+          ws.onerror = function () {{ if (results[name] === "pending") results[name] = "error"; }};
+          ws.onclose = function (e) {{
+            if (results[name] === "pending" || results[name] === "error") results[name] = "closed " + e.code;
+          }};
+        }}
+        attempt("ip", "ws://127.0.0.1:{port}/");
+        attempt("name", "ws://localhost:{port}/");
+        </script>"#
+    );
+    let (other, stop) = serve_page(attacker);
+    let browser = Chromium::open(&format!("http://127.0.0.1:{other}/"), 800, 500);
+    let mut dt = browser.devtools();
+    let results = dt.wait_until(
+        "JSON.stringify(window.results || null)",
+        Duration::from_secs(30),
+        |v| {
+            let r: serde_json::Value = serde_json::from_str(v.as_str().unwrap_or("null")).unwrap_or_default();
+            ["ip", "name"]
+                .iter()
+                .all(|k| r[k].as_str().is_some_and(|s| s.starts_with("closed")))
+        },
+    );
+    eprintln!("a page of 127.0.0.1:{other} opening the viewer's websocket: {results}");
+    assert_eq!(viewer.client_count(), 0, "a foreign page became a client");
+    // The viewer's own page connects.
+    dt.call("Page.navigate", serde_json::json!({ "url": viewer.url() }));
+    assert!(
+        viewer.wait_for_clients(1, Duration::from_secs(60)),
+        "the viewer's own page did not connect"
+    );
+    dt.wait_until(
+        "document.querySelector('#conn') && document.querySelector('#conn').textContent",
+        Duration::from_secs(30),
+        |v| v == "live",
+    );
+    stop.store(true, std::sync::atomic::Ordering::SeqCst);
+    drop(browser);
+}
+
 /// Names that would change a page if they reached its markup: each sets `window.__pwned` or
 /// breaks the script that starts the replay (no `-->`: it would end the comment state that
 /// `<!--<script>` opens).
