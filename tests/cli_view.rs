@@ -44,6 +44,17 @@ impl StderrLines {
         Self(rx)
     }
 
+    /// The lines printed within `wait` (fewer if the output ends).
+    fn collect_for(&self, wait: Duration) -> Vec<String> {
+        let deadline = Instant::now() + wait;
+        std::iter::from_fn(|| {
+            self.0
+                .recv_timeout(deadline.saturating_duration_since(Instant::now()))
+                .ok()
+        })
+        .collect()
+    }
+
     /// The next line, or `None` at the end of the output; panics at `deadline`.
     fn next_by(&self, deadline: Instant, what: &str) -> Option<String> {
         let left = deadline.saturating_duration_since(Instant::now());
@@ -236,4 +247,72 @@ fn record_writes_a_self_contained_replay() {
         html.contains("set_animation") || html.contains("animation"),
         "no animation in the replay"
     );
+}
+
+/// CPU time used so far by process `pid` (`/proc/PID/stat` utime + stime, in clock ticks of
+/// 1/100 s), seconds.
+fn process_cpu(pid: u32) -> f64 {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).expect("the server is running");
+    // Fields after the parenthesised command: state(3) … utime(14) stime(15).
+    let rest = &stat[stat.rfind(')').expect("a stat line") + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: u64 = f[11].parse::<u64>().unwrap() + f[12].parse::<u64>().unwrap();
+    ticks as f64 / 100.0
+}
+
+/// Issue 13, item 8: when `accept` fails because the process has no file descriptor left, the
+/// acceptor pauses (and says so once) instead of spinning, and serves again once descriptors
+/// are free.
+#[test]
+fn out_of_file_descriptors_the_acceptor_backs_off_instead_of_spinning() {
+    let (child, lines, addr) = start_view(&[]);
+    let pid = child.0.id();
+    let deadline = Instant::now() + Duration::from_secs(120);
+    let over = std::iter::from_fn(|| lines.next_by(deadline, "the end of the episode"))
+        .any(|line| line.contains("still serving"));
+    assert!(over, "the episode did not finish");
+    // Leave the server 4 descriptors: two connections take them (socket + the handle kept to
+    // evict it); the next accept fails with EMFILE and stays failing while they are open.
+    let open_fds = std::fs::read_dir(format!("/proc/{pid}/fd")).unwrap().count();
+    let limit = open_fds + 4;
+    let status = Command::new("prlimit")
+        .args(["--pid", &pid.to_string(), &format!("--nofile={limit}:{limit}")])
+        .status()
+        .expect("run prlimit (util-linux)");
+    assert!(status.success(), "prlimit failed: {status}");
+    let held: Vec<TcpStream> = (0..8).map(|_| TcpStream::connect(&addr).unwrap()).collect();
+    std::thread::sleep(Duration::from_millis(500));
+    let window = Duration::from_secs(2);
+    let before = process_cpu(pid);
+    std::thread::sleep(window);
+    let used = process_cpu(pid) - before;
+    eprintln!(
+        "out of descriptors ({open_fds} open, limit {limit}): the idle server used {used:.2} s of CPU in {window:?}"
+    );
+    assert!(
+        used < 0.15 * window.as_secs_f64(),
+        "the acceptor spins: {used:.2} s of CPU in {window:?}"
+    );
+    // Descriptors free again: served within the longest pause.
+    drop(held);
+    let served = Instant::now();
+    let page = loop {
+        let page = http_get(&addr, "/");
+        if page.starts_with("HTTP/1.1 200") || served.elapsed() > Duration::from_secs(15) {
+            break page;
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    assert!(page.starts_with("HTTP/1.1 200"), "not served again: {page:.200}");
+    let log = lines.collect_for(Duration::from_millis(500));
+    let warnings = log
+        .iter()
+        .filter(|l| l.contains("cannot accept connections"))
+        .count();
+    assert_eq!(warnings, 1, "the failure is logged once: {log:#?}");
+    assert!(
+        log.iter().any(|l| l.contains("accepting connections again")),
+        "{log:#?}"
+    );
+    drop(child);
 }

@@ -548,3 +548,21 @@ fn hostile_names_cannot_change_the_replay_markup() {
     assert_eq!(back, meta);
     assert_eq!(page::script_json(&meta).find(['<', '>', '&']), None);
 }
+
+/// The acceptor's pauses after failed accepts double up to a bound and reset on success.
+#[test]
+fn accept_backoff_doubles_up_to_its_bound_and_resets() {
+    use macrotree::viewer::server::{ACCEPT_BACKOFF_MAX, ACCEPT_BACKOFF_MIN, AcceptBackoff};
+    let mut b = AcceptBackoff::default();
+    let pauses: Vec<_> = (0..12).map(|_| b.failed()).collect();
+    assert_eq!(pauses[0], ACCEPT_BACKOFF_MIN);
+    assert_eq!(pauses[1], ACCEPT_BACKOFF_MIN * 2);
+    assert!(pauses.windows(2).all(|w| w[1] >= w[0]));
+    assert_eq!(*pauses.last().unwrap(), ACCEPT_BACKOFF_MAX);
+    assert_eq!(b.failures(), 12);
+    assert_eq!(b.succeeded(), 12);
+    assert_eq!(b.failed(), ACCEPT_BACKOFF_MIN, "a success starts over");
+    for _ in 0..100_000 {
+        assert!(b.failed() <= ACCEPT_BACKOFF_MAX);
+    }
+}
