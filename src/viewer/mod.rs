@@ -53,7 +53,7 @@ pub struct ViewerOptions {
     /// TCP port; 0 picks a free one.
     pub port: u16,
     /// Address to bind (127.0.0.1 by default: the page is for this machine). Requests must
-    /// name it, or 127.0.0.1, localhost or [::1], with the port (see `docs/security.md`).
+    /// name it, or `127.0.0.1`, `localhost` or `[::1]`, with the port (see `docs/security.md`).
     pub host: IpAddr,
     /// Connections, sizes and waits ([`ServerLimits::DEFAULT`]).
     pub limits: ServerLimits,

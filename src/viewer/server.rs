@@ -11,7 +11,7 @@
 //! cleared and the client is re-sent a snapshot of the tree.
 //!
 //! Who may connect and for how long: requests must name this server in `Host` and websocket
-//! upgrades must come from its own pages (`Origin`), see [`super::guard`]; every size and wait
+//! upgrades must come from its own pages (`Origin`), see `guard.rs`; every size and wait
 //! is bounded by [`ServerLimits`], and a full server evicts an idle connection rather than
 //! refusing the user (see `docs/security.md`).
 
@@ -43,6 +43,8 @@ pub const MAX_QUEUED_BYTES: usize = 64 << 20;
 pub const ACCEPT_BACKOFF_MIN: Duration = Duration::from_millis(10);
 /// Longest pause of the acceptor between failed `accept`s (the pause doubles up to it).
 pub const ACCEPT_BACKOFF_MAX: Duration = Duration::from_secs(1);
+/// Least time between two warnings about failed `accept`s.
+pub const ACCEPT_WARN_INTERVAL: Duration = Duration::from_secs(60);
 /// Time given to a refusal or a closing handshake to reach the client's socket.
 const GOODBYE_DEADLINE: Duration = Duration::from_millis(500);
 /// Messages read from a client per poll, so that a chatty client cannot starve its writes.
@@ -360,11 +362,18 @@ pub(crate) struct Site {
 
 /// Pauses between failed `accept`s: a connection the acceptor cannot take (no file descriptor
 /// left) stays queued, so retrying at once would spin a core. The pause doubles from
-/// [`ACCEPT_BACKOFF_MIN`] to [`ACCEPT_BACKOFF_MAX`]; a successful accept resets it.
+/// [`ACCEPT_BACKOFF_MIN`] to [`ACCEPT_BACKOFF_MAX`]; a successful accept resets it. Also decides
+/// when to log: a warning at the first failure and then at most once per
+/// [`ACCEPT_WARN_INTERVAL`] (near the descriptor limit accepts fail and succeed in turns), and
+/// one line when accepting works again after a warning.
 #[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
 pub struct AcceptBackoff {
     /// Failed accepts in a row.
     failures: u32,
+    /// When the last warning was logged.
+    warned_at: Option<Instant>,
+    /// A warning was logged and the recovery not yet.
+    recovery_unlogged: bool,
 }
 
 impl AcceptBackoff {
@@ -377,14 +386,30 @@ impl AcceptBackoff {
             .min(ACCEPT_BACKOFF_MAX)
     }
 
-    /// Failed accepts in a row so far (1 right after the first failure: the one to log).
+    /// Failed accepts in a row so far.
     pub fn failures(&self) -> u32 {
         self.failures
     }
 
-    /// Resets after a successful accept; returns how many failures the run that ended had.
-    pub fn succeeded(&mut self) -> u32 {
-        std::mem::take(&mut self.failures)
+    /// Whether to log a warning about a failure at `now`: yes for the first one, then at most
+    /// once per [`ACCEPT_WARN_INTERVAL`].
+    pub fn warn_now(&mut self, now: Instant) -> bool {
+        if self
+            .warned_at
+            .is_some_and(|t| now.duration_since(t) < ACCEPT_WARN_INTERVAL)
+        {
+            return false;
+        }
+        self.warned_at = Some(now);
+        self.recovery_unlogged = true;
+        true
+    }
+
+    /// Resets the pause after a successful accept; returns whether to log the recovery (once
+    /// after each warning).
+    pub fn succeeded(&mut self) -> bool {
+        self.failures = 0;
+        std::mem::take(&mut self.recovery_unlogged)
     }
 }
 
@@ -405,8 +430,8 @@ pub(crate) fn spawn_acceptor(listener: TcpListener, hub: Arc<Hub>, site: Arc<Sit
     Ok(())
 }
 
-/// Accepts connections until the hub shuts down, pausing after failures ([`AcceptBackoff`]);
-/// logs the first failure of a run and the recovery.
+/// Accepts connections until the hub shuts down, pausing after failures and logging them
+/// sparingly ([`AcceptBackoff`]).
 fn accept_loop(listener: &TcpListener, hub: &Arc<Hub>, site: &Arc<Site>) {
     let mut backoff = AcceptBackoff::default();
     loop {
@@ -416,16 +441,15 @@ fn accept_loop(listener: &TcpListener, hub: &Arc<Hub>, site: &Arc<Site>) {
         }
         match accepted {
             Ok((stream, _)) => {
-                let failures = backoff.succeeded();
-                if failures > 0 {
-                    tracing::info!(failures, "viewer: accepting connections again");
+                if backoff.succeeded() {
+                    tracing::info!("viewer: accepting connections again");
                 }
                 admit(stream, hub, site);
             }
             Err(e) if retry_at_once(&e) => {}
             Err(e) => {
                 let pause = backoff.failed();
-                if backoff.failures() == 1 {
+                if backoff.warn_now(Instant::now()) {
                     tracing::warn!(error = %e, "viewer: cannot accept connections; retrying with pauses of up to {ACCEPT_BACKOFF_MAX:?}");
                 }
                 std::thread::sleep(pause);
