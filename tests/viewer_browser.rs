@@ -1,8 +1,8 @@
 //! Real-browser tests: headless Debian Chromium opens the live page and a recorded replay.
 //!
 //! The tests start Chromium themselves (fresh profile, its own process group) and kill it when
-//! done. They skip only when `/usr/bin/chromium` is absent **and** `CI` is unset; in CI they
-//! must run (`.ci/run` installs the `chromium` package).
+//! done. A missing `/usr/bin/chromium` (or viewer bundle) fails them, unless
+//! `MACROTREE_SKIP_BROWSER_TESTS=1` asks to skip them (`.ci/run` installs the `chromium` package).
 //!
 //! Set `MACROTREE_VIEWER_SCREENSHOT=path.png` to also save a screenshot of the live page (used
 //! for docs/images/viewer.png). `cargo test --release --test viewer_browser -- --ignored
@@ -17,6 +17,7 @@ use macrotree::episode::{EpisodeConfig, NoObserver, run_episode};
 use macrotree::plan::Plan;
 use macrotree::sim::{HOME_Q, Scene, Sim};
 use macrotree::viewer::{LiveViewer, Recorder, TreeNodeView, ViewObserver, ViewerOptions, page};
+use mujoco_rs::prelude::*;
 #[path = "support/browser.rs"]
 mod browser;
 use browser::*;
@@ -35,6 +36,16 @@ fn demo_tree() -> Vec<TreeNodeView> {
         n("root/1/0", "grasp", "grasp_cube", Some(2)),
         n("root/2", "carry", "carry_to_bowl", Some(0)),
     ]
+}
+
+/// Issue 13, item 14: a machine without Chromium must not pass the browser tests silently.
+#[test]
+fn a_missing_browser_fails_unless_skipping_is_asked_for() {
+    let nowhere = Path::new("/nonexistent/macrotree-test/chromium");
+    let why = browser_check(nowhere, false).expect_err("a missing browser must fail the test");
+    assert!(why.contains(nowhere.to_str().unwrap()), "{why}");
+    assert!(why.contains(SKIP_ENV), "the message names the opt-out: {why}");
+    assert_eq!(browser_check(nowhere, true), Ok(false), "opted out: skip");
 }
 
 #[test]
@@ -83,7 +94,12 @@ fn live_page_renders_the_scene_and_the_tree_panel() {
         img.height
     );
     let with_scene = classify(&img);
-    eprintln!("live capture {}x{}: {with_scene:?}", img.width, img.height);
+    eprintln!(
+        "live capture {}x{} ({} bytes of PNG): {with_scene:?}",
+        img.width,
+        img.height,
+        png.len()
+    );
     assert_scene_visible(with_scene, "live page");
 
     // The panel shows the tree with statuses and attempts, and the events.
@@ -211,6 +227,256 @@ fn recorded_replay_plays_offline_and_animates() {
         .filter(|(a, b)| a.abs_diff(**b) > 30)
         .count();
     assert!(diff > 1000, "the replay did not animate: {diff} bytes differ");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Serves `html` for `/` (404 for anything else) on a free local port until the returned flag
+/// is set; returns the port.
+fn serve_page(html: String) -> (u16, Arc<std::sync::atomic::AtomicBool>) {
+    use std::io::{Read, Write};
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    listener.set_nonblocking(true).unwrap();
+    let port = listener.local_addr().unwrap().port();
+    let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let stopped = stop.clone();
+    std::thread::spawn(move || {
+        while !stopped.load(std::sync::atomic::Ordering::SeqCst) {
+            let Ok((mut s, _)) = listener.accept() else {
+                std::thread::sleep(Duration::from_millis(20));
+                continue;
+            };
+            let _ = s.set_nonblocking(false);
+            let _ = s.set_read_timeout(Some(Duration::from_secs(5)));
+            let mut head = Vec::new();
+            let mut buf = [0u8; 1024];
+            while !head.windows(4).any(|w| w == b"\r\n\r\n") {
+                match s.read(&mut buf) {
+                    Ok(n) if n > 0 => head.extend_from_slice(&buf[..n]),
+                    _ => break,
+                }
+            }
+            let (status, body) = if head.starts_with(b"GET / ") {
+                ("200 OK", html.as_str())
+            } else {
+                ("404 Not Found", "")
+            };
+            let _ = write!(
+                s,
+                "HTTP/1.1 {status}\r\nContent-Type: text/html\r\nContent-Length: {}\r\nConnection: close\r\n\r\n{body}",
+                body.len()
+            );
+        }
+    });
+    (port, stop)
+}
+
+/// Issue 13, item 5: a page of another local origin (any site the user visits could do the
+/// same) cannot open the viewer's websocket, by IP or by name; the viewer's own page can.
+#[test]
+fn a_page_from_another_local_port_cannot_open_the_websocket() {
+    if !browser_available() {
+        return;
+    }
+    let scene = Scene::load().unwrap();
+    let viewer = LiveViewer::start(
+        &scene.model,
+        &ViewerOptions {
+            port: 0,
+            ..ViewerOptions::default()
+        },
+    )
+    .unwrap();
+    let port = viewer.local_addr().port();
+    let attacker = format!(
+        r#"<!DOCTYPE html><title>another page</title><script>
+        window.results = {{}};
+        function attempt(name, url) {{
+          results[name] = "pending";
+          var ws = new WebSocket(url);
+          ws.onopen = function () {{ results[name] = "open"; }};
+          ws.onmessage = function () {{ results[name] = "message"; }};
+          ws.onerror = function () {{ if (results[name] === "pending") results[name] = "error"; }};
+          ws.onclose = function (e) {{
+            if (results[name] === "pending" || results[name] === "error") results[name] = "closed " + e.code;
+          }};
+        }}
+        attempt("ip", "ws://127.0.0.1:{port}/");
+        attempt("name", "ws://localhost:{port}/");
+        </script>"#
+    );
+    let (other, stop) = serve_page(attacker);
+    let browser = Chromium::open(&format!("http://127.0.0.1:{other}/"), 800, 500);
+    let mut dt = browser.devtools();
+    let results = dt.wait_until(
+        "JSON.stringify(window.results || null)",
+        Duration::from_secs(30),
+        |v| {
+            let r: serde_json::Value = serde_json::from_str(v.as_str().unwrap_or("null")).unwrap_or_default();
+            ["ip", "name"]
+                .iter()
+                .all(|k| r[k].as_str().is_some_and(|s| s.starts_with("closed")))
+        },
+    );
+    eprintln!("a page of 127.0.0.1:{other} opening the viewer's websocket: {results}");
+    assert_eq!(viewer.client_count(), 0, "a foreign page became a client");
+    // The viewer's own page connects.
+    dt.call("Page.navigate", serde_json::json!({ "url": viewer.url() }));
+    assert!(
+        viewer.wait_for_clients(1, Duration::from_secs(60)),
+        "the viewer's own page did not connect"
+    );
+    dt.wait_until(
+        "document.querySelector('#conn') && document.querySelector('#conn').textContent",
+        Duration::from_secs(30),
+        |v| v == "live",
+    );
+    stop.store(true, std::sync::atomic::Ordering::SeqCst);
+    drop(browser);
+}
+
+/// Names that would change a page if they reached its markup: each sets `window.__pwned` or
+/// breaks the script that starts the replay (no `-->`: it would end the comment state that
+/// `<!--<script>` opens).
+const HOSTILE: [&str; 5] = [
+    "<!--<script>",
+    "</script><script>window.__pwned = 1</script>",
+    "</SCRIPT ><img src=x onerror=\"window.__pwned = 2\">",
+    "a\u{2028}b\u{2029}c",
+    "&lt;b&gt; & <b>bold</b>",
+];
+
+/// A falling box whose body and geom carry hostile MuJoCo names (path segments replace `/` and
+/// whitespace, so markup in a body name has no attributes; it must still not become markup).
+fn hostile_model() -> MjModel {
+    MjModel::from_xml_string(
+        r#"<mujoco><worldbody>
+             <body name="&lt;i&gt;hostile_body" pos="0.3 0 0.3">
+               <freejoint/>
+               <geom name="&lt;!--&lt;script&gt;" type="box" size="0.05 0.05 0.05" rgba="1 0 0 1"/>
+             </body>
+           </worldbody></mujoco>"#,
+    )
+    .expect("the hostile test model compiles")
+}
+
+fn hostile_tree() -> Vec<TreeNodeView> {
+    HOSTILE
+        .iter()
+        .enumerate()
+        .map(|(i, name)| TreeNodeView {
+            path: format!("root/{name}"),
+            kind: (*name).into(),
+            name: (*name).into(),
+            parent: (i > 0).then_some(0),
+        })
+        .collect()
+}
+
+/// The panel's node names and event texts, and whether anything set `window.__pwned`.
+const PANEL_TEXT: &str = "JSON.stringify({\
+    names: Array.from(document.querySelectorAll('#tree .node .name')).map(e => e.textContent),\
+    events: Array.from(document.querySelectorAll('#events li')).map(e => e.textContent),\
+    conn: document.querySelector('#conn').textContent,\
+    pwned: window.__pwned === undefined ? null : window.__pwned,\
+    italics: document.querySelectorAll('i').length,\
+    time: document.querySelector('#replay-time').textContent,\
+    body: document.body.textContent})";
+
+fn panel(dt: &mut Devtools) -> serde_json::Value {
+    serde_json::from_str(dt.eval(PANEL_TEXT).as_str().unwrap_or("null")).unwrap_or_default()
+}
+
+/// Issue 13, item 9: tree, event and scene names that look like markup show as text, in the
+/// live page and in a replay, and the replay still starts.
+#[test]
+fn hostile_names_show_as_text_in_the_live_page_and_the_replay() {
+    if !browser_available() {
+        return;
+    }
+    let model = hostile_model();
+    let mut data = model.make_data();
+    data.forward();
+    let statuses = vec!["running"; HOSTILE.len()];
+    let events: Vec<serde_json::Value> = HOSTILE.iter().map(|&e| e.into()).collect();
+    let names: Vec<&str> = HOSTILE.to_vec();
+    let mut expected_events = names.clone();
+    expected_events.reverse(); // newest first
+
+    // Live: the names arrive as JSON text frames and the scene over the websocket.
+    let viewer = LiveViewer::start(
+        &model,
+        &ViewerOptions {
+            port: 0,
+            ..ViewerOptions::default()
+        },
+    )
+    .unwrap();
+    viewer.set_tree(hostile_tree());
+    viewer.publish_poses(&data, 0.0);
+    viewer.publish_tree_status(statuses.clone(), events.clone());
+    let browser = Chromium::open(&viewer.url(), 800, 500);
+    assert!(
+        viewer.wait_for_clients(1, Duration::from_secs(60)),
+        "the page did not connect"
+    );
+    // The capture round trip means the whole scene was handled by the page.
+    viewer.capture_image(Duration::from_secs(120)).expect("capture");
+    let mut dt = browser.devtools();
+    let live = dt.wait_until(PANEL_TEXT, Duration::from_secs(30), |v| {
+        serde_json::from_str::<serde_json::Value>(v.as_str().unwrap_or("null"))
+            .is_ok_and(|p| p["conn"] == "live" && p["names"].as_array().is_some_and(|n| n.len() == 5))
+    });
+    let live: serde_json::Value = serde_json::from_str(live.as_str().unwrap()).unwrap();
+    assert_eq!(live["names"], serde_json::json!(names), "{live}");
+    assert_eq!(live["events"], serde_json::json!(expected_events), "{live}");
+    // MeshCat's controls list the scene's names as text.
+    assert_eq!(live["italics"], 0, "the body's name became markup");
+    let body = live["body"].as_str().unwrap();
+    assert!(body.contains("<i>hostile_body<!--<script>"), "{body}");
+    std::thread::sleep(Duration::from_millis(500)); // an injected onerror would have fired
+    assert_eq!(
+        panel(&mut dt)["pwned"],
+        serde_json::Value::Null,
+        "the live page ran injected code"
+    );
+    drop(viewer);
+
+    // Replay: the names are embedded in the page itself.
+    let dir = temp_dir("hostile");
+    let mut rec = Recorder::new(&model);
+    rec.set_tree(hostile_tree());
+    rec.frame(&data, data.time());
+    rec.tree_status(0.0, statuses, events);
+    for _ in 0..300 {
+        data.step();
+        rec.frame(&data, data.time());
+    }
+    let html = dir.join("hostile.html");
+    rec.write(&html).unwrap();
+    dt.call(
+        "Page.navigate",
+        serde_json::json!({ "url": format!("file://{}", html.display()) }),
+    );
+    // Started: the page fed the scene and its time label runs against the clip's duration.
+    let replay = dt.wait_until(PANEL_TEXT, Duration::from_secs(60), |v| {
+        serde_json::from_str::<serde_json::Value>(v.as_str().unwrap_or("null")).is_ok_and(|p| {
+            p["conn"] == "replay"
+                && p["time"]
+                    .as_str()
+                    .is_some_and(|t| t.contains(" / ") && !t.ends_with("/ 0.00 s"))
+        })
+    });
+    let replay: serde_json::Value = serde_json::from_str(replay.as_str().unwrap()).unwrap();
+    assert_eq!(replay["names"], serde_json::json!(names), "{replay}");
+    assert_eq!(replay["events"], serde_json::json!(expected_events), "{replay}");
+    assert_eq!(replay["italics"], 0, "the body's name became markup");
+    std::thread::sleep(Duration::from_millis(500));
+    assert_eq!(
+        panel(&mut dt)["pwned"],
+        serde_json::Value::Null,
+        "the replay ran injected code"
+    );
+    drop(browser);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

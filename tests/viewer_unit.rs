@@ -503,3 +503,86 @@ fn the_fast_pose_encoder_matches_the_generic_one() {
         );
     }
 }
+
+/// Names that would change a page if they were pasted into its markup unescaped.
+const HOSTILE: [&str; 6] = [
+    "<!--<script>",
+    "</script><script>window.__pwned = 1</script>",
+    "</SCRIPT ><img src=x onerror=\"window.__pwned = 2\">",
+    "a\u{2028}b\u{2029}c -->",
+    "&lt;b&gt; & <b>bold</b> ]]>",
+    "'\"`${x}\\",
+];
+
+/// Issue 13, item 9: tree and event names in a replay are data, never markup.
+#[test]
+fn hostile_names_cannot_change_the_replay_markup() {
+    let nodes: Vec<_> = HOSTILE
+        .iter()
+        .enumerate()
+        .map(|(i, name)| serde_json::json!({ "path": format!("root/{i}"), "name": name, "kind": name }))
+        .collect();
+    let meta = serde_json::json!({ "tree": nodes, "timeline": [{ "t": 0.0, "events": HOSTILE }] });
+    // Code is inlined too: a bundle holding these sequences must not break out either.
+    let bundle = b"var s = '</Script><!--<script>'; // </script>";
+    let cmds = vec![proto::encode(&proto::delete("/x"))];
+    let html = page::standalone_html(bundle, &cmds, Some(&meta));
+    let lower = html.to_ascii_lowercase();
+    // Inside a script element only `</script` ends it, and `<script` matters only after `<!--`.
+    assert_eq!(
+        lower.matches("</script").count(),
+        3,
+        "only our script elements close"
+    );
+    assert!(
+        !html.contains("<!--"),
+        "nothing enters the parser's escaped states"
+    );
+    assert_eq!(html.matches("<script>\n").count(), 3);
+    for c in ['\u{2028}', '\u{2029}'] {
+        assert!(!html.contains(c), "raw line separators are escaped");
+    }
+    // The embedded metadata still reads back as the same JSON value.
+    let start = html.find("macrotree.replay(").unwrap();
+    let args = &html[start..];
+    let meta_start = args.find("], ").unwrap() + 3;
+    let meta_end = args.find(");\n</script>").unwrap();
+    let back: serde_json::Value = serde_json::from_str(&args[meta_start..meta_end]).unwrap();
+    assert_eq!(back, meta);
+    assert_eq!(page::script_json(&meta).find(['<', '>', '&']), None);
+}
+
+/// The acceptor's pauses after failed accepts double up to a bound and reset on success; it
+/// warns at the first failure, then at most once per interval, and logs one recovery per warning.
+#[test]
+fn accept_backoff_doubles_up_to_its_bound_and_warns_sparingly() {
+    use macrotree::viewer::server::{
+        ACCEPT_BACKOFF_MAX, ACCEPT_BACKOFF_MIN, ACCEPT_WARN_INTERVAL, AcceptBackoff,
+    };
+    use std::time::Instant;
+    let mut b = AcceptBackoff::default();
+    let pauses: Vec<_> = (0..12).map(|_| b.failed()).collect();
+    assert_eq!(pauses[0], ACCEPT_BACKOFF_MIN);
+    assert_eq!(pauses[1], ACCEPT_BACKOFF_MIN * 2);
+    assert!(pauses.windows(2).all(|w| w[1] >= w[0]));
+    assert_eq!(*pauses.last().unwrap(), ACCEPT_BACKOFF_MAX);
+    assert_eq!(b.failures(), 12);
+    for _ in 0..100_000 {
+        assert!(b.failed() <= ACCEPT_BACKOFF_MAX);
+    }
+    // Logging: failures and successes in turns (near the descriptor limit).
+    let t0 = Instant::now();
+    let mut b = AcceptBackoff::default();
+    assert!(!b.succeeded(), "nothing to recover from");
+    b.failed();
+    assert!(b.warn_now(t0), "the first failure is logged");
+    assert!(b.succeeded(), "and so is the recovery");
+    assert_eq!(b.failed(), ACCEPT_BACKOFF_MIN, "a success starts the pauses over");
+    assert!(
+        !b.warn_now(t0 + ACCEPT_WARN_INTERVAL / 2),
+        "not again within the interval"
+    );
+    assert!(!b.succeeded(), "no recovery line without a warning");
+    b.failed();
+    assert!(b.warn_now(t0 + ACCEPT_WARN_INTERVAL), "again after the interval");
+}

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use macrotree::sim::{HOME_Q, Scene, Sim};
 use macrotree::viewer::proto;
-use macrotree::viewer::{LiveViewer, TreeNodeView, ViewerError, ViewerOptions, page};
+use macrotree::viewer::{LiveViewer, ServerLimits, TreeNodeView, ViewerError, ViewerOptions, page};
 use tungstenite::{Message, WebSocket};
 
 type Client = WebSocket<TcpStream>;
@@ -21,7 +21,13 @@ fn opts0() -> ViewerOptions {
 
 /// Starts a viewer on a free port, or `None` (skip) when the bundle is missing outside CI.
 fn start(scene: &Scene) -> Option<LiveViewer> {
-    match LiveViewer::start(&scene.model, &opts0()) {
+    start_with(scene, ServerLimits::DEFAULT)
+}
+
+/// [`start`] with other limits.
+fn start_with(scene: &Scene, limits: ServerLimits) -> Option<LiveViewer> {
+    let opts = ViewerOptions { limits, ..opts0() };
+    match LiveViewer::start(&scene.model, &opts) {
         Ok(v) => Some(v),
         Err(ViewerError::BundleMissing { path }) if std::env::var_os("CI").is_none() => {
             eprintln!("SKIPPED: {}", page::bundle_help(&path));
@@ -31,11 +37,21 @@ fn start(scene: &Scene) -> Option<LiveViewer> {
     }
 }
 
+/// Connects as the live page does: from the server's own origin.
 fn connect(addr: SocketAddr) -> Client {
     let stream = TcpStream::connect(addr).unwrap();
     stream.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
-    let (ws, _) = tungstenite::client(format!("ws://{addr}/"), stream).unwrap();
+    let (ws, _) = tungstenite::client(page_request(addr), stream).unwrap();
     ws
+}
+
+/// A websocket request to `addr` with the `Origin` the live page sends.
+fn page_request(addr: SocketAddr) -> tungstenite::handshake::client::Request {
+    use tungstenite::client::IntoClientRequest as _;
+    let mut req = format!("ws://{addr}/").into_client_request().unwrap();
+    req.headers_mut()
+        .insert("Origin", format!("http://{addr}").parse().unwrap());
+    req
 }
 
 /// A decoded server message.
@@ -392,4 +408,428 @@ fn capture_without_a_browser_fails_cleanly() {
     let Some(v) = start(&scene) else { return };
     let err = v.capture_image(Duration::from_millis(100)).unwrap_err();
     assert!(matches!(err, ViewerError::NoClient(_)), "{err}");
+}
+
+/// Sends `head` on a fresh connection; returns the response's status line ("" if the server
+/// closed without answering). Bounded: 10 s.
+fn status_of(addr: SocketAddr, head: &str) -> String {
+    let mut s = TcpStream::connect(addr).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
+    s.write_all(head.as_bytes()).unwrap();
+    let mut buf = Vec::new();
+    let mut byte = [0u8; 1];
+    while !buf.ends_with(b"\r\n") && matches!(s.read(&mut byte), Ok(1)) {
+        buf.push(byte[0]);
+    }
+    String::from_utf8_lossy(&buf).trim_end().to_owned()
+}
+
+/// A websocket upgrade request head with `host` and, when given, `origin`.
+fn upgrade_head(host: &str, origin: Option<&str>) -> String {
+    let origin = origin.map_or(String::new(), |o| format!("Origin: {o}\r\n"));
+    format!(
+        "GET / HTTP/1.1\r\nHost: {host}\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n\
+         Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n{origin}\r\n"
+    )
+}
+
+/// Issue 13, item 5: only the server's own pages may open the websocket.
+#[test]
+fn websocket_upgrades_from_other_origins_are_refused_with_403() {
+    let scene = Scene::load().unwrap();
+    let Some(v) = start(&scene) else { return };
+    let addr = v.local_addr();
+    let port = addr.port();
+    let host = format!("127.0.0.1:{port}");
+    for origin in [
+        None,
+        Some("null".to_owned()),
+        Some("http://evil.example".to_owned()),
+        Some(format!("http://evil.example:{port}")),
+        Some(format!("http://127.0.0.1:{}", port.wrapping_add(1))),
+        Some(format!("https://127.0.0.1:{port}")),
+        Some(format!("http://127.0.0.1.evil.example:{port}")),
+    ] {
+        let status = status_of(addr, &upgrade_head(&host, origin.as_deref()));
+        assert!(status.starts_with("HTTP/1.1 403"), "Origin {origin:?}: {status}");
+    }
+    assert_eq!(v.client_count(), 0);
+    for name in ["127.0.0.1", "localhost", "[::1]"] {
+        let origin = format!("http://{name}:{port}");
+        let status = status_of(addr, &upgrade_head(&format!("{name}:{port}"), Some(&origin)));
+        assert!(status.starts_with("HTTP/1.1 101"), "Origin {origin}: {status}");
+    }
+}
+
+/// Issue 13, item 5: DNS rebinding. A page whose own name resolves to 127.0.0.1 still sends
+/// that name in `Host`; such requests are refused.
+#[test]
+fn requests_with_a_foreign_host_are_refused_with_403() {
+    let scene = Scene::load().unwrap();
+    let Some(v) = start(&scene) else { return };
+    let addr = v.local_addr();
+    let port = addr.port();
+    let get = |host: Option<&str>| {
+        let host = host.map_or(String::new(), |h| format!("Host: {h}\r\n"));
+        status_of(
+            addr,
+            &format!("GET / HTTP/1.1\r\n{host}Connection: close\r\n\r\n"),
+        )
+    };
+    for host in [
+        None,
+        Some(format!("evil.example:{port}")),
+        Some(format!("127.0.0.1:{}", port.wrapping_add(1))),
+        Some("127.0.0.1".to_owned()),
+        Some(format!("localhost.evil.example:{port}")),
+    ] {
+        let status = get(host.as_deref());
+        assert!(status.starts_with("HTTP/1.1 403"), "Host {host:?}: {status}");
+    }
+    // A same-host request from a foreign page (it carries that page's Origin) is refused too.
+    let foreign = status_of(
+        addr,
+        &format!("GET /download HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nOrigin: http://evil.example\r\n\r\n"),
+    );
+    assert!(foreign.starts_with("HTTP/1.1 403"), "{foreign}");
+    for name in ["127.0.0.1", "localhost", "LocalHost", "[::1]"] {
+        let status = get(Some(&format!("{name}:{port}")));
+        assert!(status.starts_with("HTTP/1.1 200"), "Host {name}: {status}");
+    }
+}
+
+/// The resident set size of this process (`/proc/self/status`), bytes.
+fn rss() -> u64 {
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmRSS:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
+        .unwrap_or(0)
+        * 1024
+}
+
+/// Waits up to `timeout` for `cond`; whether it held.
+fn eventually(timeout: Duration, mut cond: impl FnMut() -> bool) -> bool {
+    let deadline = Instant::now() + timeout;
+    loop {
+        if cond() {
+            return true;
+        }
+        if Instant::now() >= deadline {
+            return false;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+/// Issue 13, item 6: client messages are capped at a few KiB.
+#[test]
+fn a_client_sending_a_large_message_is_dropped_and_the_server_stays_healthy() {
+    let scene = Scene::load().unwrap();
+    let Some(v) = start(&scene) else { return };
+    let addr = v.local_addr();
+    let limit = macrotree::viewer::limits::MAX_CLIENT_MESSAGE;
+    let mut ws = connect(addr);
+    assert!(v.wait_for_clients(1, Duration::from_secs(5)));
+    // The client reads the scene first: its thread polls input between writes.
+    ws.get_ref()
+        .set_read_timeout(Some(Duration::from_millis(300)))
+        .unwrap();
+    while ws.read().is_ok() {}
+    // A message within the limit is read (and ignored): the client stays.
+    ws.send(Message::text(format!(
+        "{{\"pad\":\"{}\"}}",
+        "x".repeat(limit - 16)
+    )))
+    .unwrap();
+    std::thread::sleep(Duration::from_millis(300));
+    assert_eq!(
+        v.client_count(),
+        1,
+        "a message within the limit dropped the client"
+    );
+    // One byte over: dropped, with a close frame or a reset.
+    let _ = ws.send(Message::Binary(vec![0u8; limit + 1].into()));
+    let deadline = Instant::now() + Duration::from_secs(10);
+    let ended = loop {
+        match ws.read() {
+            Ok(Message::Close(_)) => break true,
+            Ok(_) => {}
+            Err(tungstenite::Error::Io(e))
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) =>
+            {
+                if Instant::now() >= deadline {
+                    break false;
+                }
+            }
+            Err(_) => break true,
+        }
+    };
+    assert!(ended, "a client sending {} bytes is still served", limit + 1);
+    assert!(eventually(Duration::from_secs(5), || v.client_count() == 0));
+
+    // A frame that announces 60 MiB is refused at its header: the server closes the
+    // connection instead of reading (and buffering) the payload.
+    let before = rss();
+    let announced: u64 = 60 << 20;
+    let mut raw = TcpStream::connect(addr).unwrap();
+    raw.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
+    raw.set_write_timeout(Some(Duration::from_secs(10))).unwrap();
+    raw.write_all(upgrade_head(&addr.to_string(), Some(&format!("http://{addr}"))).as_bytes())
+        .unwrap();
+    let mut header = vec![0x82, 0xff]; // binary, masked, 64-bit length
+    header.extend_from_slice(&announced.to_be_bytes());
+    header.extend_from_slice(&[1, 2, 3, 4]); // mask
+    raw.write_all(&header).unwrap();
+    // Read what the server sends (the scene) meanwhile, so that it gets to read our frame.
+    let drain = raw.try_clone().unwrap();
+    let drainer = std::thread::spawn(move || std::io::copy(&mut &drain, &mut std::io::sink()));
+    let chunk = vec![0u8; 64 << 10];
+    let mut written = 0u64;
+    let error = loop {
+        if written >= announced {
+            break None;
+        }
+        match raw.write(&chunk) {
+            Ok(n) => written += n as u64,
+            Err(e) => break Some(e.kind()),
+        }
+    };
+    let grown = rss().saturating_sub(before);
+    eprintln!(
+        "a 60 MiB frame: the connection was closed after {:.1} MiB had been written to the socket ({error:?}); this process grew by {:.1} MiB",
+        written as f64 / f64::from(1 << 20),
+        grown as f64 / f64::from(1 << 20)
+    );
+    use std::io::ErrorKind::{BrokenPipe, ConnectionAborted, ConnectionReset};
+    assert!(
+        matches!(error, Some(BrokenPipe | ConnectionReset | ConnectionAborted)),
+        "the server did not close the connection: {error:?} after {written} bytes"
+    );
+    let _ = drainer.join();
+    assert!(eventually(Duration::from_secs(5), || v.client_count() == 0));
+
+    // Still healthy: the page is served and a new client gets the scene.
+    let (head, _) = http_get(addr, "/");
+    assert!(head.starts_with("HTTP/1.1 200"), "{head}");
+    let mut fresh = connect(addr);
+    assert!(!recv_cmds(&mut fresh, 4).is_empty());
+}
+
+/// The answer to a capture request is the one client message that may be large.
+#[test]
+fn a_capture_answer_may_exceed_the_message_limit() {
+    let scene = Scene::load().unwrap();
+    let Some(v) = start(&scene) else { return };
+    let mut ws = connect(v.local_addr());
+    let png: Vec<u8> = (0..200_000u32).map(|i| (i % 251) as u8).collect();
+    let answer = {
+        use base64::Engine as _;
+        let b64 = base64::engine::general_purpose::STANDARD.encode(&png);
+        format!(r#"{{"type":"img","data":"data:image/png;base64,{b64}"}}"#)
+    };
+    assert!(answer.len() > 10 * macrotree::viewer::limits::MAX_CLIENT_MESSAGE);
+    let replier = std::thread::spawn(move || {
+        loop {
+            if let Msg::Cmd { ty, .. } = recv(&mut ws)
+                && ty == "capture_image"
+            {
+                ws.send(Message::text(answer)).unwrap();
+                return ws;
+            }
+        }
+    });
+    assert!(v.wait_for_clients(1, Duration::from_secs(5)));
+    assert_eq!(v.capture_image(Duration::from_secs(20)).unwrap(), png);
+    let _ws = replier.join().unwrap();
+    assert_eq!(v.client_count(), 1);
+}
+
+/// Issue 13, item 7: a request head must arrive whole within the request deadline, however
+/// steadily its bytes trickle in.
+#[test]
+fn a_slow_loris_request_is_closed_at_the_request_deadline() {
+    let scene = Scene::load().unwrap();
+    let deadline = Duration::from_millis(500);
+    let limits = ServerLimits {
+        request_deadline: deadline,
+        ..ServerLimits::DEFAULT
+    };
+    let Some(v) = start_with(&scene, limits) else {
+        return;
+    };
+    let addr = v.local_addr();
+    let started = Instant::now();
+    let mut s = TcpStream::connect(addr).unwrap();
+    s.set_read_timeout(Some(Duration::from_millis(50))).unwrap();
+    let head = format!("GET / HTTP/1.1\r\nHost: {addr}\r\nX-Pad: {}", "a".repeat(10_000));
+    // One byte every 50 ms: each read of the server gets data long before any per-read
+    // timeout; only a deadline on the whole head ends it.
+    let mut response = Vec::new();
+    let mut sent = 0;
+    let closed = loop {
+        if started.elapsed() > Duration::from_secs(20) {
+            break None;
+        }
+        if s.write_all(&head.as_bytes()[sent..=sent]).is_err() {
+            break Some(started.elapsed());
+        }
+        sent += 1;
+        match s.read_to_end(&mut response) {
+            Ok(_) => break Some(started.elapsed()),
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) => {}
+            Err(_) => break Some(started.elapsed()),
+        }
+    };
+    let closed = closed.expect("a client sending a byte every 50 ms was held for 20 s");
+    eprintln!(
+        "slow loris: closed after {closed:?} ({sent} bytes sent), deadline {deadline:?}; answer {:?}",
+        String::from_utf8_lossy(&response).lines().next()
+    );
+    assert!(closed >= deadline, "closed before the deadline: {closed:?}");
+    assert!(closed < deadline * 10, "held for {closed:?}");
+    assert!(eventually(Duration::from_secs(5), || v.connection_count() == 0));
+}
+
+/// Issue 13, item 7: when every slot is taken, idle connections make room for a new request
+/// (the user's); the connected browser keeps its place.
+#[test]
+fn a_full_server_makes_room_for_a_new_request() {
+    let scene = Scene::load().unwrap();
+    let limits = ServerLimits {
+        max_connections: 4,
+        request_deadline: Duration::from_secs(60),
+        ..ServerLimits::DEFAULT
+    };
+    let Some(v) = start_with(&scene, limits) else {
+        return;
+    };
+    let addr = v.local_addr();
+    let mut browser = connect(addr);
+    assert!(v.wait_for_clients(1, Duration::from_secs(5)));
+    // Three connections that send half a request head and wait.
+    let idle: Vec<TcpStream> = (0..3)
+        .map(|_| {
+            let mut s = TcpStream::connect(addr).unwrap();
+            s.write_all(b"GET / HT").unwrap();
+            s.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
+            std::thread::sleep(Duration::from_millis(20)); // distinct ages
+            s
+        })
+        .collect();
+    assert!(
+        eventually(Duration::from_secs(5), || v.connection_count() == 4),
+        "{} connections",
+        v.connection_count()
+    );
+    // Full: a new request is still answered.
+    let (head, _) = http_get(addr, "/");
+    assert!(head.starts_with("HTTP/1.1 200"), "{head}");
+    // The oldest idle connection made room; the browser and the younger ones stay.
+    let mut first = &idle[0];
+    let mut buf = [0u8; 64];
+    assert_eq!(
+        first.read(&mut buf).unwrap_or(0),
+        0,
+        "the oldest idle connection was not closed"
+    );
+    assert_eq!(v.client_count(), 1);
+    assert!(v.connection_count() <= 4);
+    let _ = recv(&mut browser); // still served
+}
+
+/// Issue 13, item 7: a browser that stops reading is dropped once the oldest update it has not
+/// read is older than the lag limit, whatever the kernel buffers; a reading one stays.
+#[test]
+fn a_websocket_client_that_stops_reading_is_dropped_at_the_lag_limit() {
+    let scene = Scene::load().unwrap();
+    let max_lag = Duration::from_secs(2);
+    let limits = ServerLimits {
+        max_client_lag: max_lag,
+        ping_interval: Duration::from_millis(100),
+        ..ServerLimits::DEFAULT
+    };
+    let Some(v) = start_with(&scene, limits) else {
+        return;
+    };
+    let addr = v.local_addr();
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let mut reader_ws = connect(addr);
+    let reader_stop = stop.clone();
+    let reader = std::thread::spawn(move || {
+        let mut n = 0u64;
+        while !reader_stop.load(std::sync::atomic::Ordering::SeqCst) {
+            reader_ws.read().expect("the reading client was dropped");
+            n += 1;
+        }
+        n
+    });
+    assert!(v.wait_for_clients(1, Duration::from_secs(5)));
+    let _stalled = connect(addr); // reads nothing after its handshake
+    assert!(v.wait_for_clients(2, Duration::from_secs(5)));
+    let joined = Instant::now();
+    let mut sim = Sim::new(&scene);
+    let mut dropped = None;
+    while joined.elapsed() < Duration::from_secs(30) {
+        for _ in 0..8 {
+            wiggle(&mut sim);
+        }
+        v.publish_poses(sim.data(), sim.time());
+        std::thread::sleep(Duration::from_millis(16));
+        if v.client_count() < 2 {
+            dropped = Some(joined.elapsed());
+            break;
+        }
+    }
+    let dropped = dropped.expect("a client that reads nothing was still connected after 30 s");
+    // Keep publishing a little: the reading client must stay.
+    for _ in 0..30 {
+        wiggle(&mut sim);
+        v.publish_poses(sim.data(), sim.time());
+        std::thread::sleep(Duration::from_millis(16));
+    }
+    assert_eq!(v.client_count(), 1, "the reading client was dropped too");
+    stop.store(true, std::sync::atomic::Ordering::SeqCst);
+    v.publish_poses(sim.data(), sim.time() + 1.0);
+    let read = reader.join().expect("the reading client kept its connection");
+    eprintln!(
+        "a client that stopped reading was dropped {dropped:?} after joining (lag limit {max_lag:?}); the reader got {read} messages"
+    );
+    assert!(dropped >= max_lag, "dropped before the lag limit: {dropped:?}");
+    assert!(dropped < max_lag * 5, "held for {dropped:?}");
+}
+
+/// How long a browser that stops reading holds its connection with the default limits, on the
+/// pose stream of a real episode (30 Hz). Nothing is asserted about time.
+#[test]
+#[ignore = "measurement (~35 s): cargo test --release --test viewer_ws -- --ignored --nocapture measure_how_long_a_stalled_reader_is_held"]
+fn measure_how_long_a_stalled_reader_is_held() {
+    let scene = Scene::load().unwrap();
+    let Some(v) = start(&scene) else { return };
+    let mut ws = connect(v.local_addr());
+    let _ = recv_cmds(&mut ws, 4); // the page starts reading, then stalls
+    assert!(v.wait_for_clients(1, Duration::from_secs(5)));
+    let stalled = Instant::now();
+    let mut sim = Sim::new(&scene);
+    while v.client_count() > 0 && stalled.elapsed() < Duration::from_secs(300) {
+        for _ in 0..16 {
+            wiggle(&mut sim);
+        }
+        v.publish_poses(sim.data(), sim.time());
+        std::thread::sleep(Duration::from_millis(33));
+    }
+    eprintln!(
+        "a reader that stalled after 4 messages was dropped after {:?} (limit {:?}, still connected: {})",
+        stalled.elapsed(),
+        macrotree::viewer::limits::MAX_CLIENT_LAG,
+        v.client_count()
+    );
 }

@@ -10,6 +10,9 @@
 //! Wire format: each server→browser binary frame is one msgpack map (a MeshCat command); the
 //! tree side panel uses JSON text frames. See `docs/viewer.md`.
 
+mod guard;
+mod http;
+pub mod limits;
 pub mod observer;
 pub mod page;
 pub mod panel;
@@ -17,6 +20,7 @@ pub mod proto;
 pub mod record;
 pub mod scene;
 pub mod server;
+mod slots;
 pub mod tree;
 
 use std::net::{IpAddr, Ipv4Addr, SocketAddr, TcpListener};
@@ -29,6 +33,7 @@ use mujoco_rs::wrappers::mj_model::traits::ModelType;
 use rmpv::Value;
 use tungstenite::Bytes;
 
+pub use limits::ServerLimits;
 pub use observer::{PUBLISH_HZ, ViewObserver, tree_view};
 pub use panel::TreeNodeView;
 pub use record::Recorder;
@@ -42,13 +47,16 @@ use server::{Hub, Site};
 /// Default port of `--view`.
 pub const DEFAULT_PORT: u16 = 7000;
 
-/// Where the live server listens.
+/// Where the live server listens, and its limits.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ViewerOptions {
     /// TCP port; 0 picks a free one.
     pub port: u16,
-    /// Address to bind (127.0.0.1 by default: the page is for this machine).
+    /// Address to bind (127.0.0.1 by default: the page is for this machine). Requests must
+    /// name it, or `127.0.0.1`, `localhost` or `[::1]`, with the port (see `docs/security.md`).
     pub host: IpAddr,
+    /// Connections, sizes and waits ([`ServerLimits::DEFAULT`]).
+    pub limits: ServerLimits,
 }
 
 impl Default for ViewerOptions {
@@ -56,6 +64,7 @@ impl Default for ViewerOptions {
         Self {
             port: DEFAULT_PORT,
             host: IpAddr::V4(Ipv4Addr::LOCALHOST),
+            limits: ServerLimits::DEFAULT,
         }
     }
 }
@@ -181,6 +190,8 @@ impl LiveViewer {
             bundle,
             script: Bytes::from_static(page::PAGE_JS.as_bytes()),
             style: Bytes::from_static(page::PAGE_CSS.as_bytes()),
+            authority: guard::Authority::new(addr.ip(), addr.port()),
+            limits: opts.limits,
         });
         server::spawn_acceptor(listener, hub.clone(), site)?;
         let nbody = layout.body_paths.len();
@@ -292,6 +303,11 @@ impl LiveViewer {
     /// Number of connected browsers (websocket clients).
     pub fn client_count(&self) -> usize {
         self.hub.client_count()
+    }
+
+    /// Number of open connections (HTTP requests being read or answered, and websocket clients).
+    pub fn connection_count(&self) -> usize {
+        self.hub.slots.len()
     }
 
     /// Waits until at least `n` browsers are connected; false on timeout.

@@ -56,15 +56,60 @@ pub fn live_html() -> String {
         )
 }
 
-/// Makes text safe to inline inside a `<script>` element.
-fn script_safe(js: &str) -> String {
-    js.replace("</script", "<\\/script")
-        .replace("</SCRIPT", "<\\/SCRIPT")
+/// Makes JavaScript source safe to inline inside a `<script>` element: `</script` (in any
+/// case) becomes `<\/script` and `<!--` becomes `<\!--`, so the code can neither end the
+/// element early nor switch the HTML parser into its escaped states. Both rewrites keep the
+/// meaning of the code inside strings and comments, the only places these sequences occur
+/// in our script and the MeshCat bundle (a regular expression with the `u` flag containing
+/// them would break).
+fn inline_code(js: &str) -> String {
+    let mut out = String::with_capacity(js.len());
+    let mut rest = js;
+    while let Some(i) = rest.find('<') {
+        out.push_str(&rest[..i]);
+        let tail = &rest[i..];
+        let closes_script = tail
+            .get(2..8)
+            .is_some_and(|w| tail.starts_with("</") && w.eq_ignore_ascii_case("script"));
+        if closes_script {
+            out.push_str("<\\/");
+            rest = &tail[2..];
+        } else if tail.starts_with("<!--") {
+            out.push_str("<\\!");
+            rest = &tail[2..];
+        } else {
+            out.push('<');
+            rest = &tail[1..];
+        }
+    }
+    out.push_str(rest);
+    out
+}
+
+/// `value` as JSON text that can sit inside a `<script>` element whatever the strings in it
+/// hold: `<`, `>` and `&` are written as `\u003c`, `\u003e`, `\u0026`, and the line
+/// separators U+2028/U+2029 as `\u2028`/`\u2029`, so no name (node, object, event) can
+/// close the element, open a comment or be read as markup. The JSON value is unchanged.
+pub fn script_json(value: &serde_json::Value) -> String {
+    let json = value.to_string();
+    let mut out = String::with_capacity(json.len() + 16);
+    for c in json.chars() {
+        match c {
+            '<' => out.push_str("\\u003c"),
+            '>' => out.push_str("\\u003e"),
+            '&' => out.push_str("\\u0026"),
+            '\u{2028}' => out.push_str("\\u2028"),
+            '\u{2029}' => out.push_str("\\u2029"),
+            c => out.push(c),
+        }
+    }
+    out
 }
 
 /// A self-contained page: bundle, script and style inlined, `commands` (encoded MeshCat
-/// messages) fed synchronously in order, then `meta` (JSON, e.g. the tree timeline) handed to
-/// the page. Plays offline.
+/// messages, carried as base64) fed synchronously in order, then `meta` (JSON, e.g. the tree
+/// timeline, escaped by [`script_json`]) handed to the page. Plays offline. No string in
+/// `commands` or `meta` can change the page's markup.
 pub fn standalone_html(bundle: &[u8], commands: &[Bytes], meta: Option<&serde_json::Value>) -> String {
     let engine = base64::engine::general_purpose::STANDARD;
     let payload: usize = commands.iter().map(|c| c.len() * 4 / 3 + 8).sum();
@@ -76,13 +121,13 @@ pub fn standalone_html(bundle: &[u8], commands: &[Bytes], meta: Option<&serde_js
         data.push_str("\",\n");
     }
     data.push(']');
-    let meta = meta.map_or_else(|| "null".to_owned(), |m| script_safe(&m.to_string()));
+    let meta = meta.map_or_else(|| "null".to_owned(), script_json);
     let bundle = String::from_utf8_lossy(bundle);
     let mut scripts = String::with_capacity(bundle.len() + data.len() + PAGE_JS.len() + 256);
     scripts.push_str("<script>\n");
-    scripts.push_str(&script_safe(&bundle));
+    scripts.push_str(&inline_code(&bundle));
     scripts.push_str("\n</script>\n<script>\n");
-    scripts.push_str(&script_safe(PAGE_JS));
+    scripts.push_str(&inline_code(PAGE_JS));
     scripts.push_str("\n</script>\n<script>\nmacrotree.replay(");
     scripts.push_str(&data);
     scripts.push_str(", ");

@@ -9,29 +9,46 @@
 //! body poses go into a **slot per body** that the next write empties (latest wins), so a slow
 //! or stalled browser skips frames instead of growing a backlog. If its queue overflows, it is
 //! cleared and the client is re-sent a snapshot of the tree.
+//!
+//! Who may connect and for how long: requests must name this server in `Host` and websocket
+//! upgrades must come from its own pages (`Origin`), see `guard.rs`; every size and wait
+//! is bounded by [`ServerLimits`], and a full server evicts an idle connection rather than
+//! refusing the user (see `docs/security.md`).
 
 use std::collections::VecDeque;
-use std::io::{self, Read, Write};
+use std::io::{self, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
-use tungstenite::protocol::{Role, WebSocket};
+use tungstenite::protocol::{Role, WebSocket, WebSocketConfig};
 use tungstenite::{Bytes, Message};
 
+use super::guard::Authority;
+use super::http::{Request, Response, TimedStream, read_request};
+use super::limits::{MAX_REQUEST_HEAD, ServerLimits};
 use super::panel::PanelState;
+use super::slots::{Refused, SlotGuard, Slots, Stage};
 use super::tree::SceneTree;
+
+pub use super::limits::{MAX_CLIENT_LAG, MAX_CONNECTIONS};
 
 /// Structural messages a client may have queued before it is reset to a snapshot.
 pub const MAX_QUEUED_MESSAGES: usize = 4096;
 /// Bytes of structural messages a client may have queued before it is reset to a snapshot.
 pub const MAX_QUEUED_BYTES: usize = 64 << 20;
-/// Open connections (HTTP and websocket) served at once; more are refused.
-pub const MAX_CONNECTIONS: usize = 64;
-/// A write that cannot progress for this long drops the client.
-pub const WRITE_TIMEOUT: Duration = Duration::from_secs(30);
+/// First pause of the acceptor after a failed `accept` (e.g. out of file descriptors).
+pub const ACCEPT_BACKOFF_MIN: Duration = Duration::from_millis(10);
+/// Longest pause of the acceptor between failed `accept`s (the pause doubles up to it).
+pub const ACCEPT_BACKOFF_MAX: Duration = Duration::from_secs(1);
+/// Least time between two warnings about failed `accept`s.
+pub const ACCEPT_WARN_INTERVAL: Duration = Duration::from_secs(60);
+/// Time given to a refusal or a closing handshake to reach the client's socket.
+const GOODBYE_DEADLINE: Duration = Duration::from_millis(500);
+/// Messages read from a client per poll, so that a chatty client cannot starve its writes.
+const MAX_READS_PER_POLL: usize = 64;
 /// How long a client thread sleeps when it has nothing to send (it then polls for input).
 const IDLE_POLL: Duration = Duration::from_millis(25);
 /// Live updates (a pose batch, the sim time and the panel's statuses) are written to a client at
@@ -75,6 +92,10 @@ struct Outbox {
     tree_dirty: bool,
     status_dirty: bool,
     closed: bool,
+    /// When the oldest update still in this outbox was queued (`None`: nothing pending).
+    pending_since: Option<Instant>,
+    /// A capture request awaits this client's answer: its messages may be larger.
+    capture_pending: bool,
     stats: ClientStats,
 }
 
@@ -100,6 +121,11 @@ impl Outbox {
     /// the simulation thread pays for on a busy machine.
     fn live_needs_wake(&self) -> bool {
         !self.live_pending() && self.next_live_at.is_none_or(|t| Instant::now() >= t)
+    }
+
+    /// Records that an update queued at `now` waits here (the oldest one counts).
+    fn mark_pending(&mut self, now: Instant) {
+        self.pending_since.get_or_insert(now);
     }
 }
 
@@ -133,7 +159,8 @@ pub(crate) struct HubState {
 pub(crate) struct Hub {
     state: Mutex<HubState>,
     next_id: AtomicU64,
-    connections: AtomicU64,
+    /// The open connections (HTTP and websocket).
+    pub slots: Arc<Slots>,
     pub shutdown: AtomicBool,
 }
 
@@ -147,11 +174,13 @@ impl Hub {
     pub fn broadcast(&self, msg: Bytes, update: impl FnOnce(&mut SceneTree, Bytes)) {
         let mut st = self.lock();
         update(&mut st.tree, msg.clone());
+        let now = Instant::now();
         for c in &st.clients {
             let mut out = c.lock();
             if out.resync {
                 continue; // the snapshot it will get already holds this message
             }
+            out.mark_pending(now);
             out.queued_bytes += msg.len();
             out.queue.push_back(msg.clone());
             if out.queue.len() > MAX_QUEUED_MESSAGES || out.queued_bytes > MAX_QUEUED_BYTES {
@@ -173,9 +202,11 @@ impl Hub {
         for (_, path, msg) in &poses {
             st.tree.set_transform(path, msg.clone());
         }
+        let now = Instant::now();
         for c in &st.clients {
             let mut out = c.lock();
             let wake = out.live_needs_wake();
+            out.mark_pending(now);
             out.stats.frames_offered += 1;
             for (slot, _, msg) in &poses {
                 if out.poses.len() <= *slot {
@@ -195,9 +226,11 @@ impl Hub {
     /// Marks the panel's tree (`tree = true`, sent at once) or status (a live update, sent with
     /// the next pose batch) as changed for every client.
     pub fn panel_changed(st: &HubState, tree: bool) {
+        let now = Instant::now();
         for c in &st.clients {
             let mut out = c.lock();
             let wake = tree || out.live_needs_wake();
+            out.mark_pending(now);
             if tree {
                 out.tree_dirty = true;
             }
@@ -222,6 +255,7 @@ impl Hub {
                 time: st.latest_time,
                 tree_dirty: st.panel.tree_message().is_some(),
                 status_dirty: st.panel.tree_message().is_some(),
+                pending_since: Some(Instant::now()),
                 stats: ClientStats {
                     id,
                     ..ClientStats::default()
@@ -258,9 +292,18 @@ impl Hub {
     pub fn request_capture(&self, msg: Bytes) -> Option<mpsc::Receiver<CaptureReply>> {
         let mut st = self.lock();
         let client = st.clients.first()?.clone();
+        if let Some((old, _)) = st.capture.take()
+            && let Some(c) = st.clients.iter().find(|c| c.id == old)
+        {
+            c.lock().capture_pending = false; // a newer request replaces an unanswered one
+        }
         let (tx, rx) = mpsc::channel();
         st.capture = Some((client.id, tx));
-        client.lock().after_poses.push(msg);
+        let mut out = client.lock();
+        out.after_poses.push(msg);
+        out.capture_pending = true;
+        out.mark_pending(Instant::now());
+        drop(out);
         client.wake.notify_all();
         Some(rx)
     }
@@ -287,6 +330,9 @@ impl Hub {
         let Some((_, tx)) = st.capture.take() else {
             return;
         };
+        if let Some(c) = st.clients.iter().find(|c| c.id == client) {
+            c.lock().capture_pending = false;
+        }
         let data = value.get("data").and_then(|d| d.as_str()).unwrap_or("");
         let reply = match data.split_once(";base64,") {
             Some((_, b64)) => {
@@ -301,50 +347,141 @@ impl Hub {
     }
 }
 
-/// Static content served over HTTP.
+/// What the server serves (the page, scripts and style) and the rules it serves by.
 #[derive(Debug)]
 pub(crate) struct Site {
     pub page: Bytes,
     pub bundle: Bytes,
     pub script: Bytes,
     pub style: Bytes,
+    /// The names requests must use (`Host`, `Origin`).
+    pub authority: Authority,
+    /// Connections, sizes and waits.
+    pub limits: ServerLimits,
+}
+
+/// Pauses between failed `accept`s: a connection the acceptor cannot take (no file descriptor
+/// left) stays queued, so retrying at once would spin a core. The pause doubles from
+/// [`ACCEPT_BACKOFF_MIN`] to [`ACCEPT_BACKOFF_MAX`]; a successful accept resets it. Also decides
+/// when to log: a warning at the first failure and then at most once per
+/// [`ACCEPT_WARN_INTERVAL`] (near the descriptor limit accepts fail and succeed in turns), and
+/// one line when accepting works again after a warning.
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
+pub struct AcceptBackoff {
+    /// Failed accepts in a row.
+    failures: u32,
+    /// When the last warning was logged.
+    warned_at: Option<Instant>,
+    /// A warning was logged and the recovery not yet.
+    recovery_unlogged: bool,
+}
+
+impl AcceptBackoff {
+    /// Counts one more failure; returns the pause before the next `accept`.
+    pub fn failed(&mut self) -> Duration {
+        self.failures = self.failures.saturating_add(1);
+        let doublings = (self.failures - 1).min(16);
+        ACCEPT_BACKOFF_MIN
+            .saturating_mul(1 << doublings)
+            .min(ACCEPT_BACKOFF_MAX)
+    }
+
+    /// Failed accepts in a row so far.
+    pub fn failures(&self) -> u32 {
+        self.failures
+    }
+
+    /// Whether to log a warning about a failure at `now`: yes for the first one, then at most
+    /// once per [`ACCEPT_WARN_INTERVAL`].
+    pub fn warn_now(&mut self, now: Instant) -> bool {
+        if self
+            .warned_at
+            .is_some_and(|t| now.duration_since(t) < ACCEPT_WARN_INTERVAL)
+        {
+            return false;
+        }
+        self.warned_at = Some(now);
+        self.recovery_unlogged = true;
+        true
+    }
+
+    /// Resets the pause after a successful accept; returns whether to log the recovery (once
+    /// after each warning).
+    pub fn succeeded(&mut self) -> bool {
+        self.failures = 0;
+        std::mem::take(&mut self.recovery_unlogged)
+    }
+}
+
+/// Whether a failed `accept` may be retried at once: the failure consumed nothing that is
+/// still queued (the peer gave up, or a signal interrupted the call).
+fn retry_at_once(e: &io::Error) -> bool {
+    matches!(
+        e.kind(),
+        io::ErrorKind::ConnectionAborted | io::ErrorKind::Interrupted
+    )
 }
 
 /// Starts the acceptor thread on `listener`.
 pub(crate) fn spawn_acceptor(listener: TcpListener, hub: Arc<Hub>, site: Arc<Site>) -> io::Result<()> {
     std::thread::Builder::new()
         .name("macrotree-viewer-accept".into())
-        .spawn(move || {
-            for stream in listener.incoming() {
-                if hub.shutdown.load(Ordering::SeqCst) {
-                    break;
-                }
-                let Ok(stream) = stream else { continue };
-                if hub.connections.load(Ordering::SeqCst) >= MAX_CONNECTIONS as u64 {
-                    let _ = respond(
-                        &stream,
-                        "503 Service Unavailable",
-                        "text/plain",
-                        "no-store",
-                        b"too many connections\n",
-                        false,
-                    );
-                    continue;
-                }
-                hub.connections.fetch_add(1, Ordering::SeqCst);
-                let (hub2, site2) = (hub.clone(), site.clone());
-                let spawned = std::thread::Builder::new()
-                    .name("macrotree-viewer-conn".into())
-                    .spawn(move || {
-                        let _ = serve_connection(stream, &hub2, &site2);
-                        hub2.connections.fetch_sub(1, Ordering::SeqCst);
-                    });
-                if spawned.is_err() {
-                    hub.connections.fetch_sub(1, Ordering::SeqCst);
-                }
-            }
-        })?;
+        .spawn(move || accept_loop(&listener, &hub, &site))?;
     Ok(())
+}
+
+/// Accepts connections until the hub shuts down, pausing after failures and logging them
+/// sparingly ([`AcceptBackoff`]).
+fn accept_loop(listener: &TcpListener, hub: &Arc<Hub>, site: &Arc<Site>) {
+    let mut backoff = AcceptBackoff::default();
+    loop {
+        let accepted = listener.accept();
+        if hub.shutdown.load(Ordering::SeqCst) {
+            break;
+        }
+        match accepted {
+            Ok((stream, _)) => {
+                if backoff.succeeded() {
+                    tracing::info!("viewer: accepting connections again");
+                }
+                admit(stream, hub, site);
+            }
+            Err(e) if retry_at_once(&e) => {}
+            Err(e) => {
+                let pause = backoff.failed();
+                if backoff.warn_now(Instant::now()) {
+                    tracing::warn!(error = %e, "viewer: cannot accept connections; retrying with pauses of up to {ACCEPT_BACKOFF_MAX:?}");
+                }
+                std::thread::sleep(pause);
+            }
+        }
+    }
+}
+
+/// Gives `stream` a slot and a thread, or answers 503 when no slot can be freed.
+fn admit(stream: TcpStream, hub: &Arc<Hub>, site: &Arc<Site>) {
+    let accepted = Instant::now();
+    let slot = match hub.slots.admit(&stream, site.limits.max_connections) {
+        Ok(slot) => slot,
+        Err(Refused::Full) => {
+            let mut stream = TimedStream::new(stream);
+            stream.set_write_deadline(Some(accepted + GOODBYE_DEADLINE));
+            let _ =
+                Response::text("503 Service Unavailable", "too many connections\n").send(&mut stream, false);
+            return;
+        }
+        Err(Refused::Io(e)) => {
+            // Out of descriptors: dropping the connection frees one.
+            tracing::debug!(error = %e, "viewer: dropped a connection it could not track");
+            return;
+        }
+    };
+    let (hub, site) = (hub.clone(), site.clone());
+    let _ = std::thread::Builder::new()
+        .name("macrotree-viewer-conn".into())
+        .spawn(move || {
+            let _ = serve_connection(stream, &hub, &site, &slot, accepted);
+        });
 }
 
 /// Wakes the acceptor (blocked in `accept`) so it sees the shutdown flag.
@@ -357,178 +494,131 @@ pub(crate) fn wake_acceptor(addr: SocketAddr) {
     let _ = TcpStream::connect_timeout(&target, Duration::from_millis(200));
 }
 
-struct Request {
-    method: String,
-    path: String,
-    headers: Vec<(String, String)>,
-    rest: Vec<u8>,
-}
-
-impl Request {
-    fn header(&self, name: &str) -> Option<&str> {
-        self.headers
-            .iter()
-            .find(|(k, _)| k.eq_ignore_ascii_case(name))
-            .map(|(_, v)| v.as_str())
+/// Why `req` is refused (403), if it is: a `Host` that does not name this server, an `Origin`
+/// that is not one of its pages, or a websocket upgrade without `Origin`.
+fn refusal(req: &Request, authority: &Authority, upgrade: bool) -> Option<&'static str> {
+    if !req.header("Host").is_some_and(|h| authority.host_allowed(h)) {
+        return Some("Host must name this server: 127.0.0.1, localhost or [::1] with its port\n");
+    }
+    match req.header("Origin") {
+        Some(origin) if !authority.origin_allowed(origin) => {
+            Some("only this server's own pages may connect (Origin)\n")
+        }
+        None if upgrade => Some("a websocket upgrade must carry Origin\n"),
+        _ => None,
     }
 }
 
-fn read_request(stream: &mut TcpStream) -> io::Result<Request> {
-    let mut buf = Vec::with_capacity(1024);
-    let mut chunk = [0u8; 1024];
-    let end = loop {
-        if let Some(pos) = buf.windows(4).position(|w| w == b"\r\n\r\n") {
-            break pos + 4;
+/// The answer to a request head that did not arrive whole, if any is worth sending.
+fn head_error_response(e: &io::Error) -> Option<Response<'static>> {
+    match e.kind() {
+        io::ErrorKind::TimedOut | io::ErrorKind::WouldBlock => {
+            Some(Response::text("408 Request Timeout", "request head too slow\n"))
         }
-        if buf.len() > 16 * 1024 {
-            return Err(io::Error::new(
-                io::ErrorKind::InvalidData,
-                "request head too large",
-            ));
-        }
-        let n = stream.read(&mut chunk)?;
-        if n == 0 {
-            return Err(io::ErrorKind::UnexpectedEof.into());
-        }
-        buf.extend_from_slice(&chunk[..n]);
-    };
-    let head = String::from_utf8_lossy(&buf[..end]).into_owned();
-    let mut lines = head.split("\r\n");
-    let mut first = lines.next().unwrap_or("").split_whitespace();
-    let method = first.next().unwrap_or("").to_owned();
-    let path = first.next().unwrap_or("/").to_owned();
-    let headers = lines
-        .filter_map(|l| l.split_once(':'))
-        .map(|(k, v)| (k.trim().to_owned(), v.trim().to_owned()))
-        .collect();
-    Ok(Request {
-        method,
-        path,
-        headers,
-        rest: buf[end..].to_vec(),
-    })
+        io::ErrorKind::InvalidData => Some(Response::text(
+            "431 Request Header Fields Too Large",
+            "request head too large\n",
+        )),
+        _ => None,
+    }
 }
 
-fn respond(
-    mut stream: &TcpStream,
-    status: &str,
-    content_type: &str,
-    cache: &str,
-    body: &[u8],
-    head_only: bool,
+fn serve_connection(
+    stream: TcpStream,
+    hub: &Hub,
+    site: &Site,
+    slot: &SlotGuard,
+    accepted: Instant,
 ) -> io::Result<()> {
-    let head = format!(
-        "HTTP/1.1 {status}\r\nContent-Type: {content_type}\r\nContent-Length: {}\r\nCache-Control: {cache}\r\nConnection: close\r\n\r\n",
-        body.len()
-    );
-    stream.write_all(head.as_bytes())?;
-    if !head_only {
-        stream.write_all(body)?;
-    }
-    stream.flush()
-}
-
-fn serve_connection(mut stream: TcpStream, hub: &Hub, site: &Site) -> io::Result<()> {
-    stream.set_read_timeout(Some(Duration::from_secs(10)))?;
-    stream.set_write_timeout(Some(WRITE_TIMEOUT))?;
-    let req = read_request(&mut stream)?;
+    let limits = &site.limits;
+    let mut stream = TimedStream::new(stream);
+    stream.set_read_deadline(Some(accepted + limits.request_deadline));
+    let req = match read_request(&mut stream, MAX_REQUEST_HEAD) {
+        Ok(req) => req,
+        Err(e) => {
+            if let Some(response) = head_error_response(&e) {
+                stream.set_write_deadline(Some(Instant::now() + GOODBYE_DEADLINE));
+                let _ = response.send(&mut stream, false);
+            }
+            return Err(e);
+        }
+    };
+    slot.set_stage(Stage::Response);
+    stream.set_read_deadline(None);
+    stream.set_write_deadline(Some(Instant::now() + limits.response_deadline));
     let upgrade = req
         .header("Upgrade")
         .is_some_and(|v| v.eq_ignore_ascii_case("websocket"));
+    if let Some(why) = refusal(&req, &site.authority, upgrade) {
+        return Response::text("403 Forbidden", why).send(&mut stream, false);
+    }
     if upgrade {
-        let Some(key) = req.header("Sec-WebSocket-Key") else {
-            return respond(
-                &stream,
-                "400 Bad Request",
-                "text/plain",
-                "no-store",
-                b"missing Sec-WebSocket-Key\n",
-                false,
-            );
-        };
-        let accept = tungstenite::handshake::derive_accept_key(key.as_bytes());
-        let head = format!(
-            "HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Accept: {accept}\r\n\r\n"
-        );
-        stream.write_all(head.as_bytes())?;
-        stream.flush()?;
-        let ws = WebSocket::from_partially_read(stream, req.rest, Role::Server, None);
-        return run_client(ws, hub);
+        return upgrade_to_websocket(stream, req, hub, site, slot);
     }
     let head_only = req.method == "HEAD";
     if req.method != "GET" && !head_only {
-        return respond(
-            &stream,
-            "405 Method Not Allowed",
-            "text/plain",
-            "no-store",
-            b"only GET\n",
-            false,
-        );
+        return Response::text("405 Method Not Allowed", "only GET\n").send(&mut stream, false);
     }
     let path = req.path.split('?').next().unwrap_or("/");
-    match path {
-        "/" | "/index.html" => respond(
-            &stream,
-            "200 OK",
-            "text/html; charset=utf-8",
-            "no-cache",
-            &site.page,
-            head_only,
-        ),
-        "/main.min.js" => respond(
-            &stream,
-            "200 OK",
+    let file = |content_type, cache, body| Response {
+        status: "200 OK",
+        content_type,
+        cache,
+        body,
+    };
+    let download;
+    let response = match path {
+        "/" | "/index.html" => file("text/html; charset=utf-8", "no-cache", &site.page[..]),
+        "/main.min.js" => file(
             "text/javascript; charset=utf-8",
             "public, max-age=3600",
-            &site.bundle,
-            head_only,
+            &site.bundle[..],
         ),
-        "/viewer.js" => respond(
-            &stream,
-            "200 OK",
-            "text/javascript; charset=utf-8",
-            "no-cache",
-            &site.script,
-            head_only,
-        ),
-        "/viewer.css" => respond(
-            &stream,
-            "200 OK",
-            "text/css; charset=utf-8",
-            "no-cache",
-            &site.style,
-            head_only,
-        ),
-        "/favicon.ico" => respond(
-            &stream,
-            "204 No Content",
-            "image/x-icon",
-            "public, max-age=86400",
-            b"",
-            head_only,
-        ),
+        "/viewer.js" => file("text/javascript; charset=utf-8", "no-cache", &site.script[..]),
+        "/viewer.css" => file("text/css; charset=utf-8", "no-cache", &site.style[..]),
+        "/favicon.ico" => Response {
+            status: "204 No Content",
+            content_type: "image/x-icon",
+            cache: "public, max-age=86400",
+            body: b"",
+        },
         "/download" => {
             let commands = hub.lock().tree.snapshot();
-            let html = super::page::standalone_html(&site.bundle, &commands, None);
-            respond(
-                &stream,
-                "200 OK",
-                "text/html; charset=utf-8",
-                "no-store",
-                html.as_bytes(),
-                head_only,
-            )
+            download = super::page::standalone_html(&site.bundle, &commands, None);
+            file("text/html; charset=utf-8", "no-store", download.as_bytes())
         }
-        _ => respond(
-            &stream,
-            "404 Not Found",
-            "text/plain",
-            "no-store",
-            b"not found\n",
-            head_only,
-        ),
-    }
+        _ => Response::text("404 Not Found", "not found\n"),
+    };
+    response.send(&mut stream, head_only)
+}
+
+/// Completes the websocket handshake and serves the client until it leaves or lags.
+fn upgrade_to_websocket(
+    mut stream: TimedStream,
+    req: Request,
+    hub: &Hub,
+    site: &Site,
+    slot: &SlotGuard,
+) -> io::Result<()> {
+    let Some(key) = req.header("Sec-WebSocket-Key") else {
+        return Response::text("400 Bad Request", "missing Sec-WebSocket-Key\n").send(&mut stream, false);
+    };
+    let accept = tungstenite::handshake::derive_accept_key(key.as_bytes());
+    let head = format!(
+        "HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Accept: {accept}\r\n\r\n"
+    );
+    stream.write_all(head.as_bytes())?;
+    stream.flush()?;
+    stream.set_write_deadline(None);
+    slot.set_stage(Stage::WebSocket);
+    let config = incoming_limits(WebSocketConfig::default(), site.limits.max_client_message);
+    let ws = WebSocket::from_partially_read(stream, req.rest, Role::Server, Some(config));
+    run_client(ws, hub, &site.limits)
+}
+
+/// `config` accepting client messages and frames of at most `max` bytes.
+fn incoming_limits(config: WebSocketConfig, max: usize) -> WebSocketConfig {
+    config.max_message_size(Some(max)).max_frame_size(Some(max))
 }
 
 /// Everything a client thread takes out of its outbox in one go.
@@ -541,6 +631,10 @@ struct Batch {
     tree: bool,
     status: bool,
     closed: bool,
+    /// When the oldest update in this batch (or still pending after it) was queued.
+    since: Option<Instant>,
+    /// A capture request awaits this client's answer.
+    capture_pending: bool,
 }
 
 /// Takes what is due: structural messages and the panel's node list at once, live updates
@@ -591,7 +685,13 @@ fn take_batch(client: &Client) -> Batch {
     let tree = std::mem::take(&mut out.tree_dirty);
     status |= tree && std::mem::take(&mut out.status_dirty);
     out.queued_bytes = 0;
+    let since = out.pending_since;
+    if !out.live_pending() {
+        out.pending_since = None; // all taken; rate-limited live updates keep their age
+    }
     Batch {
+        since,
+        capture_pending: out.capture_pending,
         queue: std::mem::take(&mut out.queue),
         poses,
         after_poses: std::mem::take(&mut out.after_poses),
@@ -603,13 +703,76 @@ fn take_batch(client: &Client) -> Batch {
     }
 }
 
-fn run_client(mut ws: WebSocket<TcpStream>, hub: &Hub) -> io::Result<()> {
-    ws.get_ref().set_nodelay(true)?;
+/// How far behind a client is. After written data the client is pinged (at most every
+/// [`ServerLimits::ping_interval`]); each ping is stamped with when the oldest data before it
+/// was queued, and a pong answers every ping up to its sequence number. This measures what the
+/// client has actually read, whatever the kernel buffers in between.
+#[derive(Debug, Default)]
+struct Lag {
+    /// Pings not answered yet: (sequence number, when the oldest data before it was queued).
+    unanswered: VecDeque<(u64, Instant)>,
+    /// When the oldest data written since the last ping was queued.
+    unpinged: Option<Instant>,
+    last_ping: Option<Instant>,
+    next_seq: u64,
+}
+
+impl Lag {
+    /// Data queued at `since` was written to the socket.
+    fn wrote(&mut self, since: Instant) {
+        self.unpinged = Some(self.unpinged.map_or(since, |u| u.min(since)));
+    }
+
+    /// The payload of a ping to send now, if data was written since the last ping and the
+    /// interval has passed.
+    fn ping_due(&mut self, now: Instant, interval: Duration) -> Option<Bytes> {
+        let since = self.unpinged?;
+        if self.last_ping.is_some_and(|t| now.duration_since(t) < interval) {
+            return None;
+        }
+        let seq = self.next_seq;
+        self.next_seq += 1;
+        self.unanswered.push_back((seq, since));
+        self.unpinged = None;
+        self.last_ping = Some(now);
+        Some(Bytes::copy_from_slice(&seq.to_be_bytes()))
+    }
+
+    /// A pong arrived: every ping up to its sequence number is answered.
+    fn answered(&mut self, payload: &[u8]) {
+        let Ok(seq) = <[u8; 8]>::try_from(payload).map(u64::from_be_bytes) else {
+            return; // not one of ours (an unsolicited pong)
+        };
+        while self.unanswered.front().is_some_and(|&(s, _)| s <= seq) {
+            self.unanswered.pop_front();
+        }
+    }
+
+    /// When the oldest data the client is not known to have read was queued.
+    fn oldest(&self) -> Option<Instant> {
+        let pinged = self.unanswered.front().map(|&(_, t)| t);
+        pinged.into_iter().chain(self.unpinged).min()
+    }
+}
+
+fn run_client(mut ws: WebSocket<TimedStream>, hub: &Hub, limits: &ServerLimits) -> io::Result<()> {
+    ws.get_ref().get_ref().set_nodelay(true)?;
     let client = hub.register();
-    let result = client_loop(&mut ws, hub, &client);
+    let result = client_loop(&mut ws, hub, &client, limits);
     hub.unregister(client.id);
+    ws.get_mut()
+        .set_write_deadline(Some(Instant::now() + GOODBYE_DEADLINE));
     let _ = ws.close(None);
     let _ = ws.flush();
+    if let Err(e) = &result
+        && e.kind() == io::ErrorKind::TimedOut
+    {
+        tracing::info!(
+            client = client.id,
+            "viewer: dropped a browser that fell {:?} behind",
+            limits.max_client_lag
+        );
+    }
     result
 }
 
@@ -620,13 +783,28 @@ fn ws_err(e: tungstenite::Error) -> io::Error {
     }
 }
 
-fn client_loop(ws: &mut WebSocket<TcpStream>, hub: &Hub, client: &Client) -> io::Result<()> {
+fn client_loop(
+    ws: &mut WebSocket<TimedStream>,
+    hub: &Hub,
+    client: &Client,
+    limits: &ServerLimits,
+) -> io::Result<()> {
     let mut events_seen = 0u64;
+    let mut lag = Lag::default();
+    let mut capture_mode = false;
     loop {
         let mut batch = take_batch(client);
         if batch.closed || hub.shutdown.load(Ordering::SeqCst) {
             return Ok(());
         }
+        // Writes may block only until the oldest unread update is `max_client_lag` old.
+        let now = Instant::now();
+        let oldest = batch.since.into_iter().chain(lag.oldest()).min().unwrap_or(now);
+        let deadline = oldest + limits.max_client_lag;
+        if now >= deadline {
+            return Err(io::Error::new(io::ErrorKind::TimedOut, "the client lags"));
+        }
+        ws.get_mut().set_write_deadline(Some(deadline));
         if batch.resync {
             // Overflowed: drop what was queued and replay the current tree instead.
             let st = hub.lock();
@@ -670,24 +848,53 @@ fn client_loop(ws: &mut WebSocket<TcpStream>, hub: &Hub, client: &Client) -> io:
             ws.write(Message::text(format!("{{\"type\":\"time\",\"t\":{t}}}")))
                 .map_err(ws_err)?;
         }
+        if let Some(since) = batch.since {
+            lag.wrote(since);
+        }
+        if let Some(ping) = lag.ping_due(now, limits.ping_interval) {
+            ws.write(Message::Ping(ping)).map_err(ws_err)?;
+        }
         ws.flush().map_err(ws_err)?;
         if messages > 0 {
             let mut out = client.lock();
             out.stats.messages_sent += messages;
             out.stats.bytes_sent += bytes;
         }
-        // Poll for input without blocking (capture replies, close frames).
-        ws.get_ref().set_nonblocking(true)?;
-        let read = loop {
-            match ws.read() {
-                Ok(Message::Text(text)) => hub.on_text(client.id, text.as_str()),
-                Ok(Message::Close(_)) => break Err(io::ErrorKind::ConnectionAborted.into()),
-                Ok(_) => {}
-                Err(tungstenite::Error::Io(e)) if e.kind() == io::ErrorKind::WouldBlock => break Ok(()),
-                Err(e) => break Err(ws_err(e)),
-            }
-        };
-        ws.get_ref().set_nonblocking(false)?;
-        read?;
+        if batch.capture_pending != capture_mode {
+            // Only the answer to a capture request may be large.
+            capture_mode = batch.capture_pending;
+            let max = if capture_mode {
+                limits.max_capture_reply
+            } else {
+                limits.max_client_message
+            };
+            ws.set_config(|c| *c = incoming_limits(*c, max));
+        }
+        poll_input(ws, hub, client.id, &mut lag)?;
     }
+}
+
+/// Reads what the client sent without blocking (capture answers, pongs, close frames), at
+/// most [`MAX_READS_PER_POLL`] messages. A message over the size limit is an error.
+fn poll_input(ws: &mut WebSocket<TimedStream>, hub: &Hub, client: u64, lag: &mut Lag) -> io::Result<()> {
+    ws.get_ref().get_ref().set_nonblocking(true)?;
+    let mut read = Ok(());
+    for _ in 0..MAX_READS_PER_POLL {
+        match ws.read() {
+            Ok(Message::Text(text)) => hub.on_text(client, text.as_str()),
+            Ok(Message::Pong(payload)) => lag.answered(&payload),
+            Ok(Message::Close(_)) => {
+                read = Err(io::ErrorKind::ConnectionAborted.into());
+                break;
+            }
+            Ok(_) => {}
+            Err(tungstenite::Error::Io(e)) if e.kind() == io::ErrorKind::WouldBlock => break,
+            Err(e) => {
+                read = Err(ws_err(e));
+                break;
+            }
+        }
+    }
+    ws.get_ref().get_ref().set_nonblocking(false)?;
+    read
 }

@@ -14,23 +14,42 @@ use tungstenite::{Message, WebSocket};
 
 pub const CHROMIUM: &str = "/usr/bin/chromium";
 
-/// Whether to run: Chromium and the bundle present; outside CI their absence skips loudly.
+/// Set to `1` to skip the real-browser tests on a machine without Chromium (they fail otherwise).
+pub const SKIP_ENV: &str = "MACROTREE_SKIP_BROWSER_TESTS";
+
+/// Whether a real-browser test runs: `Ok(true)` when `chromium` and the viewer bundle are
+/// present, `Ok(false)` (skip) when one is missing and `skip` was asked for, else `Err` with
+/// what to install or set.
+pub fn browser_check(chromium: &Path, skip: bool) -> Result<bool, String> {
+    let missing = if !chromium.exists() {
+        format!(
+            "{} is missing: install it (apt-get install chromium)",
+            chromium.display()
+        )
+    } else if let Err(p) = page::load_bundle() {
+        page::bundle_help(&p)
+    } else {
+        return Ok(true);
+    };
+    if skip {
+        eprintln!("SKIPPED ({SKIP_ENV}=1): {missing}");
+        Ok(false)
+    } else {
+        Err(format!(
+            "{missing}; or set {SKIP_ENV}=1 to skip the real-browser tests"
+        ))
+    }
+}
+
+/// Whether the opt-out [`SKIP_ENV`] is set to `1`.
+pub fn skip_requested() -> bool {
+    std::env::var_os(SKIP_ENV).is_some_and(|v| v == "1")
+}
+
+/// Whether to run a real-browser test: a missing Chromium or bundle fails the test unless
+/// [`SKIP_ENV`]`=1` (see [`browser_check`]).
 pub fn browser_available() -> bool {
-    let ci = std::env::var_os("CI").is_some();
-    if !Path::new(CHROMIUM).exists() {
-        assert!(
-            !ci,
-            "{CHROMIUM} is missing: CI must install the Debian package chromium"
-        );
-        eprintln!("SKIPPED: {CHROMIUM} is missing (apt-get install chromium)");
-        return false;
-    }
-    if let Err(p) = page::load_bundle() {
-        assert!(!ci, "{}", page::bundle_help(&p));
-        eprintln!("SKIPPED: {}", page::bundle_help(&p));
-        return false;
-    }
-    true
+    browser_check(Path::new(CHROMIUM), skip_requested()).unwrap_or_else(|why| panic!("{why}"))
 }
 
 pub fn temp_dir(tag: &str) -> PathBuf {
@@ -153,7 +172,10 @@ impl Devtools {
         self.next_id += 1;
         let msg = serde_json::json!({ "id": id, "method": method, "params": params });
         self.ws.send(Message::text(msg.to_string())).unwrap();
+        // Each read has the socket's timeout; events arriving in between must not extend it.
+        let deadline = Instant::now() + Duration::from_secs(120);
         loop {
+            assert!(Instant::now() < deadline, "{method}: no answer from chromium");
             if let Message::Text(t) = self.ws.read().unwrap() {
                 let v: serde_json::Value = serde_json::from_str(t.as_str()).unwrap();
                 if v["id"] == id {
@@ -170,6 +192,25 @@ impl Devtools {
             serde_json::json!({ "expression": js, "returnByValue": true }),
         );
         r["result"]["value"].clone()
+    }
+
+    /// Evaluates `js` every 100 ms until `done` accepts its value; panics with the last value
+    /// after `timeout`.
+    pub fn wait_until(
+        &mut self,
+        js: &str,
+        timeout: Duration,
+        done: impl Fn(&serde_json::Value) -> bool,
+    ) -> serde_json::Value {
+        let deadline = Instant::now() + timeout;
+        loop {
+            let v = self.eval(js);
+            if done(&v) {
+                return v;
+            }
+            assert!(Instant::now() < deadline, "after {timeout:?}, {js} is {v}");
+            std::thread::sleep(Duration::from_millis(100));
+        }
     }
 
     pub fn screenshot(&mut self) -> Vec<u8> {
