@@ -344,8 +344,8 @@ fn the_task_scene_draws_visual_geoms_only_from_compiled_meshes() {
         }
     }
     for name in [
-        "/mujoco/obj/cube/obj/cube",
-        "/mujoco/obj/bowl/obj/bowl/floor",
+        "/mujoco/obj_cube/obj_cube",
+        "/mujoco/obj_bowl/obj_bowl_floor",
         "/mujoco/world/floor",
     ] {
         assert!(layout.geoms.iter().any(|g| g.path == name), "{name}");
