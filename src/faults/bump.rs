@@ -4,7 +4,7 @@
 
 use rand_chacha::ChaCha8Rng;
 
-use super::push::{Push, cube_pos};
+use super::push::{Push, block_pos, legacy_cube};
 use super::{Fault, uniform};
 use crate::sim::Sim;
 use crate::world::World;
@@ -69,9 +69,10 @@ impl Fault for Bump {
                     return None;
                 }
                 let angle = *away + self.spread;
-                let mut push = Push::slide(sim, angle, self.distance, STEPS);
+                let block = legacy_cube(sim);
+                let mut push = Push::slide(sim, block, angle, self.distance, STEPS);
                 push.apply(sim);
-                let c = cube_pos(sim);
+                let c = block_pos(sim, block);
                 let detail = format!(
                     "a bump pushes the cube at ({:.3}, {:.3}) m {:.1} N toward {:.0}° (about {:.0} mm) during the approach",
                     c.x,

@@ -4,7 +4,7 @@
 
 use rand_chacha::ChaCha8Rng;
 
-use super::push::{Push, cube_pos};
+use super::push::{Push, block_pos};
 use super::{Fault, uniform};
 use crate::sim::Sim;
 use crate::world::World;
@@ -17,7 +17,10 @@ const STEPS: u32 = 10;
 enum State {
     Idle,
     /// The first grasp started: push on the next step.
-    Armed,
+    /// The first grasp started on block `block` (the block nearest the fingers).
+    Armed {
+        block: usize,
+    },
     Pushing(Push),
     Done,
 }
@@ -41,21 +44,33 @@ impl Nudge {
 }
 
 impl Fault for Nudge {
-    fn on_action_start(&mut self, kind: &str, _world: &World) {
+    fn on_action_start(&mut self, kind: &str, world: &World) {
         if kind == "grasp" && matches!(self.state, State::Idle) {
-            self.state = State::Armed;
+            // The block being grasped: the one nearest the pinch point.
+            let nearest = world
+                .scene
+                .of_kind(crate::scene::ObjectKind::Block)
+                .min_by(|&a, &b| {
+                    let d = |i: usize| (world.objects[i].pos - world.pinch_pos).norm();
+                    d(a).total_cmp(&d(b))
+                });
+            if let Some(block) = nearest {
+                self.state = State::Armed { block };
+            }
         }
     }
 
     fn before_step(&mut self, sim: &mut Sim) -> Option<String> {
         match &mut self.state {
             State::Idle | State::Done => None,
-            State::Armed => {
-                let mut push = Push::slide(sim, self.angle, self.distance, STEPS);
+            State::Armed { block } => {
+                let block = *block;
+                let mut push = Push::slide(sim, block, self.angle, self.distance, STEPS);
                 push.apply(sim);
-                let c = cube_pos(sim);
+                let c = block_pos(sim, block);
                 let detail = format!(
-                    "the cube at ({:.3}, {:.3}) m is pushed {:.1} N toward {:.0}° (about {:.0} mm) as the gripper closes",
+                    "{} at ({:.3}, {:.3}) m is pushed {:.1} N toward {:.0}° (about {:.0} mm) as the gripper closes",
+                    sim.scene().spec.objects[block].name,
                     c.x,
                     c.y,
                     push.force().norm(),

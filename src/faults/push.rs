@@ -3,13 +3,15 @@
 
 use nalgebra::Vector3;
 
+use crate::scene::Shape;
 use crate::sim::{Sim, TIMESTEP};
-use crate::world::CUBE_HALF;
 
-/// A force on the cube's centre of mass (world frame, N) and a torque (N·m), for `steps`
+/// A force on a block's centre of mass (world frame, N) and a torque (N·m), for `steps`
 /// physics steps.
 #[derive(Debug, Clone)]
 pub(super) struct Push {
+    /// The block pushed (index into the scene's objects).
+    block: usize,
     force: Vector3<f64>,
     torque: Vector3<f64>,
     steps_left: u32,
@@ -17,9 +19,10 @@ pub(super) struct Push {
 }
 
 impl Push {
-    /// A push of `force` and `torque` lasting `steps` physics steps.
-    pub fn new(force: Vector3<f64>, torque: Vector3<f64>, steps: u32) -> Self {
+    /// A push of `force` and `torque` on block `block` lasting `steps` physics steps.
+    pub fn new(block: usize, force: Vector3<f64>, torque: Vector3<f64>, steps: u32) -> Self {
         Self {
+            block,
             force,
             torque,
             steps_left: steps,
@@ -33,27 +36,31 @@ impl Push {
     /// overcomes meanwhile. The force's line of action is lowered below the centre of mass (a
     /// torque is added) by just enough to cancel the tipping moment of the table's friction, so
     /// the cube slides without tipping either way while it is pushed.
-    pub fn slide(sim: &Sim, angle: f64, distance: f64, steps: u32) -> Self {
+    pub fn slide(sim: &Sim, block: usize, angle: f64, distance: f64, steps: u32) -> Self {
         let model = &sim.scene().model;
-        let ids = &sim.scene().ids;
-        let mass = model.body_mass()[ids.cube_body];
-        let mu = model.geom_friction()[ids.cube_geom][0];
+        let ids = &sim.scene().objects[block];
+        let mass = model.body_mass()[ids.body];
+        let mu = model.geom_friction()[ids.geoms[0]][0];
+        let half = match sim.scene().spec.objects[block].shape {
+            Shape::Block { half, .. } => half,
+            _ => 0.0,
+        };
         let g = 9.81;
         let duration = steps as f64 * TIMESTEP;
         let speed = (2.0 * mu * g * distance).sqrt();
         let magnitude = mass * speed / duration + mu * mass * g;
         let dir = Vector3::new(angle.cos(), angle.sin(), 0.0);
         let force = dir * magnitude;
-        // Friction μ·m·g acts at the bottom face, CUBE_HALF below the centre: the push's moment
-        // about the centre must match it.
-        let arm = Vector3::new(0.0, 0.0, -mu * mass * g * CUBE_HALF / magnitude);
-        Self::new(force, arm.cross(&force), steps)
+        // Friction μ·m·g acts at the bottom face, half an edge below the centre: the push's
+        // moment about the centre must match it.
+        let arm = Vector3::new(0.0, 0.0, -mu * mass * g * half / magnitude);
+        Self::new(block, force, arm.cross(&force), steps)
     }
 
     /// Writes the force for the coming step, or clears it once the push is over.
     /// Returns true while the push lasts.
     pub fn apply(&mut self, sim: &mut Sim) -> bool {
-        let body = sim.scene().ids.cube_body;
+        let body = sim.scene().objects[self.block].body;
         let xfrc = &mut sim.data_mut().xfrc_applied_mut()[body];
         if self.steps_left > 0 {
             let f = self.force;
@@ -77,9 +84,19 @@ impl Push {
     }
 }
 
-/// The cube's centre, world frame, metres (read from its free joint).
-pub(super) fn cube_pos(sim: &Sim) -> Vector3<f64> {
-    let c = sim.scene().ids.cube_qpos;
+/// Block `block`'s centre, world frame, metres (read from its free joint).
+pub(super) fn block_pos(sim: &Sim, block: usize) -> Vector3<f64> {
+    let c = sim.scene().objects[block].qpos.unwrap_or_default();
     let q = sim.data().qpos();
     Vector3::new(q[c], q[c + 1], q[c + 2])
+}
+
+/// The block the legacy name `cube` stands for (the one the scene's `ids.cube_*` point at).
+pub(super) fn legacy_cube(sim: &Sim) -> usize {
+    let body = sim.scene().ids.cube_body;
+    sim.scene()
+        .objects
+        .iter()
+        .position(|o| o.body == body)
+        .unwrap_or_default()
 }
