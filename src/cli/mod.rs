@@ -96,17 +96,19 @@ pub fn main() -> ExitCode {
     }
 }
 
+/// Diagnostics as a bad-input error: each one, then a line saying `what` is invalid.
+fn invalid(diags: Vec<crate::spec::Diagnostic>, what: String) -> CliError {
+    let text: Vec<String> = diags.iter().map(|d| d.to_string()).collect();
+    CliError::Input(format!(
+        "{}\nerror: {what} is invalid ({} error(s))",
+        text.join("\n"),
+        diags.len()
+    ))
+}
+
 /// Loads and compiles a tree, or returns its diagnostics as a bad-input error.
 fn load_plan_or_exit(path: &std::path::Path) -> Result<crate::plan::Plan, CliError> {
-    crate::plan::load_plan(path).map_err(|diags| {
-        let text: Vec<String> = diags.iter().map(|d| d.to_string()).collect();
-        CliError::Input(format!(
-            "{}\nerror: {} is invalid ({} error(s))",
-            text.join("\n"),
-            path.display(),
-            diags.len()
-        ))
-    })
+    crate::plan::load_plan(path).map_err(|diags| invalid(diags, path.display().to_string()))
 }
 
 /// Loads a tree for the scene it runs on — `scene_file` (a `--scene` override) when given, else
@@ -118,25 +120,10 @@ fn load_task(
 ) -> Result<(crate::plan::Plan, crate::sim::Scene), CliError> {
     let plan = match scene_file {
         Some(path) => {
-            let scene = crate::scene::load_scene_file(path).map_err(|diags| {
-                let text: Vec<String> = diags.iter().map(|d| d.to_string()).collect();
-                CliError::Input(format!(
-                    "{}\nerror: {} is invalid ({} error(s))",
-                    text.join("\n"),
-                    path.display(),
-                    diags.len()
-                ))
-            })?;
-            crate::plan::load_plan_for(tree, Some(std::sync::Arc::new(scene))).map_err(|diags| {
-                let text: Vec<String> = diags.iter().map(|d| d.to_string()).collect();
-                CliError::Input(format!(
-                    "{}\nerror: {} is invalid for scene {} ({} error(s))",
-                    text.join("\n"),
-                    tree.display(),
-                    path.display(),
-                    diags.len()
-                ))
-            })?
+            let scene = crate::scene::load_scene_file(path)
+                .map_err(|diags| invalid(diags, path.display().to_string()))?;
+            crate::plan::load_plan_for(tree, Some(std::sync::Arc::new(scene)))
+                .map_err(|diags| invalid(diags, format!("{} for scene {}", tree.display(), path.display())))?
         }
         None => load_plan_or_exit(tree)?,
     };
