@@ -1,20 +1,12 @@
 //! Bounds of the numeric options, through the binary: out of range is exit 2 with the range,
 //! never a panic or a hang, and shard indices are computed, never listed (issue 13, items 11, 12).
 
-use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
-const BIN: &str = env!("CARGO_BIN_EXE_macrotree");
+#[path = "support/cli.rs"]
+mod cli;
+use cli::*;
 const TREE: &str = "trees/cube_to_bowl.yaml";
-
-fn macrotree(args: &[&str]) -> Output {
-    Command::new(BIN)
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .env_remove("RUST_LOG")
-        .output()
-        .expect("runs the binary")
-}
 
 fn assert_bad_input(args: &[&str], needle: &str) {
     let out = macrotree(args);

@@ -3,20 +3,13 @@
 //! error reported with exit 2 (issue 13, files).
 
 use std::os::unix::fs::FileTypeExt;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
-const BIN: &str = env!("CARGO_BIN_EXE_macrotree");
+#[path = "support/cli.rs"]
+mod cli;
+use cli::*;
 const TREE: &str = "trees/cube_to_bowl.yaml";
-
-fn macrotree(args: &[&str]) -> Output {
-    Command::new(BIN)
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .env_remove("RUST_LOG")
-        .output()
-        .expect("runs the binary")
-}
 
 /// The binary with a file size limit of `kib` KiB (writes past it fail with EFBIG).
 fn macrotree_with_file_limit(kib: u32, args: &[&str]) -> Output {
@@ -31,17 +24,6 @@ fn macrotree_with_file_limit(kib: u32, args: &[&str]) -> Output {
         .env_remove("RUST_LOG")
         .output()
         .expect("runs the binary")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("macrotree-outputs-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
 }
 
 fn text(b: &[u8]) -> String {

@@ -1,31 +1,13 @@
 //! `sweep --resume`: an interrupted sweep's file is completed to exactly the bytes and summary of
 //! an uninterrupted run, and results of another sweep are refused (issue 13, item 4).
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Output;
 
-const BIN: &str = env!("CARGO_BIN_EXE_macrotree");
+#[path = "support/cli.rs"]
+mod cli;
+use cli::*;
 const TREE: &str = "trees/cube_to_bowl.yaml";
-
-fn macrotree(args: &[&str]) -> Output {
-    Command::new(BIN)
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .env_remove("RUST_LOG")
-        .output()
-        .expect("runs the binary")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("macrotree-resume-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 /// The `--json` summary without what depends on the machine and the run (wall time, jobs).
 fn summary(out: &Output) -> serde_json::Value {
