@@ -159,7 +159,7 @@ impl<'a> MacroDriver<'a> {
                     continue;
                 };
                 let kind = w.spec(index).kind();
-                let fingers = me == Part::Fingers && kind != ObjectKind::Block;
+                let fingers = matches!(me, Part::Fingers | Part::Robot) && kind != ObjectKind::Block;
                 let carried = matches!(me, Part::Object { index: h, .. } if Some(h) == held && h != index)
                     && (piece == Piece::Wall || kind == ObjectKind::Obstacle);
                 if !(fingers || carried) {
@@ -167,6 +167,7 @@ impl<'a> MacroDriver<'a> {
                 }
                 let who = match me {
                     Part::Object { index: h, .. } => format!("the carried {}", w.name(h)),
+                    Part::Robot => "the arm".to_string(),
                     _ => "the fingers".to_string(),
                 };
                 let what = format!("{who} hit {}", w.describe(other));

@@ -1,18 +1,30 @@
 //! `reach`: move the pinch to a pose above/at a target, tool pointing down.
 
-use nalgebra::Vector3;
+use nalgebra::{Isometry3, Translation3, Vector3};
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
-use super::targets::{resolve, target_block, tool_yaw};
-use crate::motion::{CartesianMove, JointMove, MotionLimits, down_pose, ik_down};
+use super::targets::{resolve, target_block, target_object, tool_yaw};
+use crate::motion::{CartesianMove, JointMove, MotionLimits, Trajectory, down_pose, fk, ik_down};
 use crate::spec::{PathKind, Reach as ReachSpec, Target, Yaw};
+use crate::world::World;
+
+/// How far from an object's footprint the open fingers reach around the pinch, metres.
+const FINGER_REACH: f64 = 0.05;
+/// Height the fingertips keep above the top of anything they pass over, metres.
+const PATH_CLEARANCE: f64 = 0.03;
+/// Height above the highest object in the way at which a detour passes, metres.
+const DETOUR_HEIGHT: f64 = 0.08;
+/// Points checked along a joint-space path.
+const PATH_SAMPLES: usize = 24;
 
 /// Executes a [`ReachSpec`].
 pub struct Reach {
     spec: ReachSpec,
     goal_q: [f64; 6],
     arrival: Arrival,
+    /// Motions still to start, in order (a detour over an object: down after over).
+    pending: Vec<Box<dyn Trajectory>>,
 }
 
 impl Reach {
@@ -22,8 +34,40 @@ impl Reach {
             spec,
             goal_q: [0.0; 6],
             arrival: Arrival::default(),
+            pending: Vec::new(),
         }
     }
+}
+
+/// The first object (other than `skip`) the pinch passes over lower than [`PATH_CLEARANCE`]
+/// above its top on the joint-space line from `from` to `to`, with the pinch there.
+fn joint_path_conflict(w: &World, from: &[f64; 6], to: &[f64; 6], skip: Option<usize>) -> Option<usize> {
+    (1..PATH_SAMPLES).find_map(|k| {
+        let t = k as f64 / PATH_SAMPLES as f64;
+        let q: [f64; 6] = std::array::from_fn(|i| from[i] + t * (to[i] - from[i]));
+        let p = fk(&q).translation.vector;
+        (0..w.objects.len()).find(|&j| {
+            Some(j) != skip
+                && w.from_footprint(j, &p).norm() < FINGER_REACH
+                && p.z < w.top(j) + PATH_CLEARANCE
+        })
+    })
+}
+
+/// Height at which a detour from `a` to `b` (table plane) clears every object near its line,
+/// metres.
+fn detour_height(w: &World, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    let (a2, b2) = (a.xy(), b.xy());
+    let ab = b2 - a2;
+    let len2 = ab.norm_squared().max(1e-12);
+    (0..w.objects.len())
+        .filter(|&j| {
+            let c = w.objects[j].pos.xy();
+            let t = ((c - a2).dot(&ab) / len2).clamp(0.0, 1.0);
+            (c - (a2 + ab * t)).norm() < w.spec(j).shape.footprint_radius() + FINGER_REACH
+        })
+        .map(|j| w.top(j) + DETOUR_HEIGHT)
+        .fold(a.z.max(b.z), f64::max)
 }
 
 impl MacroAction for Reach {
@@ -47,8 +91,37 @@ impl MacroAction for Reach {
             tool_speed: self.spec.speed,
             ..MotionLimits::default()
         };
+        self.pending.clear();
         match self.spec.path {
-            PathKind::Joint => cell.track(Box::new(JointMove::new(from, goal_q, &limits))),
+            PathKind::Joint => {
+                let skip = target_object(&self.spec.target, w);
+                match joint_path_conflict(w, &from, &goal_q, skip) {
+                    None => cell.track(Box::new(JointMove::new(from, goal_q, &limits))),
+                    Some(j) => {
+                        // Up, over at a height that clears everything in the way, then down.
+                        let here = fk(&from);
+                        let z = detour_height(w, &here.translation.vector, &position);
+                        tracing::debug!(target: "macrotree::actions", "reach: the direct path passes low over {}; detour at {z:.3} m", w.name(j));
+                        let up = Isometry3::from_parts(
+                            Translation3::new(here.translation.x, here.translation.y, z),
+                            here.rotation,
+                        );
+                        let rise = CartesianMove::new(from, up, &limits)
+                            .map_err(|e| format!("unreachable detour (up): {e}"))?;
+                        let over_at = Vector3::new(position.x, position.y, z);
+                        let over_q = ik_down(&over_at, yaw, quarter, &rise.end())
+                            .map_err(|e| format!("unreachable detour (over): {e}"))?;
+                        let over = JointMove::new(rise.end(), over_q, &limits);
+                        let down_pose = down_pose(&position, yaw_of_solution(&over_q));
+                        let down = CartesianMove::new(over_q, down_pose, &limits)
+                            .map_err(|e| format!("unreachable detour (down): {e}"))?;
+                        self.goal_q = down.end();
+                        cell.track(Box::new(rise));
+                        self.pending = vec![Box::new(down), Box::new(over)];
+                        return Ok(());
+                    }
+                }
+            }
             PathKind::Cartesian => {
                 let pose = down_pose(&position, yaw_of_solution(&goal_q));
                 let mv =
@@ -61,6 +134,14 @@ impl MacroAction for Reach {
     }
 
     fn update(&mut self, cell: &mut Cell) -> Progress {
+        if !self.pending.is_empty() {
+            if cell.arm_motion_finished()
+                && let Some(next) = self.pending.pop()
+            {
+                cell.track(next);
+            }
+            return Progress::Running;
+        }
         self.arrival.progress(cell, &self.goal_q)
     }
 }
@@ -116,4 +197,47 @@ fn block_grasp_yaw(w: &crate::world::World, b: usize) -> (f64, bool) {
 /// The tool yaw that joint solution `q` gives, radians.
 fn yaw_of_solution(q: &[f64; 6]) -> f64 {
     tool_yaw(crate::motion::fk(q).rotation.to_rotation_matrix().matrix())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::world::conditions::tests_support::resting;
+
+    fn q_at(x: f64, y: f64, z: f64) -> [f64; 6] {
+        ik_down(&Vector3::new(x, y, z), 0.0, false, &crate::motion::HOME_Q).expect("reachable")
+    }
+
+    #[test]
+    fn a_joint_path_low_over_the_bowl_is_found_and_a_high_one_is_not() {
+        // The bowl of the built-in scene stands at (0.45, 0.08), its rim 6 cm high.
+        let w = resting();
+        let low = joint_path_conflict(&w, &q_at(0.45, -0.06, 0.05), &q_at(0.45, 0.22, 0.05), None);
+        assert_eq!(
+            low,
+            Some(1),
+            "the pinch passes 5 cm above the table across the bowl"
+        );
+        let high = joint_path_conflict(&w, &q_at(0.45, -0.06, 0.25), &q_at(0.45, 0.22, 0.25), None);
+        assert_eq!(high, None);
+        // The target itself is not in the way of a reach to it.
+        assert_eq!(
+            joint_path_conflict(&w, &q_at(0.45, -0.06, 0.05), &q_at(0.45, 0.22, 0.05), Some(1)),
+            None
+        );
+    }
+
+    #[test]
+    fn a_detour_passes_above_the_highest_object_near_its_line() {
+        let w = resting();
+        let z = detour_height(
+            &w,
+            &Vector3::new(0.45, -0.06, 0.05),
+            &Vector3::new(0.45, 0.22, 0.05),
+        );
+        assert!((z - (0.06 + DETOUR_HEIGHT)).abs() < 1e-9, "{z}");
+        // Nothing near a line far from both objects: the higher end decides.
+        let z = detour_height(&w, &Vector3::new(0.2, 0.4, 0.05), &Vector3::new(0.3, 0.5, 0.10));
+        assert_eq!(z, 0.10);
+    }
 }
