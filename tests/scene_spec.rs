@@ -2,25 +2,19 @@
 //! JSON Schema, seeded placements, and the checks of object names and blackboard variables.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use macrotree::scene::{Placement, SceneSpec, sample_placement};
 use macrotree::spec::Diagnostic;
 
+#[path = "support/cli.rs"]
+mod cli;
 #[path = "support/files.rs"]
 mod files;
 
+use cli::macrotree;
+
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 const SCHEMA: &str = "schema/scene.schema.json";
-
-fn macrotree(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_macrotree"))
-        .args(args)
-        .current_dir(ROOT)
-        .env_remove("RUST_LOG")
-        .output()
-        .expect("macrotree runs")
-}
 
 fn scene_files() -> Vec<PathBuf> {
     files::yaml_files(&Path::new(ROOT).join("scenes"))

@@ -1,19 +1,13 @@
 //! The `macrotree sweep` binary: exit codes, the `--json` summary as the last stdout line, the
 //! JSONL file, and a failure's printed command reproducing it through `macrotree run`.
 
-use std::process::{Command, Output};
+use std::process::Output;
 
-const BIN: &str = env!("CARGO_BIN_EXE_macrotree");
+#[path = "support/cli.rs"]
+mod cli;
+use cli::macrotree;
+
 const TREE: &str = "trees/cube_to_bowl.yaml";
-
-fn macrotree(args: &[&str]) -> Output {
-    Command::new(BIN)
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .env_remove("RUST_LOG")
-        .output()
-        .expect("runs the binary")
-}
 
 fn last_json_line(out: &Output) -> serde_json::Value {
     let stdout = String::from_utf8_lossy(&out.stdout);

@@ -5,7 +5,7 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
-use super::targets::{resolve, target_object};
+use super::targets::{resolve, segment_distance, target_object};
 use crate::motion::{CartesianMove, JointMove, MotionLimits, Trajectory};
 use crate::scene::ObjectKind;
 use crate::spec::Carry as CarrySpec;
@@ -98,6 +98,12 @@ impl Carry {
         target_object(&self.spec.to, w)
     }
 
+    /// How far the held block's corners and the closed fingers reach from its centre in the table
+    /// plane, metres.
+    fn finger_reach(&self) -> f64 {
+        self.half * std::f64::consts::SQRT_2 + FINGER_MARGIN
+    }
+
     /// Where the block's centre ends up when placed at the goal as it is now, metres: on a
     /// container's floor, on top of a block, or at a point, `place_height` above it.
     fn place(&self, w: &World) -> Result<Vector3<f64>, String> {
@@ -168,7 +174,7 @@ impl Carry {
     /// block, the goal's own walls included) needs it to clear its top by [`CLEARANCE`].
     fn transfer_z(&self, w: &World, from: Vector2<f64>, to: Vector2<f64>) -> f64 {
         let mut z = self.spec.lift + self.half;
-        let reach = self.half * std::f64::consts::SQRT_2 + FINGER_MARGIN;
+        let reach = self.finger_reach();
         for j in 0..w.objects.len() {
             if j == self.held {
                 continue;
@@ -187,7 +193,7 @@ impl Carry {
     fn check_descent(&self, w: &World, place: &Vector3<f64>) -> Result<(), String> {
         let dest = self.destination(w);
         let bottom = place.z - self.half;
-        let reach = self.half * std::f64::consts::SQRT_2 + FINGER_MARGIN;
+        let reach = self.finger_reach();
         for j in 0..w.objects.len() {
             if j == self.held || Some(j) == dest {
                 continue;
@@ -268,18 +274,6 @@ impl Carry {
     }
 }
 
-/// Distance from `p` to the segment `a`–`b` in the table plane, metres.
-fn segment_distance(p: Vector2<f64>, a: Vector2<f64>, b: Vector2<f64>) -> f64 {
-    let ab = b - a;
-    let len2 = ab.norm_squared();
-    let t = if len2 < 1e-12 {
-        0.0
-    } else {
-        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
-    };
-    (p - (a + ab * t)).norm()
-}
-
 impl MacroAction for Carry {
     fn start(&mut self, cell: &mut Cell) -> Result<(), String> {
         let w = cell.world();
@@ -333,6 +327,7 @@ impl MacroAction for Carry {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::Vector2;
 
     #[test]
     fn distance_to_a_segment() {

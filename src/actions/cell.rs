@@ -61,10 +61,8 @@ impl Cell {
 
     /// Back to home, gripper open, cube and bowl where `layout` puts them, time zero.
     pub fn reset(&mut self, layout: &Layout) {
-        self.sim.reset(layout);
-        self.arm = ArmPlan::Hold(crate::sim::HOME_Q);
-        self.gripper_ctrl = 0.0;
-        self.world = self.sim.observe();
+        let placement = self.sim.scene().placement_from_layout(layout);
+        self.reset_placement(&placement);
     }
 
     /// Back to home, gripper open, every object where `placement` puts it, time zero.

@@ -4,9 +4,9 @@ use nalgebra::{Isometry3, Translation3, Vector3};
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
-use super::targets::{resolve, target_block, target_object, tool_yaw};
+use super::targets::{resolve, segment_distance, target_block, target_object, tool_yaw};
 use crate::motion::{CartesianMove, JointMove, MotionLimits, Trajectory, down_pose, fk, ik_down};
-use crate::spec::{PathKind, Reach as ReachSpec, Target, Yaw};
+use crate::spec::{PathKind, Reach as ReachSpec, Yaw};
 use crate::world::World;
 
 /// How far from an object's footprint the open fingers reach around the pinch, metres.
@@ -57,14 +57,10 @@ fn joint_path_conflict(w: &World, from: &[f64; 6], to: &[f64; 6], skip: Option<u
 /// Height at which a detour from `a` to `b` (table plane) clears every object near its line,
 /// metres.
 fn detour_height(w: &World, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
-    let (a2, b2) = (a.xy(), b.xy());
-    let ab = b2 - a2;
-    let len2 = ab.norm_squared().max(1e-12);
     (0..w.objects.len())
         .filter(|&j| {
-            let c = w.objects[j].pos.xy();
-            let t = ((c - a2).dot(&ab) / len2).clamp(0.0, 1.0);
-            (c - (a2 + ab * t)).norm() < w.spec(j).shape.footprint_radius() + FINGER_REACH
+            segment_distance(w.objects[j].pos.xy(), a.xy(), b.xy())
+                < w.spec(j).shape.footprint_radius() + FINGER_REACH
         })
         .map(|j| w.top(j) + DETOUR_HEIGHT)
         .fold(a.z.max(b.z), f64::max)
@@ -77,7 +73,6 @@ impl MacroAction for Reach {
         let position = resolve(&self.spec.target, w)? + offset;
         let current_yaw = tool_yaw(&w.pinch_rot);
         let (yaw, quarter) = match (&self.spec.yaw, &self.spec.target) {
-            (Yaw::Object, Target::Cube) => grasp_yaw(w),
             (Yaw::Object, t) => match target_block(t, w) {
                 Some(b) => block_grasp_yaw(w, b),
                 None => (current_yaw, false),
@@ -146,32 +141,17 @@ impl MacroAction for Reach {
     }
 }
 
-/// Distance from the bowl within which the finger axis is chosen for clearance, metres: an open
-/// 2F-85 reaches about 6 cm from the pinch along its finger axis.
-const BOWL_CLEARANCE: f64 = 0.08;
+/// Distance from another object's footprint within which the finger axis is chosen for
+/// clearance, metres: an open 2F-85 reaches about 6 cm from the pinch along its finger axis.
+const NEAR_CLEARANCE: f64 = 0.08;
 
-/// Tool yaw for grasping the cube and whether its quarter turns are equivalent.
+/// Tool yaw for grasping block `b` and whether its quarter turns are equivalent.
 ///
-/// The fingers must straddle two opposite faces, so the finger axis is the cube's yaw or a quarter
-/// turn from it. Far from the bowl either will do (the IK picks the one nearest the wrist); near it,
-/// the one whose fingers point most across the direction to the bowl is taken, so the open
-/// fingertips do not land on its wall.
-fn grasp_yaw(w: &crate::world::World) -> (f64, bool) {
-    let yaw = w.cube_yaw();
-    let away = w.from_bowl(&w.cube_pos);
-    if away.norm() >= BOWL_CLEARANCE || away.norm() == 0.0 {
-        return (yaw, true);
-    }
-    let toward_bowl = away.normalize();
-    // At tool yaw ψ the pads separate along (cos ψ, sin ψ) in the table plane.
-    let along = |psi: f64| (psi.cos() * toward_bowl.x + psi.sin() * toward_bowl.y).abs();
-    let other = yaw + std::f64::consts::FRAC_PI_2;
-    (if along(yaw) <= along(other) { yaw } else { other }, false)
-}
-
-/// Tool yaw for grasping block `b` (any scene) and whether its quarter turns are equivalent: as
-/// [`grasp_yaw`], with the nearest other object (container wall, obstacle or block) within
-/// [`BOWL_CLEARANCE`] of the block in place of the bowl.
+/// The fingers must straddle two opposite faces, so the finger axis is the block's yaw or a
+/// quarter turn from it. Far from other objects either will do (the IK picks the one nearest the
+/// wrist); within [`NEAR_CLEARANCE`] of one (a container's wall, an obstacle, another block), the
+/// one whose fingers point most across the direction to the nearest is taken, so the open
+/// fingertips do not land on it.
 fn block_grasp_yaw(w: &crate::world::World, b: usize) -> (f64, bool) {
     let yaw = w.yaw(b);
     let p = w.objects[b].pos;
@@ -185,10 +165,11 @@ fn block_grasp_yaw(w: &crate::world::World, b: usize) -> (f64, bool) {
         })
         .filter(|away| away.norm() > 0.0)
         .min_by(|a, b| a.norm().total_cmp(&b.norm()));
-    let Some(away) = nearest.filter(|a| a.norm() < BOWL_CLEARANCE) else {
+    let Some(away) = nearest.filter(|a| a.norm() < NEAR_CLEARANCE) else {
         return (yaw, true);
     };
     let toward = away.normalize();
+    // At tool yaw ψ the pads separate along (cos ψ, sin ψ) in the table plane.
     let along = |psi: f64| (psi.cos() * toward.x + psi.sin() * toward.y).abs();
     let other = yaw + std::f64::consts::FRAC_PI_2;
     (if along(yaw) <= along(other) { yaw } else { other }, false)

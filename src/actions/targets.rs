@@ -72,3 +72,19 @@ pub fn tool_yaw(pinch_rot: &Matrix3<f64>) -> f64 {
     let x = pinch_rot.column(0);
     (-x[0]).atan2(x[1])
 }
+
+/// Distance from `p` to the segment `a`–`b` in the table plane, metres.
+pub(crate) fn segment_distance(
+    p: nalgebra::Vector2<f64>,
+    a: nalgebra::Vector2<f64>,
+    b: nalgebra::Vector2<f64>,
+) -> f64 {
+    let ab = b - a;
+    let len2 = ab.norm_squared();
+    let t = if len2 < 1e-12 {
+        0.0
+    } else {
+        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
+    };
+    (p - (a + ab * t)).norm()
+}

@@ -7,7 +7,7 @@ use crate::actions::{Checks, Collision, LeafCounters};
 use crate::runtime::TreeStatus;
 use crate::scene::ObjectKind;
 use crate::world::World;
-use crate::world::goal::{GoalValue, evaluate, goal_holds};
+use crate::world::goal::{GoalValue, evaluate};
 
 /// What happened in one episode. Lengths in metres, times in seconds.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -100,8 +100,9 @@ impl EpisodeReport {
             TreeStatus::Failure => "failure",
             TreeStatus::Running => "running",
         };
+        let goal = evaluate(world);
         let goal_ok = match config.goal {
-            Goal::Scene => goal_holds(world),
+            Goal::Scene => goal.iter().all(|g| g.holds),
             Goal::Bowl => checks.in_bowl,
             Goal::Tree => true,
         };
@@ -116,10 +117,10 @@ impl EpisodeReport {
         } else if status == TreeStatus::Success && config.goal == Goal::Bowl {
             Some("the tree succeeded but the cube is not at rest in the bowl".into())
         } else if status == TreeStatus::Success {
-            let missed: Vec<String> = evaluate(world)
-                .into_iter()
+            let missed: Vec<&str> = goal
+                .iter()
                 .filter(|g| !g.holds)
-                .map(|g| g.predicate)
+                .map(|g| g.predicate.as_str())
                 .collect();
             Some(format!(
                 "the tree succeeded but the scene's goal does not hold: not {}",
@@ -148,7 +149,7 @@ impl EpisodeReport {
             seed: config.seed,
             scene: world.scene.name.clone(),
             objects: Vec::new(),
-            goal: evaluate(world),
+            goal,
             collisions: Vec::new(),
             failed_node: None,
         }

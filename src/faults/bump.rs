@@ -4,7 +4,7 @@
 
 use rand_chacha::ChaCha8Rng;
 
-use super::push::{Push, block_pos, legacy_cube};
+use super::push::{Push, block_pos};
 use super::{Fault, uniform};
 use crate::sim::Sim;
 use crate::world::World;
@@ -69,7 +69,7 @@ impl Fault for Bump {
                     return None;
                 }
                 let angle = *away + self.spread;
-                let block = legacy_cube(sim);
+                let block = sim.scene().ids.cube;
                 let mut push = Push::slide(sim, block, angle, self.distance, STEPS);
                 push.apply(sim);
                 let c = block_pos(sim, block);

@@ -90,13 +90,3 @@ pub(super) fn block_pos(sim: &Sim, block: usize) -> Vector3<f64> {
     let q = sim.data().qpos();
     Vector3::new(q[c], q[c + 1], q[c + 2])
 }
-
-/// The block the legacy name `cube` stands for (the one the scene's `ids.cube_*` point at).
-pub(super) fn legacy_cube(sim: &Sim) -> usize {
-    let body = sim.scene().ids.cube_body;
-    sim.scene()
-        .objects
-        .iter()
-        .position(|o| o.body == body)
-        .unwrap_or_default()
-}

@@ -13,6 +13,7 @@
 use nalgebra::Vector3;
 use rand_chacha::ChaCha8Rng;
 
+use super::push::block_pos;
 use super::{Fault, uniform};
 use crate::motion::gripper::ctrl_for_width;
 use crate::sim::Sim;
@@ -65,13 +66,6 @@ impl Slip {
             state: State::Idle,
         }
     }
-}
-
-/// Block `i`'s centre, world frame, metres (read from its free joint).
-fn block_pos(sim: &Sim, i: usize) -> Vector3<f64> {
-    let q = sim.scene().objects[i].qpos.unwrap_or_default();
-    let qpos = sim.data().qpos();
-    Vector3::new(qpos[q], qpos[q + 1], qpos[q + 2])
 }
 
 impl Fault for Slip {

@@ -34,6 +34,8 @@ struct LeafRt {
     elapsed: f64,
     /// Open while the leaf runs.
     span: Option<tracing::Span>,
+    /// The leaf reads a blackboard variable (resolved before every tick).
+    reads_vars: bool,
 }
 
 struct RunState {
@@ -101,7 +103,14 @@ impl RunState {
             ancestors,
             enclosing_retry,
             attempts: vec![0; n],
-            leaves: (0..plan.leaves.len()).map(|_| LeafRt::default()).collect(),
+            leaves: plan
+                .leaves
+                .iter()
+                .map(|l| LeafRt {
+                    reads_vars: l.kind.has_vars(),
+                    ..LeafRt::default()
+                })
+                .collect(),
             yield_pending: vec![false; plan.internal.len()],
             pending_yields: Vec::new(),
             exit_flags: vec![false; n],
@@ -238,11 +247,13 @@ impl RunState {
             }
             leaf => {
                 let span = rt.span.clone().unwrap_or_else(tracing::Span::none);
-                let resolved = self.vars.resolve(leaf);
-                let out = match &resolved {
-                    Ok(std::borrow::Cow::Borrowed(l)) => span.in_scope(|| driver.tick(id, l, first)),
-                    Ok(std::borrow::Cow::Owned(l)) => span.in_scope(|| driver.tick(id, l, first)),
-                    Err(unset) => LeafOutcome::Failure(unset.clone()),
+                let out = if rt.reads_vars {
+                    match self.vars.resolve(leaf) {
+                        Ok(l) => span.in_scope(|| driver.tick(id, &l, first)),
+                        Err(unset) => LeafOutcome::Failure(unset),
+                    }
+                } else {
+                    span.in_scope(|| driver.tick(id, leaf, first))
                 };
                 let out = match (leaf, out) {
                     (Leaf::Condition(c), LeafOutcome::Running) => {

@@ -14,8 +14,11 @@ use mujoco_rs::wrappers::mj_editing::{Attach, MjSpec};
 
 use super::error::SimError;
 use super::layout::Layout;
-use crate::scene::{OBJECT_PREFIX, ObjectKind, Placement, Pose, SceneSpec, sample_placement};
-use crate::world::{Part, Piece};
+use crate::scene::{
+    CONTAINER_FLOOR, CONTAINER_WALL, OBJECT_PREFIX, ObjectKind, Placement, Pose, SceneSpec, Shape,
+    sample_placement,
+};
+use crate::world::{BowlGeometry, Part, Piece};
 
 /// The cell XML (without the robot and the scene's objects), embedded at build time.
 pub const SCENE_XML: &str = include_str!("../../assets/scene.xml");
@@ -50,15 +53,9 @@ pub struct SceneIds {
     pub gripper_driver_qpos: usize,
     /// `qvel` (dof) address of the right driver joint.
     pub gripper_driver_dof: usize,
-    /// `qpos` address of the free joint of the block the legacy name `cube` stands for (the
-    /// block called `cube`, else the scene's first block): x, y, z, qw, qx, qy, qz.
-    pub cube_qpos: usize,
-    /// `qvel` address of the cube's free joint (vx, vy, vz, wx, wy, wz).
-    pub cube_dof: usize,
-    /// Body id of the cube.
-    pub cube_body: usize,
-    /// Geom id of the cube.
-    pub cube_geom: usize,
+    /// The block the legacy name `cube` stands for (the block called `cube`, else the scene's
+    /// first block): its index into [`Scene::objects`].
+    pub cube: usize,
     /// Geom ids of the two left pad boxes.
     pub left_pads: [usize; 2],
     /// Geom ids of the two right pad boxes.
@@ -73,8 +70,12 @@ pub struct SceneIds {
 }
 
 /// Ids of a container in the compiled model.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContainerIds {
+    /// Index into [`Scene::objects`].
+    pub index: usize,
+    /// The container's shape as the legacy `bowl` fields of a world describe it.
+    pub geometry: BowlGeometry,
     /// Site id of the centre of the floor's top surface.
     pub target_site: usize,
     /// Mocap index of the body.
@@ -332,13 +333,26 @@ impl SceneIds {
             .legacy_cube()
             .or_else(|| spec.of_kind(ObjectKind::Block).next())
             .ok_or_else(|| SimError::Scene("the scene has no block".into()))?;
-        let cube_ids = &objects[cube];
         let bowl = spec
             .legacy_bowl()
             .or_else(|| spec.of_kind(ObjectKind::Container).next())
             .map(|c| -> Result<ContainerIds, SimError> {
                 let name = format!("{OBJECT_PREFIX}{}/target", spec.objects[c].name);
+                let Shape::Container {
+                    inner_half,
+                    wall_height,
+                } = spec.objects[c].shape
+                else {
+                    unreachable!("a container has a container's shape")
+                };
                 Ok(ContainerIds {
+                    index: c,
+                    geometry: BowlGeometry {
+                        inner_half_width: inner_half[0],
+                        outer_half_width: inner_half[0] + CONTAINER_WALL,
+                        rim_height: wall_height,
+                        floor_height: CONTAINER_FLOOR,
+                    },
                     target_site: id(MjtObjBase::mjOBJ_SITE, &name)?,
                     mocap: objects[c].mocap.unwrap_or_default(),
                     body: objects[c].body,
@@ -354,10 +368,7 @@ impl SceneIds {
                 as usize,
             gripper_driver_dof: jnt_dofadr[id(MjtObjBase::mjOBJ_JOINT, "gripper/right_driver_joint")?]
                 as usize,
-            cube_qpos: cube_ids.qpos.unwrap_or_default(),
-            cube_dof: cube_ids.dof.unwrap_or_default(),
-            cube_body: cube_ids.body,
-            cube_geom: cube_ids.geoms[0],
+            cube,
             left_pads: [
                 id(MjtObjBase::mjOBJ_GEOM, "gripper/left_pad1")?,
                 id(MjtObjBase::mjOBJ_GEOM, "gripper/left_pad2")?,

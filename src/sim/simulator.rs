@@ -191,26 +191,6 @@ impl Sim {
             .collect()
     }
 
-    /// The shape of the container the legacy name `bowl` stands for.
-    fn bowl_geometry(&self) -> BowlGeometry {
-        let spec = &self.scene.spec;
-        let c = spec
-            .legacy_bowl()
-            .or_else(|| spec.of_kind(crate::scene::ObjectKind::Container).next());
-        match c.map(|c| &spec.objects[c].shape) {
-            Some(Shape::Container {
-                inner_half,
-                wall_height,
-            }) => BowlGeometry {
-                inner_half_width: inner_half[0],
-                outer_half_width: inner_half[0] + crate::scene::CONTAINER_WALL,
-                rim_height: *wall_height,
-                floor_height: crate::scene::CONTAINER_FLOOR,
-            },
-            _ => BowlGeometry::NONE,
-        }
-    }
-
     /// Reads the current state into a [`World`] snapshot.
     pub fn observe(&self) -> World {
         let ids = &self.scene.ids;
@@ -230,8 +210,6 @@ impl Sim {
         let v3 = |p: [f64; 3]| Vector3::new(p[0], p[1], p[2]);
         let left_pad_pos = (v3(gx[ids.left_pads[0]]) + v3(gx[ids.left_pads[1]])) / 2.0;
         let right_pad_pos = (v3(gx[ids.right_pads[0]]) + v3(gx[ids.right_pads[1]])) / 2.0;
-        let mut left_pad_contact = false;
-        let mut right_pad_contact = false;
         let scene = &self.scene;
         let mut objects: Vec<ObjectState> = scene
             .objects
@@ -267,11 +245,6 @@ impl Sim {
         let mut touches = Vec::new();
         for c in d.contact() {
             let (a, b) = (c.geom[0] as usize, c.geom[1] as usize);
-            if a == ids.cube_geom || b == ids.cube_geom {
-                let other = if a == ids.cube_geom { b } else { a };
-                left_pad_contact |= ids.left_pads.contains(&other);
-                right_pad_contact |= ids.right_pads.contains(&other);
-            }
             let (pa, pb) = (scene.geom_parts[a], scene.geom_parts[b]);
             for (me, other) in [(pa, b), (pb, a)] {
                 if let Part::Object { index, .. } = me {
@@ -288,14 +261,7 @@ impl Sim {
                 touches.push((pa, pb));
             }
         }
-        let c = ids.cube_qpos;
-        let cube_quat = UnitQuaternion::from_quaternion(Quaternion::new(
-            qpos[c + 3],
-            qpos[c + 4],
-            qpos[c + 5],
-            qpos[c + 6],
-        ));
-        let cd = ids.cube_dof;
+        let cube = objects[ids.cube].clone();
         let nsite = self.scene.model.ffi().nsite as usize;
         // SAFETY: site_xmat holds nsite * 9 doubles for the lifetime of `data`.
         let site_xmat = unsafe { std::slice::from_raw_parts(d.ffi().site_xmat, nsite * 9) };
@@ -303,11 +269,7 @@ impl Sim {
         let pinch_rot = Matrix3::from_row_slice(m);
         let sx = d.site_xpos();
         let (bowl_pos, bowl_target, bowl) = match ids.bowl {
-            Some(b) => (
-                v3(d.mocap_pos()[b.mocap]),
-                v3(sx[b.target_site]),
-                self.bowl_geometry(),
-            ),
+            Some(b) => (v3(d.mocap_pos()[b.mocap]), v3(sx[b.target_site]), b.geometry),
             None => (NO_BOWL, NO_BOWL, BowlGeometry::NONE),
         };
         World {
@@ -319,14 +281,14 @@ impl Sim {
             gripper_speed: qvel[ids.gripper_driver_dof],
             pinch_pos: v3(sx[ids.pinch_site]),
             pinch_rot,
-            left_pad_contact,
-            right_pad_contact,
+            left_pad_contact: cube.left_pad_contact,
+            right_pad_contact: cube.right_pad_contact,
             left_pad_pos,
             right_pad_pos,
-            cube_pos: Vector3::new(qpos[c], qpos[c + 1], qpos[c + 2]),
-            cube_quat,
-            cube_linvel: Vector3::new(qvel[cd], qvel[cd + 1], qvel[cd + 2]),
-            cube_angvel: Vector3::new(qvel[cd + 3], qvel[cd + 4], qvel[cd + 5]),
+            cube_pos: cube.pos,
+            cube_quat: cube.quat,
+            cube_linvel: cube.linvel,
+            cube_angvel: cube.angvel,
             bowl_pos,
             bowl_target,
             bowl,

@@ -645,13 +645,32 @@ impl Leaf {
         }
     }
 
-    /// Every object reference of the leaf.
+    /// Every object reference of the leaf (targets, `object:`, `container:`, `support:`).
     pub fn object_refs(&self) -> Vec<ObjectRef> {
-        self.clone().refs_mut().into_iter().map(|r| *r).collect()
+        let target = |t: &Target| match t {
+            Target::Object(o) => vec![*o],
+            _ => vec![],
+        };
+        match self {
+            Leaf::Action(ActionLeaf::Reach(r)) => target(&r.target),
+            Leaf::Action(ActionLeaf::Carry(c)) => target(&c.to),
+            Leaf::Action(ActionLeaf::Grasp(g)) => g.object.into_iter().collect(),
+            Leaf::Condition(c) => match c {
+                ConditionLeaf::Grasped(p) => vec![p.object],
+                ConditionLeaf::Lifted(p) => vec![p.object],
+                ConditionLeaf::In(p) => vec![p.object, p.container],
+                ConditionLeaf::On(p) => vec![p.object, p.support],
+                ConditionLeaf::OnTable(p) => vec![p.object],
+                ConditionLeaf::At(p) => vec![p.object],
+                ConditionLeaf::GoalMet(p) => p.object.into_iter().collect(),
+                _ => vec![],
+            },
+            _ => vec![],
+        }
     }
 
     /// The leaf with object references replaced where `f` answers `Some`; `None` when nothing
-    /// was replaced (the leaf is not cloned then unless it has references).
+    /// was replaced (the leaf is cloned only when it reads a variable).
     pub fn map_objects(&self, f: &mut dyn FnMut(&ObjectRef) -> Option<ObjectRef>) -> Option<Leaf> {
         if !self.has_vars() {
             return None;
@@ -669,15 +688,7 @@ impl Leaf {
 
     /// True when the leaf reads a blackboard variable.
     pub fn has_vars(&self) -> bool {
-        let var = |t: &Target| matches!(t, Target::Object(ObjectRef::Var(_)));
-        let ovar = |o: &ObjectRef| matches!(o, ObjectRef::Var(_));
-        match self {
-            Leaf::Action(ActionLeaf::Reach(r)) => var(&r.target),
-            Leaf::Action(ActionLeaf::Carry(c)) => var(&c.to),
-            Leaf::Action(ActionLeaf::Grasp(g)) => g.object.as_ref().is_some_and(ovar),
-            Leaf::Condition(_) => self.clone().refs_mut().into_iter().any(|o| ovar(o)),
-            _ => false,
-        }
+        self.object_refs().iter().any(|o| matches!(o, ObjectRef::Var(_)))
     }
 
     /// True for condition leaves (instantaneous checks).
