@@ -16,6 +16,7 @@
 //! | MuJoCo scene, stepping, world extraction | [`sim`] | yes |
 //! | macro-action leaves (reach, grasp, carry, …) | [`actions`] | through [`sim`] |
 //! | one episode: tree + cell → report | [`episode`] | yes |
+//! | scenario suites (`macrotree test`): files, expectations, JUnit | [`suite`] | through [`sweep`] |
 //! | command-line interface | [`cli`] | yes |
 //! | safe output files (every file the CLI writes) | [`output`] | no |
 //!
@@ -34,6 +35,7 @@ pub mod runtime;
 pub mod scene;
 pub mod sim;
 pub mod spec;
+pub mod suite;
 pub mod sweep;
 pub mod viewer;
 pub mod world;

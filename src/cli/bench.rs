@@ -75,6 +75,7 @@ pub fn bench(args: BenchArgs) -> Result<(), CliError> {
     let (plan, scene) = load_task(&args.tree, args.episode.scene.as_deref())?;
     let plan = Arc::new(plan);
     let config = args.episode.config_on(&scene)?;
+    super::check_substitutions(&plan, &config.substitutions)?;
     let placement = config
         .placement
         .clone()

@@ -1,5 +1,5 @@
-//! The `macrotree` command line: `run`, `validate`, `bench`, `sweep`, and the authoring tools
-//! `schema`, `graph` and `nodes`.
+//! The `macrotree` command line: `run`, `validate`, `bench`, `sweep`, `test`, `report`, and the
+//! authoring tools `schema`, `graph` and `nodes`.
 //!
 //! Exit codes are a contract: 0 = the task succeeded (or the input is valid), 1 = the task
 //! failed, 2 = bad input (unreadable or invalid tree, bad arguments, missing assets).
@@ -11,10 +11,12 @@ mod limits;
 mod logging;
 mod nodes;
 mod outputs;
+mod report;
 mod run;
 mod schema;
 mod sweep;
 mod sweep_out;
+mod test;
 mod validate;
 
 use std::process::ExitCode;
@@ -58,6 +60,10 @@ pub enum Command {
     Graph(graph::GraphArgs),
     /// List the node kinds with their parameters, units, defaults and examples.
     Nodes(nodes::NodesArgs),
+    /// Run scenario files (default: scenarios/) and check their expectations (JUnit for CI).
+    Test(test::TestArgs),
+    /// Merge the --out files of sharded sweeps or tests into the summary of one run.
+    Report(report::ReportArgs),
 }
 
 /// A failure that maps to an exit code.
@@ -72,7 +78,10 @@ pub enum CliError {
 /// Entry point of the `macrotree` binary.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
-    let quiet = matches!(cli.command, Command::Bench(_) | Command::Sweep(_));
+    let quiet = matches!(
+        cli.command,
+        Command::Bench(_) | Command::Sweep(_) | Command::Test(_) | Command::Report(_)
+    );
     logging::init(cli.verbose, cli.log_format, quiet);
     crate::spec::set_includes_anywhere(cli.allow_include_outside);
     let result = match cli.command {
@@ -83,6 +92,8 @@ pub fn main() -> ExitCode {
         Command::Schema(args) => schema::schema(args),
         Command::Graph(args) => graph::graph(args),
         Command::Nodes(args) => nodes::nodes(args),
+        Command::Test(args) => test::test(args),
+        Command::Report(args) => report::report(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -130,6 +141,43 @@ fn load_task(
     let scene =
         crate::sim::Scene::load_spec(&plan.scene).map_err(|e| CliError::Input(format!("error: {e}")))?;
     Ok((plan, scene))
+}
+
+/// The shard to run: `--shard K/M` as given, `--shard auto` from the environment (Slurm array
+/// or Kubernetes Indexed Job, with `--shard-count`), or none.
+fn resolve_shard(
+    spec: Option<crate::sweep::ShardSpec>,
+    count: Option<u64>,
+) -> Result<Option<crate::sweep::Shard>, CliError> {
+    match spec {
+        None => Ok(None),
+        Some(crate::sweep::ShardSpec::Fixed(s)) => {
+            if count.is_some_and(|m| m != s.count) {
+                return Err(CliError::Input(format!(
+                    "error: --shard {s} and --shard-count {} disagree; --shard-count is for --shard auto",
+                    count.unwrap_or(0)
+                )));
+            }
+            Ok(Some(s))
+        }
+        Some(crate::sweep::ShardSpec::Auto) => {
+            let shard = crate::sweep::Shard::from_env(|k| std::env::var(k).ok(), count)
+                .map_err(|e| CliError::Input(format!("error: --shard auto: {e}")))?;
+            eprintln!("shard {shard} (from the environment)");
+            Ok(Some(shard))
+        }
+    }
+}
+
+/// Substitutions that do not fit `plan` (no leaf matched, a leaf matched twice, …) are bad
+/// input.
+fn check_substitutions(
+    plan: &crate::plan::Plan,
+    subs: &[crate::runtime::substitute::Substitution],
+) -> Result<(), CliError> {
+    crate::runtime::substitute::resolve(plan, subs)
+        .map(|_| ())
+        .map_err(|e| CliError::Input(format!("error: {e}")))
 }
 
 /// Writes `text` to `out` (safely, see [`crate::output`]; `inputs` are the files the command

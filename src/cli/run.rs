@@ -73,6 +73,10 @@ pub struct EpisodeArgs {
     /// conditions check the task).
     #[arg(long, value_enum, default_value_t = Goal::Scene)]
     pub goal: Goal,
+    /// Replace the leaves whose path matches PATTERN (`main/**/grasp`) with a scripted outcome:
+    /// success, failure, running:N or fail_first:N (repeatable; see docs/testing_trees.md).
+    #[arg(long = "substitute", value_name = "PATTERN=OUTCOME")]
+    pub substitute: Vec<crate::runtime::substitute::Substitution>,
 }
 
 impl EpisodeArgs {
@@ -99,6 +103,7 @@ impl EpisodeArgs {
             max_sim_time: self.max_sim_time,
             fault: self.fault,
             goal: self.goal,
+            substitutions: self.substitute.clone(),
             ..EpisodeConfig::default()
         })
     }
@@ -161,6 +166,7 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
     let (plan, scene) = load_task(&args.tree, args.episode.scene.as_deref())?;
     let plan = Arc::new(plan);
     let config = args.episode.config_on(&scene)?;
+    super::check_substitutions(&plan, &config.substitutions)?;
     let mut inputs = super::outputs::tree_inputs(&args.tree);
     inputs.extend(args.episode.scene.clone());
     let record_out = (args.record.as_deref())

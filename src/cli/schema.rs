@@ -18,8 +18,11 @@ pub struct SchemaArgs {
     #[arg(long, short)]
     pub out: Option<PathBuf>,
     /// The schema of scene files instead of tree files.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "scenario")]
     pub scene: bool,
+    /// The schema of scenario files (`macrotree test`) instead of tree files.
+    #[arg(long)]
+    pub scenario: bool,
 }
 
 /// The scene-file schema as pretty JSON with a final newline (the committed file's exact bytes).
@@ -43,7 +46,9 @@ pub fn schema_text() -> String {
 
 /// Runs `macrotree schema`.
 pub fn schema(args: SchemaArgs) -> Result<(), CliError> {
-    let text = if args.scene {
+    let text = if args.scenario {
+        crate::suite::schema_text()
+    } else if args.scene {
         scene_schema_text()
     } else {
         schema_text()

@@ -13,7 +13,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use super::{CliError, load_task};
 use crate::episode::Goal;
 use crate::faults::FaultKind;
-use crate::sweep::{Shard, Summary, SweepConfig, run_sweep_from};
+use crate::sweep::{Summary, SweepConfig, run_sweep_from};
 
 /// Arguments of `sweep`.
 #[derive(Debug, Args)]
@@ -50,9 +50,18 @@ pub struct SweepArgs {
     /// Print the summary as one JSON object on the last line of stdout.
     #[arg(long)]
     pub json: bool,
-    /// Run only the scenarios with index ≡ K (mod M), 0 ≤ K < M.
-    #[arg(long, value_name = "K/M")]
-    pub shard: Option<Shard>,
+    /// Run only the scenarios with index ≡ K (mod M), 0 ≤ K < M; `auto` takes K and M from a
+    /// Slurm array job (SLURM_ARRAY_TASK_ID, SLURM_ARRAY_TASK_COUNT) or a Kubernetes Indexed Job
+    /// (JOB_COMPLETION_INDEX and --shard-count M); see docs/scale_out.md.
+    #[arg(long, value_name = "K/M|auto")]
+    pub shard: Option<crate::sweep::ShardSpec>,
+    /// M for `--shard auto` in a Kubernetes Indexed Job (its `completions`); with Slurm, a check.
+    #[arg(long, value_name = "M", requires = "shard", value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
+    pub shard_count: Option<u64>,
+    /// Replace the leaves whose path matches PATTERN (`main/**/grasp`) with a scripted outcome:
+    /// success, failure, running:N or fail_first:N (repeatable; see docs/testing_trees.md).
+    #[arg(long = "substitute", value_name = "PATTERN=OUTCOME")]
+    pub substitute: Vec<crate::runtime::substitute::Substitution>,
     /// Stop each episode (as a failure) after this much simulated time, seconds (at most 3600).
     #[arg(long, default_value_t = 60.0, value_name = "S", value_parser = super::limits::max_sim_time)]
     pub max_sim_time: f64,
@@ -66,7 +75,9 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
             args.max_sim_time
         )));
     }
+    let shard = super::resolve_shard(args.shard, args.shard_count)?;
     let (plan, scene) = load_task(&args.tree, args.scene.as_deref())?;
+    super::check_substitutions(&plan, &args.substitute)?;
     let plan = Arc::new(plan);
     let config = SweepConfig {
         scenarios: args.scenarios,
@@ -74,20 +85,23 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
         jobs: args.jobs.map_or(0, |j| j as usize),
         fault: args.fault,
         goal: args.goal,
-        shard: args.shard,
+        shard,
         max_sim_time: args.max_sim_time,
         scene_file: args.scene.as_ref().map(|p| p.display().to_string()),
+        tree: args.tree.display().to_string(),
+        substitutions: args.substitute.clone(),
+        suite: None,
     };
     let total = config.indices().len() as u64;
     if total == 0 {
         return Err(CliError::Input(format!(
             "error: shard {} of {} scenario(s) is empty (no index below {} is {} mod {}); \
              use more --scenarios or fewer shards",
-            args.shard.map_or(String::new(), |s| s.to_string()),
+            shard.map_or(String::new(), |s| s.to_string()),
             config.scenarios,
             config.scenarios,
-            args.shard.map_or(0, |s| s.index),
-            args.shard.map_or(1, |s| s.count),
+            shard.map_or(0, |s| s.index),
+            shard.map_or(1, |s| s.count),
         )));
     }
     let (mut out, resumed) = match &args.out {

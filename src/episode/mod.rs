@@ -7,7 +7,7 @@ mod report;
 use std::sync::Arc;
 use std::time::Instant;
 
-pub use report::{EpisodeReport, ObjectReport};
+pub use report::{EpisodeReport, NodeReport, ObjectReport};
 
 use crate::actions::{Cell, MacroDriver};
 use crate::plan::Plan;
@@ -35,6 +35,9 @@ pub struct EpisodeConfig {
     pub fault: Option<crate::faults::FaultKind>,
     /// What counts as success.
     pub goal: Goal,
+    /// Leaves replaced by scripted outcomes (test doubles, see
+    /// [`crate::runtime::substitute`]).
+    pub substitutions: Vec<crate::runtime::substitute::Substitution>,
 }
 
 /// What counts as a successful episode (`run --goal`, `sweep --goal`).
@@ -73,6 +76,7 @@ impl Default for EpisodeConfig {
             control_period: crate::actions::CONTROL_PERIOD,
             fault: None,
             goal: Goal::Scene,
+            substitutions: Vec::new(),
         }
     }
 }
@@ -80,9 +84,12 @@ impl Default for EpisodeConfig {
 /// A stable name for the kind of a failure reason, for grouping failures across a sweep:
 /// `time_limit`, `unstable`, `goal_not_met`, `grasp_lost`, `grasp_failed`, `unreachable`,
 /// `blocked` (no clear way), `timeout` (a leaf's own limit), `halted`, `condition_false`,
-/// `layout`, `panicked`, or `other`.
+/// `layout`, `panicked`, `substituted` (a scripted failure of a test double), `substitution`
+/// (substitutions that do not fit the tree), or `other`.
 pub fn failure_kind(reason: &str) -> &'static str {
     const KINDS: &[(&str, &str)] = &[
+        ("substituted:", "substituted"),
+        ("substitution `", "substitution"),
         ("time limit", "time_limit"),
         ("MuJoCo reported an unstable", "unstable"),
         ("goal does not hold", "goal_not_met"),
@@ -147,9 +154,17 @@ pub fn run_in_cell(
         cell.observers.push(crate::faults::injector(kind, config.seed));
     }
     let dt = cell.control_period();
-    let mut runner = TreeRunner::new(plan);
+    let (subs, bad_subs) = match crate::runtime::substitute::resolve(&plan, &config.substitutions) {
+        Ok(subs) => (subs, None),
+        Err(e) => (Default::default(), Some(e.to_string())),
+    };
+    let mut runner = TreeRunner::with_substitutions(plan, subs);
     let mut driver = MacroDriver::new(cell);
-    let mut status = TreeStatus::Running;
+    let mut status = if bad_subs.is_some() {
+        TreeStatus::Failure
+    } else {
+        TreeStatus::Running
+    };
     let mut timed_out = false;
     let mut unstable = None;
     while status == TreeStatus::Running {
@@ -179,6 +194,7 @@ pub fn run_in_cell(
     let root_reason = runner.node_reasons().first().cloned().flatten();
     let last_failure = unstable
         .clone()
+        .or(bad_subs)
         .or(root_reason)
         .or_else(|| driver.last_failure.clone());
     cell.observers.truncate(observers_before);
@@ -195,6 +211,7 @@ pub fn run_in_cell(
         last_failure,
     );
     report.add_scene(&initial, &world, collisions, unstable);
+    report.nodes = NodeReport::of(&runner);
     if !report.success {
         report.failed_node = runner.last_failed_path();
     }

@@ -50,6 +50,37 @@ pub struct EpisodeReport {
     pub collisions: Vec<Collision>,
     /// The path of the last leaf (or check) that failed, when the episode failed.
     pub failed_node: Option<String>,
+    /// A stable name for the kind of failure (`grasp_lost`, `timeout`, `substituted`, …; see
+    /// [`super::failure_kind`]), for grouping; `None` on success.
+    pub failure_kind: Option<&'static str>,
+    /// How often every node ran, in plan order (preorder).
+    pub nodes: Vec<NodeReport>,
+}
+
+/// One node's counts in a report: how often it started, succeeded, failed and was halted.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, serde::Deserialize)]
+pub struct NodeReport {
+    /// The node path.
+    pub path: String,
+    /// Its counts.
+    #[serde(flatten)]
+    pub counts: crate::runtime::NodeCounts,
+}
+
+impl NodeReport {
+    /// Every node of `runner`'s plan with its counts, in plan order.
+    pub fn of(runner: &crate::runtime::TreeRunner) -> Vec<NodeReport> {
+        runner
+            .plan()
+            .nodes
+            .iter()
+            .zip(runner.node_counts())
+            .map(|(n, c)| NodeReport {
+                path: n.path.clone(),
+                counts: *c,
+            })
+            .collect()
+    }
 }
 
 /// One object's initial and final pose: `[x, y, z, yaw]` in metres and degrees (a block's yaw
@@ -152,6 +183,8 @@ impl EpisodeReport {
             goal,
             collisions: Vec::new(),
             failed_node: None,
+            failure_kind: None,
+            nodes: Vec::new(),
         }
     }
 
@@ -177,5 +210,6 @@ impl EpisodeReport {
             self.success = false;
             self.failure_reason = Some(why);
         }
+        self.failure_kind = self.failure_reason.as_deref().map(super::failure_kind);
     }
 }

@@ -33,6 +33,7 @@
 pub mod blackboard;
 mod runner;
 pub mod scripted;
+pub mod substitute;
 
 use std::fmt;
 
@@ -149,6 +150,31 @@ impl NodeStatus {
 impl fmt::Display for NodeStatus {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.as_str())
+    }
+}
+
+/// How often one node ran since the tree was (re)started: BehaviorTree.CPP's `TreeObserver`
+/// statistics. Deterministic: the same tree, layout and seed give the same counts.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
+pub struct NodeCounts {
+    /// Executions started (a leaf's first tick, a composite starting to run; a condition
+    /// re-checked by a guard counts once per tick).
+    pub activations: u32,
+    /// Executions that succeeded.
+    pub successes: u32,
+    /// Executions that failed.
+    pub failures: u32,
+    /// Executions preempted while running.
+    pub halts: u32,
+}
+
+impl NodeCounts {
+    /// Adds `other`'s counts (saturating).
+    pub fn add(&mut self, other: &NodeCounts) {
+        self.activations = self.activations.saturating_add(other.activations);
+        self.successes = self.successes.saturating_add(other.successes);
+        self.failures = self.failures.saturating_add(other.failures);
+        self.halts = self.halts.saturating_add(other.halts);
     }
 }
 

@@ -6,7 +6,8 @@ use bonsai_bt::{BT, Event, Status, UpdateArgs};
 use tracing::Level;
 
 use super::blackboard::Blackboard;
-use super::{LeafDriver, LeafOutcome, NodeStatus, Transition, TreeStatus};
+use super::substitute::{Resolved, Scripted};
+use super::{LeafDriver, LeafOutcome, NodeCounts, NodeStatus, Transition, TreeStatus};
 use crate::plan::{Internal, LeafId, Plan};
 use crate::spec::{Leaf, Select};
 
@@ -22,6 +23,7 @@ pub struct TreeRunner {
     plan: Arc<Plan>,
     bt: BT<LeafId, ()>,
     st: RunState,
+    subs: Resolved,
 }
 
 #[derive(Default)]
@@ -36,6 +38,14 @@ struct LeafRt {
     span: Option<tracing::Span>,
     /// The leaf reads a blackboard variable (resolved before every tick).
     reads_vars: bool,
+    /// Its substitution, if any.
+    scripted: Option<Scripted>,
+    /// Activations so far (for `fail_first:N`).
+    activations: u32,
+    /// `running:N`: Running ticks answered in the current activation.
+    scripted_ticks: u32,
+    /// The current activation runs the real leaf (`fail_first:N` after N failures).
+    real: bool,
 }
 
 struct RunState {
@@ -57,6 +67,8 @@ struct RunState {
     exit_flags: Vec<bool>,
     /// The blackboard: variables written by `select` and `for_each`.
     vars: Blackboard,
+    /// Per node: activations, successes, failures, halts (same indices as `plan.nodes`).
+    counts: Vec<NodeCounts>,
     last_failure: Option<String>,
     /// The node of the last leaf that failed.
     last_failed_node: Option<usize>,
@@ -70,7 +82,7 @@ struct RunState {
 }
 
 impl RunState {
-    fn new(plan: &Plan) -> Self {
+    fn new(plan: &Plan, subs: &Resolved) -> Self {
         let n = plan.nodes.len();
         let mut ancestors = vec![Vec::new(); n];
         let mut enclosing_retry = vec![None; n];
@@ -106,8 +118,10 @@ impl RunState {
             leaves: plan
                 .leaves
                 .iter()
-                .map(|l| LeafRt {
+                .enumerate()
+                .map(|(i, l)| LeafRt {
                     reads_vars: l.kind.has_vars(),
+                    scripted: subs.by_leaf.get(i).copied().flatten(),
                     ..LeafRt::default()
                 })
                 .collect(),
@@ -115,6 +129,7 @@ impl RunState {
             pending_yields: Vec::new(),
             exit_flags: vec![false; n],
             vars: Blackboard::default(),
+            counts: vec![NodeCounts::default(); n],
             last_failure: None,
             last_failed_node: None,
             writes: Vec::new(),
@@ -211,6 +226,7 @@ impl RunState {
                 if matches!(plan.nodes[a].kind, "retry" | "repeat" | "for_each") {
                     self.attempts[a] = 1;
                 }
+                self.counts[a].activations += 1;
                 self.set(plan, a, NodeStatus::Running, None);
             }
         }
@@ -231,11 +247,37 @@ impl RunState {
         rt.last_tick = self.tick;
         if first {
             rt.elapsed = 0.0;
+            rt.scripted_ticks = 0;
+            rt.activations = rt.activations.saturating_add(1);
+            rt.real = match rt.scripted {
+                None => true,
+                Some(Scripted::FailFirst(n)) => rt.activations > n,
+                Some(_) => false,
+            };
+            self.counts[node].activations += 1;
             rt.span = Some(
                 tracing::info_span!(target: "macrotree::tree", "leaf", path = %info.path, kind = info.kind.kind()),
             );
         }
         let (outcome, leftover) = match &info.kind {
+            _ if !rt.real => {
+                let outcome = match rt.scripted {
+                    Some(Scripted::Running(n)) if rt.scripted_ticks < n => {
+                        rt.scripted_ticks += 1;
+                        LeafOutcome::Running
+                    }
+                    Some(Scripted::Failure | Scripted::FailFirst(_)) => LeafOutcome::Failure(format!(
+                        "substituted: scripted failure ({})",
+                        rt.scripted.map_or(String::new(), |s| s.to_string())
+                    )),
+                    _ => LeafOutcome::Success,
+                };
+                let running = matches!(outcome, LeafOutcome::Running);
+                if !running {
+                    tracing::debug!(target: "macrotree::tree", path = %info.path, "substituted leaf answers {outcome:?}");
+                }
+                (outcome, if running { 0.0 } else { dt })
+            }
             Leaf::Select(sel) => (self.select(plan, node, driver, sel), dt),
             Leaf::Wait(w) => {
                 rt.elapsed += dt;
@@ -275,12 +317,14 @@ impl RunState {
             LeafOutcome::Success => {
                 rt.running = false;
                 rt.span = None;
+                self.counts[node].successes += 1;
                 self.set(plan, node, NodeStatus::Success, None);
                 true
             }
             LeafOutcome::Failure(reason) => {
                 rt.running = false;
                 rt.span = None;
+                self.counts[node].failures += 1;
                 let reason = format!("{}: {reason}", info.kind.kind());
                 self.last_failure = Some(reason.clone());
                 self.last_failed_node = Some(node);
@@ -296,6 +340,12 @@ impl RunState {
         for &inv in check.inverters.iter().rev() {
             effective = !effective;
             self.touched[inv] = self.tick;
+            self.counts[inv].activations += 1;
+            if effective {
+                self.counts[inv].successes += 1;
+            } else {
+                self.counts[inv].failures += 1;
+            }
             let (st, reason) = if effective {
                 (NodeStatus::Success, None)
             } else {
@@ -329,11 +379,13 @@ impl RunState {
         match *internal {
             Internal::Probe { node, success } => {
                 if success {
+                    self.counts[node].successes += 1;
                     self.set(plan, node, NodeStatus::Success, None);
                     (Status::Success, dt)
                 } else {
                     let reason = self.failure_reason(plan, node);
                     self.last_failure = Some(reason.clone());
+                    self.counts[node].failures += 1;
                     self.set(plan, node, NodeStatus::Failure, Some(reason));
                     (Status::Failure, dt)
                 }
@@ -551,6 +603,7 @@ impl RunState {
             if let Some(id) = plan.nodes[i].leaf {
                 self.halt_leaf(plan, driver, id);
             }
+            self.counts[i].halts += 1;
             self.set(plan, i, NodeStatus::Halted, Some(reason));
         }
         // A yield that answered Running is only completed by its own execution: reset it when it
@@ -575,7 +628,7 @@ impl RunState {
         }
         rt.running = false;
         let span = rt.span.take().unwrap_or_else(tracing::Span::none);
-        if !matches!(info.kind, Leaf::Wait(_)) {
+        if rt.real && !matches!(info.kind, Leaf::Wait(_)) {
             span.in_scope(|| driver.halt(id, &info.kind));
         }
     }
@@ -584,9 +637,21 @@ impl RunState {
 impl TreeRunner {
     /// A runner for `plan`, all nodes Idle.
     pub fn new(plan: Arc<Plan>) -> Self {
+        Self::with_substitutions(plan, Resolved::default())
+    }
+
+    /// A runner for `plan` whose substituted leaves (see [`super::substitute`]) answer their
+    /// scripted outcome instead of calling the driver.
+    pub fn with_substitutions(plan: Arc<Plan>, subs: Resolved) -> Self {
         let bt = BT::new(plan.behavior.clone(), ());
-        let st = RunState::new(&plan);
-        Self { plan, bt, st }
+        let st = RunState::new(&plan, &subs);
+        Self { plan, bt, st, subs }
+    }
+
+    /// Per-node counts since the last reset (same indices as `plan.nodes`): activations,
+    /// successes, failures and halts.
+    pub fn node_counts(&self) -> &[NodeCounts] {
+        &self.st.counts
     }
 
     /// The plan being run.
@@ -704,6 +769,7 @@ impl TreeRunner {
                 if let Some(id) = plan.nodes[i].leaf {
                     st.halt_leaf(plan, driver, id);
                 }
+                st.counts[i].halts += 1;
                 st.set(
                     plan,
                     i,
@@ -720,7 +786,7 @@ impl TreeRunner {
     /// if the tree may be running.
     pub fn reset(&mut self) {
         self.bt.reset_bt();
-        self.st = RunState::new(&self.plan);
+        self.st = RunState::new(&self.plan, &self.subs);
     }
 }
 

@@ -19,6 +19,7 @@
 
 mod indices;
 pub mod layout;
+pub mod report;
 pub mod resume;
 mod summary;
 
@@ -35,13 +36,19 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 pub use indices::ScenarioIndices;
+pub use report::{MergeError, Merged, merge_results};
 pub use layout::{Region, Scenario, ScenarioLayout, sample_scenario, sample_scenario_in};
-pub use summary::{Failure, FailureGroup, Summary, percentile, wilson_interval};
+pub use summary::{
+    Coverage, Failure, FailureGroup, NodeTotals, Summary, percentile, wilson_interval,
+};
 
 use crate::actions::{CONTROL_PERIOD, Cell, Checks, Collision};
-use crate::episode::{EpisodeConfig, EpisodeReport, Goal, NoObserver, ObjectReport, run_in_cell};
+use crate::episode::{
+    EpisodeConfig, EpisodeReport, Goal, NoObserver, NodeReport, ObjectReport, run_in_cell,
+};
 use crate::faults::FaultKind;
 use crate::plan::Plan;
+use crate::runtime::substitute::Substitution;
 use crate::scene::{Placement, PlacementError, sample_placement};
 use crate::sim::{Layout, Scene};
 use crate::world::goal::GoalValue;
@@ -82,6 +89,95 @@ impl FromStr for Shard {
     }
 }
 
+/// `--shard`: a fixed `K/M`, or `auto` (from a Slurm array or a Kubernetes Indexed Job).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ShardSpec {
+    /// `K/M`.
+    Fixed(Shard),
+    /// `auto`: see [`Shard::from_env`].
+    Auto,
+}
+
+impl FromStr for ShardSpec {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        if s.trim() == "auto" {
+            Ok(ShardSpec::Auto)
+        } else {
+            s.parse().map(ShardSpec::Fixed).map_err(|e| format!("{e}, or auto"))
+        }
+    }
+}
+
+/// Most shards `--shard auto` accepts from the environment.
+pub const MAX_AUTO_SHARDS: u64 = 1_000_000;
+
+impl Shard {
+    /// The shard of this process in a job array, read through `var` (the environment):
+    ///
+    /// - Slurm array (`sbatch --array=0-3`): K = `SLURM_ARRAY_TASK_ID` − `SLURM_ARRAY_TASK_MIN`
+    ///   (0 when unset), M = `SLURM_ARRAY_TASK_COUNT`; `count`, if given, must equal M;
+    /// - Kubernetes Indexed Job: K = `JOB_COMPLETION_INDEX`, M = `count` (the Job's
+    ///   `completions`, which the pod cannot read), required.
+    ///
+    /// Errors say which variable is missing or inconsistent.
+    pub fn from_env(var: impl Fn(&str) -> Option<String>, count: Option<u64>) -> Result<Shard, String> {
+        let num = |name: &str| -> Result<Option<u64>, String> {
+            match var(name) {
+                None => Ok(None),
+                Some(v) => v
+                    .trim()
+                    .parse::<u64>()
+                    .map(Some)
+                    .map_err(|_| format!("{name}={v:?} is not a whole number")),
+            }
+        };
+        let check = |k: u64, m: u64, how: &str| -> Result<Shard, String> {
+            if m == 0 || m > MAX_AUTO_SHARDS {
+                return Err(format!("{how}: the shard count must be 1 to {MAX_AUTO_SHARDS}, got {m}"));
+            }
+            if k >= m {
+                return Err(format!("{how}: index {k} is not below the shard count {m}"));
+            }
+            Ok(Shard { index: k, count: m })
+        };
+        if let Some(id) = num("SLURM_ARRAY_TASK_ID")? {
+            let m = num("SLURM_ARRAY_TASK_COUNT")?.ok_or(
+                "SLURM_ARRAY_TASK_ID is set but SLURM_ARRAY_TASK_COUNT is not (run as an array job: sbatch --array=0-M-1)",
+            )?;
+            let min = num("SLURM_ARRAY_TASK_MIN")?.unwrap_or(0);
+            let k = id.checked_sub(min).ok_or_else(|| {
+                format!("SLURM_ARRAY_TASK_ID {id} is below SLURM_ARRAY_TASK_MIN {min}")
+            })?;
+            if let Some(c) = count
+                && c != m
+            {
+                return Err(format!(
+                    "--shard-count {c} disagrees with SLURM_ARRAY_TASK_COUNT {m}"
+                ));
+            }
+            if let Some(step) = num("SLURM_ARRAY_TASK_STEP")?
+                && step != 1
+            {
+                return Err(format!(
+                    "SLURM_ARRAY_TASK_STEP is {step}: use a contiguous array (--array=0-{})",
+                    m.saturating_sub(1)
+                ));
+            }
+            return check(k, m, "Slurm array");
+        }
+        if let Some(k) = num("JOB_COMPLETION_INDEX")? {
+            let m = count.ok_or(
+                "JOB_COMPLETION_INDEX is set: give the Job's completions as --shard-count M",
+            )?;
+            return check(k, m, "Kubernetes Indexed Job");
+        }
+        Err("neither a Slurm array (SLURM_ARRAY_TASK_ID, SLURM_ARRAY_TASK_COUNT) nor a Kubernetes \
+             Indexed Job (JOB_COMPLETION_INDEX) is in the environment; give --shard K/M"
+            .into())
+    }
+}
+
 /// What to sweep.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SweepConfig {
@@ -101,6 +197,14 @@ pub struct SweepConfig {
     pub max_sim_time: f64,
     /// The `--scene` file the sweep was given, if any (printed in reproduction commands).
     pub scene_file: Option<String>,
+    /// The tree file, as given (written to every result line, printed in reproduction
+    /// commands).
+    pub tree: String,
+    /// Leaves replaced by scripted outcomes in every scenario (see
+    /// [`crate::runtime::substitute`]).
+    pub substitutions: Vec<Substitution>,
+    /// The scenario file of `macrotree test` this sweep belongs to, if any.
+    pub suite: Option<String>,
 }
 
 impl Default for SweepConfig {
@@ -114,6 +218,9 @@ impl Default for SweepConfig {
             shard: None,
             max_sim_time: EpisodeConfig::default().max_sim_time,
             scene_file: None,
+            tree: String::new(),
+            substitutions: Vec::new(),
+            suite: None,
         }
     }
 }
@@ -165,6 +272,7 @@ impl SweepConfig {
                 control_period: CONTROL_PERIOD,
                 fault: self.fault,
                 goal: self.goal,
+                substitutions: self.substitutions.clone(),
                 ..EpisodeConfig::default()
             },
         }
@@ -181,6 +289,7 @@ impl SweepConfig {
             control_period: CONTROL_PERIOD,
             fault: self.fault,
             goal: self.goal,
+            substitutions: self.substitutions.clone(),
         }
     }
 }
@@ -205,6 +314,23 @@ pub struct SceneScenario {
 /// of jobs and any machine).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ScenarioResult {
+    /// The scenario file of `macrotree test` this result belongs to (absent for sweeps).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub suite: Option<String>,
+    /// The tree file, as given to the sweep.
+    pub tree: String,
+    /// The `--scene` file, if one was given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scene_file: Option<String>,
+    /// Scenarios in the whole sweep (N, before sharding).
+    pub scenarios: u64,
+    /// What counted as success (`--goal`).
+    pub sweep_goal: Goal,
+    /// The per-episode simulated time limit, seconds.
+    pub max_sim_time: f64,
+    /// Substitutions applied in every scenario (`PATTERN=OUTCOME`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub substitutions: Vec<Substitution>,
     /// Scenario index k.
     pub index: u64,
     /// Sweep seed S.
@@ -250,6 +376,8 @@ pub struct ScenarioResult {
     pub failed_node: Option<String>,
     /// A stable name for the kind of failure (`timeout`, `grasp_lost`, …), for grouping.
     pub failure_kind: Option<&'static str>,
+    /// How often every node ran, in plan order.
+    pub nodes: Vec<NodeReport>,
     /// Wall-clock time of the episode, seconds (not written to the JSONL).
     #[serde(skip)]
     pub wall_time_s: f64,
@@ -289,7 +417,15 @@ impl ScenarioResult {
         r: EpisodeReport,
     ) -> Self {
         let failure_kind = r.failure_reason.as_deref().map(crate::episode::failure_kind);
+        let defaults = SweepConfig::default();
         Self {
+            suite: None,
+            tree: String::new(),
+            scene_file: None,
+            scenarios: defaults.scenarios,
+            sweep_goal: defaults.goal,
+            max_sim_time: defaults.max_sim_time,
+            substitutions: Vec::new(),
             index,
             sweep_seed,
             seed,
@@ -311,8 +447,24 @@ impl ScenarioResult {
             collisions: r.collisions,
             failure_kind,
             failed_node: r.failed_node,
+            nodes: r.nodes,
             wall_time_s: r.wall_time_s,
         }
+    }
+
+    /// This result as a result of the sweep `config`: its tree, scene file, scenario count,
+    /// goal, time limit, substitutions and suite, which every line carries so that shard
+    /// outputs can be checked and merged ([`report`]).
+    #[must_use]
+    pub fn for_sweep(mut self, config: &SweepConfig) -> Self {
+        self.suite = config.suite.clone();
+        self.tree = config.tree.clone();
+        self.scene_file = config.scene_file.clone();
+        self.scenarios = config.scenarios;
+        self.sweep_goal = config.goal;
+        self.max_sim_time = config.max_sim_time;
+        self.substitutions = config.substitutions.clone();
+        self
     }
 
     /// A result for an episode that could not run (it panicked, or its layout could not be
@@ -325,7 +477,15 @@ impl ScenarioResult {
         fault: Option<FaultKind>,
         reason: String,
     ) -> Self {
+        let defaults = SweepConfig::default();
         Self {
+            suite: None,
+            tree: String::new(),
+            scene_file: None,
+            scenarios: defaults.scenarios,
+            sweep_goal: defaults.goal,
+            max_sim_time: defaults.max_sim_time,
+            substitutions: Vec::new(),
             index,
             sweep_seed,
             seed,
@@ -353,6 +513,7 @@ impl ScenarioResult {
             goal: Vec::new(),
             collisions: Vec::new(),
             failed_node: None,
+            nodes: Vec::new(),
             wall_time_s: 0.0,
         }
     }
@@ -395,12 +556,15 @@ impl ScenarioResult {
         if config.max_sim_time != EpisodeConfig::default().max_sim_time {
             cmd += &format!(" --max-sim-time {}", config.max_sim_time);
         }
+        for sub in &config.substitutions {
+            cmd += &format!(" --substitute {}", shell_quote(&sub.to_string()));
+        }
         cmd
     }
 }
 
 /// Quotes `s` for a POSIX shell when it holds anything but `[A-Za-z0-9_./+-]`.
-fn shell_quote(s: &str) -> String {
+pub(crate) fn shell_quote(s: &str) -> String {
     if !s.is_empty()
         && s.chars()
             .all(|c| c.is_ascii_alphanumeric() || "_./+-".contains(c))
@@ -420,7 +584,7 @@ pub fn run_scenario(
 ) -> ScenarioResult {
     let episode = config.episode_config(scenario);
     let report = run_in_cell(cell, plan.clone(), &episode, &mut NoObserver);
-    ScenarioResult::new(scenario, config.fault, report)
+    ScenarioResult::new(scenario, config.fault, report).for_sweep(config)
 }
 
 /// Runs scenario `index` of `config` on the cell's scene (reset first).
@@ -434,9 +598,10 @@ pub fn run_scene_scenario(
         Ok(scenario) => {
             let episode = config.scene_episode_config(&scenario);
             let report = run_in_cell(cell, plan.clone(), &episode, &mut NoObserver);
-            ScenarioResult::of_scene(&scenario, config.fault, report)
+            ScenarioResult::of_scene(&scenario, config.fault, report).for_sweep(config)
         }
-        Err(e) => ScenarioResult::not_run(index, config.seed, 0, None, config.fault, format!("layout: {e}")),
+        Err(e) => ScenarioResult::not_run(index, config.seed, 0, None, config.fault, format!("layout: {e}"))
+            .for_sweep(config),
     }
 }
 
@@ -508,6 +673,7 @@ pub fn run_sweep_from(
                             config.fault,
                             format!("panicked: {}", panic_message(&*payload)),
                         )
+                        .for_sweep(config)
                     });
                     // The receiver lives until every result is in.
                     let _ = tx.send((pos, result));

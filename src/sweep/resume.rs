@@ -13,6 +13,8 @@
 //! - its `sweep_seed`, `fault`, episode `seed` and `layout` are those of that scenario of this
 //!   sweep seed ([`super::sample_scenario`]): the seed matches;
 //! - its `success` agrees with its `tree_status` and `checks.in_bowl` under this `--goal`;
+//! - its `tree`, `scenarios`, `sweep_goal`, `max_sim_time`, `scene_file`, `substitutions` (and `suite`
+//!   for `macrotree test`) are this sweep's;
 //! - it is exactly what this version writes for the result it holds (no unknown or reordered
 //!   fields);
 //! - and [`spot_check`] runs the last kept scenario again and compares the line byte for byte:
@@ -167,6 +169,24 @@ fn check_result(
             r.index
         ));
     }
+    if r.tree != config.tree {
+        return Err(format!("tree {:?}, not {:?}", r.tree, config.tree));
+    }
+    if r.sweep_goal != config.goal {
+        return Err(format!("--goal {}, not {}", r.sweep_goal.name(), config.goal.name()));
+    }
+    if r.max_sim_time.to_bits() != config.max_sim_time.to_bits() {
+        return Err(format!("--max-sim-time {}, not {}", r.max_sim_time, config.max_sim_time));
+    }
+    if r.scenarios != config.scenarios {
+        return Err(format!("{} scenarios, not {}", r.scenarios, config.scenarios));
+    }
+    if r.substitutions != config.substitutions {
+        return Err("its --substitute rules differ".into());
+    }
+    if r.suite != config.suite || r.scene_file != config.scene_file {
+        return Err("its scenario file or --scene differs".into());
+    }
     if r.sweep_seed != config.seed {
         return Err(format!("sweep seed {}, not {}", r.sweep_seed, config.seed));
     }
@@ -236,7 +256,41 @@ pub fn parse_line(line: &str) -> Result<ScenarioResult, String> {
                 .ok_or("unknown `fault`")?,
         ),
     };
+    let text = |k: &str| -> Result<String, String> {
+        Ok(field(k)?.as_str().ok_or_else(|| format!("`{k}` is not text"))?.to_string())
+    };
+    let sweep_goal = text("sweep_goal")?;
+    let substitutions = match v.get("substitutions") {
+        None => Vec::new(),
+        Some(list) => list
+            .as_array()
+            .ok_or("`substitutions` is not a list")?
+            .iter()
+            .map(|x| {
+                x.as_str()
+                    .ok_or_else(|| "`substitutions` holds a non-text item".to_string())?
+                    .parse()
+            })
+            .collect::<Result<Vec<_>, String>>()
+            .map_err(|e| format!("`substitutions`: {e}"))?,
+    };
     Ok(ScenarioResult {
+        suite: match v.get("suite") {
+            None => None,
+            Some(s) => Some(s.as_str().ok_or("`suite` is not text")?.to_string()),
+        },
+        tree: text("tree")?,
+        scene_file: match v.get("scene_file") {
+            None => None,
+            Some(s) => Some(s.as_str().ok_or("`scene_file` is not text")?.to_string()),
+        },
+        scenarios: u64_of("scenarios")?,
+        sweep_goal: [Goal::Scene, Goal::Bowl, Goal::Tree]
+            .into_iter()
+            .find(|g| g.name() == sweep_goal)
+            .ok_or("unknown `sweep_goal`")?,
+        max_sim_time: float(field("max_sim_time")?, "max_sim_time")?,
+        substitutions,
         index: u64_of("index")?,
         sweep_seed: u64_of("sweep_seed")?,
         seed: u64_of("seed")?,
@@ -284,6 +338,7 @@ pub fn parse_line(line: &str) -> Result<ScenarioResult, String> {
             .map_err(|e| format!("`collisions`: {e}"))?,
         failed_node: serde_json::from_value(parsed("failed_node")?)
             .map_err(|e| format!("`failed_node`: {e}"))?,
+        nodes: serde_json::from_value(parsed("nodes")?).map_err(|e| format!("`nodes`: {e}"))?,
         wall_time_s: 0.0,
     })
 }

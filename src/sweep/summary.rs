@@ -77,6 +77,83 @@ pub struct Summary {
     pub failures: Vec<Failure>,
     /// Failures grouped by (node path, failure kind), most frequent first.
     pub failure_groups: Vec<FailureGroup>,
+    /// Substitutions applied in every scenario (`PATTERN=OUTCOME`).
+    pub substitutions: Vec<String>,
+    /// Every node's counts summed over the scenarios, in plan order.
+    pub nodes: Vec<NodeTotals>,
+    /// Tree coverage: which nodes never ran, never succeeded, never failed over the sweep.
+    pub coverage: Coverage,
+}
+
+/// One node's counts summed over a sweep.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct NodeTotals {
+    /// The node path.
+    pub path: String,
+    /// Scenarios in which the node was activated at least once.
+    pub scenarios_ran: u64,
+    /// Activations over all scenarios.
+    pub activations: u64,
+    /// Successes over all scenarios.
+    pub successes: u64,
+    /// Failures over all scenarios.
+    pub failures: u64,
+    /// Halts over all scenarios.
+    pub halts: u64,
+}
+
+/// Tree coverage over a sweep ("which branches never ran").
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Default)]
+pub struct Coverage {
+    /// Nodes in the tree.
+    pub nodes: u64,
+    /// Nodes activated in at least one scenario.
+    pub ran: u64,
+    /// Paths of the nodes never activated, plan order.
+    pub never_ran: Vec<String>,
+    /// Paths of the nodes that ran but never succeeded.
+    pub never_succeeded: Vec<String>,
+    /// Paths of the nodes that ran but never failed.
+    pub never_failed: Vec<String>,
+}
+
+/// Sums the node counts of `results` (nodes in the order of the first result that lists them).
+fn node_totals(results: &[ScenarioResult]) -> (Vec<NodeTotals>, Coverage) {
+    let mut totals: Vec<NodeTotals> = Vec::new();
+    let mut at: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
+    for r in results {
+        for n in &r.nodes {
+            let i = *at.entry(n.path.clone()).or_insert_with(|| {
+                totals.push(NodeTotals {
+                    path: n.path.clone(),
+                    scenarios_ran: 0,
+                    activations: 0,
+                    successes: 0,
+                    failures: 0,
+                    halts: 0,
+                });
+                totals.len() - 1
+            });
+            let t = &mut totals[i];
+            let c = &n.counts;
+            t.scenarios_ran += u64::from(c.activations > 0);
+            t.activations += u64::from(c.activations);
+            t.successes += u64::from(c.successes);
+            t.failures += u64::from(c.failures);
+            t.halts += u64::from(c.halts);
+        }
+    }
+    let paths = |f: &dyn Fn(&NodeTotals) -> bool| -> Vec<String> {
+        totals.iter().filter(|t| f(t)).map(|t| t.path.clone()).collect()
+    };
+    let coverage = Coverage {
+        nodes: totals.len() as u64,
+        ran: totals.iter().filter(|t| t.activations > 0).count() as u64,
+        never_ran: paths(&|t| t.activations == 0),
+        never_succeeded: paths(&|t| t.activations > 0 && t.successes == 0),
+        never_failed: paths(&|t| t.activations > 0 && t.failures == 0),
+    };
+    (totals, coverage)
 }
 
 /// Failures that share the node that failed and the kind of failure.
@@ -143,6 +220,7 @@ impl Summary {
             })
             .collect();
         failure_groups.sort_by_key(|g| std::cmp::Reverse(g.count));
+        let (nodes, coverage) = node_totals(results);
         Self {
             tree: tree.to_string(),
             seed: config.seed,
@@ -165,6 +243,9 @@ impl Summary {
             },
             failures,
             failure_groups,
+            substitutions: config.substitutions.iter().map(|s| s.to_string()).collect(),
+            nodes,
+            coverage,
         }
     }
 
@@ -212,6 +293,26 @@ impl Summary {
             "  wall time {:.1} s on {} job(s): {:.0} scenarios/minute",
             self.wall_time_s, self.jobs, self.scenarios_per_minute
         );
+        if !self.substitutions.is_empty() {
+            let _ = writeln!(s, "  substitutions: {}", self.substitutions.join(", "));
+        }
+        let c = &self.coverage;
+        if c.nodes > 0 {
+            let _ = writeln!(
+                s,
+                "  tree coverage: {} of {} nodes ran; {} never succeeded, {} never failed",
+                c.ran,
+                c.nodes,
+                c.never_succeeded.len(),
+                c.never_failed.len()
+            );
+            for p in c.never_ran.iter().take(20) {
+                let _ = writeln!(s, "    never ran: {p}");
+            }
+            if c.never_ran.len() > 20 {
+                let _ = writeln!(s, "    … and {} more (see --json)", c.never_ran.len() - 20);
+            }
+        }
         if !self.failure_groups.is_empty() {
             let _ = writeln!(s, "  failures by node and kind:");
             for g in &self.failure_groups {

@@ -1,0 +1,83 @@
+//! `macrotree report FILE.jsonl…`: merges the `--out` files of sharded sweeps or `macrotree
+//! test` runs into the summary (and, for tests, the JUnit report) of one unsharded run.
+//!
+//! Exit codes as for `sweep` / `test`: 0 when every scenario succeeded (every expectation held),
+//! 1 when not, 2 on bad input (unreadable or mixed files, missing or duplicate scenarios).
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+use super::CliError;
+use super::outputs::check_output;
+use crate::suite::{SuiteOutcome, load_scenario_file};
+use crate::sweep::{Summary, merge_results};
+
+/// Arguments of `report`.
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// JSONL files written by `sweep --out` or `test --out` (the shards of one run, any order).
+    #[arg(required = true)]
+    pub files: Vec<PathBuf>,
+    /// Print the summary as one JSON object on the last line of stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// For `macrotree test` results: write the JUnit XML report here.
+    #[arg(long, value_name = "FILE.xml")]
+    pub junit: Option<PathBuf>,
+}
+
+/// Runs `macrotree report`.
+pub fn report(args: ReportArgs) -> Result<(), CliError> {
+    let merged = merge_results(&args.files).map_err(|e| CliError::Input(format!("error: {e}")))?;
+    let is_test = merged.iter().any(|m| m.config.suite.is_some());
+    if !is_test {
+        if args.junit.is_some() {
+            return Err(CliError::Input(
+                "error: --junit needs `macrotree test` results (these are a sweep's)".into(),
+            ));
+        }
+        let m = &merged[0];
+        let summary = Summary::new(&m.config.tree, &m.config, &m.results, 0.0, 0);
+        print!("{}", summary.to_text());
+        if args.json {
+            println!("{}", serde_json::to_string(&summary).expect("summary serializes"));
+        }
+        return if summary.all_succeeded() {
+            Ok(())
+        } else {
+            Err(CliError::TaskFailed)
+        };
+    }
+    // Expectations live in the scenario files: read them again, and check that they still
+    // describe the runs the lines came from.
+    let mut files = Vec::new();
+    for m in &merged {
+        let path = PathBuf::from(m.config.suite.as_deref().unwrap_or_default());
+        let file = load_scenario_file(&path).map_err(|d| {
+            super::invalid(d, format!("{} (named by the results)", path.display()))
+        })?;
+        let mut same = file.sweep.clone();
+        same.jobs = 0;
+        same.shard = None;
+        if same != m.config {
+            return Err(CliError::Input(format!(
+                "error: {} no longer describes the run in these results (tree, scene, count, seed, fault, goal, time limit or substitutions changed); run `macrotree test` again",
+                path.display()
+            )));
+        }
+        files.push(file);
+    }
+    let mut inputs = args.files.clone();
+    inputs.extend(files.iter().map(|f| f.path.clone()));
+    let junit = args.junit.as_deref().map(|p| check_output(p, &inputs)).transpose()?;
+    let outcomes: Vec<_> = files
+        .iter()
+        .zip(merged)
+        .map(|(f, m)| {
+            let o = SuiteOutcome::new(f, &m.results, 0.0, 0);
+            (f, o, m.results)
+        })
+        .collect();
+    super::test::finish(&outcomes, junit.as_ref(), args.json)
+}

@@ -1,0 +1,229 @@
+//! `macrotree test [PATH…]`: runs scenario files (default: `scenarios/`) and checks their
+//! expectations; a summary per file, `--junit FILE.xml`, `--out FILE.jsonl`, `--json`.
+//!
+//! Exit codes: 0 when every expectation holds, 1 when one does not, 2 on bad input (any
+//! scenario file, tree, scene or substitution invalid: nothing runs).
+
+use std::io::IsTerminal;
+use std::ops::ControlFlow;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde::Serialize;
+
+use super::outputs::{check_output, output_error, tree_inputs};
+use super::{CliError, load_task};
+use crate::suite::junit::{Case, to_xml};
+use crate::suite::{ScenarioFile, SuiteOutcome, find_files, load_scenario_file, offending_commands};
+use crate::sweep::run_sweep_from;
+
+/// Most reproduce commands listed per failing scenario file (JUnit and text).
+const MAX_LISTED: usize = 20;
+
+/// Arguments of `test`.
+#[derive(Debug, Args)]
+pub struct TestArgs {
+    /// Scenario files, or folders to search for `*.yaml` (default: scenarios/).
+    pub paths: Vec<PathBuf>,
+    /// Worker threads (default: one per core).
+    #[arg(long, short = 'j', value_name = "J", value_parser = clap::value_parser!(u64).range(1..=1024))]
+    pub jobs: Option<u64>,
+    /// Run only the scenarios with index ≡ K (mod M) of every file; `auto` as for `sweep`
+    /// (Slurm array or Kubernetes Indexed Job). Merge the shards' --out with `macrotree report`.
+    #[arg(long, value_name = "K/M|auto")]
+    pub shard: Option<crate::sweep::ShardSpec>,
+    /// M for `--shard auto` in a Kubernetes Indexed Job.
+    #[arg(long, value_name = "M", requires = "shard", value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
+    pub shard_count: Option<u64>,
+    /// Write a JUnit XML report here (one test case per scenario file).
+    #[arg(long, value_name = "FILE.xml")]
+    pub junit: Option<PathBuf>,
+    /// Write one JSON line per scenario here (the sweep's lines, each naming its `suite`).
+    #[arg(long, value_name = "FILE.jsonl")]
+    pub out: Option<PathBuf>,
+    /// Print the outcome as one JSON object on the last line of stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The whole outcome, as `--json` prints it.
+#[derive(Debug, Serialize)]
+pub(super) struct TestReport {
+    /// Every expectation of every file holds.
+    pub passed: bool,
+    /// Scenario files run.
+    pub files: usize,
+    /// Files whose expectations all hold.
+    pub files_passed: usize,
+    /// Each file's outcome.
+    pub suites: Vec<SuiteOutcome>,
+}
+
+/// Runs `macrotree test`.
+pub fn test(args: TestArgs) -> Result<(), CliError> {
+    let shard = super::resolve_shard(args.shard, args.shard_count)?;
+    let paths = if args.paths.is_empty() {
+        vec![PathBuf::from("scenarios")]
+    } else {
+        args.paths.clone()
+    };
+    let files = find_files(&paths).map_err(|e| CliError::Input(format!("error: {e}")))?;
+    if files.is_empty() {
+        return Err(CliError::Input(format!(
+            "error: no scenario files (*.yaml) in {}",
+            paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+        )));
+    }
+    // Everything is checked before anything runs.
+    let mut diags = Vec::new();
+    let mut suites = Vec::new();
+    for f in &files {
+        match load_scenario_file(f) {
+            Ok(s) => suites.push(s),
+            Err(d) => diags.extend(d),
+        }
+    }
+    if !diags.is_empty() {
+        return Err(super::invalid(diags, format!("{} scenario file(s)", files.len())));
+    }
+    let mut inputs: Vec<PathBuf> = files.clone();
+    let mut tasks = Vec::new();
+    for s in &mut suites {
+        let (plan, scene) = load_task(&s.tree, s.scene.as_deref()).map_err(|e| match e {
+            CliError::Input(m) => CliError::Input(format!("{m}\n  (named by {})", s.path.display())),
+            other => other,
+        })?;
+        crate::runtime::substitute::resolve(&plan, &s.sweep.substitutions)
+            .map_err(|e| CliError::Input(format!("error: {}: {e}", s.path.display())))?;
+        s.check_patterns(&plan).map_err(|e| CliError::Input(format!("error: {e}")))?;
+        s.sweep.shard = shard;
+        s.sweep.jobs = args.jobs.map_or(0, |j| j as usize);
+        inputs.extend(tree_inputs(&s.tree));
+        inputs.extend(s.scene.clone());
+        tasks.push((Arc::new(plan), scene));
+    }
+    let junit_out = args.junit.as_deref().map(|p| check_output(p, &inputs)).transpose()?;
+    let mut out = match &args.out {
+        Some(p) => Some(check_output(p, &inputs)?.stream(&[]).map_err(output_error)?),
+        None => None,
+    };
+    let total: u64 = suites.iter().map(|s| s.sweep.indices().len() as u64).sum();
+    let bar = if std::io::stderr().is_terminal() {
+        ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
+    } else {
+        ProgressBar::hidden()
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} {msg}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    let mut outcomes = Vec::new();
+    let mut failed_cases = 0u64;
+    for (s, (plan, scene)) in suites.iter().zip(&tasks) {
+        bar.set_message(s.path.display().to_string());
+        let mut write_error = None;
+        let run = run_sweep_from(scene, plan, &s.sweep, 0, |r| {
+            if let Some(w) = out.as_mut()
+                && let Err(e) = w.write_line(&r.to_jsonl())
+            {
+                write_error = Some(e);
+                return ControlFlow::Break(());
+            }
+            if !r.success {
+                failed_cases += 1;
+            }
+            bar.inc(1);
+            ControlFlow::Continue(())
+        })
+        .map_err(|e| CliError::Input(format!("error: cannot start worker threads: {e}")))?;
+        if let Some(e) = write_error {
+            bar.finish_and_clear();
+            return Err(output_error(e));
+        }
+        outcomes.push((s, SuiteOutcome::new(s, &run.results, run.wall_time_s, run.jobs), run.results));
+    }
+    bar.finish_and_clear();
+    if let Some(w) = out {
+        w.finish().map_err(output_error)?;
+    }
+    finish(&outcomes, junit_out.as_ref(), args.json)
+}
+
+/// Prints the outcome of every file and the totals, writes the JUnit file, and maps the
+/// verdict to the exit code (shared with `macrotree report`).
+pub(super) fn finish(
+    outcomes: &[(&ScenarioFile, SuiteOutcome, Vec<crate::sweep::ScenarioResult>)],
+    junit: Option<&crate::output::OutputFile>,
+    json: bool,
+) -> Result<(), CliError> {
+    let mut cases = Vec::new();
+    for (file, o, results) in outcomes {
+        let sm = &o.summary;
+        println!(
+            "{} {}: {} of {} succeeded, sim time median {:.2} s, p95 {:.2} s{}",
+            if o.passed { "PASS" } else { "FAIL" },
+            o.file,
+            sm.successes,
+            sm.scenarios,
+            sm.median_sim_time_s,
+            sm.p95_sim_time_s,
+            sm.shard.as_ref().map_or(String::new(), |k| format!(" (shard {k})"))
+        );
+        let mut details = String::new();
+        for c in &o.checks {
+            println!("  {} {}: {}", if c.ok { "ok  " } else { "FAIL" }, c.expectation, c.measured);
+            if !c.ok {
+                details += &format!("expected {}: {}\n", c.expectation, c.measured);
+            }
+        }
+        for g in &sm.failure_groups {
+            println!("  failures: {} × {} at {}", g.count, g.kind, g.node);
+        }
+        let cmds = offending_commands(&file.expect, results, &file.sweep);
+        if !o.passed && !cmds.is_empty() {
+            details += "reproduce:\n";
+            println!("  reproduce:");
+            for c in cmds.iter().take(MAX_LISTED) {
+                println!("    {c}");
+                details += &format!("  {c}\n");
+            }
+            if cmds.len() > MAX_LISTED {
+                println!("    … and {} more (see --out)", cmds.len() - MAX_LISTED);
+                details += &format!("  … and {} more\n", cmds.len() - MAX_LISTED);
+            }
+        }
+        let failed = o.checks.iter().filter(|c| !c.ok).count();
+        cases.push(Case {
+            name: o.file.clone(),
+            time_s: sm.wall_time_s,
+            failure: (!o.passed).then(|| (format!("{failed} expectation(s) failed"), details)),
+            out: sm.to_text(),
+        });
+    }
+    let passed = outcomes.iter().filter(|(_, o, _)| o.passed).count();
+    println!(
+        "{} of {} scenario file(s) passed",
+        passed,
+        outcomes.len()
+    );
+    if let Some(j) = junit {
+        j.write_all(to_xml(&cases).as_bytes()).map_err(output_error)?;
+    }
+    if json {
+        let report = TestReport {
+            passed: passed == outcomes.len(),
+            files: outcomes.len(),
+            files_passed: passed,
+            suites: outcomes.iter().map(|(_, o, _)| o.clone()).collect(),
+        };
+        println!("{}", serde_json::to_string(&report).expect("the report serializes"));
+    }
+    if passed == outcomes.len() {
+        Ok(())
+    } else {
+        Err(CliError::TaskFailed)
+    }
+}
