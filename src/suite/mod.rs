@@ -78,6 +78,10 @@ pub struct Expect {
     /// Node path globs of which some node ran in every scenario.
     #[serde(default)]
     pub ran_in_every: Vec<String>,
+    /// Node path globs of which some node failed at least once over the suite (e.g. the step a
+    /// substitution makes fail, before the recovery runs).
+    #[serde(default)]
+    pub failed: Vec<String>,
     /// Node path globs whose nodes never ran over the suite.
     #[serde(default)]
     pub never_ran: Vec<String>,
@@ -270,6 +274,7 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>) -> Option<ScenarioFile>
             "max_sim_time",
             "ran",
             "ran_in_every",
+            "failed",
             "never_ran",
             "never_failed",
         ];
@@ -356,6 +361,7 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>) -> Option<ScenarioFile>
         .ran
         .iter()
         .chain(&e.ran_in_every)
+        .chain(&e.failed)
         .chain(&e.never_ran)
         .chain(&e.never_failed)
         .chain(&e.failed_node);
@@ -364,7 +370,7 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>) -> Option<ScenarioFile>
             issues.push(Issue::new(at(&["expect"]), format!("node pattern: {reason}")));
         }
     }
-    if raw.substitute.len() > MAX_RULES || e.ran.len() + e.ran_in_every.len() + e.never_ran.len() + e.never_failed.len() > MAX_RULES {
+    if raw.substitute.len() > MAX_RULES || e.ran.len() + e.ran_in_every.len() + e.failed.len() + e.never_ran.len() + e.never_failed.len() > MAX_RULES {
         issues.push(Issue::new(v.loc, format!("at most {MAX_RULES} substitutions and {MAX_RULES} node patterns per file")));
     }
     for (i, s) in raw.substitute.iter().enumerate() {
@@ -410,9 +416,10 @@ impl ScenarioFile {
     /// matches nothing would pass or fail for the wrong reason).
     pub fn check_patterns(&self, plan: &Plan) -> Result<(), String> {
         let e = &self.expect;
-        let lists: [(&str, &Vec<String>); 4] = [
+        let lists: [(&str, &Vec<String>); 5] = [
             ("ran", &e.ran),
             ("ran_in_every", &e.ran_in_every),
+            ("failed", &e.failed),
             ("never_ran", &e.never_ran),
             ("never_failed", &e.never_failed),
         ];
@@ -561,6 +568,14 @@ pub fn check(expect: &Expect, results: &[ScenarioResult], summary: &Summary) -> 
             } else {
                 format!("not in scenario(s) {missing:?}")
             },
+        });
+    }
+    for p in &expect.failed {
+        let f = sum(p, |t| t.failures);
+        out.push(Checked {
+            expectation: format!("`{p}` failed at least once"),
+            ok: f > 0,
+            measured: format!("{f} failure(s)"),
         });
     }
     for p in &expect.never_ran {
