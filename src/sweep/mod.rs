@@ -329,7 +329,7 @@ pub struct ScenarioResult {
     /// The per-episode simulated time limit, seconds.
     pub max_sim_time: f64,
     /// Substitutions applied in every scenario (`PATTERN=OUTCOME`).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(skip_serializing_if = "Vec::is_empty", serialize_with = "as_rules")]
     pub substitutions: Vec<Substitution>,
     /// Scenario index k.
     pub index: u64,
@@ -561,6 +561,11 @@ impl ScenarioResult {
         }
         cmd
     }
+}
+
+/// Substitutions as their `PATTERN=OUTCOME` text.
+fn as_rules<S: serde::Serializer>(subs: &[Substitution], s: S) -> Result<S::Ok, S::Error> {
+    s.collect_seq(subs.iter().map(|x| x.to_string()))
 }
 
 /// Quotes `s` for a POSIX shell when it holds anything but `[A-Za-z0-9_./+-]`.
