@@ -33,7 +33,10 @@ fn last_json(out: &std::process::Output) -> serde_json::Value {
 /// `<testsuite>`s holding `<testcase>`s (with `failure` / `system-out` children), and the
 /// counts in the attributes match the elements. Returns (testcases, failures, failure texts).
 fn check_junit(xml: &str) -> (usize, usize, Vec<String>) {
-    assert!(xml.starts_with("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"), "{xml}");
+    assert!(
+        xml.starts_with("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"),
+        "{xml}"
+    );
     let body = &xml[xml.find("?>").unwrap() + 2..];
     let mut stack: Vec<String> = Vec::new();
     let (mut cases, mut failures) = (0, 0);
@@ -55,12 +58,20 @@ fn check_junit(xml: &str) -> (usize, usize, Vec<String>) {
         for (i, _) in text.match_indices('&') {
             let ent = &text[i..];
             assert!(
-                ["&amp;", "&lt;", "&gt;", "&quot;", "&apos;"].iter().any(|e| ent.starts_with(e)),
+                ["&amp;", "&lt;", "&gt;", "&quot;", "&apos;"]
+                    .iter()
+                    .any(|e| ent.starts_with(e)),
                 "bad entity in {ent:.20}"
             );
         }
         if let Some(_start) = text_start.take() {
-            texts.push(text.replace("&lt;", "<").replace("&gt;", ">").replace("&apos;", "'").replace("&quot;", "\"").replace("&amp;", "&"));
+            texts.push(
+                text.replace("&lt;", "<")
+                    .replace("&gt;", ">")
+                    .replace("&apos;", "'")
+                    .replace("&quot;", "\"")
+                    .replace("&amp;", "&"),
+            );
         }
         let close = rest[open..].find('>').expect("tag closes") + open;
         let tag = &rest[open + 1..close];
@@ -84,15 +95,25 @@ fn check_junit(xml: &str) -> (usize, usize, Vec<String>) {
                 a = a[end + 1..].trim_start();
             }
             let parent = stack.last().map_or("", String::as_str);
-            assert!(allowed_parent(name).contains(&parent), "<{name}> inside <{parent}>");
+            assert!(
+                allowed_parent(name).contains(&parent),
+                "<{name}> inside <{parent}>"
+            );
             match name {
                 "testsuite" => {
-                    declared = Some((map["tests"].parse::<usize>().unwrap(), map["failures"].parse::<usize>().unwrap()));
+                    declared = Some((
+                        map["tests"].parse::<usize>().unwrap(),
+                        map["failures"].parse::<usize>().unwrap(),
+                    ));
                     assert!(map.contains_key("name") && map.contains_key("time"));
                 }
                 "testcase" => {
                     cases += 1;
-                    assert!(map.contains_key("name") && map.contains_key("classname") && map["time"].parse::<f64>().is_ok());
+                    assert!(
+                        map.contains_key("name")
+                            && map.contains_key("classname")
+                            && map["time"].parse::<f64>().is_ok()
+                    );
                 }
                 "failure" => {
                     failures += 1;
@@ -109,7 +130,11 @@ fn check_junit(xml: &str) -> (usize, usize, Vec<String>) {
     }
     assert!(stack.is_empty(), "unclosed {stack:?}");
     assert_eq!(rest.trim(), "");
-    assert_eq!(declared, Some((cases, failures)), "counts in <testsuite> disagree with its elements");
+    assert_eq!(
+        declared,
+        Some((cases, failures)),
+        "counts in <testsuite> disagree with its elements"
+    );
     (cases, failures, texts)
 }
 
@@ -143,7 +168,11 @@ fn every_shipped_scenario_file_loads_and_passes_the_schema() {
     let mut covered = std::collections::HashSet::new();
     for path in &files {
         let text = std::fs::read_to_string(path).unwrap();
-        assert!(text.starts_with("# yaml-language-server: $schema=../schema/scenario.schema.json"), "{}", path.display());
+        assert!(
+            text.starts_with("# yaml-language-server: $schema=../schema/scenario.schema.json"),
+            "{}",
+            path.display()
+        );
         let file = macrotree::suite::load_scenario_file(path).unwrap_or_else(|d| panic!("{}", d[0]));
         covered.insert(std::fs::canonicalize(Path::new(ROOT).join(&file.tree)).unwrap_or_default());
         let v: serde_json::Value = serde_saphyr::from_str(&text).unwrap();
@@ -151,7 +180,11 @@ fn every_shipped_scenario_file_loads_and_passes_the_schema() {
         assert!(errors.is_empty(), "{}: {errors:?}", path.display());
     }
     for t in trees {
-        assert!(covered.contains(&std::fs::canonicalize(&t).unwrap()), "no scenario file runs {}", t.display());
+        assert!(
+            covered.contains(&std::fs::canonicalize(&t).unwrap()),
+            "no scenario file runs {}",
+            t.display()
+        );
     }
 }
 
@@ -159,10 +192,23 @@ fn every_shipped_scenario_file_loads_and_passes_the_schema() {
 fn a_passing_suite_exits_0_with_junit_and_jsonl() {
     let dir = scratch("suite-pass");
     let (xml, jsonl) = (dir.join("report.xml"), dir.join("out.jsonl"));
-    let out = macrotree(&["test", PASS, "-j", "2", "--junit", s(&xml), "--out", s(&jsonl), "--json"]);
+    let out = macrotree(&[
+        "test",
+        PASS,
+        "-j",
+        "2",
+        "--junit",
+        s(&xml),
+        "--out",
+        s(&jsonl),
+        "--json",
+    ]);
     assert_eq!(out.status.code(), Some(0), "{}{}", stdout(&out), stderr(&out));
     let text = stdout(&out);
-    assert!(text.contains("PASS tests/fixtures/scenarios/pass/grasp_fails_once.yaml: 3 of 3 succeeded"), "{text}");
+    assert!(
+        text.contains("PASS tests/fixtures/scenarios/pass/grasp_fails_once.yaml: 3 of 3 succeeded"),
+        "{text}"
+    );
     assert!(text.contains("2 of 2 scenario file(s) passed"), "{text}");
     let report = last_json(&out);
     assert_eq!(report["passed"], true);
@@ -176,16 +222,42 @@ fn a_passing_suite_exits_0_with_junit_and_jsonl() {
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();
     assert_eq!(lines.len(), 5);
-    let once: Vec<_> = lines.iter().filter(|l| l["suite"].as_str().unwrap().ends_with("grasp_fails_once.yaml")).collect();
+    let once: Vec<_> = lines
+        .iter()
+        .filter(|l| l["suite"].as_str().unwrap().ends_with("grasp_fails_once.yaml"))
+        .collect();
     assert_eq!(once.len(), 3);
     for l in once {
         assert_eq!(l["success"], true);
-        let pick = l["nodes"].as_array().unwrap().iter().find(|n| n["path"].as_str().unwrap().ends_with("/subtree[pick]")).unwrap();
-        assert_eq!((pick["activations"].as_u64(), pick["failures"].as_u64(), pick["successes"].as_u64()), (Some(2), Some(1), Some(1)), "{pick}");
-        assert_eq!(l["substitutions"][0], "main/**/subtree[pick]/**/grasp=fail_first:1");
+        let pick = l["nodes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|n| n["path"].as_str().unwrap().ends_with("/subtree[pick]"))
+            .unwrap();
+        assert_eq!(
+            (
+                pick["activations"].as_u64(),
+                pick["failures"].as_u64(),
+                pick["successes"].as_u64()
+            ),
+            (Some(2), Some(1), Some(1)),
+            "{pick}"
+        );
+        assert_eq!(
+            l["substitutions"][0],
+            "main/**/subtree[pick]/**/grasp=fail_first:1"
+        );
     }
-    let never: Vec<_> = lines.iter().filter(|l| l["suite"].as_str().unwrap().ends_with("never_works.yaml")).collect();
-    assert!(never.iter().all(|l| l["success"] == false && l["failure_kind"] == "substituted"));
+    let never: Vec<_> = lines
+        .iter()
+        .filter(|l| l["suite"].as_str().unwrap().ends_with("never_works.yaml"))
+        .collect();
+    assert!(
+        never
+            .iter()
+            .all(|l| l["success"] == false && l["failure_kind"] == "substituted")
+    );
 }
 
 #[test]
@@ -198,10 +270,17 @@ fn a_failing_expectation_exits_1_and_its_junit_failure_reproduces() {
     let (cases, failures, texts) = check_junit(&std::fs::read_to_string(&xml).unwrap());
     assert_eq!((cases, failures), (3, 1));
     let text = &texts[0];
-    assert!(text.contains("expected every scenario fails: 2 of 2 succeeded"), "{text}");
+    assert!(
+        text.contains("expected every scenario fails: 2 of 2 succeeded"),
+        "{text}"
+    );
     // The scenarios that broke the expectation (they succeeded) are listed with commands that
     // reproduce them.
-    let cmds: Vec<&str> = text.lines().map(str::trim).filter(|l| l.starts_with("macrotree run ")).collect();
+    let cmds: Vec<&str> = text
+        .lines()
+        .map(str::trim)
+        .filter(|l| l.starts_with("macrotree run "))
+        .collect();
     assert_eq!(cmds.len(), 2, "{text}");
     let args: Vec<&str> = cmds[0].split_whitespace().skip(1).collect();
     let again = macrotree(&args);
@@ -213,7 +292,11 @@ fn bad_scenario_files_exit_2_with_located_errors_and_nothing_runs() {
     let cases = [
         ("typo.yaml", "typo.yaml:4:3", "min_success_rate"),
         ("range.yaml", "range.yaml:2:8", "`count` must be 1 to"),
-        ("nomatch.yaml", "matches no node", "subtree[pick]/sequence[pick]/grasp"),
+        (
+            "nomatch.yaml",
+            "matches no node",
+            "subtree[pick]/sequence[pick]/grasp",
+        ),
     ];
     for (file, where_, what) in cases {
         let path = format!("tests/fixtures/scenarios/bad/{file}");
@@ -251,18 +334,38 @@ fn four_sweep_shards_as_processes_merge_into_the_unsharded_report() {
     let dir = scratch("shards-sweep");
     let all = dir.join("all.jsonl");
     let base = [
-        "sweep", TREE, "--scenarios", "10", "--seed", "7", "-j", "1", "--fault", "slip",
-        "--substitute", "main/**/subtree[pick]/**/grasp=fail_first:1",
+        "sweep",
+        TREE,
+        "--scenarios",
+        "10",
+        "--seed",
+        "7",
+        "-j",
+        "1",
+        "--fault",
+        "slip",
+        "--substitute",
+        "main/**/subtree[pick]/**/grasp=fail_first:1",
     ];
     let whole = macrotree(&[&base[..], &["--out", s(&all), "--json"]].concat());
     assert!(whole.status.code().is_some_and(|c| c < 2), "{}", stderr(&whole));
     let shard_files: Vec<PathBuf> = (0..4).map(|k| dir.join(format!("shard{k}.jsonl"))).collect();
     let children: Vec<_> = (0..4u64)
-        .map(|k| slurm_shard(&[&base[..], &["--out", s(&shard_files[k as usize])]].concat(), k, 4))
+        .map(|k| {
+            slurm_shard(
+                &[&base[..], &["--out", s(&shard_files[k as usize])]].concat(),
+                k,
+                4,
+            )
+        })
         .collect();
     for c in children {
         let o = c.wait_with_output().unwrap();
-        assert!(o.status.code().is_some_and(|c| c < 2), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(
+            o.status.code().is_some_and(|c| c < 2),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
         assert!(String::from_utf8_lossy(&o.stderr).contains("(from the environment)"));
     }
     let mut args = vec!["report", "--json"];
@@ -286,22 +389,65 @@ fn four_sweep_shards_as_processes_merge_into_the_unsharded_report() {
     assert_eq!(strip(last_json(&merged)), strip(last_json(&whole)));
     let summary = last_json(&merged);
     assert_eq!(summary["scenarios"], 10);
-    assert_eq!(summary["substitutions"][0], "main/**/subtree[pick]/**/grasp=fail_first:1");
+    assert_eq!(
+        summary["substitutions"][0],
+        "main/**/subtree[pick]/**/grasp=fail_first:1"
+    );
     assert!(summary["coverage"]["ran"].as_u64().unwrap() > 0);
 
     // Missing, duplicate and foreign shards are refused, naming what is wrong.
-    let out = macrotree(&["report", s(&shard_files[0]), s(&shard_files[1]), s(&shard_files[2])]);
+    let out = macrotree(&[
+        "report",
+        s(&shard_files[0]),
+        s(&shard_files[1]),
+        s(&shard_files[2]),
+    ]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(stderr(&out).contains("2 of 10 scenarios are missing: 3, 7"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("2 of 10 scenarios are missing: 3, 7"),
+        "{}",
+        stderr(&out)
+    );
     let out = macrotree(&["report", s(&all), s(&shard_files[1])]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(stderr(&out).contains("duplicate scenarios: scenario 1"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("duplicate scenarios: scenario 1"),
+        "{}",
+        stderr(&out)
+    );
     let other = dir.join("other.jsonl");
-    let o = macrotree(&["sweep", TREE, "--scenarios", "10", "--seed", "8", "-j", "1", "--shard", "3/4", "--out", s(&other), "--fault", "slip", "--substitute", "main/**/subtree[pick]/**/grasp=fail_first:1"]);
+    let o = macrotree(&[
+        "sweep",
+        TREE,
+        "--scenarios",
+        "10",
+        "--seed",
+        "8",
+        "-j",
+        "1",
+        "--shard",
+        "3/4",
+        "--out",
+        s(&other),
+        "--fault",
+        "slip",
+        "--substitute",
+        "main/**/subtree[pick]/**/grasp=fail_first:1",
+    ]);
     assert!(o.status.code().is_some_and(|c| c < 2));
-    let out = macrotree(&["report", s(&shard_files[0]), s(&shard_files[1]), s(&shard_files[2]), s(&other)]);
+    let out = macrotree(&[
+        "report",
+        s(&shard_files[0]),
+        s(&shard_files[1]),
+        s(&shard_files[2]),
+        s(&other),
+    ]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(stderr(&out).contains("its seed is 8") && stderr(&out).contains("has 7"), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("its seed is 8") && stderr(&out).contains("has 7"),
+        "{}",
+        stderr(&out)
+    );
 }
 
 #[test]
@@ -314,7 +460,18 @@ fn test_shards_merge_into_the_unsharded_junit_and_outcome() {
     let children: Vec<_> = (0..4usize)
         .map(|k| {
             std::process::Command::new(BIN)
-                .args(["test", PASS, "-j", "1", "--shard", "auto", "--shard-count", "4", "--out", s(&files[k])])
+                .args([
+                    "test",
+                    PASS,
+                    "-j",
+                    "1",
+                    "--shard",
+                    "auto",
+                    "--shard-count",
+                    "4",
+                    "--out",
+                    s(&files[k]),
+                ])
                 .current_dir(ROOT)
                 .env_remove("RUST_LOG")
                 .env("JOB_COMPLETION_INDEX", k.to_string())
@@ -325,7 +482,11 @@ fn test_shards_merge_into_the_unsharded_junit_and_outcome() {
     for o in &children {
         // A shard's verdict covers only its scenarios (a shard with one scenario of
         // `grasp_fails_once` still passes; an empty one does not).
-        assert!(o.status.code().is_some_and(|c| c < 2), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(
+            o.status.code().is_some_and(|c| c < 2),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
     }
     let (xa, xb) = (dir.join("a.xml"), dir.join("b.xml"));
     let mut args = vec!["report", "--json", "--junit", s(&xa)];
@@ -342,8 +503,16 @@ fn test_shards_merge_into_the_unsharded_junit_and_outcome() {
 fn shard_auto_needs_a_job_array_environment() {
     let run = |env: &[(&str, &str)], extra: &[&str]| {
         let mut c = std::process::Command::new(BIN);
-        c.args(["sweep", TREE, "--scenarios", "4", "--shard", "auto"]).args(extra).current_dir(ROOT);
-        for k in ["SLURM_ARRAY_TASK_ID", "SLURM_ARRAY_TASK_COUNT", "SLURM_ARRAY_TASK_MIN", "SLURM_ARRAY_TASK_STEP", "JOB_COMPLETION_INDEX"] {
+        c.args(["sweep", TREE, "--scenarios", "4", "--shard", "auto"])
+            .args(extra)
+            .current_dir(ROOT);
+        for k in [
+            "SLURM_ARRAY_TASK_ID",
+            "SLURM_ARRAY_TASK_COUNT",
+            "SLURM_ARRAY_TASK_MIN",
+            "SLURM_ARRAY_TASK_STEP",
+            "JOB_COMPLETION_INDEX",
+        ] {
             c.env_remove(k);
         }
         for (k, v) in env {
@@ -354,7 +523,10 @@ fn shard_auto_needs_a_job_array_environment() {
     };
     let (code, err) = run(&[], &[]);
     assert_eq!(code, Some(2));
-    assert!(err.contains("neither a Slurm array") && err.contains("--shard K/M"), "{err}");
+    assert!(
+        err.contains("neither a Slurm array") && err.contains("--shard K/M"),
+        "{err}"
+    );
     let (code, err) = run(&[("JOB_COMPLETION_INDEX", "1")], &[]);
     assert_eq!(code, Some(2));
     assert!(err.contains("--shard-count"), "{err}");
@@ -364,10 +536,16 @@ fn shard_auto_needs_a_job_array_environment() {
     let (code, err) = run(&[("SLURM_ARRAY_TASK_ID", "2")], &[]);
     assert_eq!(code, Some(2));
     assert!(err.contains("SLURM_ARRAY_TASK_COUNT"), "{err}");
-    let (code, err) = run(&[("SLURM_ARRAY_TASK_ID", "1"), ("SLURM_ARRAY_TASK_COUNT", "4")], &["--shard-count", "3"]);
+    let (code, err) = run(
+        &[("SLURM_ARRAY_TASK_ID", "1"), ("SLURM_ARRAY_TASK_COUNT", "4")],
+        &["--shard-count", "3"],
+    );
     assert_eq!(code, Some(2));
     assert!(err.contains("disagrees"), "{err}");
-    let (code, err) = run(&[("SLURM_ARRAY_TASK_ID", "x"), ("SLURM_ARRAY_TASK_COUNT", "4")], &[]);
+    let (code, err) = run(
+        &[("SLURM_ARRAY_TASK_ID", "x"), ("SLURM_ARRAY_TASK_COUNT", "4")],
+        &[],
+    );
     assert_eq!(code, Some(2));
     assert!(err.contains("not a whole number"), "{err}");
 }

@@ -102,10 +102,11 @@ fn sweep_resume_refuses_results_of_another_sweep() {
             vec!["--scenarios", "10", "--seed", "4", "--shard", "1/2"],
             "expected scenario 1",
         ),
-        (vec!["--scenarios", "2", "--seed", "4"], "only 2 scenario"),
+        // Every line names the sweep's scenario count, time limit and tree.
+        (vec!["--scenarios", "2", "--seed", "4"], "10 scenarios, not 2"),
         (
             vec!["--scenarios", "10", "--seed", "4", "--max-sim-time", "2"],
-            "different result",
+            "--max-sim-time 60, not 2",
         ),
     ] {
         std::fs::write(&file, half).unwrap();
@@ -122,7 +123,7 @@ fn sweep_resume_refuses_results_of_another_sweep() {
             "{opts:?}: the file was changed"
         );
     }
-    // Another tree: the kept results are checked by running the last one again.
+    // Another tree: named in every line.
     std::fs::write(&file, half).unwrap();
     let mut args = vec![
         "sweep",
@@ -135,7 +136,10 @@ fn sweep_resume_refuses_results_of_another_sweep() {
     let out = macrotree(&args);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("different result"), "{stderr}");
+    assert!(
+        stderr.contains("tree \"trees/cube_to_bowl.yaml\", not \"trees/place_on_table.yaml\""),
+        "{stderr}"
+    );
     // A line that is not a result at all.
     std::fs::write(&file, b"{\"index\":0}\n").unwrap();
     let out = sweep(&base, &file, &["--resume"]);

@@ -68,7 +68,10 @@ fn fail_first_fails_then_runs_the_real_leaf() {
     let plan = plan();
     let mut driver = ScriptedDriver::new(&plan);
     driver.set_default(LeafOutcome::Success);
-    let mut runner = TreeRunner::with_substitutions(plan.clone(), subs(&plan, &["main/**/sequence[plain]/grasp=fail_first:1"]));
+    let mut runner = TreeRunner::with_substitutions(
+        plan.clone(),
+        subs(&plan, &["main/**/sequence[plain]/grasp=fail_first:1"]),
+    );
     let (status, _) = run(&mut runner, &mut driver);
     assert_eq!(status, TreeStatus::Success);
     // The first activation of the plain grasp failed without reaching the driver; the recovery ran.
@@ -87,7 +90,8 @@ fn fail_first_counts_activations_across_retries() {
     driver.set_default(LeafOutcome::Success);
     // Both grasps fail their first two activations: attempts 1 and 2 fail, attempt 3 succeeds
     // through the real plain grasp.
-    let mut runner = TreeRunner::with_substitutions(plan.clone(), subs(&plan, &["main/**/grasp*=fail_first:2"]));
+    let mut runner =
+        TreeRunner::with_substitutions(plan.clone(), subs(&plan, &["main/**/grasp*=fail_first:2"]));
     let (status, _) = run(&mut runner, &mut driver);
     assert_eq!(status, TreeStatus::Success);
     let plain = counts(&runner, "sequence[plain]/grasp");
@@ -105,7 +109,15 @@ fn failure_and_success_never_reach_the_driver() {
     driver.set_default(LeafOutcome::Failure("real leaf ran".into()));
     let mut runner = TreeRunner::with_substitutions(
         plan.clone(),
-        subs(&plan, &["main/*/home=success", "main/**/grasp*=failure", "main/**/release=success", "main/**/cube_grasped=success"]),
+        subs(
+            &plan,
+            &[
+                "main/*/home=success",
+                "main/**/grasp*=failure",
+                "main/**/release=success",
+                "main/**/cube_grasped=success",
+            ],
+        ),
     );
     let (status, _) = run(&mut runner, &mut driver);
     assert_eq!(status, TreeStatus::Failure);
@@ -114,7 +126,10 @@ fn failure_and_success_never_reach_the_driver() {
     assert_eq!(macrotree::episode::failure_kind(&reason), "substituted");
     assert_eq!(counts(&runner, "/retry").failures, 1);
     assert_eq!(counts(&runner, "grasp[again]").activations, 3);
-    assert_eq!(driver.starts("home") + driver.starts("grasp") + driver.starts("release"), 0);
+    assert_eq!(
+        driver.starts("home") + driver.starts("grasp") + driver.starts("release"),
+        0
+    );
 }
 
 #[test]
@@ -138,24 +153,22 @@ fn running_n_takes_n_ticks_then_succeeds() {
 
 #[test]
 fn halts_are_counted() {
-    let plan = Arc::new(
-        compile_str(
-            "main: {timeout: {seconds: 0.2, child: {home: {}}}}",
-            "t.yaml",
-        )
-        .unwrap(),
-    );
+    let plan = Arc::new(compile_str("main: {timeout: {seconds: 0.2, child: {home: {}}}}", "t.yaml").unwrap());
     let mut driver = ScriptedDriver::new(&plan);
     driver.set_default(LeafOutcome::Running);
     let mut runner = TreeRunner::new(plan.clone());
     let (status, _) = run(&mut runner, &mut driver);
     assert_eq!(status, TreeStatus::Failure);
     let home = counts(&runner, "/home");
-    assert_eq!((home.activations, home.successes, home.failures, home.halts), (1, 0, 0, 1));
+    assert_eq!(
+        (home.activations, home.successes, home.failures, home.halts),
+        (1, 0, 0, 1)
+    );
     assert_eq!(driver.halts("home"), 1);
     // A halted substitute is not a driver halt.
     let mut driver = ScriptedDriver::new(&plan);
-    let mut runner = TreeRunner::with_substitutions(plan.clone(), subs(&plan, &["main/**/home=running:1000"]));
+    let mut runner =
+        TreeRunner::with_substitutions(plan.clone(), subs(&plan, &["main/**/home=running:1000"]));
     run(&mut runner, &mut driver);
     assert_eq!(counts(&runner, "/home").halts, 1);
     assert_eq!(driver.halts("home"), 0);
@@ -167,7 +180,8 @@ fn counts_are_deterministic_and_reset() {
     let go = || {
         let mut driver = ScriptedDriver::new(&plan);
         driver.set_default(LeafOutcome::Success);
-        let mut runner = TreeRunner::with_substitutions(plan.clone(), subs(&plan, &["main/**/grasp*=fail_first:1"]));
+        let mut runner =
+            TreeRunner::with_substitutions(plan.clone(), subs(&plan, &["main/**/grasp*=fail_first:1"]));
         run(&mut runner, &mut driver);
         let c = runner.node_counts().to_vec();
         runner.reset();
@@ -193,5 +207,10 @@ fn rules_that_do_not_fit_are_refused_with_close_paths() {
         .iter()
         .map(|r| r.parse().unwrap())
         .collect();
-    assert!(resolve(&plan, &two).unwrap_err().to_string().contains("also matched"));
+    assert!(
+        resolve(&plan, &two)
+            .unwrap_err()
+            .to_string()
+            .contains("also matched")
+    );
 }

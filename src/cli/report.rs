@@ -54,9 +54,8 @@ pub fn report(args: ReportArgs) -> Result<(), CliError> {
     let mut files = Vec::new();
     for m in &merged {
         let path = PathBuf::from(m.config.suite.as_deref().unwrap_or_default());
-        let file = load_scenario_file(&path).map_err(|d| {
-            super::invalid(d, format!("{} (named by the results)", path.display()))
-        })?;
+        let file = load_scenario_file(&path)
+            .map_err(|d| super::invalid(d, format!("{} (named by the results)", path.display())))?;
         let mut same = file.sweep.clone();
         same.jobs = 0;
         same.shard = None;
@@ -70,7 +69,11 @@ pub fn report(args: ReportArgs) -> Result<(), CliError> {
     }
     let mut inputs = args.files.clone();
     inputs.extend(files.iter().map(|f| f.path.clone()));
-    let junit = args.junit.as_deref().map(|p| check_output(p, &inputs)).transpose()?;
+    let junit = args
+        .junit
+        .as_deref()
+        .map(|p| check_output(p, &inputs))
+        .transpose()?;
     let outcomes: Vec<_> = files
         .iter()
         .zip(merged)

@@ -73,7 +73,11 @@ pub fn test(args: TestArgs) -> Result<(), CliError> {
     if files.is_empty() {
         return Err(CliError::Input(format!(
             "error: no scenario files (*.yaml) in {}",
-            paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+            paths
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
         )));
     }
     // Everything is checked before anything runs.
@@ -97,14 +101,19 @@ pub fn test(args: TestArgs) -> Result<(), CliError> {
         })?;
         crate::runtime::substitute::resolve(&plan, &s.sweep.substitutions)
             .map_err(|e| CliError::Input(format!("error: {}: {e}", s.path.display())))?;
-        s.check_patterns(&plan).map_err(|e| CliError::Input(format!("error: {e}")))?;
+        s.check_patterns(&plan)
+            .map_err(|e| CliError::Input(format!("error: {e}")))?;
         s.sweep.shard = shard;
         s.sweep.jobs = args.jobs.map_or(0, |j| j as usize);
         inputs.extend(tree_inputs(&s.tree));
         inputs.extend(s.scene.clone());
         tasks.push((Arc::new(plan), scene));
     }
-    let junit_out = args.junit.as_deref().map(|p| check_output(p, &inputs)).transpose()?;
+    let junit_out = args
+        .junit
+        .as_deref()
+        .map(|p| check_output(p, &inputs))
+        .transpose()?;
     let mut out = match &args.out {
         Some(p) => Some(check_output(p, &inputs)?.stream(&[]).map_err(output_error)?),
         None => None,
@@ -143,7 +152,11 @@ pub fn test(args: TestArgs) -> Result<(), CliError> {
             bar.finish_and_clear();
             return Err(output_error(e));
         }
-        outcomes.push((s, SuiteOutcome::new(s, &run.results, run.wall_time_s, run.jobs), run.results));
+        outcomes.push((
+            s,
+            SuiteOutcome::new(s, &run.results, run.wall_time_s, run.jobs),
+            run.results,
+        ));
     }
     bar.finish_and_clear();
     if let Some(w) = out {
@@ -170,11 +183,18 @@ pub(super) fn finish(
             sm.scenarios,
             sm.median_sim_time_s,
             sm.p95_sim_time_s,
-            sm.shard.as_ref().map_or(String::new(), |k| format!(" (shard {k})"))
+            sm.shard
+                .as_ref()
+                .map_or(String::new(), |k| format!(" (shard {k})"))
         );
         let mut details = String::new();
         for c in &o.checks {
-            println!("  {} {}: {}", if c.ok { "ok  " } else { "FAIL" }, c.expectation, c.measured);
+            println!(
+                "  {} {}: {}",
+                if c.ok { "ok  " } else { "FAIL" },
+                c.expectation,
+                c.measured
+            );
             if !c.ok {
                 details += &format!("expected {}: {}\n", c.expectation, c.measured);
             }
@@ -204,11 +224,7 @@ pub(super) fn finish(
         });
     }
     let passed = outcomes.iter().filter(|(_, o, _)| o.passed).count();
-    println!(
-        "{} of {} scenario file(s) passed",
-        passed,
-        outcomes.len()
-    );
+    println!("{} of {} scenario file(s) passed", passed, outcomes.len());
     if let Some(j) = junit {
         j.write_all(to_xml(&cases).as_bytes()).map_err(output_error)?;
     }
@@ -219,7 +235,10 @@ pub(super) fn finish(
             files_passed: passed,
             suites: outcomes.iter().map(|(_, o, _)| o.clone()).collect(),
         };
-        println!("{}", serde_json::to_string(&report).expect("the report serializes"));
+        println!(
+            "{}",
+            serde_json::to_string(&report).expect("the report serializes")
+        );
     }
     if passed == outcomes.len() {
         Ok(())

@@ -133,7 +133,9 @@ impl Substitution {
             return Err(format!("the pattern is longer than {MAX_PATTERN_LEN} characters"));
         }
         if pattern.split('/').any(str::is_empty) {
-            return Err(format!("{pattern:?} has an empty segment (`//` or a `/` at an end)"));
+            return Err(format!(
+                "{pattern:?} has an empty segment (`//` or a `/` at an end)"
+            ));
         }
         if pattern.chars().any(char::is_control) {
             return Err("the pattern holds a control character".into());
@@ -152,9 +154,9 @@ impl FromStr for Substitution {
     type Err = String;
     /// `PATTERN=OUTCOME`, split at the last `=` (names may hold `=`, outcomes never do).
     fn from_str(s: &str) -> Result<Self, String> {
-        let (pattern, outcome) = s.rsplit_once('=').ok_or_else(|| {
-            format!("{s:?}: expected PATTERN=OUTCOME, e.g. 'main/**/grasp=fail_first:1'")
-        })?;
+        let (pattern, outcome) = s
+            .rsplit_once('=')
+            .ok_or_else(|| format!("{s:?}: expected PATTERN=OUTCOME, e.g. 'main/**/grasp=fail_first:1'"))?;
         let pattern = pattern.trim();
         Self::check_pattern(pattern)?;
         Ok(Self {
@@ -350,7 +352,14 @@ mod tests {
         assert!(!glob_match("main", "main/x"));
         // Many stars stay fast (no exponential backtracking).
         let long = "a/".repeat(200) + "b";
-        assert!(!glob_match(&"**/".repeat(50).to_string().trim_end_matches('/').replace("**", "**/c"), &long));
+        assert!(!glob_match(
+            &"**/"
+                .repeat(50)
+                .to_string()
+                .trim_end_matches('/')
+                .replace("**", "**/c"),
+            &long
+        ));
     }
 
     #[test]

@@ -89,7 +89,10 @@ mod tests {
 
     #[test]
     fn escapes_and_counts() {
-        assert_eq!(escape("a<b & 'c' \"d\"\u{1}"), "a&lt;b &amp; &apos;c&apos; &quot;d&quot;?");
+        assert_eq!(
+            escape("a<b & 'c' \"d\"\u{1}"),
+            "a&lt;b &amp; &apos;c&apos; &quot;d&quot;?"
+        );
         let xml = to_xml(&[
             Case {
                 name: "ok.yaml".into(),
@@ -106,6 +109,8 @@ mod tests {
         ]);
         assert!(xml.contains("tests=\"2\" failures=\"1\""), "{xml}");
         assert!(xml.contains("time=\"3.500\""), "{xml}");
-        assert!(xml.contains("<failure message=\"1 expectation failed\" type=\"expectation\">macrotree run x</failure>"));
+        assert!(xml.contains(
+            "<failure message=\"1 expectation failed\" type=\"expectation\">macrotree run x</failure>"
+        ));
     }
 }

@@ -249,9 +249,12 @@ pub fn load_scenario_file(path: &Path) -> Result<ScenarioFile, Vec<Diagnostic>> 
 fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>) -> Option<ScenarioFile> {
     let Some(entries) = v.as_map() else {
         issues.push(
-            Issue::new(v.loc, format!("a scenario file must be a mapping, found {}", v.describe()))
-                .label("expected `tree:`, `count:` and `expect:`")
-                .help("see docs/testing_trees.md"),
+            Issue::new(
+                v.loc,
+                format!("a scenario file must be a mapping, found {}", v.describe()),
+            )
+            .label("expected `tree:`, `count:` and `expect:`")
+            .help("see docs/testing_trees.md"),
         );
         return None;
     };
@@ -314,15 +317,21 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>) -> Option<ScenarioFile>
     };
     if !(1..=MAX_COUNT).contains(&raw.count) {
         issues.push(
-            Issue::new(at(&["count"]), format!("`count` must be 1 to {MAX_COUNT}, got {}", raw.count))
-                .label("number of scenarios"),
+            Issue::new(
+                at(&["count"]),
+                format!("`count` must be 1 to {MAX_COUNT}, got {}", raw.count),
+            )
+            .label("number of scenarios"),
         );
     }
     let max_sim_time = raw.max_sim_time.unwrap_or(60.0);
     if !(max_sim_time.is_finite() && max_sim_time > 0.0 && max_sim_time <= 3600.0) {
         issues.push(
-            Issue::new(at(&["max_sim_time"]), format!("`max_sim_time` must be more than 0 and at most 3600 s, got {max_sim_time}"))
-                .label("seconds of simulated time"),
+            Issue::new(
+                at(&["max_sim_time"]),
+                format!("`max_sim_time` must be more than 0 and at most 3600 s, got {max_sim_time}"),
+            )
+            .label("seconds of simulated time"),
         );
     }
     let e = &raw.expect;
@@ -330,31 +339,47 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>) -> Option<ScenarioFile>
         && !(0.0..=1.0).contains(&r)
     {
         issues.push(
-            Issue::new(at(&["expect", "min_success_rate"]), format!("`min_success_rate` must be 0 … 1, got {r}"))
-                .label("a fraction, e.g. 0.9"),
+            Issue::new(
+                at(&["expect", "min_success_rate"]),
+                format!("`min_success_rate` must be 0 … 1, got {r}"),
+            )
+            .label("a fraction, e.g. 0.9"),
         );
     }
     if e.outcome == Outcome::Failure && e.min_success_rate.is_some() {
         issues.push(
-            Issue::new(at(&["expect", "min_success_rate"]), "`min_success_rate` goes with `outcome: success`")
-                .label("with `outcome: failure` every scenario must fail")
-                .help("remove one of the two"),
+            Issue::new(
+                at(&["expect", "min_success_rate"]),
+                "`min_success_rate` goes with `outcome: success`",
+            )
+            .label("with `outcome: failure` every scenario must fail")
+            .help("remove one of the two"),
         );
     }
     if e.outcome == Outcome::Success && (e.failure_kind.is_some() || e.failed_node.is_some()) {
-        let key = if e.failure_kind.is_some() { "failure_kind" } else { "failed_node" };
+        let key = if e.failure_kind.is_some() {
+            "failure_kind"
+        } else {
+            "failed_node"
+        };
         issues.push(
-            Issue::new(at(&["expect", key]), format!("`{key}` goes with `outcome: failure`"))
-                .label("what every failure must look like")
-                .help("add `outcome: failure`, or remove it"),
+            Issue::new(
+                at(&["expect", key]),
+                format!("`{key}` goes with `outcome: failure`"),
+            )
+            .label("what every failure must look like")
+            .help("add `outcome: failure`, or remove it"),
         );
     }
     if let Some(t) = e.max_sim_time
         && !(t.is_finite() && t > 0.0 && t <= 3600.0)
     {
         issues.push(
-            Issue::new(at(&["expect", "max_sim_time"]), format!("`max_sim_time` must be more than 0 and at most 3600 s, got {t}"))
-                .label("seconds of simulated time"),
+            Issue::new(
+                at(&["expect", "max_sim_time"]),
+                format!("`max_sim_time` must be more than 0 and at most 3600 s, got {t}"),
+            )
+            .label("seconds of simulated time"),
         );
     }
     let patterns = e
@@ -370,8 +395,14 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>) -> Option<ScenarioFile>
             issues.push(Issue::new(at(&["expect"]), format!("node pattern: {reason}")));
         }
     }
-    if raw.substitute.len() > MAX_RULES || e.ran.len() + e.ran_in_every.len() + e.failed.len() + e.never_ran.len() + e.never_failed.len() > MAX_RULES {
-        issues.push(Issue::new(v.loc, format!("at most {MAX_RULES} substitutions and {MAX_RULES} node patterns per file")));
+    if raw.substitute.len() > MAX_RULES
+        || e.ran.len() + e.ran_in_every.len() + e.failed.len() + e.never_ran.len() + e.never_failed.len()
+            > MAX_RULES
+    {
+        issues.push(Issue::new(
+            v.loc,
+            format!("at most {MAX_RULES} substitutions and {MAX_RULES} node patterns per file"),
+        ));
     }
     for (i, s) in raw.substitute.iter().enumerate() {
         if let Err(reason) = Substitution::check_pattern(&s.pattern) {
@@ -544,7 +575,12 @@ pub fn check(expect: &Expect, results: &[ScenarioResult], summary: &Summary) -> 
         });
     }
     let sum = |p: &str, f: fn(&crate::sweep::NodeTotals) -> u64| -> u64 {
-        summary.nodes.iter().filter(|t| glob_match(p, &t.path)).map(f).sum()
+        summary
+            .nodes
+            .iter()
+            .filter(|t| glob_match(p, &t.path))
+            .map(f)
+            .sum()
     };
     for p in &expect.ran {
         let a = sum(p, |t| t.activations);
@@ -557,7 +593,11 @@ pub fn check(expect: &Expect, results: &[ScenarioResult], summary: &Summary) -> 
     for p in &expect.ran_in_every {
         let missing: Vec<u64> = results
             .iter()
-            .filter(|r| !r.nodes.iter().any(|nd| nd.counts.activations > 0 && glob_match(p, &nd.path)))
+            .filter(|r| {
+                !r.nodes
+                    .iter()
+                    .any(|nd| nd.counts.activations > 0 && glob_match(p, &nd.path))
+            })
             .map(|r| r.index)
             .collect();
         out.push(Checked {
@@ -605,7 +645,10 @@ pub fn offending_commands(expect: &Expect, results: &[ScenarioResult], config: &
             Outcome::Success => !r.success,
             Outcome::Failure => {
                 r.success
-                    || expect.failure_kind.as_deref().is_some_and(|k| r.failure_kind != Some(k))
+                    || expect
+                        .failure_kind
+                        .as_deref()
+                        .is_some_and(|k| r.failure_kind != Some(k))
                     || expect
                         .failed_node
                         .as_deref()
@@ -649,7 +692,10 @@ pub fn find_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
 
 fn walk(dir: &Path, out: &mut Vec<PathBuf>, depth: usize) -> Result<(), String> {
     if depth > 8 {
-        return Err(format!("{}: folders nested too deep (more than 8)", dir.display()));
+        return Err(format!(
+            "{}: folders nested too deep (more than 8)",
+            dir.display()
+        ));
     }
     let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(|e| format!("{}: {e}", dir.display()))?

@@ -36,16 +36,12 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 pub use indices::ScenarioIndices;
-pub use report::{MergeError, Merged, merge_results};
 pub use layout::{Region, Scenario, ScenarioLayout, sample_scenario, sample_scenario_in};
-pub use summary::{
-    Coverage, Failure, FailureGroup, NodeTotals, Summary, percentile, wilson_interval,
-};
+pub use report::{MergeError, Merged, merge_results};
+pub use summary::{Coverage, Failure, FailureGroup, NodeTotals, Summary, percentile, wilson_interval};
 
 use crate::actions::{CONTROL_PERIOD, Cell, Checks, Collision};
-use crate::episode::{
-    EpisodeConfig, EpisodeReport, Goal, NoObserver, NodeReport, ObjectReport, run_in_cell,
-};
+use crate::episode::{EpisodeConfig, EpisodeReport, Goal, NoObserver, NodeReport, ObjectReport, run_in_cell};
 use crate::faults::FaultKind;
 use crate::plan::Plan;
 use crate::runtime::substitute::Substitution;
@@ -104,7 +100,9 @@ impl FromStr for ShardSpec {
         if s.trim() == "auto" {
             Ok(ShardSpec::Auto)
         } else {
-            s.parse().map(ShardSpec::Fixed).map_err(|e| format!("{e}, or auto"))
+            s.parse()
+                .map(ShardSpec::Fixed)
+                .map_err(|e| format!("{e}, or auto"))
         }
     }
 }
@@ -134,7 +132,9 @@ impl Shard {
         };
         let check = |k: u64, m: u64, how: &str| -> Result<Shard, String> {
             if m == 0 || m > MAX_AUTO_SHARDS {
-                return Err(format!("{how}: the shard count must be 1 to {MAX_AUTO_SHARDS}, got {m}"));
+                return Err(format!(
+                    "{how}: the shard count must be 1 to {MAX_AUTO_SHARDS}, got {m}"
+                ));
             }
             if k >= m {
                 return Err(format!("{how}: index {k} is not below the shard count {m}"));
@@ -146,9 +146,9 @@ impl Shard {
                 "SLURM_ARRAY_TASK_ID is set but SLURM_ARRAY_TASK_COUNT is not (run as an array job: sbatch --array=0-M-1)",
             )?;
             let min = num("SLURM_ARRAY_TASK_MIN")?.unwrap_or(0);
-            let k = id.checked_sub(min).ok_or_else(|| {
-                format!("SLURM_ARRAY_TASK_ID {id} is below SLURM_ARRAY_TASK_MIN {min}")
-            })?;
+            let k = id
+                .checked_sub(min)
+                .ok_or_else(|| format!("SLURM_ARRAY_TASK_ID {id} is below SLURM_ARRAY_TASK_MIN {min}"))?;
             if let Some(c) = count
                 && c != m
             {
@@ -167,14 +167,15 @@ impl Shard {
             return check(k, m, "Slurm array");
         }
         if let Some(k) = num("JOB_COMPLETION_INDEX")? {
-            let m = count.ok_or(
-                "JOB_COMPLETION_INDEX is set: give the Job's completions as --shard-count M",
-            )?;
+            let m =
+                count.ok_or("JOB_COMPLETION_INDEX is set: give the Job's completions as --shard-count M")?;
             return check(k, m, "Kubernetes Indexed Job");
         }
-        Err("neither a Slurm array (SLURM_ARRAY_TASK_ID, SLURM_ARRAY_TASK_COUNT) nor a Kubernetes \
+        Err(
+            "neither a Slurm array (SLURM_ARRAY_TASK_ID, SLURM_ARRAY_TASK_COUNT) nor a Kubernetes \
              Indexed Job (JOB_COMPLETION_INDEX) is in the environment; give --shard K/M"
-            .into())
+                .into(),
+        )
     }
 }
 

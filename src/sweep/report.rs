@@ -65,7 +65,11 @@ fn identity(r: &ScenarioResult) -> Vec<(&'static str, String)> {
         ("max sim time", format!("{:?}", r.max_sim_time)),
         (
             "substitutions",
-            r.substitutions.iter().map(|s| s.to_string()).collect::<Vec<_>>().join(" "),
+            r.substitutions
+                .iter()
+                .map(|s| s.to_string())
+                .collect::<Vec<_>>()
+                .join(" "),
         ),
     ]
 }
@@ -89,10 +93,15 @@ pub fn merge_results(files: &[PathBuf]) -> Result<Vec<Merged>, MergeError> {
             }
             total += 1;
             if total > MAX_LINES {
-                return Err(MergeError(format!("more than {MAX_LINES} lines; merge fewer files at once")));
+                return Err(MergeError(format!(
+                    "more than {MAX_LINES} lines; merge fewer files at once"
+                )));
             }
-            let r = parse_line(line)
-                .map_err(|e| MergeError(format!("{origin}: not a result line of `macrotree sweep --out` or `test --out` ({e})")))?;
+            let r = parse_line(line).map_err(|e| {
+                MergeError(format!(
+                    "{origin}: not a result line of `macrotree sweep --out` or `test --out` ({e})"
+                ))
+            })?;
             if r.to_jsonl() != line {
                 return Err(MergeError(format!(
                     "{origin}: not exactly what this version writes (edited, or written by another version)"
@@ -146,9 +155,16 @@ fn merge_group(mut lines: Vec<(Origin, ScenarioResult)>) -> Result<Merged, Merge
     if lines.len() as u64 != n || lines.iter().any(|(_, r)| r.index >= n) {
         let present: std::collections::HashSet<u64> = lines.iter().map(|(_, r)| r.index).collect();
         let missing: Vec<u64> = (0..n).filter(|i| !present.contains(i)).take(11).collect();
-        let extra: Vec<u64> = lines.iter().map(|(_, r)| r.index).filter(|&i| i >= n).take(10).collect();
+        let extra: Vec<u64> = lines
+            .iter()
+            .map(|(_, r)| r.index)
+            .filter(|&i| i >= n)
+            .take(10)
+            .collect();
         if !extra.is_empty() {
-            return Err(MergeError(format!("{what}: scenario(s) {extra:?} are beyond its {n} scenarios")));
+            return Err(MergeError(format!(
+                "{what}: scenario(s) {extra:?} are beyond its {n} scenarios"
+            )));
         }
         let listed: Vec<String> = missing.iter().take(10).map(u64::to_string).collect();
         return Err(MergeError(format!(

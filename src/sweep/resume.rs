@@ -173,10 +173,17 @@ fn check_result(
         return Err(format!("tree {:?}, not {:?}", r.tree, config.tree));
     }
     if r.sweep_goal != config.goal {
-        return Err(format!("--goal {}, not {}", r.sweep_goal.name(), config.goal.name()));
+        return Err(format!(
+            "--goal {}, not {}",
+            r.sweep_goal.name(),
+            config.goal.name()
+        ));
     }
     if r.max_sim_time.to_bits() != config.max_sim_time.to_bits() {
-        return Err(format!("--max-sim-time {}, not {}", r.max_sim_time, config.max_sim_time));
+        return Err(format!(
+            "--max-sim-time {}, not {}",
+            r.max_sim_time, config.max_sim_time
+        ));
     }
     if r.scenarios != config.scenarios {
         return Err(format!("{} scenarios, not {}", r.scenarios, config.scenarios));
@@ -257,7 +264,10 @@ pub fn parse_line(line: &str) -> Result<ScenarioResult, String> {
         ),
     };
     let text = |k: &str| -> Result<String, String> {
-        Ok(field(k)?.as_str().ok_or_else(|| format!("`{k}` is not text"))?.to_string())
+        Ok(field(k)?
+            .as_str()
+            .ok_or_else(|| format!("`{k}` is not text"))?
+            .to_string())
     };
     let sweep_goal = text("sweep_goal")?;
     let substitutions = match v.get("substitutions") {
