@@ -130,7 +130,6 @@ pub fn test(args: TestArgs) -> Result<(), CliError> {
             .progress_chars("=> "),
     );
     let mut outcomes = Vec::new();
-    let mut failed_cases = 0u64;
     for (s, (plan, scene)) in suites.iter().zip(&tasks) {
         bar.set_message(s.path.display().to_string());
         let mut write_error = None;
@@ -140,9 +139,6 @@ pub fn test(args: TestArgs) -> Result<(), CliError> {
             {
                 write_error = Some(e);
                 return ControlFlow::Break(());
-            }
-            if !r.success {
-                failed_cases += 1;
             }
             bar.inc(1);
             ControlFlow::Continue(())
