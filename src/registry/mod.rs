@@ -6,7 +6,8 @@
 //! did-you-mean suggestions for misspelled kinds), the JSON Schema of tree files,
 //! `macrotree nodes`, the `graph` labels, the docs and execution. The built-in leaves register
 //! through the same [`Registry::register_action`] / [`Registry::register_condition`] calls a
-//! crate user makes for their own leaves (see [`builtin`] and `docs/custom_nodes.md`).
+//! crate user makes for their own leaves (see `src/registry/builtin.rs` and
+//! `docs/custom_nodes.md`).
 //!
 //! A leaf's parameters are a type implementing [`Params`] (`Deserialize` + `JsonSchema`):
 //! the YAML body of the node is read into it with located errors, its doc comments become the
@@ -80,8 +81,9 @@ pub trait Params:
     Serialize + DeserializeOwned + JsonSchema + Clone + fmt::Debug + PartialEq + Send + Sync + 'static
 {
     /// Every object reference among the parameters, so that `{variables}` are resolved before
-    /// each tick (and object names checked against the scene when the key is `object`,
-    /// `container`, `support`, `target` or `to`). Default: none.
+    /// each tick. Object names are checked against the scene when the tree loads, by key:
+    /// `object` and `support` must name a block, `container` a container, `target` and `to` any
+    /// object. Default: none.
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
         Vec::new()
     }

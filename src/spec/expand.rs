@@ -28,7 +28,7 @@ pub const MAX_LEAF_ERRORS: usize = 16;
 pub const MAX_COUNT: u32 = 1_000;
 
 /// Expands nodes; collects issues.
-pub struct Expander<'a> {
+pub(crate) struct Expander<'a> {
     registry: &'a Registry,
     subtrees: &'a HashMap<String, SubtreeDef>,
     sources: &'a Sources,
