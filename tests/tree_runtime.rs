@@ -457,10 +457,7 @@ fn subtree_arguments_reach_the_leaves() {
     let offsets: Vec<f64> = p
         .leaves
         .iter()
-        .filter_map(|l| match &l.kind {
-            macrotree::spec::Leaf::Action(macrotree::spec::ActionLeaf::Reach(r)) => Some(r.offset[2]),
-            _ => None,
-        })
+        .filter_map(|l| l.kind.params::<macrotree::spec::Reach>().map(|r| r.offset[2]))
         .collect();
     assert_eq!(offsets, [0.12, 0.15]);
     assert_eq!(p.nodes[1].path, "main/sequence/subtree[pick]#1");

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use macrotree::plan::{compile_str, load_plan};
-use macrotree::spec::{ActionLeaf, Diagnostic, Leaf, PathKind, Target, Yaw};
+use macrotree::spec::{Carry, Diagnostic, Grasp, Leaf, MoveJoints, PathKind, Reach, Target, Yaw};
 
 fn errors(yaml: &str) -> Vec<Diagnostic> {
     match compile_str(yaml, "bad.yaml") {
@@ -55,13 +55,13 @@ fn fixture_with_include_and_subtrees_compiles() {
             "main/sequence[pick and place]/home#2",
         ]
     );
-    let Leaf::Action(ActionLeaf::Reach(r)) = &plan.leaves[1].kind else {
+    let Some(r) = plan.leaves[1].kind.params::<Reach>() else {
         panic!("not a reach")
     };
     assert_eq!(r.offset, [0.0, 0.0, 0.12], "argument overrides the default");
     assert_eq!(r.yaw, Yaw::Object, "default argument");
     assert_eq!(r.speed, 0.5, "leaf default");
-    let Leaf::Action(ActionLeaf::Reach(r2)) = &plan.leaves[2].kind else {
+    let Some(r2) = plan.leaves[2].kind.params::<Reach>() else {
         panic!("not a reach")
     };
     assert_eq!(r2.path, PathKind::Cartesian);
@@ -105,13 +105,13 @@ fn angles_in_degrees_and_radians() {
         "t.yaml",
     )
     .unwrap();
-    let Leaf::Action(ActionLeaf::MoveJoints(m)) = &plan.leaves[0].kind else {
+    let Some(m) = plan.leaves[0].kind.params::<MoveJoints>() else {
         panic!()
     };
     assert!((m.joints[1] + std::f64::consts::FRAC_PI_2).abs() < 1e-12);
     assert_eq!(m.joints[2], 1.5);
     assert_eq!(m.joints[3], -1.57);
-    let Leaf::Action(ActionLeaf::Reach(r)) = &plan.leaves[1].kind else {
+    let Some(r) = plan.leaves[1].kind.params::<Reach>() else {
         panic!()
     };
     assert_eq!(r.target, Target::Point([0.5, 0.0, 0.3]));
@@ -125,14 +125,14 @@ fn defaults_are_filled_in() {
         "t.yaml",
     )
     .unwrap();
-    let Leaf::Action(ActionLeaf::Carry(c)) = &plan.leaves[0].kind else {
+    let Some(c) = plan.leaves[0].kind.params::<Carry>() else {
         panic!()
     };
     assert_eq!(
         (c.to, c.lift, c.place_height, c.speed, c.timeout),
         (Target::Bowl, 0.20, 0.03, 0.5, 10.0)
     );
-    let Leaf::Action(ActionLeaf::Grasp(g)) = &plan.leaves[1].kind else {
+    let Some(g) = plan.leaves[1].kind.params::<Grasp>() else {
         panic!()
     };
     assert_eq!((g.width, g.timeout), (None, 2.0));
@@ -277,7 +277,7 @@ fn undefined_and_misplaced_params_are_errors() {
 fn whole_offset_can_be_a_parameter() {
     let src = "subtrees:\n  above:\n    params: {off: [0, 0, 0.2]}\n    root: {reach: {target: bowl, offset: $off}}\nmain: {subtree: {ref: above, args: {off: [0.1, 0, 0.3]}}}\n";
     let plan = compile_str(src, "t.yaml").unwrap();
-    let Leaf::Action(ActionLeaf::Reach(r)) = &plan.leaves[0].kind else {
+    let Some(r) = plan.leaves[0].kind.params::<Reach>() else {
         panic!()
     };
     assert_eq!(r.offset, [0.1, 0.0, 0.3]);
@@ -369,7 +369,7 @@ fn diagnostic_display_is_rustc_like() {
 fn regression_yaml11_boolean_words_are_plain_names() {
     let src = "subtrees:\n  s:\n    params: {off: 0.1, on: 0.2, yes: 0.3, no: 0.4}\n    root: {reach: {target: cube, offset: [$off, $on, $yes]}}\nmain: {subtree: {ref: s, args: {no: 1}}}\n";
     let plan = compile_str(src, "t.yaml").unwrap();
-    let Leaf::Action(ActionLeaf::Reach(r)) = &plan.leaves[0].kind else {
+    let Some(r) = plan.leaves[0].kind.params::<Reach>() else {
         panic!()
     };
     assert_eq!(r.offset, [0.1, 0.2, 0.3]);
@@ -386,22 +386,20 @@ fn regression_non_finite_numbers_reach_the_parameter_check() {
 
 #[test]
 fn condition_tolerances_are_overridable_and_checked() {
-    use macrotree::spec::ConditionLeaf;
+    use macrotree::spec::{CubeGrasped, CubeInBowl};
     let yaml = "main:\n  sequence:\n    children:\n      - cube_grasped: {off_axis: 0.01}\n      - cube_in_bowl: {rest_speed: 0.02}\n      - cube_in_bowl: {}\n";
     let plan = compile_str(yaml, "t.yaml").unwrap();
-    let conds: Vec<&ConditionLeaf> = plan
+    let conds: Vec<&Leaf> = plan
         .leaves
         .iter()
-        .filter_map(|l| match &l.kind {
-            Leaf::Condition(c) => Some(c),
-            _ => None,
-        })
+        .map(|l| &l.kind)
+        .filter(|l| l.is_condition())
         .collect();
-    assert!(matches!(conds[0], ConditionLeaf::CubeGrasped(c) if c.off_axis == 0.01));
-    assert!(matches!(conds[1], ConditionLeaf::CubeInBowl(c) if c.rest_speed == 0.02));
+    assert!(matches!(conds[0].params::<CubeGrasped>(), Some(c) if c.off_axis == 0.01));
+    assert!(matches!(conds[1].params::<CubeInBowl>(), Some(c) if c.rest_speed == 0.02));
     // Omitted tolerances are the condition module's defaults.
     let default = macrotree::world::conditions::Tolerances::REST_SPEED;
-    assert!(matches!(conds[2], ConditionLeaf::CubeInBowl(c) if c.rest_speed == default));
+    assert!(matches!(conds[2].params::<CubeInBowl>(), Some(c) if c.rest_speed == default));
 
     let diags = errors("main:\n  cube_in_bowl: {rest_speed: 0}\n");
     let d = find(&diags, "speed");

@@ -3,19 +3,13 @@
 
 use std::collections::HashMap;
 
-use super::carry::Carry;
 use super::cell::Cell;
 use super::checks::ChecksRecorder;
-use super::grasp::Grasp;
-use super::joints::MoveJoints;
 use super::macro_action::{MacroAction, Progress};
-use super::reach::Reach;
-use super::release::Release;
-use super::targets::object_index;
 use crate::plan::LeafId;
 use crate::runtime::{LeafDriver, LeafOutcome, Selection};
 use crate::scene::ObjectKind;
-use crate::spec::{ActionLeaf, ConditionLeaf, Leaf, ObjectRef};
+use crate::spec::{Leaf, LeafCall};
 use crate::world::conditions as cond;
 use crate::world::query::{self, Query};
 use crate::world::{Part, Piece, goal};
@@ -87,62 +81,16 @@ impl<'a> MacroDriver<'a> {
         self.checks.on_tick(self.cell.world(), closed);
     }
 
-    fn start_action(&mut self, leaf: &ActionLeaf) -> Box<dyn MacroAction> {
-        match leaf {
-            ActionLeaf::Reach(s) => Box::new(Reach::new(s.clone())),
-            ActionLeaf::MoveJoints(s) => Box::new(MoveJoints::new(s.joints)),
-            ActionLeaf::Home(_) => Box::new(MoveJoints::home()),
-            ActionLeaf::Grasp(s) => {
-                self.counters.grasp_attempts += 1;
-                Box::new(Grasp::new(s.clone()))
-            }
-            ActionLeaf::Carry(s) => {
-                self.counters.carries += 1;
-                Box::new(Carry::new(s.clone()))
-            }
-            ActionLeaf::Release(s) => {
-                self.checks.on_open();
-                Box::new(Release::new(s.clone()))
-            }
+    /// A new controller for `action` (`None` if the call is not an action). Counts the grasps
+    /// and carries the report needs, and tells the checks when the gripper opens.
+    fn start_action(&mut self, action: &LeafCall) -> Option<Box<dyn MacroAction>> {
+        match action.kind() {
+            "grasp" => self.counters.grasp_attempts += 1,
+            "carry" => self.counters.carries += 1,
+            "release" => self.checks.on_open(),
+            _ => {}
         }
-    }
-
-    fn condition(&self, leaf: &ConditionLeaf) -> Result<bool, String> {
-        let w = self.cell.world();
-        let obj = |o: &ObjectRef| object_index(o, w);
-        Ok(match leaf {
-            ConditionLeaf::Grasped(c) => w.holds(obj(&c.object)?, c.off_axis),
-            ConditionLeaf::Lifted(c) => w.bottom(obj(&c.object)?) >= c.min_height,
-            ConditionLeaf::In(c) => goal::rests_in(w, obj(&c.object)?, obj(&c.container)?, c.rest_speed),
-            ConditionLeaf::On(c) => goal::rests_on(w, obj(&c.object)?, obj(&c.support)?, c.rest_speed),
-            ConditionLeaf::OnTable(c) => cond::on_table(w, obj(&c.object)?, c.tolerance, c.rest_speed),
-            ConditionLeaf::At(c) => {
-                let i = obj(&c.object)?;
-                let p = w.objects[i].pos;
-                let near = (p.x - c.point[0]).hypot(p.y - c.point[1]) <= c.tolerance;
-                let turned = c.yaw.is_none_or(|target| {
-                    crate::world::snapshot::fold_quarter_turn(w.yaw(i) - target.0).abs() <= c.yaw_tolerance
-                });
-                cond::on_table(w, i, cond::Tolerances::ON_TABLE_HEIGHT, c.rest_speed) && near && turned
-            }
-            ConditionLeaf::GoalMet(c) => match &c.object {
-                Some(o) => goal::done(w, obj(o)?),
-                None => goal::goal_holds(w),
-            },
-            ConditionLeaf::CubeGrasped(c) => cond::cube_grasped(w, c.off_axis),
-            ConditionLeaf::CubeLifted(c) => cond::cube_lifted(w, c.min_height),
-            ConditionLeaf::CubeInBowl(c) => cond::cube_in_bowl(w, c.rest_speed),
-            ConditionLeaf::CubeOnTable(c) => cond::cube_on_table(w, c.tolerance, c.rest_speed),
-            ConditionLeaf::CubeAt(c) => cond::cube_at(
-                w,
-                c.point,
-                c.tolerance,
-                cond::Tolerances::ON_TABLE_HEIGHT,
-                c.rest_speed,
-            ),
-            ConditionLeaf::GripperOpen(c) => cond::gripper_open(w, c.min_width),
-            ConditionLeaf::AtHome(c) => cond::at_home(w, c.tolerance),
-        })
+        action.start_action()
     }
 
     /// Notes contacts that should not happen: the fingers on a container or an obstacle, and the
@@ -182,7 +130,7 @@ impl<'a> MacroDriver<'a> {
     fn finish(&mut self, id: LeafId, leaf: &Leaf, progress: Progress) -> LeafOutcome {
         if !matches!(progress, Progress::Running) {
             self.active.remove(&id);
-            if matches!(leaf, Leaf::Action(ActionLeaf::Grasp(_))) {
+            if matches!(leaf, Leaf::Action(a) if a.kind() == "grasp") {
                 self.checks.after_grasp(self.cell.world());
             }
         }
@@ -201,10 +149,11 @@ impl LeafDriver for MacroDriver<'_> {
     fn tick(&mut self, id: LeafId, leaf: &Leaf, first: bool) -> LeafOutcome {
         let action = match leaf {
             Leaf::Condition(c) => {
-                return match self.condition(c) {
-                    Ok(true) => LeafOutcome::Success,
-                    Ok(false) => LeafOutcome::Failure("not satisfied".into()),
-                    Err(e) => LeafOutcome::Failure(e),
+                return match c.check(self.cell.world()) {
+                    Some(Ok(true)) => LeafOutcome::Success,
+                    Some(Ok(false)) => LeafOutcome::Failure("not satisfied".into()),
+                    Some(Err(e)) => LeafOutcome::Failure(e),
+                    None => LeafOutcome::Failure(format!("`{}` is not a condition", c.kind())),
                 };
             }
             Leaf::Action(a) => a,
@@ -216,13 +165,15 @@ impl LeafDriver for MacroDriver<'_> {
             }
         };
         if first || !self.active.contains_key(&id) {
-            let mut controller = self.start_action(action);
+            let Some(mut controller) = self.start_action(action) else {
+                return LeafOutcome::Failure(format!("`{}` is not an action", action.kind()));
+            };
             self.cell.notify_action_start(action.kind());
             if let Err(reason) = controller.start(self.cell) {
                 return self.finish(id, leaf, Progress::Failed(reason));
             }
             let now = self.cell.world().time;
-            let timeout = action.timeout();
+            let timeout = action.timeout().unwrap_or(f64::INFINITY);
             self.active.insert(
                 id,
                 Active {

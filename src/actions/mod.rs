@@ -16,8 +16,13 @@ mod reach;
 mod release;
 mod targets;
 
+pub(crate) use carry::Carry as CarryAction;
 pub use cell::{CONTROL_PERIOD, Cell, StepObserver};
 pub use checks::{Checks, ChecksRecorder, pad_cube_distance};
 pub use driver::{Collision, LeafCounters, MacroDriver};
+pub(crate) use grasp::Grasp as GraspAction;
+pub(crate) use joints::MoveJoints as MoveJointsAction;
 pub use macro_action::{Arrival, MacroAction, Progress};
+pub(crate) use reach::Reach as ReachAction;
+pub(crate) use release::Release as ReleaseAction;
 pub use targets::{object_index, object_point, resolve, target_block, target_object, tool_yaw};

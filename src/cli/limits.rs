@@ -11,6 +11,21 @@ pub const MAX_SPEED: f64 = 1000.0;
 /// tree's ~1000 scenarios per minute. Split bigger studies by `--seed`.
 pub const MAX_SCENARIOS: u64 = 10_000_000;
 
+/// `--fault NAME`: one of the faults' names (the library's [`crate::faults::FaultKind`] has no
+/// command-line types).
+pub fn fault() -> impl clap::builder::TypedValueParser<Value = crate::faults::FaultKind> {
+    use clap::builder::TypedValueParser as _;
+    clap::builder::PossibleValuesParser::new(crate::faults::FaultKind::ALL.map(|k| k.name()))
+        .try_map(|s| s.parse::<crate::faults::FaultKind>())
+}
+
+/// `--goal NAME`: `scene`, `bowl` or `tree`.
+pub fn goal() -> impl clap::builder::TypedValueParser<Value = crate::episode::Goal> {
+    use clap::builder::TypedValueParser as _;
+    clap::builder::PossibleValuesParser::new(crate::episode::Goal::ALL.map(|g| g.name()))
+        .try_map(|s| s.parse::<crate::episode::Goal>())
+}
+
 /// `s` as a number accepted by `ok`, or an error that gives the `range`.
 fn number_in(s: &str, ok: impl Fn(f64) -> bool, range: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {

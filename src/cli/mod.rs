@@ -75,6 +75,15 @@ pub enum CliError {
     TaskFailed,
 }
 
+/// Entry point of a `macrotree`-like program whose trees may use the node kinds of `registry`
+/// (the built-in ones plus its own): installs it (see [`crate::registry::Registry::install`])
+/// and runs [`main`]. `nodes`, `schema`, `validate`, `run`, `sweep` and `graph` all know its
+/// kinds.
+pub fn main_with(registry: crate::registry::Registry) -> ExitCode {
+    registry.install();
+    main()
+}
+
 /// Entry point of the `macrotree` binary.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();

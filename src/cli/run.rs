@@ -66,12 +66,12 @@ pub struct EpisodeArgs {
     #[arg(long, default_value_t = 60.0, value_name = "S", value_parser = super::limits::max_sim_time)]
     pub max_sim_time: f64,
     /// Inject a fault through physics (see docs/faults.md).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::limits::fault())]
     pub fault: Option<crate::faults::FaultKind>,
     /// Success means: `scene` = the tree succeeded and the scene's goal holds; `bowl` = the tree
     /// succeeded and the cube rests in the bowl; `tree` = the tree succeeded (its own
     /// conditions check the task).
-    #[arg(long, value_enum, default_value_t = Goal::Scene)]
+    #[arg(long, value_parser = super::limits::goal(), default_value = "scene")]
     pub goal: Goal,
     /// Replace the leaves whose path matches PATTERN (`main/**/grasp`) with a scripted outcome:
     /// success, failure, running:N or fail_first:N (repeatable; see docs/testing_trees.md).

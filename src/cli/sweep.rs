@@ -34,11 +34,11 @@ pub struct SweepArgs {
     #[arg(long, short = 'j', value_name = "J", value_parser = clap::value_parser!(u64).range(1..))]
     pub jobs: Option<u64>,
     /// Inject this fault through physics in every scenario (see docs/faults.md).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::limits::fault())]
     pub fault: Option<FaultKind>,
     /// Success means: `scene` = the tree succeeded and the scene's goal holds; `bowl` = the tree
     /// succeeded and the cube rests in the bowl; `tree` = the tree succeeded.
-    #[arg(long, value_enum, default_value_t = Goal::Scene)]
+    #[arg(long, value_parser = super::limits::goal(), default_value = "scene")]
     pub goal: Goal,
     /// Write one JSON line per scenario here, in scenario order (a regular file or a new path).
     #[arg(long, value_name = "FILE.jsonl")]

@@ -41,7 +41,7 @@ pub struct EpisodeConfig {
 }
 
 /// What counts as a successful episode (`run --goal`, `sweep --goal`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Goal {
     /// The tree succeeded and the scene's goal holds (for the `cube_bowl` scene: the cube rests
@@ -56,6 +56,9 @@ pub enum Goal {
 }
 
 impl Goal {
+    /// Every goal.
+    pub const ALL: [Goal; 3] = [Goal::Scene, Goal::Bowl, Goal::Tree];
+
     /// The name used on the command line (`bowl`, `tree`).
     pub fn name(self) -> &'static str {
         match self {
@@ -63,6 +66,18 @@ impl Goal {
             Goal::Bowl => "bowl",
             Goal::Tree => "tree",
         }
+    }
+}
+
+impl std::str::FromStr for Goal {
+    type Err = String;
+
+    /// Reads a goal's command-line name (`scene`, `bowl`, `tree`).
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL.into_iter().find(|g| g.name() == s).ok_or_else(|| {
+            let names: Vec<&str> = Self::ALL.iter().map(|g| g.name()).collect();
+            format!("unknown goal `{s}`: expected one of {}", names.join(", "))
+        })
     }
 }
 

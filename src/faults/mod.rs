@@ -28,7 +28,7 @@ pub use nudge::Nudge;
 pub use slip::Slip;
 
 /// The faults `run --fault` and `sweep --fault` can inject.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, clap::ValueEnum, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum FaultKind {
     /// During the first carry, shortly after the cube is lifted, a downward blow knocks it out
@@ -40,7 +40,6 @@ pub enum FaultKind {
     /// from the bowl (a bumped table).
     Bump,
     /// During the first carry, the bowl slides 3–6 cm to a new place (a tray on a conveyor).
-    #[value(name = "late_bowl")]
     LateBowl,
 }
 
@@ -69,6 +68,18 @@ impl FaultKind {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         rng.set_stream(0xfa17_0000 + self as u64);
         rng
+    }
+}
+
+impl std::str::FromStr for FaultKind {
+    type Err = String;
+
+    /// Reads a fault's command-line name (`slip`, `nudge`, `bump`, `late_bowl`).
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL.into_iter().find(|k| k.name() == s).ok_or_else(|| {
+            let names: Vec<&str> = Self::ALL.iter().map(|k| k.name()).collect();
+            format!("unknown fault `{s}`: expected one of {}", names.join(", "))
+        })
     }
 }
 

@@ -5,8 +5,8 @@ use std::collections::HashMap;
 use bonsai_bt::Behavior;
 
 use super::{Check, Internal, LeafId, LeafInfo, NodeInfo, Plan};
-use crate::spec::leaves::{ActionLeaf, ConditionLeaf};
-use crate::spec::{Diagnostic, Issue, Leaf, Node, NodeKind, Sources, Spec, Target, Yaw};
+use crate::spec::leaves::fmt_num;
+use crate::spec::{Diagnostic, Issue, Leaf, Node, NodeKind, Sources, Spec};
 
 /// Validate and compile a loaded spec.
 pub fn compile_spec(spec: &Spec) -> Result<Plan, Vec<Diagnostic>> {
@@ -71,67 +71,10 @@ fn child_paths(parent: &str, children: &[&Node]) -> Vec<String> {
         .collect()
 }
 
-fn fmt_num(x: f64) -> String {
-    let s = format!("{x:.3}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" { "0".into() } else { s.to_string() }
-}
-
-fn fmt_vec(v: &[f64]) -> String {
-    format!(
-        "[{}]",
-        v.iter().map(|x| fmt_num(*x)).collect::<Vec<_>>().join(", ")
-    )
-}
-
-fn fmt_target(t: &Target) -> String {
-    match t {
-        Target::Point(p) => fmt_vec(p),
-        other => other.to_string(),
-    }
-}
-
 /// Short summary of a leaf and its key parameters.
 pub(crate) fn leaf_label(leaf: &Leaf) -> String {
     match leaf {
-        Leaf::Action(a) => match a {
-            ActionLeaf::Reach(p) => {
-                let mut s = format!("reach {}", fmt_target(&p.target));
-                if p.offset != [0.0; 3] {
-                    s.push_str(&format!(" +{}", fmt_vec(&p.offset)));
-                }
-                if p.path == crate::spec::PathKind::Cartesian {
-                    s.push_str(" cartesian");
-                }
-                match p.yaw {
-                    Yaw::Object => {}
-                    Yaw::Keep => s.push_str(" yaw=keep"),
-                    Yaw::Angle(a) => s.push_str(&format!(" yaw={}°", fmt_num(a.to_degrees()))),
-                }
-                s
-            }
-            ActionLeaf::MoveJoints(p) => format!("move_joints {}", fmt_vec(&p.joints)),
-            ActionLeaf::Home(_) => "home".into(),
-            ActionLeaf::Grasp(p) => match p.width {
-                Some(w) => format!("grasp width={} m", fmt_num(w)),
-                None => "grasp".into(),
-            },
-            ActionLeaf::Carry(p) => {
-                format!("carry to {} lift={} m", fmt_target(&p.to), fmt_num(p.lift))
-            }
-            ActionLeaf::Release(p) => format!("release retreat={} m", fmt_num(p.retreat)),
-        },
-        Leaf::Condition(c) => match c {
-            ConditionLeaf::CubeLifted(p) => format!("cube_lifted ≥{} m", fmt_num(p.min_height)),
-            ConditionLeaf::GripperOpen(p) => format!("gripper_open ≥{} m", fmt_num(p.min_width)),
-            ConditionLeaf::CubeAt(p) => format!(
-                "cube_at? [{}, {}] ±{} m",
-                fmt_num(p.point[0]),
-                fmt_num(p.point[1]),
-                fmt_num(p.tolerance)
-            ),
-            other => format!("{}?", other.kind()),
-        },
+        Leaf::Action(c) | Leaf::Condition(c) => c.label(),
         Leaf::Wait(w) => format!("wait {} s", fmt_num(w.seconds)),
         Leaf::Select(sel) => format!("select {} → {{{}}}", sel.query().describe(), sel.var),
     }
@@ -205,6 +148,7 @@ impl Compiler<'_> {
         self.nodes.push(NodeInfo {
             path: path.to_string(),
             kind: n.kind.kind_name(),
+            category: n.kind.category(),
             name,
             parent,
             children: Vec::new(),

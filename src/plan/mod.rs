@@ -106,6 +106,8 @@ pub struct NodeInfo {
     pub path: String,
     /// The YAML node kind (`sequence`, `retry`, `reach`, …).
     pub kind: &'static str,
+    /// What the node is (composite, decorator, action, condition, runtime leaf).
+    pub category: crate::registry::Category,
     /// The `name:` given in YAML (for a subtree call without a name: the subtree's name).
     pub name: Option<String>,
     /// Parent node index (`None` for the root).

@@ -4,19 +4,12 @@ use std::fmt::Write as _;
 
 use super::Plan;
 
-/// Visual family of a node kind.
-fn family(kind: &str) -> &'static str {
-    match kind {
-        "sequence" | "fallback" | "reactive_sequence" | "reactive_fallback" | "parallel" | "race" => {
-            "composite"
-        }
-        "guard" | "retry" | "repeat" | "timeout" | "inverter" | "force_success" | "force_failure" => {
-            "decorator"
-        }
-        "subtree" => "subtree",
-        "wait" => "runtime",
-        k if crate::spec::leaves::CONDITION_KINDS.contains(&k) => "condition",
-        _ => "action",
+/// Visual family of a node: its category, with subtree calls on their own.
+fn family(n: &super::NodeInfo) -> &'static str {
+    if n.kind == "subtree" {
+        "subtree"
+    } else {
+        n.category.as_str()
     }
 }
 
@@ -34,7 +27,7 @@ pub fn to_dot(plan: &Plan) -> String {
     let _ = writeln!(out, "  node [fontname=\"Helvetica\", fontsize=10];");
     let _ = writeln!(out, "  edge [arrowsize=0.6, fontname=\"Helvetica\", fontsize=9];");
     for (i, n) in plan.nodes.iter().enumerate() {
-        let style = match family(n.kind) {
+        let style = match family(n) {
             "composite" => "shape=box, style=\"rounded,bold\"",
             "decorator" => "shape=hexagon",
             "subtree" => "shape=box, style=dashed",
@@ -76,7 +69,7 @@ pub fn to_mermaid(plan: &Plan) -> String {
     let mut out = String::from("flowchart TD\n");
     for (i, n) in plan.nodes.iter().enumerate() {
         let l = mermaid_escape(&n.label);
-        let shape = match family(n.kind) {
+        let shape = match family(n) {
             "decorator" => format!("{{{{\"{l}\"}}}}"),
             "condition" => format!("([\"{l}\"])"),
             "subtree" => format!("[[\"{l}\"]]"),
@@ -95,7 +88,7 @@ pub fn to_mermaid(plan: &Plan) -> String {
         }
     }
     for (i, n) in plan.nodes.iter().enumerate() {
-        let class = match family(n.kind) {
+        let class = match family(n) {
             "action" => "action",
             "condition" => "condition",
             _ => continue,

@@ -6,15 +6,17 @@
 //! the file:line:column of whatever is wrong, argument or body.
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
 use super::check::{ObjectUse, Role, VarDef};
 use super::de::DeError;
 use super::diag::{Issue, Loc, Sources};
 use super::file::{SubtreeDef, param_ref};
-use super::leaves::{ACTION_KINDS, CONDITION_KINDS, Leaf, Select, parse_leaf};
-use super::node::{COMPOSITE_KINDS, DECORATOR_KINDS, Node, NodeKind};
+use super::leaves::{Leaf, Select};
+use super::node::{Node, NodeKind};
 use super::suggest::did_you_mean;
 use super::value::{Value, ValueKind};
+use crate::registry::{Category, NodeType, Registry};
 
 /// Deepest node nesting accepted after subtree expansion.
 pub const MAX_TREE_DEPTH: usize = 64;
@@ -25,19 +27,9 @@ pub const MAX_LEAF_ERRORS: usize = 16;
 /// Largest `attempts` / `times`.
 pub const MAX_COUNT: u32 = 1_000;
 
-/// All node kinds (composites, decorators, leaves), for suggestions.
-pub fn all_kinds() -> impl Iterator<Item = &'static str> {
-    COMPOSITE_KINDS
-        .iter()
-        .chain(DECORATOR_KINDS)
-        .chain(ACTION_KINDS)
-        .chain(CONDITION_KINDS)
-        .chain(&["wait"])
-        .copied()
-}
-
 /// Expands nodes; collects issues.
-pub struct Expander<'a> {
+pub(crate) struct Expander<'a> {
+    registry: &'a Registry,
     subtrees: &'a HashMap<String, SubtreeDef>,
     sources: &'a Sources,
     /// Problems found so far.
@@ -57,9 +49,14 @@ pub struct Expander<'a> {
 }
 
 impl<'a> Expander<'a> {
-    /// A new expander over the given subtree definitions.
-    pub fn new(subtrees: &'a HashMap<String, SubtreeDef>, sources: &'a Sources) -> Self {
+    /// A new expander over the given subtree definitions, for the node kinds of `registry`.
+    pub fn new(
+        registry: &'a Registry,
+        subtrees: &'a HashMap<String, SubtreeDef>,
+        sources: &'a Sources,
+    ) -> Self {
         Self {
+            registry,
             subtrees,
             sources,
             issues: Vec::new(),
@@ -142,9 +139,9 @@ impl<'a> Expander<'a> {
                     issue = issue.help(format!(
                         "`${r}` stands for a value, not a node; pass nodes as subtrees"
                     ));
-                } else if all_kinds().any(|k| k == s) {
+                } else if self.registry.get(s).is_some() {
                     issue = issue.help(format!("write `{s}: {{}}`"));
-                } else if let Some(h) = did_you_mean(s, all_kinds()) {
+                } else if let Some(h) = did_you_mean(s, self.registry.names()) {
                     issue = issue.help(h);
                 }
                 self.err(issue);
@@ -180,7 +177,11 @@ impl<'a> Expander<'a> {
                     ),
                 )
                 .label("expected `{...}`");
-                if COMPOSITE_KINDS.contains(&kind.as_str()) && body.as_seq().is_some() {
+                let composite = self
+                    .registry
+                    .get(&kind)
+                    .is_some_and(|t| t.category() == Category::Composite);
+                if composite && body.as_seq().is_some() {
                     issue = issue.help(format!("write `{kind}: {{children: [...]}}`"));
                 } else {
                     issue = issue.help(format!(
@@ -194,14 +195,27 @@ impl<'a> Expander<'a> {
         let name = self.take_name(body);
         let loc = key.loc;
         let k = kind.as_str();
-        let node_kind = if COMPOSITE_KINDS.contains(&k) {
+        let ty = self.registry.entry(k).cloned();
+        let category = ty.as_ref().map(|t| t.category());
+        let node_kind = if category == Some(Category::Composite) {
             self.composite(k, loc, body, depth)?
-        } else if DECORATOR_KINDS.contains(&k) {
+        } else if category == Some(Category::Decorator) {
             self.decorator(k, loc, body, depth)?
-        } else if let Some(parsed) = parse_leaf_reporting_all(k, without_name(body)) {
+        } else if let Some(parsed) = ty
+            .as_ref()
+            .and_then(|t| parse_leaf_reporting_all(t, without_name(body)))
+        {
             self.record_objects(k, body);
             match parsed {
                 Ok(leaf) => {
+                    if let Some(Err(why)) = leaf.call().map(|c| c.validate()) {
+                        self.err(
+                            Issue::new(loc, format!("invalid parameters in `{k}`: {why}"))
+                                .label("the parameters do not fit together")
+                                .help(format!("see `macrotree nodes {k}` for its parameters and units")),
+                        );
+                        return None;
+                    }
                     if let Leaf::Select(s) = &leaf {
                         let at = |key: &str| body.get(key).map_or(body.loc, |v| v.loc);
                         self.var_defs.extend(VarDef::from_select(
@@ -240,7 +254,7 @@ impl<'a> Expander<'a> {
                 issue = issue.help(format!(
                     "`{k}` is a subtree: call it with `subtree: {{ref: {k}}}`"
                 ));
-            } else if let Some(h) = did_you_mean(k, all_kinds()) {
+            } else if let Some(h) = did_you_mean(k, self.registry.names()) {
                 issue = issue.help(h);
             } else {
                 issue = issue.help("see docs/tree_format.md (or `macrotree nodes`) for the node kinds");
@@ -519,7 +533,10 @@ impl<'a> Expander<'a> {
                                 condition.kind.kind_name()
                             ),
                         )
-                        .label(format!("expected one of {}", CONDITION_KINDS.join(", ")))
+                        .label(format!(
+                            "expected one of {}",
+                            self.registry.names_of(Category::Condition).join(", ")
+                        ))
                         .help("conditions are checked every tick and never run; put actions in `child:`"),
                     );
                     return None;
@@ -831,18 +848,18 @@ fn valid_name(s: &str) -> bool {
     !s.trim().is_empty() && s.chars().count() <= 80 && !s.contains(['/', '[', ']', '#', '\n', '\r'])
 }
 
-/// Reads leaf `kind` from `params` like [`parse_leaf`], but reports every bad parameter, not just
+/// Reads a leaf of kind `ty` from `params`, reporting every bad parameter, not just
 /// the first: after an error located in one parameter (its key or anything in its value), that
 /// parameter is set aside and the rest read again. It stops at an error that no parameter
 /// explains (a missing parameter) or after [`MAX_LEAF_ERRORS`] (each retry re-reads the leaf, so
 /// the cap keeps a leaf with thousands of bad keys linear). A "missing" error for a parameter set
-/// aside, or for the one a misspelled key was suggested as, is not repeated. `None` if `kind` is
+/// aside, or for the one a misspelled key was suggested as, is not repeated. `None` if `ty` is
 /// not a leaf kind.
-fn parse_leaf_reporting_all(kind: &str, mut params: Value) -> Option<Result<Leaf, Vec<DeError>>> {
+fn parse_leaf_reporting_all(ty: &Arc<NodeType>, mut params: Value) -> Option<Result<Leaf, Vec<DeError>>> {
     let mut errors = Vec::new();
     let mut set_aside: Vec<String> = Vec::new();
     loop {
-        let e = match parse_leaf(kind, &params)? {
+        let e = match ty.parse_leaf(&params)? {
             Ok(leaf) if errors.is_empty() => return Some(Ok(leaf)),
             Ok(_) => return Some(Err(errors)),
             Err(e) => e,

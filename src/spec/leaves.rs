@@ -11,6 +11,7 @@ use schemars::JsonSchema;
 
 use super::objects::{ObjectRef, opt_var_name, var_name};
 use super::units::{self, Angle, PathKind, Target, Yaw};
+pub use crate::registry::{LeafCall, Params};
 use crate::world::conditions::Tolerances;
 use crate::world::query::{Filter, KindFilter, Order, Query};
 
@@ -489,70 +490,19 @@ impl Select {
     }
 }
 
-/// A macro action, executed over several ticks by the driver.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum ActionLeaf {
-    /// See [`Reach`].
-    Reach(Reach),
-    /// See [`MoveJoints`].
-    MoveJoints(MoveJoints),
-    /// See [`Home`].
-    Home(Home),
-    /// See [`Grasp`].
-    Grasp(Grasp),
-    /// See [`Carry`].
-    Carry(Carry),
-    /// See [`Release`].
-    Release(Release),
-}
-
-/// An instantaneous check of the world: the driver must answer Success or Failure in the same
-/// tick (a Running answer is treated as a Failure and reported).
-#[derive(Clone, Debug, PartialEq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum ConditionLeaf {
-    /// See [`CubeGrasped`].
-    CubeGrasped(CubeGrasped),
-    /// See [`CubeLifted`].
-    CubeLifted(CubeLifted),
-    /// See [`CubeInBowl`].
-    CubeInBowl(CubeInBowl),
-    /// See [`CubeOnTable`].
-    CubeOnTable(CubeOnTable),
-    /// See [`CubeAt`].
-    CubeAt(CubeAt),
-    /// See [`GripperOpen`].
-    GripperOpen(GripperOpen),
-    /// See [`AtHome`].
-    AtHome(AtHome),
-    /// See [`Grasped`].
-    Grasped(Grasped),
-    /// See [`Lifted`].
-    Lifted(Lifted),
-    /// See [`In`].
-    In(In),
-    /// See [`On`].
-    On(On),
-    /// See [`OnTable`].
-    OnTable(OnTable),
-    /// See [`At`].
-    At(At),
-    /// See [`GoalMet`].
-    GoalMet(GoalMet),
-}
-
 /// A leaf of the tree, with all parameters resolved.
 ///
-/// Drivers see only [`Leaf::Action`] and [`Leaf::Condition`]; [`Leaf::Wait`] is handled by
-/// the runtime.
+/// Drivers see only [`Leaf::Action`] and [`Leaf::Condition`]; [`Leaf::Wait`] and
+/// [`Leaf::Select`] are handled by the runtime. Actions and conditions are [`LeafCall`]s of a
+/// registered kind (see [`crate::registry`]): read their parameters with
+/// [`Leaf::params`], e.g. `leaf.params::<Reach>()`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Leaf {
     /// A macro action (multi-tick).
-    Action(ActionLeaf),
+    Action(LeafCall),
     /// A condition (instantaneous).
-    Condition(ConditionLeaf),
+    Condition(LeafCall),
     /// `wait: {seconds}` (runtime-internal).
     Wait(Wait),
     /// `select: {as, …}`: picks an object through the driver and writes the blackboard
@@ -560,113 +510,35 @@ pub enum Leaf {
     Select(Select),
 }
 
-impl ActionLeaf {
-    /// The YAML node kind (`reach`, `grasp`, …).
-    pub fn kind(&self) -> &'static str {
-        match self {
-            ActionLeaf::Reach(_) => "reach",
-            ActionLeaf::MoveJoints(_) => "move_joints",
-            ActionLeaf::Home(_) => "home",
-            ActionLeaf::Grasp(_) => "grasp",
-            ActionLeaf::Carry(_) => "carry",
-            ActionLeaf::Release(_) => "release",
-        }
-    }
-
-    /// The action's own time limit in simulated seconds (enforced by the driver).
-    pub fn timeout(&self) -> f64 {
-        match self {
-            ActionLeaf::Reach(p) => p.timeout,
-            ActionLeaf::MoveJoints(p) => p.timeout,
-            ActionLeaf::Home(p) => p.timeout,
-            ActionLeaf::Grasp(p) => p.timeout,
-            ActionLeaf::Carry(p) => p.timeout,
-            ActionLeaf::Release(p) => p.timeout,
-        }
-    }
-}
-
-impl ConditionLeaf {
-    /// The YAML node kind (`cube_grasped`, …).
-    pub fn kind(&self) -> &'static str {
-        match self {
-            ConditionLeaf::CubeGrasped(_) => "cube_grasped",
-            ConditionLeaf::CubeLifted(_) => "cube_lifted",
-            ConditionLeaf::CubeInBowl(_) => "cube_in_bowl",
-            ConditionLeaf::CubeOnTable(_) => "cube_on_table",
-            ConditionLeaf::CubeAt(_) => "cube_at",
-            ConditionLeaf::GripperOpen(_) => "gripper_open",
-            ConditionLeaf::AtHome(_) => "at_home",
-            ConditionLeaf::Grasped(_) => "grasped",
-            ConditionLeaf::Lifted(_) => "lifted",
-            ConditionLeaf::In(_) => "in",
-            ConditionLeaf::On(_) => "on",
-            ConditionLeaf::OnTable(_) => "on_table",
-            ConditionLeaf::At(_) => "at",
-            ConditionLeaf::GoalMet(_) => "goal_met",
-        }
-    }
-}
-
 impl Leaf {
     /// The YAML node kind (`reach`, `cube_grasped`, `wait`, …).
     pub fn kind(&self) -> &'static str {
         match self {
-            Leaf::Action(a) => a.kind(),
-            Leaf::Condition(c) => c.kind(),
+            Leaf::Action(c) | Leaf::Condition(c) => c.kind(),
             Leaf::Wait(_) => "wait",
             Leaf::Select(_) => "select",
         }
     }
 
-    /// Every object reference of the leaf (targets, `object:`, `container:`, `support:`), mutably.
-    fn refs_mut(&mut self) -> Vec<&mut ObjectRef> {
-        fn target(t: &mut Target) -> Option<&mut ObjectRef> {
-            match t {
-                Target::Object(o) => Some(o),
-                _ => None,
-            }
-        }
+    /// The parameters of an action or condition, if they are of type `P` (e.g. [`Reach`]).
+    pub fn params<P: Params>(&self) -> Option<&P> {
         match self {
-            Leaf::Action(ActionLeaf::Reach(r)) => target(&mut r.target).into_iter().collect(),
-            Leaf::Action(ActionLeaf::Carry(c)) => target(&mut c.to).into_iter().collect(),
-            Leaf::Action(ActionLeaf::Grasp(g)) => g.object.iter_mut().collect(),
-            Leaf::Condition(c) => match c {
-                ConditionLeaf::Grasped(p) => vec![&mut p.object],
-                ConditionLeaf::Lifted(p) => vec![&mut p.object],
-                ConditionLeaf::In(p) => vec![&mut p.object, &mut p.container],
-                ConditionLeaf::On(p) => vec![&mut p.object, &mut p.support],
-                ConditionLeaf::OnTable(p) => vec![&mut p.object],
-                ConditionLeaf::At(p) => vec![&mut p.object],
-                ConditionLeaf::GoalMet(p) => p.object.iter_mut().collect(),
-                _ => vec![],
-            },
-            _ => vec![],
+            Leaf::Action(c) | Leaf::Condition(c) => c.params::<P>(),
+            _ => None,
+        }
+    }
+
+    /// The action or condition call (`None` for `wait` and `select`).
+    pub fn call(&self) -> Option<&LeafCall> {
+        match self {
+            Leaf::Action(c) | Leaf::Condition(c) => Some(c),
+            _ => None,
         }
     }
 
     /// Every object reference of the leaf (targets, `object:`, `container:`, `support:`).
     pub fn object_refs(&self) -> Vec<ObjectRef> {
-        let target = |t: &Target| match t {
-            Target::Object(o) => vec![*o],
-            _ => vec![],
-        };
-        match self {
-            Leaf::Action(ActionLeaf::Reach(r)) => target(&r.target),
-            Leaf::Action(ActionLeaf::Carry(c)) => target(&c.to),
-            Leaf::Action(ActionLeaf::Grasp(g)) => g.object.into_iter().collect(),
-            Leaf::Condition(c) => match c {
-                ConditionLeaf::Grasped(p) => vec![p.object],
-                ConditionLeaf::Lifted(p) => vec![p.object],
-                ConditionLeaf::In(p) => vec![p.object, p.container],
-                ConditionLeaf::On(p) => vec![p.object, p.support],
-                ConditionLeaf::OnTable(p) => vec![p.object],
-                ConditionLeaf::At(p) => vec![p.object],
-                ConditionLeaf::GoalMet(p) => p.object.into_iter().collect(),
-                _ => vec![],
-            },
-            _ => vec![],
-        }
+        self.call().map(LeafCall::object_refs).unwrap_or_default()
     }
 
     /// The leaf with object references replaced where `f` answers `Some`; `None` when nothing
@@ -675,15 +547,11 @@ impl Leaf {
         if !self.has_vars() {
             return None;
         }
-        let mut out = self.clone();
-        let mut changed = false;
-        for r in out.refs_mut() {
-            if let Some(new) = f(r) {
-                *r = new;
-                changed = true;
-            }
+        match self {
+            Leaf::Action(c) => c.map_objects(f).map(Leaf::Action),
+            Leaf::Condition(c) => c.map_objects(f).map(Leaf::Condition),
+            _ => None,
         }
-        changed.then_some(out)
     }
 
     /// True when the leaf reads a blackboard variable.
@@ -698,66 +566,185 @@ impl Leaf {
 
     /// Compact one-line rendering of the parameters (JSON), for logs and diagrams.
     pub fn params_json(&self) -> String {
-        let v = serde_json::to_value(self).unwrap_or(serde_json::Value::Null);
-        match v {
-            serde_json::Value::Object(m) => m
-                .into_iter()
-                .next()
-                .map(|(_, p)| p.to_string())
-                .unwrap_or_else(|| "{}".into()),
-            other => other.to_string(),
+        match self {
+            Leaf::Action(c) | Leaf::Condition(c) => c.params_json().to_string(),
+            Leaf::Wait(w) => serde_json::to_string(w).unwrap_or_else(|_| "{}".into()),
+            Leaf::Select(s) => serde_json::to_string(s).unwrap_or_else(|_| "{}".into()),
         }
     }
 }
 
-/// Kinds of action leaves, in documentation order.
-pub const ACTION_KINDS: &[&str] = &["reach", "move_joints", "home", "grasp", "carry", "release"];
-/// Kinds of condition leaves, in documentation order.
-pub const CONDITION_KINDS: &[&str] = &[
-    "grasped",
-    "lifted",
-    "in",
-    "on",
-    "on_table",
-    "at",
-    "goal_met",
-    "cube_grasped",
-    "cube_lifted",
-    "cube_in_bowl",
-    "cube_on_table",
-    "cube_at",
-    "gripper_open",
-    "at_home",
-];
+fn target_mut(t: &mut Target) -> Vec<&mut ObjectRef> {
+    match t {
+        Target::Object(o) => vec![o],
+        _ => vec![],
+    }
+}
 
-/// Read the parameters of leaf kind `kind` from `params`; `None` if `kind` is not a leaf kind.
-pub fn parse_leaf(kind: &str, params: &super::value::Value) -> Option<Result<Leaf, super::de::DeError>> {
-    use super::de::from_value as f;
-    let a = |r: Result<ActionLeaf, _>| Some(r.map(Leaf::Action));
-    let c = |r: Result<ConditionLeaf, _>| Some(r.map(Leaf::Condition));
-    match kind {
-        "reach" => a(f(params).map(ActionLeaf::Reach)),
-        "move_joints" => a(f(params).map(ActionLeaf::MoveJoints)),
-        "home" => a(f(params).map(ActionLeaf::Home)),
-        "grasp" => a(f(params).map(ActionLeaf::Grasp)),
-        "carry" => a(f(params).map(ActionLeaf::Carry)),
-        "release" => a(f(params).map(ActionLeaf::Release)),
-        "wait" => Some(f(params).map(Leaf::Wait)),
-        "select" => Some(f(params).map(Leaf::Select)),
-        "grasped" => c(f(params).map(ConditionLeaf::Grasped)),
-        "lifted" => c(f(params).map(ConditionLeaf::Lifted)),
-        "in" => c(f(params).map(ConditionLeaf::In)),
-        "on" => c(f(params).map(ConditionLeaf::On)),
-        "on_table" => c(f(params).map(ConditionLeaf::OnTable)),
-        "at" => c(f(params).map(ConditionLeaf::At)),
-        "goal_met" => c(f(params).map(ConditionLeaf::GoalMet)),
-        "cube_grasped" => c(f(params).map(ConditionLeaf::CubeGrasped)),
-        "cube_lifted" => c(f(params).map(ConditionLeaf::CubeLifted)),
-        "cube_in_bowl" => c(f(params).map(ConditionLeaf::CubeInBowl)),
-        "cube_on_table" => c(f(params).map(ConditionLeaf::CubeOnTable)),
-        "cube_at" => c(f(params).map(ConditionLeaf::CubeAt)),
-        "gripper_open" => c(f(params).map(ConditionLeaf::GripperOpen)),
-        "at_home" => c(f(params).map(ConditionLeaf::AtHome)),
-        _ => None,
+fn fmt_target(t: &Target) -> String {
+    match t {
+        Target::Point(p) => fmt_vec(p),
+        other => other.to_string(),
+    }
+}
+
+/// A number with at most 3 decimals, trailing zeros dropped (for labels).
+pub(crate) fn fmt_num(x: f64) -> String {
+    let s = format!("{x:.3}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" { "0".into() } else { s.to_string() }
+}
+
+/// `[a, b, c]` with [`fmt_num`] numbers.
+pub(crate) fn fmt_vec(v: &[f64]) -> String {
+    format!(
+        "[{}]",
+        v.iter().map(|x| fmt_num(*x)).collect::<Vec<_>>().join(", ")
+    )
+}
+
+impl Params for Reach {
+    fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
+        target_mut(&mut self.target)
+    }
+    fn label(&self, _: &str) -> Option<String> {
+        let mut s = format!("reach {}", fmt_target(&self.target));
+        if self.offset != [0.0; 3] {
+            s.push_str(&format!(" +{}", fmt_vec(&self.offset)));
+        }
+        if self.path == PathKind::Cartesian {
+            s.push_str(" cartesian");
+        }
+        match self.yaw {
+            Yaw::Object => {}
+            Yaw::Keep => s.push_str(" yaw=keep"),
+            Yaw::Angle(a) => s.push_str(&format!(" yaw={}°", fmt_num(a.to_degrees()))),
+        }
+        Some(s)
+    }
+    fn timeout(&self) -> Option<f64> {
+        Some(self.timeout)
+    }
+}
+
+impl Params for MoveJoints {
+    fn label(&self, _: &str) -> Option<String> {
+        Some(format!("move_joints {}", fmt_vec(&self.joints)))
+    }
+    fn timeout(&self) -> Option<f64> {
+        Some(self.timeout)
+    }
+}
+
+impl Params for Home {
+    fn timeout(&self) -> Option<f64> {
+        Some(self.timeout)
+    }
+}
+
+impl Params for Grasp {
+    fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
+        self.object.iter_mut().collect()
+    }
+    fn label(&self, _: &str) -> Option<String> {
+        self.width.map(|w| format!("grasp width={} m", fmt_num(w)))
+    }
+    fn timeout(&self) -> Option<f64> {
+        Some(self.timeout)
+    }
+}
+
+impl Params for Carry {
+    fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
+        target_mut(&mut self.to)
+    }
+    fn label(&self, _: &str) -> Option<String> {
+        Some(format!(
+            "carry to {} lift={} m",
+            fmt_target(&self.to),
+            fmt_num(self.lift)
+        ))
+    }
+    fn timeout(&self) -> Option<f64> {
+        Some(self.timeout)
+    }
+}
+
+impl Params for Release {
+    fn label(&self, _: &str) -> Option<String> {
+        Some(format!("release retreat={} m", fmt_num(self.retreat)))
+    }
+    fn timeout(&self) -> Option<f64> {
+        Some(self.timeout)
+    }
+}
+
+impl Params for CubeGrasped {}
+impl Params for CubeInBowl {}
+impl Params for CubeOnTable {}
+impl Params for AtHome {}
+
+impl Params for CubeLifted {
+    fn label(&self, _: &str) -> Option<String> {
+        Some(format!("cube_lifted ≥{} m", fmt_num(self.min_height)))
+    }
+}
+
+impl Params for GripperOpen {
+    fn label(&self, _: &str) -> Option<String> {
+        Some(format!("gripper_open ≥{} m", fmt_num(self.min_width)))
+    }
+}
+
+impl Params for CubeAt {
+    fn label(&self, _: &str) -> Option<String> {
+        Some(format!(
+            "cube_at? [{}, {}] ±{} m",
+            fmt_num(self.point[0]),
+            fmt_num(self.point[1]),
+            fmt_num(self.tolerance)
+        ))
+    }
+}
+
+impl Params for Grasped {
+    fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
+        vec![&mut self.object]
+    }
+}
+
+impl Params for Lifted {
+    fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
+        vec![&mut self.object]
+    }
+}
+
+impl Params for In {
+    fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
+        vec![&mut self.object, &mut self.container]
+    }
+}
+
+impl Params for On {
+    fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
+        vec![&mut self.object, &mut self.support]
+    }
+}
+
+impl Params for OnTable {
+    fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
+        vec![&mut self.object]
+    }
+}
+
+impl Params for At {
+    fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
+        vec![&mut self.object]
+    }
+}
+
+impl Params for GoalMet {
+    fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
+        self.object.iter_mut().collect()
     }
 }

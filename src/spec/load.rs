@@ -12,6 +12,7 @@ use super::file::{SubtreeDef, TreeFile};
 use super::node::Node;
 use super::suggest::closest;
 use super::value::{MAX_FILE_BYTES, decode_utf8, parse_yaml};
+use crate::registry::Registry;
 use crate::scene::SceneSpec;
 
 /// Deepest chain of includes.
@@ -53,9 +54,18 @@ pub fn load_file(path: &Path) -> Result<Spec, Vec<Diagnostic>> {
 /// Load a tree file from disk like [`load_file`], checking the objects it names against `scene`
 /// when given (a `--scene` override) instead of the tree's own `scene:`.
 pub fn load_file_with(path: &Path, scene: Option<Arc<SceneSpec>>) -> Result<Spec, Vec<Diagnostic>> {
+    load_file_in(&crate::registry::installed(), path, scene)
+}
+
+/// Load a tree file like [`load_file_with`], for the node kinds of `registry`.
+pub fn load_file_in(
+    registry: &Arc<Registry>,
+    path: &Path,
+    scene: Option<Arc<SceneSpec>>,
+) -> Result<Spec, Vec<Diagnostic>> {
     let name = path.display().to_string();
     match read_limited(path) {
-        Ok(bytes) => load_bytes_at(&bytes, name, path, scene),
+        Ok(bytes) => load_bytes_at(registry, &bytes, name, path, scene),
         Err((msg, help)) => {
             let mut l = Loader::default();
             let id = l.sources.add(name, "");
@@ -68,7 +78,15 @@ pub fn load_file_with(path: &Path, scene: Option<Arc<SceneSpec>>) -> Result<Spec
 /// Load a tree from text. `file_name` is used in diagnostics and, when it has a folder part,
 /// as the base for relative `include:` paths (otherwise the current folder).
 pub fn load_str(text: &str, file_name: &str) -> Result<Spec, Vec<Diagnostic>> {
-    let mut l = Loader::default();
+    load_str_in(&crate::registry::installed(), text, file_name)
+}
+
+/// Load a tree from text like [`load_str`], for the node kinds of `registry`.
+pub fn load_str_in(registry: &Arc<Registry>, text: &str, file_name: &str) -> Result<Spec, Vec<Diagnostic>> {
+    let mut l = Loader {
+        registry: Some(registry.clone()),
+        ..Loader::default()
+    };
     let path = Path::new(file_name);
     if let Ok(c) = path.canonicalize() {
         l.loaded.insert(c);
@@ -80,10 +98,17 @@ pub fn load_str(text: &str, file_name: &str) -> Result<Spec, Vec<Diagnostic>> {
 /// invalid UTF-8 is a located error, the rest is [`load_str`]. `file_name` plays the same role
 /// as in [`load_str`].
 pub fn load_bytes(bytes: &[u8], file_name: &str) -> Result<Spec, Vec<Diagnostic>> {
-    load_bytes_at(bytes, file_name.to_string(), Path::new(file_name), None)
+    load_bytes_at(
+        &crate::registry::installed(),
+        bytes,
+        file_name.to_string(),
+        Path::new(file_name),
+        None,
+    )
 }
 
 fn load_bytes_at(
+    registry: &Arc<Registry>,
     bytes: &[u8],
     name: String,
     path: &Path,
@@ -91,6 +116,7 @@ fn load_bytes_at(
 ) -> Result<Spec, Vec<Diagnostic>> {
     let mut l = Loader {
         scene_override: scene,
+        registry: Some(registry.clone()),
         ..Loader::default()
     };
     let text = match std::str::from_utf8(bytes) {
@@ -170,6 +196,8 @@ struct Loader {
     /// Diagnostics of a scene file the tree names (reported with the tree's).
     scene_diagnostics: Vec<Diagnostic>,
     scope: IncludeScope,
+    /// The node kinds (`None`: the installed registry).
+    registry: Option<Arc<Registry>>,
 }
 
 /// The built-in `cube_bowl` scene, parsed once.
@@ -262,7 +290,8 @@ impl Loader {
         }
 
         let reported: Vec<Loc> = self.issues.iter().map(|i| i.loc).collect();
-        let mut ex = Expander::new(&table, &self.sources);
+        let registry = self.registry.clone().unwrap_or_else(crate::registry::installed);
+        let mut ex = Expander::new(&registry, &table, &self.sources);
         ex.reported.clone_from(&reported);
         let root = ex.node(&main, 0);
         let called: HashSet<String> = ex.calls.keys().cloned().collect();
@@ -289,7 +318,7 @@ impl Loader {
             if called.contains(n) || d.params.iter().any(|p| p.default.is_none()) {
                 continue;
             }
-            let mut ex = Expander::new(&table, &self.sources);
+            let mut ex = Expander::new(&registry, &table, &self.sources);
             ex.reported.clone_from(&reported);
             let call = super::value::Value::new(
                 super::value::ValueKind::Map(vec![(

@@ -28,9 +28,9 @@ pub use catalog::{NodeDoc, ParamDoc, catalog, json_schema};
 pub use confine::{includes_anywhere, set_includes_anywhere};
 pub use diag::{Diagnostic, Issue, Loc, Sources};
 pub use leaves::{
-    ActionLeaf, At, AtHome, Carry, ConditionLeaf, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable,
-    GoalMet, Grasp, Grasped, GripperOpen, Home, In, Leaf, Lifted, MoveJoints, On, OnTable, Reach, Release,
-    Select, Wait,
+    At, AtHome, Carry, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, GoalMet, Grasp, Grasped,
+    GripperOpen, Home, In, Leaf, LeafCall, Lifted, MoveJoints, On, OnTable, Params, Reach, Release, Select,
+    Wait,
 };
 pub use load::{Spec, load_bytes, load_file, load_str};
 pub use node::{Node, NodeKind};

@@ -86,30 +86,25 @@ pub enum NodeKind {
     Leaf(Leaf),
 }
 
-/// Composite node kinds (take `children:`).
-pub const COMPOSITE_KINDS: &[&str] = &[
-    "sequence",
-    "fallback",
-    "reactive_sequence",
-    "reactive_fallback",
-    "parallel",
-    "race",
-];
-
-/// Decorator node kinds (take `child:`), plus `subtree`.
-pub const DECORATOR_KINDS: &[&str] = &[
-    "guard",
-    "retry",
-    "repeat",
-    "for_each",
-    "timeout",
-    "inverter",
-    "force_success",
-    "force_failure",
-    "subtree",
-];
-
 impl NodeKind {
+    /// What the node is: composite, decorator (a subtree call counts as one), action, condition
+    /// or runtime leaf.
+    pub fn category(&self) -> crate::registry::Category {
+        use crate::registry::Category;
+        match self {
+            NodeKind::Sequence(_)
+            | NodeKind::Fallback(_)
+            | NodeKind::ReactiveSequence(_)
+            | NodeKind::ReactiveFallback(_)
+            | NodeKind::Parallel(_)
+            | NodeKind::Race(_) => Category::Composite,
+            NodeKind::Leaf(Leaf::Action(_)) => Category::Action,
+            NodeKind::Leaf(Leaf::Condition(_)) => Category::Condition,
+            NodeKind::Leaf(_) => Category::Runtime,
+            _ => Category::Decorator,
+        }
+    }
+
     /// The YAML kind name (`sequence`, `retry`, `reach`, …).
     pub fn kind_name(&self) -> &'static str {
         match self {

@@ -2,7 +2,7 @@
 //!
 //! Threads: one acceptor, one thread per connection (an HTTP request is answered and closed; a
 //! websocket connection stays and becomes a client). The simulation thread never touches a
-//! socket: it updates the [`Hub`] (scene tree + per-client outboxes) under one short lock and
+//! socket: it updates the `Hub` (scene tree + per-client outboxes) under one short lock and
 //! wakes the clients' threads.
 //!
 //! Per client, structural commands (objects, properties, deletes) go through a bounded queue;
