@@ -42,9 +42,20 @@ impl EpisodeObserver for Track {
     }
 }
 
+/// The cube's and the bowl's positions, metres.
+type Positions = (Vector3<f64>, Vector3<f64>);
+
+/// What one faulted episode left: its cell, report, the fault's firing and the track.
+type Episode = (
+    Cell,
+    macrotree::episode::EpisodeReport,
+    macrotree::faults::FaultEvent,
+    Track,
+);
+
 impl Track {
     /// The last sample before `t` and the first sample at least `after` seconds later.
-    fn around(&self, t: f64, after: f64) -> ((Vector3<f64>, Vector3<f64>), (Vector3<f64>, Vector3<f64>)) {
+    fn around(&self, t: f64, after: f64) -> (Positions, Positions) {
         let before = self
             .samples
             .iter()
@@ -62,15 +73,7 @@ impl Track {
 
 /// Runs scenario `index` of sweep seed 2024 with `kind` injected, in a fresh cell; returns the
 /// cell, the report, the fault's firing and the track.
-fn episode(
-    kind: FaultKind,
-    index: u64,
-) -> (
-    Cell,
-    macrotree::episode::EpisodeReport,
-    macrotree::faults::FaultEvent,
-    Track,
-) {
+fn episode(kind: FaultKind, index: u64) -> Episode {
     let scenario = sample_scenario(2024, index);
     let config = EpisodeConfig {
         layout: scenario.layout.to_layout(),
