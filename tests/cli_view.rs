@@ -101,16 +101,42 @@ fn output_within(mut cmd: Command, timeout: Duration) -> Output {
     }
 }
 
+/// `GET path` with `Connection: close`; the whole exchange (connect, request, every read) must
+/// finish within 10 s, even if the server sends nothing or trickles bytes: panics otherwise.
 fn http_get(addr: &str, path: &str) -> String {
-    let mut s = TcpStream::connect(addr).expect("connect to the live view");
-    s.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
+    let limit = Duration::from_secs(10);
+    let deadline = Instant::now() + limit;
+    let left = || {
+        let d = deadline.saturating_duration_since(Instant::now());
+        assert!(!d.is_zero(), "GET {path}: no complete answer within {limit:?}");
+        d
+    };
+    let sock: std::net::SocketAddr = addr.parse().expect("host:port");
+    let mut s = TcpStream::connect_timeout(&sock, left()).expect("connect to the live view");
+    s.set_write_timeout(Some(left())).unwrap();
     write!(
         s,
         "GET {path} HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n\r\n"
     )
     .unwrap();
     let mut body = Vec::new();
-    let _ = s.read_to_end(&mut body);
+    let mut buf = [0u8; 16 * 1024];
+    loop {
+        s.set_read_timeout(Some(left())).unwrap();
+        match s.read(&mut buf) {
+            Ok(0) => break,
+            Ok(n) => body.extend_from_slice(&buf[..n]),
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) =>
+            {
+                let _ = left();
+            }
+            Err(_) => break,
+        }
+    }
     String::from_utf8_lossy(&body).into_owned()
 }
 
@@ -225,6 +251,7 @@ fn record_writes_a_self_contained_replay() {
     cmd.args([
         "run",
         "trees/cube_to_bowl.yaml",
+        "--json",
         "--record",
         file.to_str().unwrap(),
     ]);
@@ -243,10 +270,114 @@ fn record_writes_a_self_contained_replay() {
         "the replay must not load anything from the network"
     );
     assert!(html.contains("MeshCat"), "the viewer bundle is not inlined");
-    assert!(
-        html.contains("set_animation") || html.contains("animation"),
-        "no animation in the replay"
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let report: serde_json::Value =
+        serde_json::from_str(stdout.lines().last().expect("a JSON report")).expect("the report is JSON");
+    check_replay(&html, &report);
+}
+
+/// The replay really holds the episode: its metadata covers the episode's simulated time at its
+/// frame rate, its one `set_animation` has a track of exactly that many frames for the cube, and
+/// the cube's last frame is where the episode left it.
+fn check_replay(html: &str, report: &serde_json::Value) {
+    use base64::Engine;
+    // `macrotree.replay([ "base64", … ], META);` — the page's data script.
+    let start = html.find("macrotree.replay([").expect("the replay call") + "macrotree.replay(".len();
+    let end = start + html[start..].find("]").expect("the command list") + 1;
+    let commands: Vec<String> = serde_json::from_str(&trailing_commas_removed(&html[start..end]))
+        .expect("the command list is a list of strings");
+    let meta_end = start + html[start..].find(");\n</script>").expect("the end of the call");
+    let meta: serde_json::Value =
+        serde_json::from_str(html[end..meta_end].trim_start_matches(", ")).expect("the metadata is JSON");
+    let sim_time = report["sim_time_s"].as_f64().expect("sim_time_s");
+    let fps = meta["fps"].as_f64().expect("fps");
+    let frames = meta["frames"].as_u64().expect("frames") as f64;
+    let duration = meta["duration"].as_f64().expect("duration");
+    eprintln!(
+        "replay: {frames} frames at {fps} fps over {duration:.3} s; the episode simulated {sim_time:.3} s"
     );
+    assert_eq!(fps, 30.0);
+    assert!(
+        (duration - sim_time).abs() <= 1.0 / fps + 1e-9,
+        "{duration} s of {sim_time} s"
+    );
+    assert!(
+        (frames - sim_time * fps).abs() <= 2.0,
+        "{frames} frames for {sim_time} s at {fps} fps"
+    );
+    // Exactly one set_animation; the cube's position track has `frames` samples and ends at the
+    // episode's final cube position.
+    let engine = base64::engine::general_purpose::STANDARD;
+    let mut animations = Vec::new();
+    for c in &commands {
+        let bytes = engine.decode(c).expect("base64");
+        let v = rmpv::decode::read_value(&mut bytes.as_slice()).expect("msgpack");
+        if field(&v, "type").and_then(|t| t.as_str()) == Some("set_animation") {
+            animations.push(v);
+        }
+    }
+    assert_eq!(animations.len(), 1, "set_animation commands");
+    let animated = field(&animations[0], "animations")
+        .and_then(|a| a.as_array())
+        .expect("animations");
+    let paths: Vec<&str> = animated
+        .iter()
+        .filter_map(|a| field(a, "path").and_then(|p| p.as_str()))
+        .collect();
+    let cube = animated
+        .iter()
+        .find(|a| {
+            field(a, "path")
+                .and_then(|p| p.as_str())
+                .is_some_and(|p| p == "/mujoco/obj_cube")
+        })
+        .unwrap_or_else(|| panic!("the cube is not animated: {paths:?}"));
+    let tracks = field(field(cube, "clip").expect("clip"), "tracks")
+        .and_then(|t| t.as_array())
+        .expect("tracks");
+    let position = tracks
+        .iter()
+        .find(|t| field(t, "name").and_then(|n| n.as_str()) == Some(".position"))
+        .expect("a position track");
+    let floats = |name: &str| -> Vec<f32> {
+        match field(position, name) {
+            Some(rmpv::Value::Ext(_, b)) => b
+                .chunks_exact(4)
+                .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+                .collect(),
+            other => panic!("{name}: {other:?}"),
+        }
+    };
+    let times = floats("times");
+    let values = floats("values");
+    assert_eq!(times.len() as f64, frames, "cube track frames");
+    assert_eq!(values.len(), times.len() * 3);
+    let last = &values[values.len() - 3..];
+    let end = report["cube_final"].as_array().expect("cube_final");
+    for k in 0..3 {
+        let want = end[k].as_f64().unwrap();
+        assert!(
+            (f64::from(last[k]) - want).abs() < 1e-4,
+            "cube's last frame {last:?}, episode end {end:?}"
+        );
+    }
+}
+
+fn field<'a>(v: &'a rmpv::Value, key: &str) -> Option<&'a rmpv::Value> {
+    v.as_map()?
+        .iter()
+        .find(|(k, _)| k.as_str() == Some(key))
+        .map(|(_, v)| v)
+}
+
+fn trailing_commas_removed(list: &str) -> String {
+    let mut out = list
+        .trim_end_matches(']')
+        .trim_end()
+        .trim_end_matches(',')
+        .to_string();
+    out.push(']');
+    out
 }
 
 /// CPU time used so far by process `pid` (`/proc/PID/stat` utime + stime, in clock ticks of

@@ -8,6 +8,9 @@ use macrotree::episode::{EpisodeConfig, EpisodeObserver, run_in_cell};
 use macrotree::runtime::{NodeStatus, Transition, TreeRunner};
 use macrotree::sim::{Layout, Scene};
 
+#[path = "support/oracle.rs"]
+mod oracle;
+
 /// Collects transitions and the pinch position after every tick.
 #[derive(Default)]
 struct Trace {
@@ -62,6 +65,25 @@ main:
         .collect();
     let spread = late.iter().map(|p| (p - late[0]).norm()).fold(0.0, f64::max);
     assert!(spread < 1e-3, "arm still moving {spread} m after the halt");
+    // … and it holds within 1 cm of where it was when halted, over the whole 1 s that follows.
+    let at_halt = trace
+        .pinch
+        .iter()
+        .find(|(t, _)| *t >= t_halt)
+        .expect("a sample at the halt")
+        .1;
+    let farthest = trace
+        .pinch
+        .iter()
+        .filter(|(t, _)| *t >= t_halt)
+        .map(|(_, p)| (p - at_halt).norm())
+        .fold(0.0, f64::max);
+    eprintln!(
+        "after the halt the pinch stayed within {:.2} mm of where it was",
+        farthest * 1e3
+    );
+    assert!(farthest < 0.01, "the halted arm drifted {farthest} m");
+    oracle::assert_no_warning(cell.sim(), "halt episode");
     let target = nalgebra::Vector3::new(0.45, -0.25, 0.25);
     assert!((late[0] - target).norm() > 0.1, "the reach was not interrupted");
 }

@@ -1,7 +1,12 @@
 //! The flagship tree on real physics: the reference tutorial's five layouts pass its checks, and
-//! rotated cubes over the whole task region go into the bowl.
+//! rotated cubes over the whole task region go into the bowl — as judged by the independent
+//! oracle of `support/oracle.rs` (MuJoCo contact with the bowl's floor, height, footprint, at
+//! rest), with no MuJoCo warning in any episode.
 
 use std::sync::Arc;
+
+#[path = "support/oracle.rs"]
+mod oracle;
 
 use macrotree::episode::{EpisodeConfig, EpisodeReport, NoObserver, run_in_cell};
 use macrotree::sim::{Layout, Scene};
@@ -11,7 +16,9 @@ fn flagship() -> Arc<macrotree::plan::Plan> {
     Arc::new(macrotree::plan::load_plan(std::path::Path::new(path)).expect("flagship tree is valid"))
 }
 
-fn run_all(layouts: &[Layout]) -> Vec<EpisodeReport> {
+/// Runs the flagship on every layout; after each episode, checks MuJoCo raised no warning and
+/// asks the oracle whether the cube rests in the bowl.
+fn run_all(layouts: &[Layout]) -> Vec<(EpisodeReport, oracle::Verdict)> {
     let scene = Scene::load().expect("scene (run tools/bootstrap)");
     let plan = flagship();
     let mut cell =
@@ -23,7 +30,10 @@ fn run_all(layouts: &[Layout]) -> Vec<EpisodeReport> {
                 layout: *layout,
                 ..EpisodeConfig::default()
             };
-            run_in_cell(&mut cell, plan.clone(), &config, &mut NoObserver)
+            let r = run_in_cell(&mut cell, plan.clone(), &config, &mut NoObserver);
+            oracle::assert_no_warning(cell.sim(), &format!("{layout:?}"));
+            let v = oracle::settle_and_judge(cell.sim_mut(), "cube", "bowl");
+            (r, v)
         })
         .collect()
 }
@@ -31,7 +41,7 @@ fn run_all(layouts: &[Layout]) -> Vec<EpisodeReport> {
 #[test]
 fn reference_layouts_pass_the_tutorial_checks() {
     let layouts = Layout::reference_layouts();
-    for (layout, r) in layouts.iter().zip(run_all(&layouts)) {
+    for (layout, (r, verdict)) in layouts.iter().zip(run_all(&layouts)) {
         let c = &r.checks;
         eprintln!(
             "{layout:?}: success {} in {:.2} s sim, grasp {:?} m, motion {:.3} m, lift {:.3} m, home {:.4} rad",
@@ -66,6 +76,7 @@ fn reference_layouts_pass_the_tutorial_checks() {
             r.cube_final
         );
         assert!(c.pass_reference());
+        assert!(verdict.inside(), "{layout:?}: the oracle disagrees: {verdict:?}");
         assert_eq!(r.grasp_attempts, 1, "{layout:?}: a clean layout needs one grasp");
     }
 }
@@ -99,11 +110,14 @@ fn rotated_cubes_across_the_region_end_in_the_bowl() {
     let failures: Vec<String> = layouts
         .iter()
         .zip(&reports)
-        .filter(|(_, r)| !r.success)
-        .map(|(l, r)| format!("{l:?}: {:?}", r.failure_reason))
+        .filter(|(_, (r, v))| !r.success || !v.inside())
+        .map(|(l, (r, v))| format!("{l:?}: {:?}, oracle {v:?}", r.failure_reason))
         .collect();
-    for (l, r) in layouts.iter().zip(&reports) {
-        eprintln!("{l:?}: {:.2} s sim, {} grasp(s)", r.sim_time_s, r.grasp_attempts);
+    for (l, (r, v)) in layouts.iter().zip(&reports) {
+        eprintln!(
+            "{l:?}: {:.2} s sim, {} grasp(s), oracle offset {:?} of ±{:?} m, height error {:.2e} m",
+            r.sim_time_s, r.grasp_attempts, v.offset, v.allowed, v.height_error
+        );
     }
     assert!(failures.is_empty(), "failed layouts:\n{}", failures.join("\n"));
 }
@@ -128,6 +142,8 @@ fn same_tree_layout_and_seed_give_a_bit_identical_episode() {
     let mut ra = run_in_cell(&mut a, plan.clone(), &config, &mut NoObserver);
     let mut rb = run_in_cell(&mut b, plan, &config, &mut NoObserver);
     assert!(ra.success);
+    oracle::assert_no_warning(a.sim(), "episode a");
+    oracle::assert_no_warning(b.sim(), "episode b");
     assert_eq!(
         a.sim().state_fingerprint(),
         b.sim().state_fingerprint(),

@@ -10,6 +10,9 @@ use macrotree::plan::Plan;
 use macrotree::runtime::{NodeStatus, Transition, TreeRunner};
 use macrotree::sim::{Layout, Scene};
 
+#[path = "support/oracle.rs"]
+mod oracle;
+
 fn scene() -> &'static Scene {
     static SCENE: OnceLock<Scene> = OnceLock::new();
     SCENE.get_or_init(|| Scene::load().expect("scene (run tools/bootstrap)"))
@@ -84,6 +87,8 @@ impl EpisodeObserver for Trace {
 
 struct Outcome {
     report: EpisodeReport,
+    /// The independent oracle's view of cube and bowl after the episode (and extra settling).
+    oracle: oracle::Verdict,
     trace: Trace,
     /// The cube's yaw at the end, folded to [−45°, 45°), radians.
     cube_yaw: f64,
@@ -100,6 +105,8 @@ fn run(plan: &Arc<Plan>, layout: Layout, fault: Option<(FaultKind, u64)>) -> Out
     let mut trace = Trace::default();
     let report = run_in_cell(&mut cell, plan.clone(), &config, &mut trace);
     let cube_yaw = cell.world().cube_yaw();
+    oracle::assert_no_warning(cell.sim(), &format!("{layout:?} {fault:?}"));
+    let verdict = oracle::settle_and_judge(cell.sim_mut(), "cube", "bowl");
     eprintln!(
         "{layout:?} {fault:?}: tree {}, in bowl {}, {:.2} s sim, {} grasp(s), cube at ({:.4}, {:.4}, {:.4}) m, yaw {:.2}°{}",
         report.tree_status,
@@ -118,6 +125,7 @@ fn run(plan: &Arc<Plan>, layout: Layout, fault: Option<(FaultKind, u64)>) -> Out
     );
     Outcome {
         report,
+        oracle: verdict,
         trace,
         cube_yaw,
     }
@@ -150,6 +158,7 @@ fn place_on_table_sets_the_cube_down_square_on_the_spot() {
             o.cube_yaw.to_degrees()
         );
         assert!(!r.checks.in_bowl);
+        assert!(!o.oracle.inside(), "{layout:?}: {:?}", o.oracle);
         assert!(o.trace.reached("cube_at[on the spot?]", NodeStatus::Success));
         let grasps = if fault.is_some() { 2 } else { 1 };
         assert_eq!(r.grasp_attempts, grasps, "{layout:?} {fault:?}");
@@ -162,6 +171,7 @@ fn recenter_and_grasp_recovers_a_missed_taught_pick() {
     // The cube where it was taught: the blind pick works, the recovery never runs.
     let o = run(&plan, Layout::default(), None);
     assert!(o.report.success, "{:?}", o.report.failure_reason);
+    assert!(o.oracle.inside(), "{:?}", o.oracle);
     assert_eq!(o.report.grasp_attempts, 1);
     assert!(
         !o.trace.touched("sequence[recentre]"),
@@ -179,6 +189,7 @@ fn recenter_and_grasp_recovers_a_missed_taught_pick() {
         let r = &o.report;
         assert!(r.success, "{layout:?}: {:?}", r.failure_reason);
         assert!(r.checks.in_bowl);
+        assert!(o.oracle.inside(), "{layout:?}: {:?}", o.oracle);
         assert!(
             o.trace.reached("sequence[taught pick]", NodeStatus::Failure),
             "{layout:?}: the taught pick did not fail"
@@ -233,6 +244,7 @@ fn library_pick_place_puts_the_cube_in_the_bowl() {
     ] {
         let o = run(&plan, layout, fault);
         assert!(o.report.success, "{layout:?}: {:?}", o.report.failure_reason);
+        assert!(o.oracle.inside(), "{layout:?}: {:?}", o.oracle);
         assert!(o.trace.reached("subtree[pick_and_place]", NodeStatus::Success));
         let grasps = if fault.is_some() { 2 } else { 1 };
         assert_eq!(o.report.grasp_attempts, grasps, "{layout:?} {fault:?}");

@@ -11,6 +11,11 @@ use macrotree::runtime::TreeRunner;
 use macrotree::sim::{Layout, Scene};
 use macrotree::sweep::{SweepConfig, run_sweep};
 
+#[path = "support/logs.rs"]
+mod logs;
+#[path = "support/oracle.rs"]
+mod oracle;
+
 fn scene() -> &'static Scene {
     static SCENE: OnceLock<Scene> = OnceLock::new();
     SCENE.get_or_init(|| Scene::load().expect("scene (run tools/bootstrap)"))
@@ -79,6 +84,8 @@ fn a_nudge_really_moves_the_cube_as_the_gripper_closes() {
             report.grasp_attempts
         );
         assert!(report.success, "seed {seed}: {:?}", report.failure_reason);
+        oracle::assert_no_warning(cell.sim(), &format!("seed {seed}"));
+        oracle::assert_in(cell.sim_mut(), "cube", "bowl", &format!("seed {seed}"));
         assert!(
             moved.max > 0.005,
             "seed {seed}: the cube moved only {:.1} mm",
@@ -106,8 +113,10 @@ fn every_fault_fires_exactly_once_in_an_episode() {
             seed: 7,
             ..EpisodeConfig::default()
         };
-        let report = run_in_cell(&mut cell, plan(), &config, &mut macrotree::episode::NoObserver);
+        let (report, lines) =
+            logs::capture(|| run_in_cell(&mut cell, plan(), &config, &mut macrotree::episode::NoObserver));
         cell.observers.clear();
+        oracle::assert_no_warning(cell.sim(), kind.name());
         let event = log.lock().unwrap().clone();
         let event = event.unwrap_or_else(|| panic!("{kind} never fired"));
         eprintln!(
@@ -115,5 +124,15 @@ fn every_fault_fires_exactly_once_in_an_episode() {
             event.detail, event.time, report.success
         );
         assert_eq!(event.kind, kind);
+        // Every firing is logged, and there is exactly one: one `fault KIND:` line, at the
+        // recorded time.
+        let fired: Vec<&String> = lines
+            .iter()
+            .filter(|l| l.contains(&format!("fault {kind}: ")))
+            .collect();
+        assert_eq!(fired.len(), 1, "{kind}: {fired:#?}");
+        assert!(fired[0].contains(&event.detail), "{kind}: {}", fired[0]);
+        assert!(report.success, "{kind}: {:?}", report.failure_reason);
+        oracle::assert_in(cell.sim_mut(), "cube", "bowl", kind.name());
     }
 }

@@ -14,6 +14,11 @@ use macrotree::sweep::{SweepConfig, run_sweep, sample_scenario};
 use macrotree::world::CUBE_HALF;
 use nalgebra::Vector3;
 
+#[path = "support/logs.rs"]
+mod logs;
+#[path = "support/oracle.rs"]
+mod oracle;
+
 fn scene() -> &'static Scene {
     static SCENE: OnceLock<Scene> = OnceLock::new();
     SCENE.get_or_init(|| Scene::load().expect("scene (run tools/bootstrap)"))
@@ -55,9 +60,13 @@ fn a_slip_drops_the_cube_and_the_tree_picks_it_up_where_it_fell() {
     let (slip, log) = injector_with_log(FaultKind::Slip, config.seed);
     cell.observers.push(slip);
     let mut trace = Trace::default();
-    let report = run_in_cell(&mut cell, plan(), &config, &mut trace);
+    let (report, lines) = logs::capture(|| run_in_cell(&mut cell, plan(), &config, &mut trace));
     assert!(report.success, "{:?}", report.failure_reason);
     assert_eq!(report.grasp_attempts, 2);
+    oracle::assert_no_warning(cell.sim(), "slip episode");
+    // The slip fired once, and said so once.
+    let fired = lines.iter().filter(|l| l.contains("fault slip: ")).count();
+    assert_eq!(fired, 1, "logged firings: {lines:#?}");
 
     let fired = log.lock().unwrap().clone().expect("the slip fired");
     assert_eq!(fired.kind, FaultKind::Slip);
@@ -86,6 +95,23 @@ fn a_slip_drops_the_cube_and_the_tree_picks_it_up_where_it_fell() {
     .expect("the carry stops");
     let guard_fails =
         pos(&|t| t.kind == "guard" && t.to == NodeStatus::Failure).expect("the guarded carry fails");
+    // The guard stopped the carry: the carry did not fail on its own, it was halted in the same
+    // tick, and its reason names the guard and its condition (not an ancestor further up).
+    let (carry, guard) = (&tr[carry_stops], &tr[guard_fails]);
+    assert_eq!(carry.to, NodeStatus::Halted, "{carry:?}");
+    assert_eq!(carry.tick, guard.tick, "halted in the tick the guard failed");
+    assert_eq!(
+        carry.reason.as_deref(),
+        Some(
+            format!(
+                "preempted: `{}` failed (condition failed: cube_grasped: not satisfied)",
+                guard.path
+            )
+            .as_str()
+        ),
+        "{carry:?}"
+    );
+    assert!(guard.path.ends_with("guard[carry while held]"), "{}", guard.path);
     // retry: the next grasp runs in attempt 2 …
     let regrasp = pos(&|t| leaf(t) == "grasp" && t.to == NodeStatus::Running && t.attempt == Some(2))
         .expect("a second grasp in attempt 2");
@@ -109,6 +135,7 @@ fn a_slip_drops_the_cube_and_the_tree_picks_it_up_where_it_fell() {
         "the cube lies at {landed:?} after the fall and at {at_regrasp:?} at the re-grasp"
     );
     assert!(at_regrasp.z < CUBE_HALF + 0.003, "re-grasped from the table");
+    oracle::assert_in(cell.sim_mut(), "cube", "bowl", "after the slip");
 }
 
 #[test]
@@ -152,6 +179,7 @@ fn a_slip_is_deterministic_and_fires_once() {
             ..EpisodeConfig::default()
         };
         let mut report = run_in_cell(&mut cell, plan(), &config, &mut macrotree::episode::NoObserver);
+        oracle::assert_no_warning(cell.sim(), &format!("seed {seed}"));
         report.wall_time_s = 0.0;
         let event = log.lock().unwrap().clone().expect("fired");
         (report, event, cell.sim().state_fingerprint())

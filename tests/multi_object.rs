@@ -4,15 +4,26 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use macrotree::episode::{EpisodeConfig, EpisodeReport, NoObserver, run_episode};
+use macrotree::actions::{CONTROL_PERIOD, Cell};
+use macrotree::episode::{EpisodeConfig, EpisodeReport, NoObserver, run_episode, run_in_cell};
 use macrotree::plan::load_plan;
-use macrotree::sim::{Scene, Sim};
+use macrotree::sim::{Layout, Scene, Sim};
 use macrotree::sweep::SweepConfig;
+
+#[path = "support/oracle.rs"]
+mod oracle;
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
-/// Scenario `k` of sweep seed `s` of `tree` on its own scene, as `run --scenario k --sweep-seed s`.
-fn run_scenario(tree: &str, s: u64, k: u64, fault: Option<macrotree::faults::FaultKind>) -> EpisodeReport {
+/// Scenario `k` of sweep seed `s` of `tree` on its own scene, as `run --scenario k --sweep-seed s`;
+/// the report and the cell it ran in (its final state, for the oracle). Asserts MuJoCo raised no
+/// warning.
+fn run_scenario(
+    tree: &str,
+    s: u64,
+    k: u64,
+    fault: Option<macrotree::faults::FaultKind>,
+) -> (EpisodeReport, Cell) {
     let plan = Arc::new(load_plan(&Path::new(ROOT).join(tree)).unwrap_or_else(|d| panic!("{}", d[0])));
     let scene = Scene::load_spec(&plan.scene).expect("scene compiles");
     let sweep = SweepConfig {
@@ -21,12 +32,15 @@ fn run_scenario(tree: &str, s: u64, k: u64, fault: Option<macrotree::faults::Fau
         ..SweepConfig::default()
     };
     let scenario = sweep.scene_scenario(&scene, k).expect("a placement");
-    run_episode(
-        &scene,
+    let mut cell = Cell::new(&scene, &Layout::default(), CONTROL_PERIOD);
+    let r = run_in_cell(
+        &mut cell,
         plan,
         &sweep.scene_episode_config(&scenario),
         &mut NoObserver,
-    )
+    );
+    oracle::assert_no_warning(cell.sim(), &format!("{tree} #{k}"));
+    (r, cell)
 }
 
 fn assert_done(r: &EpisodeReport, what: &str) {
@@ -41,7 +55,7 @@ fn assert_done(r: &EpisodeReport, what: &str) {
 #[test]
 fn sort_by_color_puts_every_block_in_the_bin_of_its_colour() {
     for k in [0, 1] {
-        let r = run_scenario("trees/sort_by_color.yaml", 0, k, None);
+        let (r, mut cell) = run_scenario("trees/sort_by_color.yaml", 0, k, None);
         assert_done(&r, "sort");
         // Independently of the predicate code: each block's final centre lies inside the walls
         // (12 cm inner, so within 6 cm in x and y) of the bin of its colour, on its floor.
@@ -61,12 +75,17 @@ fn sort_by_color_puts_every_block_in_the_bin_of_its_colour() {
             );
         }
         assert!(r.sim_time_s < 3.0 * 6.0, "{} s for three blocks", r.sim_time_s);
+        // The oracle: MuJoCo contact with the bin's floor, height, footprint, at rest.
+        for colour in ["red", "green", "blue"] {
+            let bin = format!("{colour}_bin");
+            oracle::assert_in(cell.sim_mut(), colour, &bin, &format!("sort #{k}"));
+        }
     }
 }
 
 #[test]
 fn stack_three_builds_the_tower() {
-    let r = run_scenario("trees/stack_three.yaml", 0, 3, None);
+    let (r, _) = run_scenario("trees/stack_three.yaml", 0, 3, None);
     assert_done(&r, "stack");
     let z = |n: &str| r.objects.iter().find(|o| o.name == n).unwrap().end;
     let (red, green, blue) = (z("red"), z("green"), z("blue"));
@@ -80,7 +99,7 @@ fn stack_three_builds_the_tower() {
 
 #[test]
 fn clear_table_puts_every_block_in_the_bin() {
-    let r = run_scenario("trees/clear_table.yaml", 0, 0, None);
+    let (r, mut cell) = run_scenario("trees/clear_table.yaml", 0, 0, None);
     assert_done(&r, "clear");
     let bin = r.objects.iter().find(|o| o.name == "bin").unwrap().end;
     for o in r.objects.iter().filter(|o| o.name != "bin") {
@@ -90,17 +109,28 @@ fn clear_table_puts_every_block_in_the_bin() {
             o.name
         );
     }
+    for block in ["a", "b", "c", "d", "e"] {
+        oracle::assert_in(cell.sim_mut(), block, "bin", "clear");
+    }
 }
 
 #[test]
 fn a_slip_hits_the_carried_block_and_the_task_still_finishes() {
-    let r = run_scenario(
+    let (r, mut cell) = run_scenario(
         "trees/sort_by_color.yaml",
         0,
         0,
         Some(macrotree::faults::FaultKind::Slip),
     );
     assert_done(&r, "sort with a slip");
+    for colour in ["red", "green", "blue"] {
+        oracle::assert_in(
+            cell.sim_mut(),
+            colour,
+            &format!("{colour}_bin"),
+            "sort with a slip",
+        );
+    }
     assert!(
         r.grasp_attempts >= 4,
         "one block was grasped twice: {}",

@@ -444,9 +444,49 @@ fn halted_transition_names_the_preempting_node() {
     assert_eq!(halted[0].path, "main/timeout/sequence");
     assert_eq!(
         halted[0].reason.as_deref(),
-        Some("preempted: `main/timeout` failed")
+        Some("preempted: `main/timeout` failed (timeout 0.2 s expired)")
     );
     assert_eq!(halted[1].path, "main/timeout/sequence/home");
+    // The sequence between them was halted in the same pass: the leaf names the timeout that
+    // finished, not the halted sequence.
+    assert_eq!(halted[1].reason, halted[0].reason);
+}
+
+/// Issue 13, item 16: a guard whose condition fails halts its running child, and the child's
+/// halt reason names the guard (its path) and the condition — not an ancestor further up.
+#[test]
+fn a_failing_guard_is_named_in_its_childs_halt_reason() {
+    let p = plan(
+        "main: {retry: {attempts: 2, child: {fallback: {children: [{sequence: {children: [{guard: {name: held, condition: {cube_grasped: {}}, child: {carry: {}}}}]}}]}}}}",
+    );
+    let mut d = ScriptedDriver::new(&p);
+    d.set("carry", Running);
+    d.script("cube_grasped", [Success, Success]);
+    d.eventually("cube_grasped", fail("slipped"));
+    let mut r = TreeRunner::new(p.clone());
+    run(&mut r, &mut d, 4);
+    let t = r.drain_transitions();
+    let halted: Vec<_> = t
+        .iter()
+        .filter(|t| t.to == NodeStatus::Halted && t.kind == "carry")
+        .collect();
+    assert!(!halted.is_empty(), "{t:#?}");
+    let guard = t
+        .iter()
+        .find(|t| t.kind == "guard" && t.to == NodeStatus::Failure)
+        .expect("the guard failed");
+    assert_eq!(halted[0].tick, guard.tick);
+    assert_eq!(
+        halted[0].reason.as_deref(),
+        Some(
+            format!(
+                "preempted: `{}` failed (condition failed: cube_grasped: slipped)",
+                guard.path
+            )
+            .as_str()
+        ),
+        "{t:#?}"
+    );
 }
 
 #[test]

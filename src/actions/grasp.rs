@@ -34,12 +34,21 @@ impl Grasp {
 
 impl MacroAction for Grasp {
     fn start(&mut self, cell: &mut Cell) -> Result<(), String> {
-        cell.hold();
+        // The arm holds still — unless a sibling action (in a `parallel`) is moving it.
+        if cell.arm_motion_finished() {
+            cell.hold();
+        }
         let ctrl = self.spec.width.map_or(CLOSED_CTRL, ctrl_for_width);
         cell.set_gripper(ctrl);
         self.t0 = cell.world().time;
         self.stalled = 0;
         Ok(())
+    }
+
+    /// Preempted: the arm holds, and the fingers stop at the opening they have now (a finger on
+    /// a block keeps its command, so a grip is not loosened).
+    fn halt(&mut self, cell: &mut Cell) {
+        super::macro_action::freeze_gripper(cell);
     }
 
     fn update(&mut self, cell: &mut Cell) -> Progress {

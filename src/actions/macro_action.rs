@@ -26,6 +26,19 @@ pub trait MacroAction: Send {
     }
 }
 
+/// The halt of a gripper motion: the arm holds where it is commanded to be, and the fingers stop
+/// at their current opening — unless a pad touches a block (then the command stays, so a grip
+/// is not loosened).
+pub(crate) fn freeze_gripper(cell: &mut Cell) {
+    cell.hold();
+    let w = cell.world();
+    let touching = (0..w.objects.len()).any(|i| !w.released(i));
+    if !touching {
+        let ctrl = crate::motion::gripper::ctrl_for_width(w.gripper_width);
+        cell.set_gripper(ctrl);
+    }
+}
+
 /// Decides when an arm motion has arrived — or is blocked.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Arrival {

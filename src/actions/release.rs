@@ -46,7 +46,10 @@ impl Release {
 
 impl MacroAction for Release {
     fn start(&mut self, cell: &mut Cell) -> Result<(), String> {
-        cell.hold();
+        // The arm holds still — unless a sibling action (in a `parallel`) is moving it.
+        if cell.arm_motion_finished() {
+            cell.hold();
+        }
         let (ctrl, width) = match self.spec.width {
             Some(w) => (ctrl_for_width(w), w.min(width_for_ctrl(OPEN_CTRL))),
             None => (OPEN_CTRL, width_for_ctrl(OPEN_CTRL)),
@@ -57,6 +60,12 @@ impl MacroAction for Release {
         self.t0 = cell.world().time;
         self.stalled = 0;
         Ok(())
+    }
+
+    /// Preempted: the arm holds, and the fingers stop at the opening they have now (a finger on
+    /// a block keeps its command, so a grip is not loosened).
+    fn halt(&mut self, cell: &mut Cell) {
+        super::macro_action::freeze_gripper(cell);
     }
 
     fn update(&mut self, cell: &mut Cell) -> Progress {

@@ -51,6 +51,22 @@ pub struct BenchReport {
     pub ik_us_per_solve: f64,
     /// Repetitions behind each median.
     pub repeat: usize,
+    /// The episode's final physics state ([`Sim::state_fingerprint`]: qpos, qvel, ctrl, time as
+    /// bits), hashed with 64-bit FNV-1a over the little-endian bytes, as 16 hex digits.
+    pub state_fingerprint: String,
+    /// The replay of the recorded controls ended in exactly the episode's final state (bit for
+    /// bit); `null` with a fault, which acts through forces and moves the controls do not hold.
+    pub replay_matches_episode: Option<bool>,
+}
+
+/// 64-bit FNV-1a of `bits` (each as 8 little-endian bytes), as 16 hex digits.
+fn fnv1a_hex(bits: &[u64]) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in bits.iter().flat_map(|v| v.to_le_bytes()) {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    format!("{h:016x}")
 }
 
 struct Recorder(Arc<Mutex<Vec<f64>>>);
@@ -84,6 +100,7 @@ pub fn bench(args: BenchArgs) -> Result<(), CliError> {
     let mut episode_times = Vec::new();
     let mut replay_times = Vec::new();
     let mut last = None;
+    let mut states = None;
     for _ in 0..repeat {
         let controls = Arc::new(Mutex::new(Vec::new()));
         let mut cell = Cell::new(&scene, &config.layout, config.control_period);
@@ -94,12 +111,19 @@ pub fn bench(args: BenchArgs) -> Result<(), CliError> {
         let report = run_in_cell(&mut cell, plan.clone(), &config, &mut NoObserver);
         episode_times.push(t.elapsed().as_secs_f64());
         let controls = controls.lock().expect("recorder lock").clone();
-        replay_times.push(replay(&scene, &placement, &controls));
+        let (wall, replayed) = replay(&scene, &placement, &controls);
+        replay_times.push(wall);
+        states = Some((cell.sim().state_fingerprint(), replayed));
         last = Some(report);
     }
     let report = last.expect("repeat >= 1");
     let episode = median(episode_times);
     let replay = median(replay_times);
+    let (episode_state, replay_state) = states.expect("repeat >= 1");
+    let matches = config.fault.is_none().then(|| episode_state == replay_state);
+    if matches == Some(false) {
+        tracing::warn!(target: "macrotree::bench", "the replay of the recorded controls did not end in the episode's final state");
+    }
     let result = BenchReport {
         episode_wall_time_s: episode,
         replay_wall_time_s: replay,
@@ -109,6 +133,8 @@ pub fn bench(args: BenchArgs) -> Result<(), CliError> {
         success: report.success,
         ik_us_per_solve: crate::motion::ik_benchmark(10_000),
         repeat,
+        state_fingerprint: fnv1a_hex(&episode_state),
+        replay_matches_episode: matches,
     };
     println!(
         "episode {:.4} s wall, replay (bare mj_step) {:.4} s wall, ratio {:.3}; {:.2} s simulated, {} steps, success {}; IK {:.2} µs/solve (median of {repeat})",
@@ -120,6 +146,17 @@ pub fn bench(args: BenchArgs) -> Result<(), CliError> {
         result.success,
         result.ik_us_per_solve
     );
+    if let Some(m) = result.replay_matches_episode {
+        println!(
+            "final state {}: the replay {} the episode",
+            result.state_fingerprint,
+            if m {
+                "ends exactly where"
+            } else {
+                "does NOT end where"
+            }
+        );
+    }
     if args.json {
         println!(
             "{}",
@@ -129,8 +166,9 @@ pub fn bench(args: BenchArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Wall time of stepping a fresh simulation through `controls` (nu values per step), seconds.
-fn replay(scene: &Scene, placement: &crate::scene::Placement, controls: &[f64]) -> f64 {
+/// Wall time of stepping a fresh simulation through `controls` (nu values per step), seconds,
+/// and the state it ends in ([`Sim::state_fingerprint`]).
+fn replay(scene: &Scene, placement: &crate::scene::Placement, controls: &[f64]) -> (f64, Vec<u64>) {
     let mut sim = Sim::new(scene);
     sim.reset_placement(placement);
     let nu = sim.ctrl().len();
@@ -139,5 +177,6 @@ fn replay(scene: &Scene, placement: &crate::scene::Placement, controls: &[f64]) 
         sim.set_ctrl(ctrl);
         sim.step();
     }
-    t.elapsed().as_secs_f64()
+    let wall = t.elapsed().as_secs_f64();
+    (wall, sim.state_fingerprint())
 }

@@ -580,23 +580,36 @@ impl RunState {
             }
             let reason = match parent {
                 Some(_) if !parent_running => {
-                    // The nearest ancestor that stopped running is the one that preempted us.
-                    let stopped = self.ancestors[i]
+                    // The preempting node is the nearest ancestor that finished (a guard whose
+                    // condition failed, a timeout that fired); ancestors halted in this pass
+                    // were preempted themselves. Without one, the topmost stopped ancestor.
+                    let stopped: Vec<usize> = self.ancestors[i]
                         .iter()
                         .rev()
-                        .take_while(|&&a| self.statuses[a] != NodeStatus::Running)
-                        .last()
                         .copied()
+                        .take_while(|&a| self.statuses[a] != NodeStatus::Running)
+                        .collect();
+                    let by = stopped
+                        .iter()
+                        .copied()
+                        .find(|&a| self.statuses[a] != NodeStatus::Halted)
+                        .or(stopped.last().copied())
                         .unwrap_or(i);
-                    format!(
+                    let mut reason = format!(
                         "preempted: `{}` {}",
-                        plan.nodes[stopped].path,
-                        match self.statuses[stopped] {
+                        plan.nodes[by].path,
+                        match self.statuses[by] {
                             NodeStatus::Halted => "was halted",
                             NodeStatus::Success => "succeeded",
                             _ => "failed",
                         }
-                    )
+                    );
+                    if self.statuses[by] == NodeStatus::Failure
+                        && let Some(why) = &self.reasons[by]
+                    {
+                        reason.push_str(&format!(" ({why})"));
+                    }
+                    reason
                 }
                 _ => "preempted: no longer ticked by its parent".to_string(),
             };

@@ -48,11 +48,17 @@ pub fn cube_lifted(w: &World, min_height: f64) -> bool {
 }
 
 /// The cube is at rest (speed below `rest_speed`, m/s) inside the bowl, released: its centre
-/// within the inner footprint and below the rim, and no pad touching it (a cube squeezed onto the
-/// rim by a closed gripper is not in the bowl).
+/// at most (inner half-width − the cube's half-size) from the bowl's centre along each axis — so
+/// the whole cube fits between the walls — and below the rim, and no pad touching it (a cube
+/// squeezed onto the rim by a closed gripper is not in the bowl).
 pub fn cube_in_bowl(w: &World, rest_speed: f64) -> bool {
     let d = w.cube_pos - w.bowl_pos;
-    let inside = d.x.abs() < w.bowl.inner_half_width && d.y.abs() < w.bowl.inner_half_width;
+    let half = w
+        .scene
+        .legacy_cube()
+        .map_or(super::CUBE_HALF, |c| w.spec(c).shape.footprint_half()[0]);
+    let room = w.bowl.inner_half_width - half;
+    let inside = d.x.abs() <= room && d.y.abs() <= room;
     let below_rim = w.cube_pos.z < w.bowl.rim_height;
     let released = !(w.left_pad_contact || w.right_pad_contact);
     inside && below_rim && released && w.cube_linvel.norm() < rest_speed
@@ -234,6 +240,16 @@ mod tests {
         let mut on_rim = w.clone();
         on_rim.cube_pos.x = 0.45 + 0.08;
         assert!(!cube_in_bowl(&on_rim, Tolerances::REST_SPEED));
+        // The whole cube must fit between the walls: its centre at most 0.075 − 0.022 m from the
+        // bowl's centre (issue 13, item 15: the centre alone within 0.075 m was accepted).
+        let mut flush = w.clone();
+        flush.cube_pos.x = w.bowl_pos.x + 0.075 - CUBE_HALF - 1e-9;
+        assert!(cube_in_bowl(&flush, Tolerances::REST_SPEED));
+        let mut in_wall = w.clone();
+        in_wall.cube_pos.x = w.bowl_pos.x + 0.075 - CUBE_HALF + 0.001;
+        assert!(!cube_in_bowl(&in_wall, Tolerances::REST_SPEED));
+        in_wall.cube_pos.x = w.bowl_pos.x + 0.074;
+        assert!(!cube_in_bowl(&in_wall, Tolerances::REST_SPEED));
         assert!(!cube_in_bowl(&resting(), Tolerances::REST_SPEED));
     }
 

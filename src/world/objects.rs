@@ -177,7 +177,9 @@ impl World {
             .find(|&i| self.holds(i, off_axis))
     }
 
-    /// Block `i`'s centre lies inside container `c`'s walls, below its rim.
+    /// Block `i` lies inside container `c`'s walls, below its rim: its centre at most (inner
+    /// half-width − its half-size) from the container's centre along each of the container's
+    /// axes, so the whole block fits between the walls.
     pub fn inside(&self, i: usize, c: usize) -> bool {
         let Shape::Container {
             inner_half,
@@ -186,9 +188,10 @@ impl World {
         else {
             return false;
         };
+        let [half, _] = self.spec(i).shape.footprint_half();
         let d = self.local_xy(c, &self.objects[i].pos);
-        d.x.abs() < inner_half[0]
-            && d.y.abs() < inner_half[1]
+        d.x.abs() <= inner_half[0] - half
+            && d.y.abs() <= inner_half[1] - half
             && self.objects[i].pos.z < self.objects[c].pos.z + wall_height
     }
 
