@@ -69,8 +69,20 @@ pub enum CliError {
     TaskFailed,
 }
 
+/// When the process started (as near as [`main`] can tell).
+static STARTED: std::sync::OnceLock<std::time::Instant> = std::sync::OnceLock::new();
+
+/// Seconds since the process started ([`main`] was entered).
+fn process_elapsed_s() -> f64 {
+    STARTED
+        .get_or_init(std::time::Instant::now)
+        .elapsed()
+        .as_secs_f64()
+}
+
 /// Entry point of the `macrotree` binary.
 pub fn main() -> ExitCode {
+    STARTED.get_or_init(std::time::Instant::now);
     let cli = Cli::parse();
     let quiet = matches!(cli.command, Command::Bench(_) | Command::Sweep(_));
     logging::init(cli.verbose, cli.log_format, quiet);

@@ -27,7 +27,7 @@ use std::ops::ControlFlow;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::str::FromStr;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::time::Instant;
 
@@ -449,6 +449,8 @@ pub struct SweepRun {
     pub wall_time_s: f64,
     /// Worker threads used.
     pub jobs: usize,
+    /// Wall-clock time the workers spent inside `mj_step`, summed over workers, seconds.
+    pub physics_time_s: f64,
 }
 
 /// Runs the sweep on `config.jobs` worker threads (one [`Cell`] each) and calls `on_result` on
@@ -487,16 +489,24 @@ pub fn run_sweep_from(
     let mut results = Vec::with_capacity(indices.len().min(4096));
     let (tx, rx) = mpsc::channel::<(usize, ScenarioResult)>();
     let stop = AtomicBool::new(false);
+    let physics_ns = AtomicU64::new(0);
     std::thread::scope(|s| {
         let stop = &stop;
+        let physics_ns = &physics_ns;
         s.spawn(move || {
             let new_cell = || Cell::new(scene, &Layout::default(), CONTROL_PERIOD);
             pool.install(|| {
                 // par_bridge hands out scenarios in index order, so results arrive nearly in order.
                 let todo = indices.take_while(|_| !stop.load(Ordering::Relaxed)).enumerate();
                 todo.par_bridge().for_each_init(new_cell, |cell, (pos, index)| {
+                    let before = cell.sim().physics_time();
                     let outcome =
                         catch_unwind(AssertUnwindSafe(|| run_scene_scenario(cell, plan, config, index)));
+                    let spent = cell.sim().physics_time().saturating_sub(before);
+                    physics_ns.fetch_add(
+                        u64::try_from(spent.as_nanos()).unwrap_or(u64::MAX),
+                        Ordering::Relaxed,
+                    );
                     let result = outcome.unwrap_or_else(|payload| {
                         *cell = new_cell();
                         let s = config.scene_scenario(scene, index).ok();
@@ -534,6 +544,7 @@ pub fn run_sweep_from(
         results,
         wall_time_s: wall.elapsed().as_secs_f64(),
         jobs,
+        physics_time_s: physics_ns.load(Ordering::Relaxed) as f64 * 1e-9,
     })
 }
 
