@@ -118,9 +118,19 @@ fn invalid(diags: Vec<crate::spec::Diagnostic>, what: String) -> CliError {
     ))
 }
 
-/// Loads and compiles a tree, or returns its diagnostics as a bad-input error.
+/// Loads and compiles a tree, or returns its diagnostics as a bad-input error. Warnings are
+/// printed on stderr.
 fn load_plan_or_exit(path: &std::path::Path) -> Result<crate::plan::Plan, CliError> {
-    crate::plan::load_plan(path).map_err(|diags| invalid(diags, path.display().to_string()))
+    let plan = crate::plan::load_plan(path).map_err(|diags| invalid(diags, path.display().to_string()))?;
+    print_warnings(&plan);
+    Ok(plan)
+}
+
+/// Prints the tree's warnings on stderr.
+fn print_warnings(plan: &crate::plan::Plan) {
+    for w in &plan.warnings {
+        eprintln!("{w}");
+    }
 }
 
 /// Loads a tree for the scene it runs on — `scene_file` (a `--scene` override) when given, else
@@ -134,8 +144,12 @@ fn load_task(
         Some(path) => {
             let scene = crate::scene::load_scene_file(path)
                 .map_err(|diags| invalid(diags, path.display().to_string()))?;
-            crate::plan::load_plan_for(tree, Some(std::sync::Arc::new(scene)))
-                .map_err(|diags| invalid(diags, format!("{} for scene {}", tree.display(), path.display())))?
+            let plan =
+                crate::plan::load_plan_for(tree, Some(std::sync::Arc::new(scene))).map_err(|diags| {
+                    invalid(diags, format!("{} for scene {}", tree.display(), path.display()))
+                })?;
+            print_warnings(&plan);
+            plan
         }
         None => load_plan_or_exit(tree)?,
     };
