@@ -106,12 +106,23 @@ fn failures_exit_1_and_their_printed_command_reproduces_them() {
     let cmd = f["reproduce"].as_str().expect("reproduce");
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains(cmd), "the human summary prints the command too");
-    // Run the printed command and compare its report with the sweep's.
+    // Run the printed command as printed, from the repository, with a shell (the binary under
+    // test is not on PATH, so the command names it by its path), and compare its report with
+    // the sweep's.
     let words: Vec<&str> = cmd.split_whitespace().collect();
-    assert_eq!(&words[..2], ["macrotree", "run"]);
-    let mut args = words[1..].to_vec();
-    args.push("--json");
-    let again = macrotree(&args);
+    let bin = std::path::Path::new(cli::BIN).canonicalize().unwrap();
+    let repo = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .canonicalize()
+        .unwrap();
+    let expected = bin.strip_prefix(&repo).unwrap_or(&bin).display().to_string();
+    assert_eq!(&words[..2], [expected.as_str(), "run"], "{cmd}");
+    let again = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!("{cmd} --json"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env_remove("RUST_LOG")
+        .output()
+        .expect("runs the printed command");
     assert_eq!(again.status.code(), Some(1), "{cmd}");
     let r = last_json_line(&again);
     let sweep = macrotree(&[

@@ -133,13 +133,20 @@ impl<'a> MacroDriver<'a> {
             ConditionLeaf::CubeLifted(c) => cond::cube_lifted(w, c.min_height),
             ConditionLeaf::CubeInBowl(c) => cond::cube_in_bowl(w, c.rest_speed),
             ConditionLeaf::CubeOnTable(c) => cond::cube_on_table(w, c.tolerance, c.rest_speed),
-            ConditionLeaf::CubeAt(c) => cond::cube_at(
-                w,
-                c.point,
-                c.tolerance,
-                cond::Tolerances::ON_TABLE_HEIGHT,
-                c.rest_speed,
-            ),
+            ConditionLeaf::CubeAt(c) => {
+                let turned = c.yaw.is_none_or(|target| {
+                    crate::world::snapshot::fold_quarter_turn(w.cube_yaw() - target.0).abs()
+                        <= c.yaw_tolerance
+                });
+                turned
+                    && cond::cube_at(
+                        w,
+                        c.point,
+                        c.tolerance,
+                        cond::Tolerances::ON_TABLE_HEIGHT,
+                        c.rest_speed,
+                    )
+            }
             ConditionLeaf::GripperOpen(c) => cond::gripper_open(w, c.min_width),
             ConditionLeaf::AtHome(c) => cond::at_home(w, c.tolerance),
         })
@@ -237,8 +244,9 @@ impl LeafDriver for MacroDriver<'_> {
         let active = self.active.get_mut(&id).expect("checked above");
         let mut progress = active.action.update(self.cell);
         if progress == Progress::Running && now >= active.deadline {
+            let waiting = active.action.waiting_for(self.cell);
             active.action.halt(self.cell);
-            progress = Progress::Failed(format!("timeout: not done after {:.2} s", active.timeout));
+            progress = Progress::Failed(format!("timeout after {:.2} s: {waiting}", active.timeout));
         }
         self.finish(id, leaf, progress)
     }

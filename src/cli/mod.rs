@@ -69,6 +69,30 @@ pub enum CliError {
     TaskFailed,
 }
 
+/// How a command printed for people to run (a sweep's reproduction commands) names this
+/// program: `macrotree` when that name on `PATH` is this very binary (e.g. after
+/// `cargo install --path .`); otherwise the path of this binary, relative to the current folder
+/// when it lies inside it (`target/release/macrotree` from the repository), else absolute.
+pub fn program_name() -> String {
+    let Some(exe) = std::env::current_exe().ok().and_then(|p| p.canonicalize().ok()) else {
+        return "macrotree".to_string();
+    };
+    let on_path = std::env::var_os("PATH").is_some_and(|paths| {
+        std::env::split_paths(&paths).any(|dir| dir.join("macrotree").canonicalize().is_ok_and(|p| p == exe))
+    });
+    if on_path {
+        return "macrotree".to_string();
+    }
+    let cwd = std::env::current_dir().ok().and_then(|d| d.canonicalize().ok());
+    let shown = match cwd.as_deref().and_then(|d| exe.strip_prefix(d).ok()) {
+        // `./macrotree`, not `macrotree` (which the shell would look up on PATH).
+        Some(rel) if rel.components().count() == 1 => std::path::Path::new(".").join(rel),
+        Some(rel) => rel.to_path_buf(),
+        None => exe.clone(),
+    };
+    crate::sweep::shell_quote(&shown.display().to_string())
+}
+
 /// When the process started (as near as [`main`] can tell).
 static STARTED: std::sync::OnceLock<std::time::Instant> = std::sync::OnceLock::new();
 

@@ -77,6 +77,7 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
         shard: args.shard,
         max_sim_time: args.max_sim_time,
         scene_file: args.scene.as_ref().map(|p| p.display().to_string()),
+        program: super::program_name(),
     };
     let total = config.indices().len() as u64;
     if total == 0 {

@@ -101,6 +101,9 @@ pub struct SweepConfig {
     pub max_sim_time: f64,
     /// The `--scene` file the sweep was given, if any (printed in reproduction commands).
     pub scene_file: Option<String>,
+    /// How reproduction commands name the program (`macrotree` when it is on `PATH`, else the
+    /// path of the binary that ran, e.g. `target/release/macrotree`), shell-quoted.
+    pub program: String,
 }
 
 impl Default for SweepConfig {
@@ -114,6 +117,7 @@ impl Default for SweepConfig {
             shard: None,
             max_sim_time: EpisodeConfig::default().max_sim_time,
             scene_file: None,
+            program: "macrotree".to_string(),
         }
     }
 }
@@ -362,12 +366,14 @@ impl ScenarioResult {
         serde_json::to_string(self).expect("a scenario result serializes")
     }
 
-    /// The `macrotree run …` command that reproduces this scenario bit for bit. Floats are
+    /// The `macrotree run …` command that reproduces this scenario bit for bit (the program
+    /// named as [`SweepConfig::program`] says). Floats are
     /// printed with Rust's shortest round-trip formatting, so they parse back to the same bits.
     pub fn reproduce(&self, tree: &str, config: &SweepConfig) -> String {
         let mut cmd = match &self.layout {
             Some(l) => format!(
-                "macrotree run {} --cube {},{},{} --bowl {},{} --seed {}",
+                "{} run {} --cube {},{},{} --bowl {},{} --seed {}",
+                config.program,
                 shell_quote(tree),
                 l.cube[0],
                 l.cube[1],
@@ -377,7 +383,8 @@ impl ScenarioResult {
                 self.seed
             ),
             None => format!(
-                "macrotree run {} --sweep-seed {} --scenario {}",
+                "{} run {} --sweep-seed {} --scenario {}",
+                config.program,
                 shell_quote(tree),
                 self.sweep_seed,
                 self.index
@@ -400,7 +407,7 @@ impl ScenarioResult {
 }
 
 /// Quotes `s` for a POSIX shell when it holds anything but `[A-Za-z0-9_./+-]`.
-fn shell_quote(s: &str) -> String {
+pub fn shell_quote(s: &str) -> String {
     if !s.is_empty()
         && s.chars()
             .all(|c| c.is_ascii_alphanumeric() || "_./+-".contains(c))
