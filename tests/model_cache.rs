@@ -11,7 +11,7 @@ use std::sync::Arc;
 use cli::{s, scratch};
 use macrotree::episode::{EpisodeConfig, EpisodeReport, NoObserver, run_episode};
 use macrotree::scene::SceneSpec;
-use macrotree::sim::cache::{model_key, model_path};
+use macrotree::sim::cache::{model_key, model_key_stamped, model_path};
 use macrotree::sim::scene::{SCENE_XML, menagerie_dir};
 use macrotree::sim::{ModelOrigin, Scene};
 
@@ -62,8 +62,17 @@ fn another_scene_is_another_key_and_is_compiled() {
         "a changed scene is never served the old model"
     );
     assert_eq!(scene.objects.len(), other.objects.len());
-    let files = std::fs::read_dir(&dir).unwrap().count();
-    assert_eq!(files, 2, "one file per model");
+    let models = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .ends_with(".mjb")
+        })
+        .count();
+    assert_eq!(models, 2, "one file per model");
 }
 
 #[test]
@@ -125,6 +134,33 @@ fn a_changed_menagerie_file_changes_the_key() {
         model_key(&scene.replace("<mujoco", "<mujoco "), &real).unwrap(),
         original,
         "an edited scene MJCF"
+    );
+    // The remembered digest gives the same keys, and notices the edit.
+    let stamps = dir.join("stamps");
+    std::fs::write(arm.join("ur5e.xml"), &xml).unwrap();
+    assert_eq!(
+        model_key_stamped(&scene, &dir, &stamps).unwrap(),
+        original,
+        "hashed"
+    );
+    assert_eq!(
+        model_key_stamped(&scene, &dir, &stamps).unwrap(),
+        original,
+        "remembered"
+    );
+    std::fs::write(
+        arm.join("ur5e.xml"),
+        xml.replace("</mujoco>", "<!-- edited --></mujoco>"),
+    )
+    .unwrap();
+    assert_ne!(
+        model_key_stamped(&scene, &dir, &stamps).unwrap(),
+        original,
+        "edited after"
+    );
+    assert_eq!(
+        model_key_stamped(&scene, &dir, &stamps).unwrap(),
+        model_key(&scene, &dir).unwrap()
     );
 }
 

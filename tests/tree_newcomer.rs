@@ -186,7 +186,8 @@ fn cube_at_checks_the_yaw_of_a_placement() {
         let yaml = format!(
             "main: {{cube_at: {{point: [0.45, -0.18], tolerance: 0.01, yaw: {yaw}, yaw_tolerance: deg(3)}}}}\n"
         );
-        let plan = std::sync::Arc::new(compile_str(&yaml, "at.yaml").unwrap_or_else(|d| panic!("{}", show(&d))));
+        let plan =
+            std::sync::Arc::new(compile_str(&yaml, "at.yaml").unwrap_or_else(|d| panic!("{}", show(&d))));
         let config = EpisodeConfig {
             layout: Layout {
                 cube_yaw: cube_yaw_deg.to_radians(),
@@ -198,7 +199,10 @@ fn cube_at_checks_the_yaw_of_a_placement() {
         run_episode(&scene, plan, &config, &mut NoObserver).success
     };
     assert!(check("deg(30)", 30.0), "a cube turned 30° is at 30°");
-    assert!(check("deg(120)", 30.0), "…and at 120° (a quarter turn looks the same)");
+    assert!(
+        check("deg(120)", 30.0),
+        "…and at 120° (a quarter turn looks the same)"
+    );
     assert!(!check("deg(30)", 0.0), "a square cube is not at 30°");
     assert!(!check("deg(30)", 35.0), "5° off is outside 3°");
 }

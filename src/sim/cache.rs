@@ -11,6 +11,10 @@
 //! temporary file created exclusively and then renamed into place ([`crate::output`]), so a
 //! reader never sees half a file and concurrent writers do not clash.
 //!
+//! Hashing the Menagerie meshes (33 MB) on every start would cost more than the episode, so their
+//! digest is remembered next to the models with each file's size, times, inode and device
+//! ([`model_key_stamped`]); a file whose metadata changed is read again.
+//!
 //! Where: `$MACROTREE_CACHE_DIR` when set (`off` turns the cache off), else
 //! `$XDG_CACHE_HOME/macrotree`, else `~/.cache/macrotree`.
 
@@ -52,8 +56,82 @@ pub fn cache_dir() -> Option<PathBuf> {
 }
 
 /// The cache key (40 hex digits) of the model composed from `scene_mjcf` and the Menagerie
-/// models in `menagerie`. Reads every file of the model folders.
+/// models in `menagerie`. Reads and hashes every file of the model folders.
 pub fn model_key(scene_mjcf: &str, menagerie: &Path) -> std::io::Result<String> {
+    Ok(key_from(scene_mjcf, &menagerie_digest(menagerie)?))
+}
+
+/// [`model_key`], reading the Menagerie files only when they changed since the last time: their
+/// digest is remembered in `dir` with each file's size, modification and status-change times,
+/// inode and device (what `git` trusts to tell a file changed; writing a file always updates its
+/// status-change time). Any difference, or no remembered digest, hashes the files again.
+pub fn model_key_stamped(scene_mjcf: &str, menagerie: &Path, dir: &Path) -> std::io::Result<String> {
+    let files = model_files(menagerie)?;
+    let mut stamp = String::new();
+    for (model, rel) in &files {
+        let meta = std::fs::metadata(menagerie.join(model).join(rel))?;
+        stamp += &format!(
+            "{model}/{}\t{}\t{}\n",
+            rel.display(),
+            meta.len(),
+            file_times(&meta)
+        );
+    }
+    let stamp_path = dir.join(format!(
+        "menagerie-{}.stamp",
+        &hex(&Sha1::digest(menagerie.as_os_str().as_encoded_bytes()))[..16]
+    ));
+    if let Ok(saved) = std::fs::read_to_string(&stamp_path)
+        && let Some((listing, digest)) = saved.rsplit_once("digest ")
+        && listing == stamp
+        && let Some(d) = unhex(digest.trim())
+    {
+        return Ok(key_from(scene_mjcf, &d));
+    }
+    let digest = menagerie_digest(menagerie)?;
+    // Only files unchanged while they were hashed are remembered.
+    let mut after = String::new();
+    for (model, rel) in &files {
+        let meta = std::fs::metadata(menagerie.join(model).join(rel))?;
+        after += &format!(
+            "{model}/{}\t{}\t{}\n",
+            rel.display(),
+            meta.len(),
+            file_times(&meta)
+        );
+    }
+    if after == stamp {
+        let text = format!("{stamp}digest {}\n", hex(&digest));
+        let _ = std::fs::create_dir_all(dir);
+        if let Ok(out) = crate::output::OutputFile::check(&stamp_path, &[]) {
+            let _ = out.write_all(text.as_bytes());
+        }
+    }
+    Ok(key_from(scene_mjcf, &digest))
+}
+
+#[cfg(unix)]
+fn file_times(meta: &std::fs::Metadata) -> String {
+    use std::os::unix::fs::MetadataExt;
+    format!(
+        "{}.{:09}\t{}.{:09}\t{}\t{}",
+        meta.mtime(),
+        meta.mtime_nsec(),
+        meta.ctime(),
+        meta.ctime_nsec(),
+        meta.ino(),
+        meta.dev()
+    )
+}
+
+#[cfg(not(unix))]
+fn file_times(_: &std::fs::Metadata) -> String {
+    // Without status-change times a stamp cannot be trusted: never match.
+    format!("{:?}", std::time::SystemTime::now())
+}
+
+/// The key of `scene_mjcf` with the Menagerie files whose digest is `menagerie`.
+fn key_from(scene_mjcf: &str, menagerie: &[u8]) -> String {
     let mut h = Sha1::new();
     let field = |h: &mut Sha1, bytes: &[u8]| {
         h.update((bytes.len() as u64).to_le_bytes());
@@ -66,19 +144,46 @@ pub fn model_key(scene_mjcf: &str, menagerie: &Path) -> std::io::Result<String> 
         field(&mut h, src.as_bytes());
     }
     field(&mut h, scene_mjcf.as_bytes());
+    field(&mut h, menagerie);
+    hex(&h.finalize())
+}
+
+/// Every file of the Menagerie model folders: (model folder, path inside it), sorted.
+fn model_files(menagerie: &Path) -> std::io::Result<Vec<(&'static str, PathBuf)>> {
+    let mut out = Vec::new();
     for model in MENAGERIE_MODELS {
         let root = menagerie.join(model);
         let mut files = Vec::new();
         list_files(&root, &root, &mut files)?;
         files.sort();
-        for rel in files {
-            let bytes = std::fs::read(root.join(&rel))?;
-            field(&mut h, model.as_bytes());
-            field(&mut h, rel.to_string_lossy().as_bytes());
-            field(&mut h, &bytes);
-        }
+        out.extend(files.into_iter().map(|f| (model, f)));
     }
-    Ok(hex(&h.finalize()))
+    Ok(out)
+}
+
+/// SHA-1 over the relative path and bytes of every file of the Menagerie model folders.
+fn menagerie_digest(menagerie: &Path) -> std::io::Result<Vec<u8>> {
+    let mut h = Sha1::new();
+    let field = |h: &mut Sha1, bytes: &[u8]| {
+        h.update((bytes.len() as u64).to_le_bytes());
+        h.update(bytes);
+    };
+    for (model, rel) in model_files(menagerie)? {
+        let bytes = std::fs::read(menagerie.join(model).join(&rel))?;
+        field(&mut h, model.as_bytes());
+        field(&mut h, rel.to_string_lossy().as_bytes());
+        field(&mut h, &bytes);
+    }
+    Ok(h.finalize().to_vec())
+}
+
+fn unhex(s: &str) -> Option<Vec<u8>> {
+    if s.len() % 2 != 0 {
+        return None;
+    }
+    (0..s.len() / 2)
+        .map(|i| u8::from_str_radix(s.get(2 * i..2 * i + 2)?, 16).ok())
+        .collect()
 }
 
 fn list_files(root: &Path, dir: &Path, out: &mut Vec<PathBuf>) -> std::io::Result<()> {
@@ -135,10 +240,7 @@ pub fn store(dir: &Path, key: &str, model: &MjModel) -> Result<PathBuf, String> 
     model
         .save_to_buffer(&mut payload)
         .map_err(|e| format!("cannot save the model: {e:?}"))?;
-    let key_bytes: Vec<u8> = (0..key.len() / 2)
-        .map(|i| u8::from_str_radix(&key[2 * i..2 * i + 2], 16))
-        .collect::<Result<_, _>>()
-        .map_err(|_| format!("bad key {key}"))?;
+    let key_bytes = unhex(key).ok_or_else(|| format!("bad key {key}"))?;
     if key_bytes.len() != 20 {
         return Err(format!("bad key {key}"));
     }

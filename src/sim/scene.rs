@@ -232,7 +232,7 @@ fn cached_model(
     menagerie: &Path,
     dir: &Path,
 ) -> Result<(MjModel, ModelOrigin), SimError> {
-    let key = match super::cache::model_key(xml, menagerie) {
+    let key = match super::cache::model_key_stamped(xml, menagerie, dir) {
         Ok(key) => key,
         Err(e) => {
             tracing::debug!(error = %e, "model cache: cannot hash the model's files; compiling");
