@@ -51,6 +51,22 @@ fn a_successful_sweep_exits_0_with_a_json_summary_and_jsonl() {
     ] {
         assert!(s.get(key).is_some(), "summary lacks {key}: {s}");
     }
+    // The share of the workers' time spent in mj_step, measured inside this run: a fraction,
+    // and consistent with its parts.
+    let share = s["physics_share"].as_f64().expect("physics_share");
+    let physics = s["physics_time_s"].as_f64().unwrap();
+    let process = s["process_wall_time_s"].as_f64().unwrap();
+    let jobs = s["jobs"].as_f64().unwrap();
+    assert!(share > 0.0 && share <= 1.0, "{s}");
+    assert!(
+        process >= s["wall_time_s"].as_f64().unwrap(),
+        "the process includes the sweep: {s}"
+    );
+    assert!((share - physics / (jobs * process)).abs() < 1e-9, "{s}");
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("physics share "),
+        "the human summary shows it too"
+    );
     assert_eq!(s["scenarios"], 4);
     assert_eq!(s["successes"], 4);
     assert_eq!(s["success_rate"], 1.0);

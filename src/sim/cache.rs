@@ -178,7 +178,7 @@ fn menagerie_digest(menagerie: &Path) -> std::io::Result<Vec<u8>> {
 }
 
 fn unhex(s: &str) -> Option<Vec<u8>> {
-    if s.len() % 2 != 0 {
+    if !s.len().is_multiple_of(2) {
         return None;
     }
     (0..s.len() / 2)
