@@ -51,6 +51,22 @@ fn a_successful_sweep_exits_0_with_a_json_summary_and_jsonl() {
     ] {
         assert!(s.get(key).is_some(), "summary lacks {key}: {s}");
     }
+    // The share of the workers' time spent in mj_step, measured inside this run: a fraction,
+    // and consistent with its parts.
+    let share = s["physics_share"].as_f64().expect("physics_share");
+    let physics = s["physics_time_s"].as_f64().unwrap();
+    let process = s["process_wall_time_s"].as_f64().unwrap();
+    let jobs = s["jobs"].as_f64().unwrap();
+    assert!(share > 0.0 && share <= 1.0, "{s}");
+    assert!(
+        process >= s["wall_time_s"].as_f64().unwrap(),
+        "the process includes the sweep: {s}"
+    );
+    assert!((share - physics / (jobs * process)).abs() < 1e-9, "{s}");
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("physics share "),
+        "the human summary shows it too"
+    );
     assert_eq!(s["scenarios"], 4);
     assert_eq!(s["successes"], 4);
     assert_eq!(s["success_rate"], 1.0);
@@ -106,12 +122,23 @@ fn failures_exit_1_and_their_printed_command_reproduces_them() {
     let cmd = f["reproduce"].as_str().expect("reproduce");
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains(cmd), "the human summary prints the command too");
-    // Run the printed command and compare its report with the sweep's.
+    // Run the printed command as printed, from the repository, with a shell (the binary under
+    // test is not on PATH, so the command names it by its path), and compare its report with
+    // the sweep's.
     let words: Vec<&str> = cmd.split_whitespace().collect();
-    assert_eq!(&words[..2], ["macrotree", "run"]);
-    let mut args = words[1..].to_vec();
-    args.push("--json");
-    let again = macrotree(&args);
+    let bin = std::path::Path::new(cli::BIN).canonicalize().unwrap();
+    let repo = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .canonicalize()
+        .unwrap();
+    let expected = bin.strip_prefix(&repo).unwrap_or(&bin).display().to_string();
+    assert_eq!(&words[..2], [expected.as_str(), "run"], "{cmd}");
+    let again = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!("{cmd} --json"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env_remove("RUST_LOG")
+        .output()
+        .expect("runs the printed command");
     assert_eq!(again.status.code(), Some(1), "{cmd}");
     let r = last_json_line(&again);
     let sweep = macrotree(&[

@@ -249,12 +249,36 @@ fn retry_succeeds_on_attempt_two_with_exactly_two_starts() {
     assert_eq!(d.starts("grasp"), 2);
     assert_eq!(d.starts("reach"), 2);
     assert_eq!(r.attempt(0), 2);
-    // The attempt number is on the leaves' transitions.
+    // The attempt number is on the leaves' transitions; before attempt 2 the failed grasp is
+    // reset to idle (an event of attempt 1), and attempt 2 starts it from idle.
     let t = r.drain_transitions();
-    let grasp: Vec<_> = t.iter().filter(|t| t.path.ends_with("/grasp")).collect();
-    assert_eq!(grasp.len(), 2);
-    assert_eq!((grasp[0].to, grasp[0].attempt), (NodeStatus::Failure, Some(1)));
-    assert_eq!((grasp[1].to, grasp[1].attempt), (NodeStatus::Success, Some(2)));
+    let grasp: Vec<_> = t
+        .iter()
+        .filter(|t| t.path.ends_with("/grasp"))
+        .map(|t| (t.from, t.to, t.attempt))
+        .collect();
+    assert_eq!(
+        grasp,
+        [
+            (NodeStatus::Idle, NodeStatus::Failure, Some(1)),
+            (NodeStatus::Failure, NodeStatus::Idle, Some(1)),
+            (NodeStatus::Idle, NodeStatus::Success, Some(2)),
+        ]
+    );
+    let reach: Vec<_> = t
+        .iter()
+        .filter(|t| t.path.ends_with("/reach"))
+        .map(|t| (t.from, t.to, t.attempt))
+        .collect();
+    assert_eq!(
+        reach,
+        [
+            (NodeStatus::Idle, NodeStatus::Success, Some(1)),
+            (NodeStatus::Success, NodeStatus::Idle, Some(1)),
+            (NodeStatus::Idle, NodeStatus::Success, Some(2)),
+        ],
+        "re-entered from idle, after an explicit reset"
+    );
 }
 
 #[test]

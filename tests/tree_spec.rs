@@ -217,7 +217,7 @@ fn missing_leaf_parameter_is_reported() {
 #[test]
 fn invalid_numbers_are_errors() {
     let d = errors(
-        "main:\n  sequence:\n    children:\n      - retry: {attempts: 0, child: {home: {}}}\n      - timeout: {seconds: -1, child: {home: {}}}\n      - reach: {target: cube, speed: 0}\n      - wait: {seconds: .inf}\n      - repeat: {times: 2.5, child: {home: {}}}\n      - reach: {target: [1, 2]}\n",
+        "main:\n  sequence:\n    children:\n      - retry: {attempts: 0, child: {home: {}}}\n      - timeout: {seconds: -1, child: {home: {}}}\n      - reach: {target: cube, speed: 0}\n      - wait: {seconds: .inf}\n      - repeat: {times: 2.5, child: {home: {}}}\n      - reach: {target: [0.1, 0.2]}\n",
     );
     assert_eq!(at(find(&d, "`attempts` must be between 1")), (4, 27));
     assert_eq!(at(find(&d, "time limit (s) must be > 0")), (5, 28));
@@ -408,7 +408,9 @@ fn condition_tolerances_are_overridable_and_checked() {
 
 #[test]
 fn out_of_range_numbers_are_located_errors() {
-    let yaml = "main:\n  sequence:\n    children:\n      - release: {width: 0.2}\n      - move_joints: {joints: [0, 0, 10, 0, 0, 0]}\n      - carry: {lift: 15}\n      - reach: {target: [45, 0, 10]}\n      - reach: {target: cube, offset: [0, 0, 12]}\n      - reach: {target: [0.4, 0, -0.1]}\n";
+    // Each coordinate and joint angle is in range on its own (a single one out of range is
+    // reported at itself, see tests/tree_newcomer.rs); the whole is not.
+    let yaml = "main:\n  sequence:\n    children:\n      - release: {width: 0.2}\n      - move_joints: {joints: [0, 0, 3.5, 0, 0, 0]}\n      - carry: {lift: 15}\n      - reach: {target: [1.0, 0.9, 0.5]}\n      - reach: {target: cube, offset: [0.9, 0.9, 0.9]}\n      - reach: {target: [0.4, 0, -0.1]}\n";
     let diags = errors(yaml);
     assert_eq!(diags.len(), 6, "one error per bad value, all at once");
     assert_eq!(at(find(&diags, "gripper opening")), (4, 26));
@@ -416,10 +418,10 @@ fn out_of_range_numbers_are_located_errors() {
     assert_eq!(at(find(&diags, "joint 3 (`elbow`)")), (5, 31));
     assert_eq!(at(find(&diags, "a distance of 15 m")), (6, 23));
     assert_eq!(at(find(&diags, "from the shoulder")), (7, 25));
-    assert_eq!(at(find(&diags, "an offset of 12.000 m")), (8, 39));
+    assert_eq!(at(find(&diags, "an offset of 1.559 m")), (8, 39));
     assert_eq!(at(find(&diags, "below the table top")), (9, 25));
-    // A value written as a one-line list is underlined whole: `[0, 0, 12]`, `[0.4, 0, -0.1]`.
-    assert_eq!(find(&diags, "an offset of 12.000 m").width, 10);
+    // A value written as a one-line list is underlined whole: `[0.9, 0.9, 0.9]`, `[0.4, 0, -0.1]`.
+    assert_eq!(find(&diags, "an offset of 1.559 m").width, 15);
     assert_eq!(find(&diags, "below the table top").width, 14);
     for d in &diags {
         assert!(d.to_string().contains("bad.yaml:"), "{d}");

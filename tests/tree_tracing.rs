@@ -4,7 +4,7 @@ use std::sync::{Arc, Mutex};
 
 use macrotree::plan::compile_str;
 use macrotree::runtime::scripted::ScriptedDriver;
-use macrotree::runtime::{LeafOutcome, TreeRunner, TreeStatus};
+use macrotree::runtime::{LeafOutcome, NodeStatus, TreeRunner, TreeStatus};
 use tracing::field::{Field, Visit};
 use tracing_subscriber::layer::{Context, SubscriberExt};
 use tracing_subscriber::{Layer, Registry};
@@ -114,14 +114,72 @@ fn one_event_per_transition_with_fields() {
             .iter()
             .any(|e| e.get("path") == Some("main/retry/guard/carry") && e.get("to") == Some("halted"))
     );
-    // The retry announces its second attempt.
-    assert!(events.iter().any(|e| e.get("path") == Some("main/retry")
-        && e.get("attempt") == Some("2")
-        && e.get("to").is_none()));
+    // The carry halted when attempt 1 failed belongs to attempt 1.
+    let halt = status_events
+        .iter()
+        .find(|e| e.get("path") == Some("main/retry/guard/carry") && e.get("to") == Some("halted"))
+        .unwrap();
+    assert_eq!(
+        halt.get("attempt"),
+        Some("1"),
+        "the halt is labelled with its own attempt"
+    );
+    // The retry announces its second attempt with an explicit reset of the finished nodes.
+    let announce = events
+        .iter()
+        .find(|e| {
+            e.get("path") == Some("main/retry") && e.get("attempt") == Some("2") && e.get("to").is_none()
+        })
+        .expect("the retry announces attempt 2");
+    assert!(
+        announce.get("reset").is_some_and(|n| n != "0"),
+        "{:?}",
+        announce.fields
+    );
+    // Nothing re-enters `running` from a finished status: it is reset to idle first.
+    for t in &transitions {
+        assert!(
+            t.to != NodeStatus::Running || t.from == NodeStatus::Idle,
+            "{} {} → {}",
+            t.path,
+            t.from,
+            t.to
+        );
+    }
+    let carry: Vec<(&str, &str)> = status_events
+        .iter()
+        .filter(|e| e.get("path") == Some("main/retry/guard/carry"))
+        .map(|e| (e.get("from").unwrap(), e.get("to").unwrap()))
+        .collect();
+    assert_eq!(
+        carry,
+        [
+            ("idle", "running"),
+            ("running", "halted"),
+            ("halted", "idle"),
+            ("idle", "running"),
+            ("running", "success")
+        ],
+        "halted with attempt 1, reset to idle at once (attempt 2 was announced), re-entered from idle"
+    );
+    let reset_tick = transitions
+        .iter()
+        .find(|t| t.path == "main/retry/guard/carry" && t.to == NodeStatus::Idle)
+        .map(|t| t.tick);
+    let halt_tick = transitions
+        .iter()
+        .find(|t| t.path == "main/retry/guard/carry" && t.to == NodeStatus::Halted)
+        .map(|t| t.tick);
+    assert_eq!(reset_tick, halt_tick);
     // The guard condition holding tick after tick produces no events of its own.
-    let cond_events = status_events
+    let cond_events: Vec<&str> = status_events
         .iter()
         .filter(|e| e.get("path") == Some("main/retry/guard/cube_grasped"))
-        .count();
-    assert_eq!(cond_events, 3, "success, failure, success again");
+        .map(|e| e.get("to").unwrap())
+        .collect();
+    assert_eq!(
+        cond_events,
+        ["success", "failure", "idle", "success"],
+        "success, failure, reset for attempt 2, success again"
+    );
 }

@@ -7,7 +7,13 @@
   var mt = (window.macrotree = {});
   var viewer = null;
   var nodeEls = [];
+  var nodeByPath = {};
   var MAX_EVENTS = 100;
+  var TERMINAL = { success: true, failure: true, halted: true };
+  // Per node: its last status, and the outcome it had before it was last reset to idle (the
+  // previous attempt's), shown as a badge while the next attempt runs.
+  var lastStatus = [];
+  var badges = [];
 
   function $(id) { return document.getElementById(id); }
 
@@ -40,11 +46,15 @@
       root.appendChild(li);
       return;
     }
+    nodeByPath = {};
+    lastStatus = [];
+    badges = [];
     nodes.forEach(function (n, i) {
       var li = document.createElement("li");
       var row = document.createElement("div");
       row.className = "node idle";
-      row.title = n.path;
+      // The whole name (it may be cut with an ellipsis) and the path, on hover.
+      row.title = n.name + " (" + n.kind + ")\n" + n.path;
       var dot = document.createElement("span");
       dot.className = "dot";
       var name = document.createElement("span");
@@ -53,12 +63,17 @@
       var kind = document.createElement("span");
       kind.className = "kind";
       kind.textContent = n.kind;
+      var badge = document.createElement("span");
+      badge.className = "badge";
       var attempts = document.createElement("span");
       attempts.className = "attempts";
       row.appendChild(dot);
       row.appendChild(name);
       row.appendChild(kind);
+      row.appendChild(badge);
       row.appendChild(attempts);
+      nodeByPath[n.path] = i;
+      lastStatus[i] = "idle";
       li.appendChild(row);
       var parentList = root;
       if (n.parent !== null && n.parent !== undefined && nodeEls[n.parent]) {
@@ -69,7 +84,24 @@
         parentList = lists[n.parent];
       }
       parentList.appendChild(li);
-      nodeEls[i] = { li: li, row: row, attempts: attempts };
+      nodeEls[i] = { li: li, row: row, attempts: attempts, badge: badge, name: n.name };
+    });
+  }
+
+  // A node reset to idle after it finished keeps that outcome as its badge.
+  function noteStatus(i, s) {
+    if (s === "idle" && TERMINAL[lastStatus[i]]) badges[i] = lastStatus[i];
+    lastStatus[i] = s;
+  }
+
+  // Reset events (`from` a finished status `to` idle) set badges too, even when a status
+  // snapshot in between was not seen.
+  function noteEvents(events) {
+    (events || []).forEach(function (ev) {
+      if (ev && typeof ev === "object" && ev.to === "idle" && TERMINAL[ev.from]) {
+        var i = nodeByPath[ev.path];
+        if (i !== undefined) badges[i] = ev.from;
+      }
     });
   }
 
@@ -77,18 +109,61 @@
     (statuses || []).forEach(function (s, i) {
       var el = nodeEls[i];
       if (!el) return;
+      noteStatus(i, s);
       el.row.className = "node " + s;
       el.row.dataset.status = s;
+      var b = badges[i] || "";
+      el.badge.textContent = b;
+      el.badge.className = "badge " + b;
+      el.badge.title = b ? "the previous attempt ended: " + b : "";
       var a = attempts && attempts[i];
       el.attempts.textContent = a > 0 ? "attempt " + a : "";
     });
   }
 
+  // Numbers in events to the millisecond (sim times) or 4 decimals, never 17 digits.
+  function num(x, digits) {
+    return Number(x.toFixed(digits)).toString();
+  }
+
+  // One trace event as a line of text parts: [time, what, class].
+  function describeEvent(ev) {
+    if (typeof ev === "string") return { t: "", text: ev, cls: "" };
+    if (!ev || typeof ev !== "object") return { t: "", text: String(ev), cls: "" };
+    var t = typeof ev.t === "number" ? num(ev.t, 3) + " s  " : "";
+    var i = nodeByPath[ev.path];
+    var who = i !== undefined && nodeEls[i] ? nodeEls[i].name : (ev.path || "");
+    if (ev.kind === "blackboard") {
+      return { t: t, text: "{" + ev["var"] + "} = " + JSON.stringify(ev.value) + "  (" + who + ")", cls: "" };
+    }
+    if (ev.from !== undefined && ev.to !== undefined) {
+      var text = who + ": " + ev.from + " → " + ev.to;
+      if (ev.to === "idle") text += " (reset for the next attempt)";
+      if (ev.attempt) text += "  attempt " + ev.attempt;
+      if (ev.reason) text += " — " + ev.reason;
+      return { t: t, text: text, cls: "to-" + ev.to };
+    }
+    var rounded = JSON.stringify(ev, function (k, v) {
+      return typeof v === "number" && !Number.isInteger(v) ? Number(v.toFixed(4)) : v;
+    });
+    return { t: t, text: rounded, cls: "" };
+  }
+
   function addEvents(events) {
     var list = $("events");
     (events || []).forEach(function (ev) {
+      var d = describeEvent(ev);
       var li = document.createElement("li");
-      li.textContent = typeof ev === "string" ? ev : JSON.stringify(ev);
+      if (d.t) {
+        var ts = document.createElement("span");
+        ts.className = "t";
+        ts.textContent = d.t;
+        li.appendChild(ts);
+      }
+      var what = document.createElement("span");
+      what.className = d.cls;
+      what.textContent = d.text;
+      li.appendChild(what);
       list.insertBefore(li, list.firstChild);
     });
     while (list.childNodes.length > MAX_EVENTS) list.removeChild(list.lastChild);
@@ -98,8 +173,10 @@
     if (msg.type === "tree") {
       renderTree(msg.nodes);
     } else if (msg.type === "status") {
+      var events = (msg.events || []).map(function (e) { return e.event; });
+      noteEvents(events);
       applyStatuses(msg.statuses, msg.attempts);
-      addEvents((msg.events || []).map(function (e) { return e.event; }));
+      addEvents(events);
     } else if (msg.type === "time") {
       setClock(msg.t);
     }
@@ -161,9 +238,27 @@
     if (meta.tree) renderTree(meta.tree);
     var a = viewer.animator;
     var duration = a.duration || meta.duration || 0;
-    // set_animation started playing; hold at t = 0 until the first frame has rendered (shader
-    // compilation can take a second), then play from the start.
-    var autoplay = a.actions.length > 0;
+    // `#t=3.5` opens at simulated time 3.5 s (the clock's time), `#t=3.5&paused` holds there:
+    // screenshots and bug reports can point at an instant.
+    function readHash() {
+      var hash = {};
+      location.hash.replace(/^#/, "").split("&").forEach(function (part) {
+        if (!part) return;
+        var kv = part.split("=");
+        hash[decodeURIComponent(kv[0])] = kv.length > 1 ? decodeURIComponent(kv.slice(1).join("=")) : "";
+      });
+      var at = null;
+      if (hash.t !== undefined && hash.t !== "" && isFinite(Number(hash.t))) {
+        at = Math.min(Math.max(Number(hash.t) - start, 0), duration);
+      }
+      return { at: at, paused: hash.paused !== undefined };
+    }
+    var opened = readHash();
+    var startAt = opened.at === null ? 0 : opened.at;
+    var startPaused = opened.paused;
+    // set_animation started playing; hold at the start until the first frame has rendered
+    // (shader compilation can take a second), then play from there.
+    var autoplay = a.actions.length > 0 && !startPaused;
     a.pause();
     a.seek(0);
     var bar = $("replay-bar");
@@ -172,7 +267,8 @@
     var scrub = $("scrub");
     var label = $("replay-time");
     scrub.max = String(duration);
-    scrub.step = String(1 / (meta.fps || 30));
+    // Any instant (a URL may name one between two frames); the arrow keys step 0.1 s.
+    scrub.step = "any";
     var shownEvent = -1;
 
     function showStatusAt(t) {
@@ -182,6 +278,14 @@
       if (idx === shownEvent) return;
       shownEvent = idx;
       $("events").textContent = "";
+      // Badges depend on the history up to t: replay it (scrubbing may go backwards).
+      lastStatus = lastStatus.map(function () { return "idle"; });
+      badges = [];
+      for (var h = 0; h < idx; h++) {
+        noteEvents(timeline[h].events);
+        (timeline[h].statuses || []).forEach(function (s, i) { noteStatus(i, s); });
+      }
+      if (idx >= 0) noteEvents(timeline[idx].events);
       applyStatuses(idx >= 0 ? timeline[idx].statuses : (meta.tree || []).map(function () { return "idle"; }));
       for (var j = Math.max(0, idx - MAX_EVENTS); j <= idx; j++) addEvents(timeline[j].events);
     }
@@ -226,16 +330,52 @@
       if (a.playing) a.pause();
       a.seek(Number(scrub.value));
     };
+    mt.seek = function (t) { userPaused = true; if (a.playing) a.pause(); scrub.value = String(t); a.seek(t); };
+    // The instant shown, in the URL, whenever the replay is paused (copy it into a bug report).
+    function rememberInstant() {
+      if (a.playing || !window.history || !history.replaceState) return;
+      var t = start + Number(scrub.value);
+      try { history.replaceState(null, "", "#t=" + num(t, 3) + "&paused"); } catch (e) { /* file: URLs may refuse */ }
+    }
+    play.addEventListener("click", function () { setTimeout(rememberInstant, 0); });
+    scrub.addEventListener("change", rememberInstant);
     document.addEventListener("keydown", function (ev) {
-      if (ev.code === "Space" && ev.target === document.body) {
+      var onBody = ev.target === document.body || ev.target === play || ev.target === scrub;
+      if (!onBody || ev.altKey || ev.ctrlKey || ev.metaKey) return;
+      var step = ev.shiftKey ? 1 : 0.1;
+      var now = a.playing ? current() : Number(scrub.value);
+      if (ev.code === "Space") {
         ev.preventDefault();
         play.onclick();
+        setTimeout(rememberInstant, 0);
+      } else if (ev.code === "ArrowRight" || ev.code === "ArrowLeft") {
+        ev.preventDefault();
+        var to = now + (ev.code === "ArrowRight" ? step : -step);
+        mt.seek(Math.min(Math.max(to, 0), duration));
+        rememberInstant();
+      } else if (ev.code === "Home" || ev.code === "End") {
+        ev.preventDefault();
+        mt.seek(ev.code === "Home" ? 0 : duration);
+        rememberInstant();
       }
     });
-    mt.seek = function (t) { userPaused = true; if (a.playing) a.pause(); scrub.value = String(t); a.seek(t); };
+    // Editing the URL's `#t=…` later jumps there too.
+    window.addEventListener("hashchange", function () {
+      var h = readHash();
+      if (h.at === null) return;
+      if (h.paused) {
+        mt.seek(h.at);
+      } else {
+        scrub.value = String(h.at);
+        a.play();
+        a.seek(h.at);
+      }
+    });
+    scrub.value = String(startAt);
+    a.seek(startAt);
     requestAnimationFrame(function () {
       requestAnimationFrame(function () {
-        if (autoplay) { a.play(); a.seek(0); }
+        if (autoplay) { a.play(); a.seek(startAt); } else { a.seek(startAt); }
         tick();
       });
     });

@@ -294,6 +294,14 @@ impl MacroAction for Carry {
         self.start_phase(cell, Phase::Lift, lift)
     }
 
+    fn waiting_for(&self, cell: &Cell) -> String {
+        format!(
+            "{} phase: {}",
+            self.phase.name(),
+            self.arrival.waiting_for(cell, &self.goal_q)
+        )
+    }
+
     fn update(&mut self, cell: &mut Cell) -> Progress {
         let w = cell.world();
         if w.holds(self.held, Tolerances::GRASP_OFF_AXIS) {

@@ -110,6 +110,27 @@ impl Cell {
 
     /// Starts following `trajectory` now.
     pub fn track(&mut self, trajectory: Box<dyn Trajectory>) {
+        if tracing::enabled!(target: "macrotree::motion", tracing::Level::DEBUG) {
+            let q = trajectory.end();
+            let pose = crate::motion::fk(&q);
+            let p = pose.translation.vector;
+            let tool_yaw = super::targets::tool_yaw(pose.rotation.to_rotation_matrix().matrix()).to_degrees();
+            let sign = |x: f64| if x >= 0.0 { '+' } else { '−' };
+            tracing::debug!(
+                target: "macrotree::motion",
+                sim_time = self.sim.time(),
+                "plan: {} of {:.3} s to pinch ({:.3}, {:.3}, {:.3}) m, tool yaw {tool_yaw:.1}°, joints [{}] rad (IK branch: shoulder {}, elbow {}, wrist {})",
+                trajectory.name(),
+                trajectory.duration(),
+                p.x,
+                p.y,
+                p.z,
+                q.iter().map(|v| format!("{v:.3}")).collect::<Vec<_>>().join(", "),
+                sign(q[1]),
+                sign(q[2]),
+                sign(q[4]),
+            );
+        }
         self.arm = ArmPlan::Track {
             trajectory,
             t0: self.sim.time(),

@@ -188,8 +188,9 @@ impl LeafDriver for MacroDriver<'_> {
         let active = self.active.get_mut(&id).expect("checked above");
         let mut progress = active.action.update(self.cell);
         if progress == Progress::Running && now >= active.deadline {
+            let waiting = active.action.waiting_for(self.cell);
             active.action.halt(self.cell);
-            progress = Progress::Failed(format!("timeout: not done after {:.2} s", active.timeout));
+            progress = Progress::Failed(format!("timeout after {:.2} s: {waiting}", active.timeout));
         }
         self.finish(id, leaf, progress)
     }

@@ -51,6 +51,15 @@ impl MacroAction for Grasp {
         super::macro_action::freeze_gripper(cell);
     }
 
+    fn waiting_for(&self, cell: &Cell) -> String {
+        let w = cell.world();
+        format!(
+            "gripper still closing, width {:.3} m (fingers at {:.2} rad/s)",
+            w.gripper_width,
+            w.gripper_speed.abs()
+        )
+    }
+
     fn update(&mut self, cell: &mut Cell) -> Progress {
         let w = cell.world();
         if w.time - self.t0 < MIN_CLOSE_TIME {

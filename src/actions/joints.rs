@@ -39,4 +39,8 @@ impl MacroAction for MoveJoints {
     fn update(&mut self, cell: &mut Cell) -> Progress {
         self.arrival.progress(cell, &self.goal_q)
     }
+
+    fn waiting_for(&self, cell: &Cell) -> String {
+        self.arrival.waiting_for(cell, &self.goal_q)
+    }
 }

@@ -24,6 +24,12 @@ pub trait MacroAction: Send {
     fn halt(&mut self, cell: &mut Cell) {
         cell.hold();
     }
+    /// What the action is still waiting for, in a few words with the measured values (for a
+    /// timeout's reason, e.g. "gripper still closing, width 0.031 m").
+    fn waiting_for(&self, cell: &Cell) -> String {
+        let _ = cell;
+        "the action to finish".to_string()
+    }
 }
 
 /// The halt of a gripper motion: the arm holds where it is commanded to be, and the fingers stop
@@ -65,6 +71,27 @@ impl Default for Arrival {
 }
 
 impl Arrival {
+    /// What a motion towards `goal_q` still waits for: the arm moving along its path, or at rest
+    /// (or settling) some distance from its goal.
+    pub fn waiting_for(&self, cell: &Cell, goal_q: &[f64; 6]) -> String {
+        let w = cell.world();
+        let error = (crate::motion::fk(goal_q).translation.vector - w.pinch_pos).norm();
+        let speed = w.arm_qd.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if !cell.arm_motion_finished() {
+            format!(
+                "arm still moving along its path, {:.1} mm from its goal",
+                error * 1e3
+            )
+        } else if speed > self.joint_speed {
+            format!(
+                "arm still settling, {:.1} mm from its goal, joints at up to {speed:.2} rad/s",
+                error * 1e3
+            )
+        } else {
+            format!("arm at rest {:.1} mm from its goal", error * 1e3)
+        }
+    }
+
     /// Progress of a motion towards the joint goal `goal_q`: Done when the trajectory has ended,
     /// the pinch is within `position` of where `goal_q` puts it and every joint moves slower than
     /// `joint_speed`; Failed when the arm has rested short of it for `blocked_after`.

@@ -128,6 +128,15 @@ impl MacroAction for Reach {
         Ok(())
     }
 
+    fn waiting_for(&self, cell: &Cell) -> String {
+        let detour = if self.pending.is_empty() {
+            String::new()
+        } else {
+            format!(" ({} more leg(s) of the detour to go)", self.pending.len())
+        };
+        format!("{}{detour}", self.arrival.waiting_for(cell, &self.goal_q))
+    }
+
     fn update(&mut self, cell: &mut Cell) -> Progress {
         if !self.pending.is_empty() {
             if cell.arm_motion_finished()

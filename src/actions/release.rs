@@ -68,6 +68,25 @@ impl MacroAction for Release {
         super::macro_action::freeze_gripper(cell);
     }
 
+    fn waiting_for(&self, cell: &Cell) -> String {
+        if self.retreating {
+            return format!("retreat: {}", self.arrival.waiting_for(cell, &self.goal_q));
+        }
+        let w = cell.world();
+        let touching: Vec<&str> = (0..w.objects.len())
+            .filter(|&i| !w.released(i))
+            .map(|i| w.name(i))
+            .collect();
+        let mut s = format!(
+            "gripper still opening, width {:.3} m of {:.3} m",
+            w.gripper_width, self.target_width
+        );
+        if !touching.is_empty() {
+            s += &format!(", pads still touch {}", touching.join(", "));
+        }
+        s
+    }
+
     fn update(&mut self, cell: &mut Cell) -> Progress {
         if !self.retreating {
             let w = cell.world();

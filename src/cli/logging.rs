@@ -58,7 +58,7 @@ impl Visit for Fields {
         if field.name() == "sim_time" {
             self.sim_time = Some(value);
         } else {
-            self.rest.push((field.name(), format!("{value}")));
+            self.rest.push((field.name(), short_float(field.name(), value)));
         }
     }
 
@@ -78,6 +78,26 @@ impl Visit for Fields {
             name => self.rest.push((name, format!("{value:?}"))),
         }
     }
+}
+
+/// A float field for people: times (`…_s`, `…time…`) to the millisecond, anything else to four
+/// decimals, without trailing zeros (`5.336`, `0.031`, `2`).
+fn short_float(name: &str, value: f64) -> String {
+    if !value.is_finite() {
+        return format!("{value}");
+    }
+    let decimals = if name.ends_with("_s") || name.contains("time") {
+        3
+    } else {
+        4
+    };
+    let s = format!("{value:.decimals$}");
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    };
+    if s == "-0" { "0".to_string() } else { s }
 }
 
 /// `  2.244 s  reach "above cube" running → success  attempt=1`
@@ -128,5 +148,19 @@ where
             write!(w, "  {}={value}", self.paint("2", name))?;
         }
         writeln!(w)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::short_float;
+
+    #[test]
+    fn floats_are_printed_to_a_readable_precision() {
+        assert_eq!(short_float("sim_time_s", 5.335999999999634), "5.336");
+        assert_eq!(short_float("width", 0.031_000_000_4), "0.031");
+        assert_eq!(short_float("width", 2.0), "2");
+        assert_eq!(short_float("x", -0.000_01), "0");
+        assert_eq!(short_float("x", f64::NAN), "NaN");
     }
 }

@@ -84,8 +84,44 @@ pub fn main_with(registry: crate::registry::Registry) -> ExitCode {
     main()
 }
 
+/// How a command printed for people to run (a sweep's reproduction commands) names this
+/// program: `macrotree` when that name on `PATH` is this very binary (e.g. after
+/// `cargo install --path .`); otherwise the path of this binary, relative to the current folder
+/// when it lies inside it (`target/release/macrotree` from the repository), else absolute.
+pub fn program_name() -> String {
+    let Some(exe) = std::env::current_exe().ok().and_then(|p| p.canonicalize().ok()) else {
+        return "macrotree".to_string();
+    };
+    let on_path = std::env::var_os("PATH").is_some_and(|paths| {
+        std::env::split_paths(&paths).any(|dir| dir.join("macrotree").canonicalize().is_ok_and(|p| p == exe))
+    });
+    if on_path {
+        return "macrotree".to_string();
+    }
+    let cwd = std::env::current_dir().ok().and_then(|d| d.canonicalize().ok());
+    let shown = match cwd.as_deref().and_then(|d| exe.strip_prefix(d).ok()) {
+        // `./macrotree`, not `macrotree` (which the shell would look up on PATH).
+        Some(rel) if rel.components().count() == 1 => std::path::Path::new(".").join(rel),
+        Some(rel) => rel.to_path_buf(),
+        None => exe.clone(),
+    };
+    crate::sweep::shell_quote(&shown.display().to_string())
+}
+
+/// When the process started (as near as [`main`] can tell).
+static STARTED: std::sync::OnceLock<std::time::Instant> = std::sync::OnceLock::new();
+
+/// Seconds since the process started ([`main`] was entered).
+fn process_elapsed_s() -> f64 {
+    STARTED
+        .get_or_init(std::time::Instant::now)
+        .elapsed()
+        .as_secs_f64()
+}
+
 /// Entry point of the `macrotree` binary.
 pub fn main() -> ExitCode {
+    STARTED.get_or_init(std::time::Instant::now);
     let cli = Cli::parse();
     let quiet = matches!(
         cli.command,
@@ -126,9 +162,19 @@ fn invalid(diags: Vec<crate::spec::Diagnostic>, what: String) -> CliError {
     ))
 }
 
-/// Loads and compiles a tree, or returns its diagnostics as a bad-input error.
+/// Loads and compiles a tree, or returns its diagnostics as a bad-input error. Warnings are
+/// printed on stderr.
 fn load_plan_or_exit(path: &std::path::Path) -> Result<crate::plan::Plan, CliError> {
-    crate::plan::load_plan(path).map_err(|diags| invalid(diags, path.display().to_string()))
+    let plan = crate::plan::load_plan(path).map_err(|diags| invalid(diags, path.display().to_string()))?;
+    print_warnings(&plan);
+    Ok(plan)
+}
+
+/// Prints the tree's warnings on stderr.
+fn print_warnings(plan: &crate::plan::Plan) {
+    for w in &plan.warnings {
+        eprintln!("{w}");
+    }
 }
 
 /// Loads a tree for the scene it runs on — `scene_file` (a `--scene` override) when given, else
@@ -142,8 +188,12 @@ fn load_task(
         Some(path) => {
             let scene = crate::scene::load_scene_file(path)
                 .map_err(|diags| invalid(diags, path.display().to_string()))?;
-            crate::plan::load_plan_for(tree, Some(std::sync::Arc::new(scene)))
-                .map_err(|diags| invalid(diags, format!("{} for scene {}", tree.display(), path.display())))?
+            let plan =
+                crate::plan::load_plan_for(tree, Some(std::sync::Arc::new(scene))).map_err(|diags| {
+                    invalid(diags, format!("{} for scene {}", tree.display(), path.display()))
+                })?;
+            print_warnings(&plan);
+            plan
         }
         None => load_plan_or_exit(tree)?,
     };

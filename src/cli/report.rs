@@ -29,7 +29,10 @@ pub struct ReportArgs {
 
 /// Runs `macrotree report`.
 pub fn report(args: ReportArgs) -> Result<(), CliError> {
-    let merged = merge_results(&args.files).map_err(|e| CliError::Input(format!("error: {e}")))?;
+    let mut merged = merge_results(&args.files).map_err(|e| CliError::Input(format!("error: {e}")))?;
+    for m in &mut merged {
+        m.config.program = super::program_name();
+    }
     let is_test = merged.iter().any(|m| m.config.suite.is_some());
     if !is_test {
         if args.junit.is_some() {
@@ -59,6 +62,7 @@ pub fn report(args: ReportArgs) -> Result<(), CliError> {
         let mut same = file.sweep.clone();
         same.jobs = 0;
         same.shard = None;
+        same.program = super::program_name();
         if same != m.config {
             return Err(CliError::Input(format!(
                 "error: {} no longer describes the run in these results (tree, scene, count, seed, fault, goal, time limit or substitutions changed); run `macrotree test` again",

@@ -214,7 +214,7 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
                 .map_err(|e| CliError::Input(format!("error: {e}")))?;
             eprintln!("replay written to {}", out.path().display());
         }
-        finish_report(&report, args.json);
+        finish_report(&report, args.episode.goal, args.json);
         if let Some(live) = live {
             eprintln!("episode over; still serving {} (Ctrl-C to stop)", live.url());
             live.serve_forever();
@@ -222,7 +222,7 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
         report
     } else {
         let report = run_episode(&scene, plan, &config, &mut NoObserver);
-        finish_report(&report, args.json);
+        finish_report(&report, args.episode.goal, args.json);
         report
     };
     if report.success {
@@ -232,36 +232,51 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
     }
 }
 
-fn finish_report(report: &crate::episode::EpisodeReport, json: bool) {
+/// What a successful episode achieved, in the words of the goal that was checked: the scene's
+/// goal predicates, the cube in the bowl, or only the tree's own success.
+fn success_message(report: &crate::episode::EpisodeReport, goal: Goal) -> String {
+    match goal {
+        Goal::Tree => "the tree succeeded (goal checked: the tree's own conditions)".to_string(),
+        Goal::Bowl => "the tree succeeded and the cube rests in the bowl".to_string(),
+        Goal::Scene if report.goal.is_empty() => "the tree succeeded".to_string(),
+        Goal::Scene => {
+            let holds: Vec<String> = report.goal.iter().map(|g| g.predicate.clone()).collect();
+            format!(
+                "the tree succeeded and the scene's goal holds: {}",
+                holds.join(", ")
+            )
+        }
+    }
+}
+
+/// `x` seconds rounded to the millisecond (the logs' resolution; the control period is 4 ms).
+fn ms(x: f64) -> f64 {
+    (x * 1e3).round() / 1e3
+}
+
+fn finish_report(report: &crate::episode::EpisodeReport, goal: Goal, json: bool) {
     if report.success {
-        let what = if report.goal.is_empty() {
-            "the tree succeeded".to_string()
-        } else {
-            report
-                .goal
-                .iter()
-                .map(|g| g.predicate.clone())
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
         tracing::info!(
-            sim_time_s = report.sim_time_s,
+            sim_time_s = ms(report.sim_time_s),
             grasp_attempts = report.grasp_attempts,
-            "episode succeeded: {what}"
+            "episode succeeded: {}",
+            success_message(report, goal)
         );
     } else {
         tracing::warn!(
             reason = report.failure_reason.as_deref().unwrap_or(""),
+            node = report.failed_node.as_deref().unwrap_or("-"),
+            sim_time_s = ms(report.sim_time_s),
             "episode failed"
         );
     }
-    print_summary(report);
+    print_summary(report, goal);
     if json {
         println!("{}", serde_json::to_string(report).expect("report serializes"));
     }
 }
 
-fn print_summary(r: &crate::episode::EpisodeReport) {
+fn print_summary(r: &crate::episode::EpisodeReport, goal: Goal) {
     let c = &r.checks;
     println!(
         "{}: tree {}, {:.2} s simulated in {:.3} s wall ({} physics steps), {} grasp attempt(s)",
@@ -274,6 +289,20 @@ fn print_summary(r: &crate::episode::EpisodeReport) {
     );
     if let Some(reason) = &r.failure_reason {
         println!("  reason: {reason}");
+    }
+    if let Some(node) = &r.failed_node {
+        println!("  failed node: {node}");
+    }
+    if goal != Goal::Scene {
+        println!(
+            "  success judged by --goal {}{}",
+            goal.name(),
+            if goal == Goal::Tree {
+                " (the tree's own conditions); the scene's goal below is shown, not checked"
+            } else {
+                ""
+            }
+        );
     }
     for o in &r.objects {
         let [x, y, z, yaw] = o.end;

@@ -91,6 +91,7 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
         tree: args.tree.display().to_string(),
         substitutions: args.substitute.clone(),
         suite: None,
+        program: super::program_name(),
     };
     let total = config.indices().len() as u64;
     if total == 0 {
@@ -161,7 +162,8 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
     let mut results = resumed.results;
     results.extend(run.results);
     let tree = args.tree.display().to_string();
-    let summary = Summary::new(&tree, &config, &results, run.wall_time_s, run.jobs);
+    let summary = Summary::new(&tree, &config, &results, run.wall_time_s, run.jobs)
+        .with_physics(run.physics_time_s, super::process_elapsed_s());
     print!("{}", summary.to_text());
     if args.json {
         println!("{}", serde_json::to_string(&summary).expect("summary serializes"));

@@ -105,6 +105,7 @@ pub fn test(args: TestArgs) -> Result<(), CliError> {
             .map_err(|e| CliError::Input(format!("error: {e}")))?;
         s.sweep.shard = shard;
         s.sweep.jobs = args.jobs.map_or(0, |j| j as usize);
+        s.sweep.program = super::program_name();
         inputs.extend(tree_inputs(&s.tree));
         inputs.extend(s.scene.clone());
         tasks.push((Arc::new(plan), scene));

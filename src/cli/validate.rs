@@ -49,16 +49,29 @@ pub fn validate(args: ValidateArgs) -> Result<(), CliError> {
         None => None,
     };
     for tree in &args.trees {
+        let mut warnings = Vec::new();
         let result = if is_scene_file(tree) {
             crate::scene::load_scene_file(tree).map(|s| (s.objects.len(), s.goal.atoms.len()))
         } else {
-            crate::plan::load_plan_for(tree, override_scene.clone()).map(|p| (p.nodes.len(), p.leaves.len()))
+            crate::plan::load_plan_for(tree, override_scene.clone()).map(|p| {
+                warnings.clone_from(&p.warnings);
+                (p.nodes.len(), p.leaves.len())
+            })
         };
         if result.is_err() {
             failed += 1;
         }
         match args.format {
             DiagnosticFormat::Human => match &result {
+                _ if !warnings.is_empty() && result.is_ok() => {
+                    warnings.iter().for_each(|d| eprintln!("{d}"));
+                    let (nodes, leaves) = result.as_ref().map_or((0, 0), |r| *r);
+                    println!(
+                        "{}: ok with {} warning(s) ({nodes} nodes, {leaves} leaves)",
+                        tree.display(),
+                        warnings.len()
+                    );
+                }
                 Ok((a, b)) if is_scene_file(tree) => {
                     println!("{}: ok (scene: {a} objects, {b} goal predicates)", tree.display())
                 }
@@ -67,7 +80,7 @@ pub fn validate(args: ValidateArgs) -> Result<(), CliError> {
             },
             DiagnosticFormat::Json => {
                 let (nodes, leaves, diags) = match &result {
-                    Ok((a, b)) => (*a, *b, &[][..]),
+                    Ok((a, b)) => (*a, *b, &warnings[..]),
                     Err(diags) => (0, 0, &diags[..]),
                 };
                 let line = serde_json::json!({
@@ -80,9 +93,8 @@ pub fn validate(args: ValidateArgs) -> Result<(), CliError> {
                 println!("{line}");
             }
             DiagnosticFormat::Github => {
-                if let Err(diags) = &result {
-                    diags.iter().for_each(|d| println!("{}", github_annotation(d)));
-                }
+                let diags = result.as_ref().err().unwrap_or(&warnings);
+                diags.iter().for_each(|d| println!("{}", github_annotation(d)));
             }
         }
     }
@@ -118,7 +130,7 @@ fn diagnostic_json(d: &Diagnostic) -> serde_json::Value {
         "line": d.line,
         "column": d.column,
         "end_column": d.column + d.width,
-        "severity": "error",
+        "severity": if d.warning { "warning" } else { "error" },
         "message": d.message,
         "label": d.label,
         "help": d.help,
@@ -126,7 +138,7 @@ fn diagnostic_json(d: &Diagnostic) -> serde_json::Value {
     })
 }
 
-/// A diagnostic as a GitHub Actions `::error` workflow command (one line; `endColumn` is
+/// A diagnostic as a GitHub Actions `::error` (or `::warning`) workflow command (one line; `endColumn` is
 /// inclusive).
 pub fn github_annotation(d: &Diagnostic) -> String {
     let mut text = d.message.clone();
@@ -134,7 +146,8 @@ pub fn github_annotation(d: &Diagnostic) -> String {
         text += &format!("\n{extra}");
     }
     format!(
-        "::error file={},line={},col={},endColumn={},title=macrotree::{}",
+        "::{} file={},line={},col={},endColumn={},title=macrotree::{}",
+        if d.warning { "warning" } else { "error" },
         escape_property(&d.file),
         d.line,
         d.column,
@@ -170,6 +183,7 @@ mod tests {
             source_line: None,
             source_column: 17,
             width: 5,
+            warning: false,
         };
         assert_eq!(
             github_annotation(&d),

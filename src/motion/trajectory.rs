@@ -67,6 +67,10 @@ pub trait Trajectory: Send {
     fn duration(&self) -> f64;
     /// Final joint positions, radians (exactly what `sample(t)` returns for `t ≥ duration()`).
     fn end(&self) -> [f64; 6];
+    /// What kind of motion this is, for logs ("joint move", "straight line", …).
+    fn name(&self) -> &'static str {
+        "motion"
+    }
 }
 
 /// Joint-space move with minimum-jerk time scaling: every joint follows `from + (to − from)·s(t/T)`.
@@ -100,6 +104,10 @@ impl JointMove {
 }
 
 impl Trajectory for JointMove {
+    fn name(&self) -> &'static str {
+        "joint move"
+    }
+
     fn sample(&self, t: f64) -> ([f64; 6], [f64; 6]) {
         if t >= self.duration {
             return (self.to, [0.0; 6]);
@@ -142,6 +150,10 @@ impl Hold {
 }
 
 impl Trajectory for Hold {
+    fn name(&self) -> &'static str {
+        "hold"
+    }
+
     fn sample(&self, _t: f64) -> ([f64; 6], [f64; 6]) {
         (self.q, [0.0; 6])
     }
@@ -361,6 +373,10 @@ impl CartesianMove {
 }
 
 impl Trajectory for CartesianMove {
+    fn name(&self) -> &'static str {
+        "straight line"
+    }
+
     fn sample(&self, t: f64) -> ([f64; 6], [f64; 6]) {
         if t >= self.duration {
             return (self.end(), [0.0; 6]);

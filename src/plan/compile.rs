@@ -29,6 +29,7 @@ pub fn compile_spec(spec: &Spec) -> Result<Plan, Vec<Diagnostic>> {
         file: spec.sources.name(0).to_string(),
         description: spec.description.clone(),
         scene: spec.scene_spec.clone(),
+        warnings: spec.warnings.clone(),
     })
 }
 

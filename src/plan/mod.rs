@@ -185,6 +185,8 @@ pub struct Plan {
     pub description: Option<String>,
     /// The scene the tree's object names were checked against, which it runs on.
     pub scene: std::sync::Arc<crate::scene::SceneSpec>,
+    /// Warnings about the tree file: accepted, but probably not what was meant.
+    pub warnings: Vec<Diagnostic>,
 }
 
 impl Plan {

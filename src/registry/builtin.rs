@@ -152,13 +152,10 @@ fn register(r: &mut Registry) -> Result<(), crate::error::Error> {
         Ok(cond::cube_on_table(w, p.tolerance, p.rest_speed))
     })?;
     r.register_condition("cube_at", doc!("cube_at"), |w, p: &CubeAt| {
-        Ok(cond::cube_at(
-            w,
-            p.point,
-            p.tolerance,
-            Tolerances::ON_TABLE_HEIGHT,
-            p.rest_speed,
-        ))
+        let turned = p.yaw.is_none_or(|target| {
+            crate::world::snapshot::fold_quarter_turn(w.cube_yaw() - target.0).abs() <= p.yaw_tolerance
+        });
+        Ok(turned && cond::cube_at(w, p.point, p.tolerance, Tolerances::ON_TABLE_HEIGHT, p.rest_speed))
     })?;
     r.register_condition("gripper_open", doc!("gripper_open"), |w, p: &GripperOpen| {
         Ok(cond::gripper_open(w, p.min_width))

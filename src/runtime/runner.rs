@@ -55,6 +55,9 @@ struct RunState {
     /// Root-first ancestors of each node, excluding the node itself.
     ancestors: Vec<Vec<usize>>,
     enclosing_retry: Vec<Option<usize>>,
+    /// The attempt (of the enclosing retry) each node's current status belongs to: set when it
+    /// leaves Idle.
+    node_attempt: Vec<Option<u32>>,
     /// `inverter` nodes folded into a re-checked condition: their status is set with the
     /// condition's, never Running.
     instant: Vec<bool>,
@@ -114,6 +117,7 @@ impl RunState {
             touched: vec![0; n],
             ancestors,
             enclosing_retry,
+            node_attempt: vec![None; n],
             attempts: vec![0; n],
             leaves: plan
                 .leaves
@@ -156,7 +160,13 @@ impl RunState {
         }
     }
 
-    /// Set a node's status; log a transition if it changed.
+    /// The attempt of `node`'s enclosing retry now (the retry's own for a retry).
+    fn current_attempt(&self, node: usize) -> Option<u32> {
+        self.enclosing_retry[node].map(|r| self.attempts[r].max(1))
+    }
+
+    /// Set a node's status; log a transition if it changed. A node that starts running again
+    /// after it finished (re-entered by a loop) is first reset to Idle, with its own event.
     fn set(&mut self, plan: &Plan, node: usize, to: NodeStatus, reason: Option<String>) {
         let from = self.statuses[node];
         if to == NodeStatus::Failure || to == NodeStatus::Halted {
@@ -165,7 +175,52 @@ impl RunState {
         if from == to {
             return;
         }
+        if to == NodeStatus::Running && from != NodeStatus::Idle {
+            self.reset_node(plan, node);
+        }
+        self.record(plan, node, to, reason);
+    }
+
+    /// Back to Idle (a loop starts its child again), logged at debug level.
+    fn reset_node(&mut self, plan: &Plan, node: usize) {
+        if self.statuses[node] != NodeStatus::Idle {
+            self.record(plan, node, NodeStatus::Idle, None);
+        }
+    }
+
+    /// Every finished node below the loop `node` back to Idle, before its next attempt or
+    /// iteration starts (running ones are reset when they are re-entered); how many.
+    fn reset_below(&mut self, plan: &Plan, node: usize) -> usize {
+        let mut n = 0;
+        for i in node + 1..plan.nodes.len() {
+            if !self.ancestors[i].contains(&node) {
+                continue;
+            }
+            if matches!(
+                self.statuses[i],
+                NodeStatus::Success | NodeStatus::Failure | NodeStatus::Halted
+            ) {
+                self.record(plan, i, NodeStatus::Idle, None);
+                n += 1;
+            }
+        }
+        n
+    }
+
+    /// Record and log a status change of `node` to `to`.
+    fn record(&mut self, plan: &Plan, node: usize, to: NodeStatus, reason: Option<String>) {
+        let from = self.statuses[node];
         self.statuses[node] = to;
+        // Label the event with the attempt it belongs to: a node leaving Idle joins the current
+        // attempt; a node finishing (or halted, or reset) belongs to the attempt it started in,
+        // even when the retry has already moved on to the next one.
+        let attempt = if from == NodeStatus::Idle || self.enclosing_retry[node] == Some(node) {
+            let now = self.current_attempt(node);
+            self.node_attempt[node] = now;
+            now
+        } else {
+            self.node_attempt[node].or_else(|| self.current_attempt(node))
+        };
         let info = &plan.nodes[node];
         let t = Transition {
             tick: self.tick,
@@ -180,7 +235,7 @@ impl RunState {
             } else {
                 None
             },
-            attempt: self.enclosing_retry[node].map(|r| self.attempts[r].max(1)),
+            attempt,
         };
         macro_rules! emit {
             ($mac:ident) => {
@@ -201,7 +256,7 @@ impl RunState {
                 )
             };
         }
-        if Self::level(plan, node) == Level::INFO {
+        if Self::level(plan, node) == Level::INFO && to != NodeStatus::Idle {
             emit!(info);
         } else {
             emit!(debug);
@@ -408,7 +463,9 @@ impl RunState {
                 self.yield_pending[i] = true;
                 self.pending_yields.push((i, node, self.tick));
                 let iteration = done + 1;
+                let reset = self.reset_below(plan, node);
                 self.attempts[node] = iteration;
+                let info = &plan.nodes[node];
                 if info.kind == "retry" {
                     tracing::info!(
                         target: "macrotree::tree",
@@ -417,9 +474,11 @@ impl RunState {
                         path = %info.path,
                         kind = info.kind,
                         attempt = iteration,
+                        reset,
                         reason = self.last_failure.as_deref(),
-                        "{}: attempt {} of {} starts next tick",
+                        "{}: reset {} node(s) to idle; attempt {} of {} starts next tick",
                         display_name(info),
+                        reset,
                         iteration,
                         limit
                     );
@@ -431,8 +490,10 @@ impl RunState {
                         path = %info.path,
                         kind = info.kind,
                         iteration,
-                        "{}: iteration {} of {} starts next tick",
+                        reset,
+                        "{}: reset {} node(s) to idle; iteration {} of {} starts next tick",
                         display_name(info),
+                        reset,
                         iteration,
                         limit
                     );
@@ -618,6 +679,11 @@ impl RunState {
             }
             self.counts[i].halts += 1;
             self.set(plan, i, NodeStatus::Halted, Some(reason));
+            // Halted because its attempt failed, after the next attempt was announced: it is
+            // reset with the rest of its attempt.
+            if self.node_attempt[i].is_some() && self.node_attempt[i] < self.current_attempt(i) {
+                self.reset_node(plan, i);
+            }
         }
         // A yield that answered Running is only completed by its own execution: reset it when it
         // was not ticked this tick or its retry/repeat stopped running (preempted).

@@ -1,6 +1,7 @@
 //! The MuJoCo adapter: scene composition, layouts, stepping and world extraction.
 //! Nothing outside this module (and the viewer) touches MuJoCo types.
 
+pub mod cache;
 pub mod error;
 pub mod layout;
 pub mod mjcf;
@@ -9,5 +10,5 @@ pub mod simulator;
 
 pub use error::SimError;
 pub use layout::Layout;
-pub use scene::{ContainerIds, ObjectIds, Scene};
+pub use scene::{ContainerIds, ModelOrigin, ObjectIds, Scene};
 pub use simulator::{HOME_Q, Sim, TIMESTEP};

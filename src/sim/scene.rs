@@ -5,6 +5,7 @@
 //!
 //! The compiled model is kept in memory and shared (`Arc`); layouts are applied by writing the
 //! blocks' free joints and the containers' and obstacles' mocap poses, never by recompiling.
+//! Compiled models are cached on disk in MuJoCo's binary format ([`super::cache`]).
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -144,8 +145,19 @@ impl Scene {
         Self::build(spec, &menagerie_dir())
     }
 
-    /// Compiles `spec` with the Menagerie models found in `menagerie`.
+    /// Compiles `spec` with the Menagerie models found in `menagerie`, or loads the compiled
+    /// model from the cache ([`super::cache::cache_dir`]) when it holds this exact model.
     pub fn build(spec: &SceneSpec, menagerie: &Path) -> Result<Self, SimError> {
+        Self::build_with_cache(spec, menagerie, super::cache::cache_dir().as_deref()).map(|(s, _)| s)
+    }
+
+    /// [`Scene::build`] with the model cache in `cache` (`None`: always compile), saying where
+    /// the model came from.
+    pub fn build_with_cache(
+        spec: &SceneSpec,
+        menagerie: &Path,
+        cache: Option<&Path>,
+    ) -> Result<(Self, ModelOrigin), SimError> {
         let ur5e = menagerie.join("universal_robots_ur5e/ur5e.xml");
         let gripper = menagerie.join("robotiq_2f85/2f85.xml");
         for file in [&ur5e, &gripper] {
@@ -164,24 +176,19 @@ impl Scene {
                 )));
             }
         }
-        let spec_err = |what: &str, e: MjEditError| SimError::Scene(format!("{what}: {e:?}"));
         if spec.of_kind(ObjectKind::Block).next().is_none() {
             return Err(SimError::Scene(format!("scene `{}` has no block", spec.name)));
         }
         let xml = super::mjcf::cell_mjcf(SCENE_XML, spec);
-        let mut scene = MjSpec::from_xml_string(&xml).map_err(|e| spec_err("the scene's MJCF", e))?;
-        let mut arm = MjSpec::from_xml(&ur5e).map_err(|e| spec_err("ur5e.xml", e))?;
-        let mut hand = MjSpec::from_xml(&gripper).map_err(|e| spec_err("2f85.xml", e))?;
-        scene
-            .world_body_mut()
-            .attach_by_deep_copy(&mut arm, "ur5e/", "")
-            .map_err(|e| spec_err("attaching the UR5e", e))?;
-        scene
-            .site_mut("ur5e/attachment_site")
-            .ok_or_else(|| SimError::Scene("ur5e/attachment_site not found in ur5e.xml".into()))?
-            .attach_by_deep_copy(&mut hand, "gripper/", "")
-            .map_err(|e| spec_err("attaching the 2F-85", e))?;
-        let model = scene.compile().map_err(|e| spec_err("compiling the scene", e))?;
+        let (model, origin) = match cache {
+            Some(dir) => cached_model(&xml, &ur5e, &gripper, menagerie, dir)?,
+            None => (compile_model(&xml, &ur5e, &gripper)?, ModelOrigin::Compiled),
+        };
+        Ok((Self::from_model(model, spec)?, origin))
+    }
+
+    /// The scene of `spec` around an already compiled `model` (of that scene).
+    fn from_model(model: MjModel, spec: &SceneSpec) -> Result<Self, SimError> {
         let objects = lookup_objects(&model, spec)?;
         let ids = SceneIds::lookup(&model, spec, &objects)?;
         let geom_parts = geom_parts(&model, spec, &objects);
@@ -200,6 +207,73 @@ impl Scene {
             arm_ctrlrange,
         })
     }
+}
+
+/// Where a [`Scene`]'s compiled model came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ModelOrigin {
+    /// Compiled from the MJCF and meshes, without the cache.
+    Compiled,
+    /// Loaded from a valid cache file of exactly this model.
+    Cache,
+    /// Compiled (no valid cache file) and written to the cache.
+    CompiledAndStored,
+    /// Compiled (no valid cache file); the cache could not be written.
+    CompiledNotStored,
+}
+
+/// The compiled model of `xml` with the Menagerie models, from the cache in `dir` when it holds
+/// this exact model, else compiled and stored there. A cache that cannot be read or written only
+/// costs the compile (logged at debug level).
+fn cached_model(
+    xml: &str,
+    ur5e: &Path,
+    gripper: &Path,
+    menagerie: &Path,
+    dir: &Path,
+) -> Result<(MjModel, ModelOrigin), SimError> {
+    let key = match super::cache::model_key_stamped(xml, menagerie, dir) {
+        Ok(key) => key,
+        Err(e) => {
+            tracing::debug!(error = %e, "model cache: cannot hash the model's files; compiling");
+            return Ok((compile_model(xml, ur5e, gripper)?, ModelOrigin::CompiledNotStored));
+        }
+    };
+    if let Some(model) = super::cache::load(dir, &key) {
+        tracing::debug!(%key, "model cache: hit");
+        return Ok((model, ModelOrigin::Cache));
+    }
+    let model = compile_model(xml, ur5e, gripper)?;
+    let origin = match super::cache::store(dir, &key, &model) {
+        Ok(path) => {
+            tracing::debug!(path = %path.display(), "model cache: stored");
+            ModelOrigin::CompiledAndStored
+        }
+        Err(e) => {
+            tracing::debug!(error = %e, "model cache: not stored");
+            ModelOrigin::CompiledNotStored
+        }
+    };
+    Ok((model, origin))
+}
+
+/// Parses the cell `xml`, attaches the UR5e (`ur5e/`) and the 2F-85 at its attachment site
+/// (`gripper/`) and compiles the whole.
+pub fn compile_model(xml: &str, ur5e: &Path, gripper: &Path) -> Result<MjModel, SimError> {
+    let spec_err = |what: &str, e: MjEditError| SimError::Scene(format!("{what}: {e:?}"));
+    let mut scene = MjSpec::from_xml_string(xml).map_err(|e| spec_err("the scene's MJCF", e))?;
+    let mut arm = MjSpec::from_xml(ur5e).map_err(|e| spec_err("ur5e.xml", e))?;
+    let mut hand = MjSpec::from_xml(gripper).map_err(|e| spec_err("2f85.xml", e))?;
+    scene
+        .world_body_mut()
+        .attach_by_deep_copy(&mut arm, "ur5e/", "")
+        .map_err(|e| spec_err("attaching the UR5e", e))?;
+    scene
+        .site_mut("ur5e/attachment_site")
+        .ok_or_else(|| SimError::Scene("ur5e/attachment_site not found in ur5e.xml".into()))?
+        .attach_by_deep_copy(&mut hand, "gripper/", "")
+        .map_err(|e| spec_err("attaching the 2F-85", e))?;
+    scene.compile().map_err(|e| spec_err("compiling the scene", e))
 }
 
 impl Scene {

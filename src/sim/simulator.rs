@@ -28,6 +28,8 @@ pub struct Sim {
     scene: Scene,
     data: MjData<Arc<MjModel>>,
     steps: u64,
+    /// Wall-clock time spent inside `mj_step` since this simulation was created (never reset).
+    physics_time: std::time::Duration,
 }
 
 impl Sim {
@@ -38,6 +40,7 @@ impl Sim {
             scene: scene.clone(),
             data,
             steps: 0,
+            physics_time: std::time::Duration::ZERO,
         };
         let placement = scene.default_placement();
         sim.reset_placement(&placement);
@@ -155,8 +158,16 @@ impl Sim {
 
     /// Advances the physics by one time step ([`TIMESTEP`]).
     pub fn step(&mut self) {
+        let start = std::time::Instant::now();
         self.data.step();
+        self.physics_time += start.elapsed();
         self.steps += 1;
+    }
+
+    /// Wall-clock time spent inside `mj_step` since this simulation was created (resets do not
+    /// clear it), for measuring how much of a run is physics.
+    pub fn physics_time(&self) -> std::time::Duration {
+        self.physics_time
     }
 
     /// Physics steps taken since the last reset.

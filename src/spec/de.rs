@@ -34,11 +34,108 @@ pub struct DeError {
     pub via: Option<Loc>,
 }
 
+/// Separates a message from its help in a custom error's text (`"message\nhelp: what to do"`),
+/// so that checks written against any serde error type can give help too.
+pub const HELP_SEPARATOR: &str = "\nhelp: ";
+
+/// A warning raised while reading a value: something accepted that is probably not what the
+/// author meant (e.g. `yaw: 5`, read as 5 radians).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DeWarning {
+    /// What looks wrong.
+    pub message: String,
+    /// What to do.
+    pub help: Option<String>,
+    /// Where (the value read).
+    pub loc: Loc,
+    /// If the value came from a subtree `$param`, where that `$param` was used.
+    pub via: Option<Loc>,
+}
+
+thread_local! {
+    /// Warnings raised by the value being read, not yet located.
+    static PENDING: std::cell::RefCell<Vec<(String, Option<String>)>> = const { std::cell::RefCell::new(Vec::new()) };
+    /// Located warnings, until [`take_warnings`] collects them.
+    static LOCATED: std::cell::RefCell<Vec<DeWarning>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// Raise a warning about the value being read (located by the deserializer once it returns).
+/// Outside [`from_value`] the warning is dropped.
+pub fn warn(message: impl Into<String>, help: Option<String>) {
+    PENDING.with(|p| p.borrow_mut().push((message.into(), help)));
+}
+
+/// The warnings raised since the last call, in order (and forget them).
+pub fn take_warnings() -> Vec<DeWarning> {
+    PENDING.with(|p| p.borrow_mut().clear());
+    LOCATED.with(|l| std::mem::take(&mut *l.borrow_mut()))
+}
+
+/// Locate the pending warnings at `v`.
+fn locate_warnings(v: &Value) {
+    let pending = PENDING.with(|p| std::mem::take(&mut *p.borrow_mut()));
+    if pending.is_empty() {
+        return;
+    }
+    LOCATED.with(|l| {
+        l.borrow_mut()
+            .extend(pending.into_iter().map(|(message, help)| DeWarning {
+                message,
+                help,
+                loc: v.loc,
+                via: v.via,
+            }));
+    });
+}
+
+/// The first item of the list `v` that a subtree argument put there, preferring one
+/// written in another file than `v` (an argument of the call rather than a default of the
+/// subtree's own `params:`).
+fn substituted_part(v: &Value) -> Option<&Value> {
+    fn walk<'a>(v: &'a Value, out: &mut Vec<&'a Value>) {
+        match &v.kind {
+            ValueKind::Seq(items) => items.iter().for_each(|i| {
+                if i.via.is_some() {
+                    out.push(i);
+                } else {
+                    walk(i, out);
+                }
+            }),
+            ValueKind::Map(entries) => entries.iter().for_each(|(_, x)| {
+                if x.via.is_some() {
+                    out.push(x);
+                } else {
+                    walk(x, out);
+                }
+            }),
+            _ => {}
+        }
+    }
+    let mut found = Vec::new();
+    walk(v, &mut found);
+    let one_argument = found.windows(2).all(|w| w[0].loc == w[1].loc);
+    found
+        .iter()
+        .find(|p| p.loc.file != v.loc.file)
+        .or_else(|| one_argument.then(|| found.first()).flatten())
+        .copied()
+}
+
 impl DeError {
     fn at(mut self, v: &Value) -> Self {
         if self.loc.is_none() {
             self.loc = Some(v.loc);
             self.via = v.via;
+            // A check of a whole value (a point out of reach) built from a subtree argument:
+            // point at the argument, with a note at the use, like a check of the argument itself.
+            if v.via.is_none()
+                && self.label.is_none()
+                && matches!(v.kind, ValueKind::Seq(_))
+                && let Some(part) = substituted_part(v)
+            {
+                self.loc = Some(part.loc);
+                self.via = part.via;
+            }
         }
         self
     }
@@ -118,7 +215,11 @@ fn list(expected: &[&str]) -> String {
 
 impl de::Error for DeError {
     fn custom<T: fmt::Display>(msg: T) -> Self {
-        Self::msg(msg.to_string())
+        let text = msg.to_string();
+        match text.split_once(HELP_SEPARATOR) {
+            Some((message, help)) => Self::msg(message).with_help(help),
+            None => Self::msg(text),
+        }
     }
 
     fn invalid_type(unexp: de::Unexpected, exp: &dyn de::Expected) -> Self {
@@ -194,6 +295,7 @@ impl<'de> Deserializer<'de> for ValueDe<'_> {
                 pending: None,
             }),
         };
+        locate_warnings(v);
         r.map_err(|e| e.at(v))
     }
 
@@ -208,12 +310,13 @@ impl<'de> Deserializer<'de> for ValueDe<'_> {
 
     fn deserialize_f64<V: Visitor<'de>>(self, visitor: V) -> Result<V::Value, DeError> {
         let v = self.0;
-        match &v.kind {
+        let r = match &v.kind {
             ValueKind::Int(i) => visitor.visit_f64(*i as f64),
             ValueKind::Float(x) => visitor.visit_f64(*x),
             _ => return self.deserialize_any(visitor),
-        }
-        .map_err(|e: DeError| e.at(v))
+        };
+        locate_warnings(v);
+        r.map_err(|e: DeError| e.at(v))
     }
 
     fn deserialize_f32<V: Visitor<'de>>(self, visitor: V) -> Result<V::Value, DeError> {

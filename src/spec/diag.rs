@@ -73,6 +73,9 @@ pub struct Diagnostic {
     pub source_column: u32,
     /// Width of the caret underline in characters (at least 1).
     pub width: u32,
+    /// A warning (the tree is accepted, but this is probably not what was meant) rather than an
+    /// error.
+    pub warning: bool,
 }
 
 impl Diagnostic {
@@ -84,7 +87,8 @@ impl Diagnostic {
 
 impl fmt::Display for Diagnostic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        writeln!(f, "error: {}", self.message)?;
+        let severity = if self.warning { "warning" } else { "error" };
+        writeln!(f, "{severity}: {}", self.message)?;
         let gutter = self.line.to_string().len();
         let pad = " ".repeat(gutter);
         write!(f, "{pad}--> {}", self.location())?;
@@ -310,7 +314,17 @@ impl Sources {
             source_line,
             source_column,
             width,
+            warning: false,
         }
+    }
+
+    /// Turn warnings into diagnostics (printed `warning:`), sorted and without duplicates.
+    pub fn warnings(&self, issues: &[Issue]) -> Vec<Diagnostic> {
+        let mut out = self.diagnostics(issues);
+        for d in &mut out {
+            d.warning = true;
+        }
+        out
     }
 
     /// Turn many issues into diagnostics, sorted by file, line and column, without duplicates.

@@ -34,6 +34,8 @@ pub(crate) struct Expander<'a> {
     sources: &'a Sources,
     /// Problems found so far.
     pub issues: Vec<Issue>,
+    /// Warnings found so far (accepted, but probably not what was meant).
+    pub warnings: Vec<Issue>,
     stack: Vec<String>,
     nodes: usize,
     too_many_reported: bool,
@@ -60,6 +62,7 @@ impl<'a> Expander<'a> {
             subtrees,
             sources,
             issues: Vec::new(),
+            warnings: Vec::new(),
             stack: Vec::new(),
             nodes: 0,
             too_many_reported: false,
@@ -205,6 +208,16 @@ impl<'a> Expander<'a> {
             .as_ref()
             .and_then(|t| parse_leaf_reporting_all(t, without_name(body)))
         {
+            for w in super::de::take_warnings() {
+                let mut issue = Issue::new(w.loc, format!("{} in `{k}`", w.message)).maybe_help(w.help);
+                if let Some(via) = w.via {
+                    issue = issue.note(format!(
+                        "this value is a subtree argument, used at {}",
+                        self.sources.describe(via)
+                    ));
+                }
+                self.warnings.push(issue);
+            }
             self.record_objects(k, body);
             match parsed {
                 Ok(leaf) => {
@@ -229,6 +242,12 @@ impl<'a> Expander<'a> {
                 Err(errors) => {
                     for e in errors {
                         let mut issue = e.into_issue(body.loc, |l| self.sources.describe(l));
+                        if let Some(help) = (category == Some(Category::Condition))
+                            .then(|| condition_param_help(k, &issue.message))
+                            .flatten()
+                        {
+                            issue.help = Some(help);
+                        }
                         // A value already reported (an undefined `$param` left in place) needs
                         // no second error for its type.
                         if self.reported.contains(&issue.loc)
@@ -997,4 +1016,22 @@ pub fn render_value(v: &Value) -> String {
                 .join(", ")
         ),
     }
+}
+
+/// For a condition given an action's parameter (`cube_in_bowl: {timeout: 2}`): what to write
+/// instead. Conditions are instantaneous, so waiting for one or bounding it in time is the job of
+/// the decorators around it. `None` for any other error. Called for conditions only.
+fn condition_param_help(kind: &str, message: &str) -> Option<String> {
+    let param = message.strip_prefix("unknown parameter `")?.split('`').next()?;
+    let timing = [
+        "timeout", "seconds", "speed", "wait", "duration", "retries", "attempts", "until", "poll",
+    ];
+    if !timing.contains(&param) {
+        return None;
+    }
+    Some(format!(
+        "conditions are instantaneous: `{kind}` checks the world on the tick it runs and succeeds or fails at once, so it takes no `{param}`. \
+         To wait up to 2 s for it to hold, wrap it: `timeout: {{seconds: 2, child: {{retry: {{attempts: 1000, child: {{{kind}: {{}}}}}}}}}}`; \
+         to run an action only while it holds, use `guard: {{condition: {{{kind}: {{}}}}, child: ...}}`"
+    ))
 }

@@ -298,6 +298,13 @@ pub struct CubeAt {
     #[serde(default = "d_point_tol", deserialize_with = "units::distance")]
     #[schemars(range(min = 0.0, max = units::MAX_REACH))]
     pub tolerance: f64,
+    /// The yaw the cube's faces should have (radians or `deg(..)`, modulo 90°). Absent: any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub yaw: Option<Angle>,
+    /// Largest yaw error when `yaw` is given, radians (or `deg(..)`). Default 3°.
+    #[serde(default = "d_yaw_tol", deserialize_with = "units::angle_tolerance")]
+    #[schemars(with = "units::Angle")]
+    pub yaw_tolerance: f64,
     /// Cube speed below which it counts as at rest, m/s (> 0). Default 0.05.
     #[serde(default = "d_rest_speed", deserialize_with = "units::speed")]
     #[schemars(range(min = 0.0))]

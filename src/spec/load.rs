@@ -43,6 +43,8 @@ pub struct Spec {
     pub var_defs: Vec<super::check::VarDef>,
     /// The canonical paths of the files read from disk (main file and includes), sorted.
     pub files: Vec<PathBuf>,
+    /// Warnings: accepted, but probably not what was meant (e.g. `yaw: 5`, read as 5 radians).
+    pub warnings: Vec<Diagnostic>,
 }
 
 /// Load a tree file from disk (following includes relative to it), checking the objects it
@@ -209,6 +211,9 @@ pub fn builtin_scene() -> Arc<SceneSpec> {
 impl Loader {
     fn finish(mut self, text: &str, name: &str, base: Option<&Path>) -> Result<Spec, Vec<Diagnostic>> {
         self.scope = IncludeScope::for_base(base);
+        // Warnings left over from reading something else on this thread (a scene file).
+        let _ = super::de::take_warnings();
+        let mut warnings = Vec::new();
         let id = self.sources.add(name, text);
         let (root_file, is_tree) = match parse_yaml(text, id).map(|v| parse_top_level(&v, &mut self.issues)) {
             Ok((Some(f), is_tree)) => (f, is_tree),
@@ -296,6 +301,7 @@ impl Loader {
         let root = ex.node(&main, 0);
         let called: HashSet<String> = ex.calls.keys().cloned().collect();
         self.issues.append(&mut ex.issues);
+        warnings.append(&mut ex.warnings);
         let object_uses = std::mem::take(&mut ex.object_uses);
         let var_defs = std::mem::take(&mut ex.var_defs);
         let scene = self.scene_for(&root_file, base);
@@ -335,12 +341,14 @@ impl Loader {
             );
             let _ = ex.node(&call, 0);
             self.issues.append(&mut ex.issues);
+            warnings.append(&mut ex.warnings);
         }
 
         match root {
             Some(root) if self.issues.is_empty() => {
                 let mut files: Vec<PathBuf> = self.loaded.into_iter().collect();
                 files.sort();
+                let warnings = self.sources.warnings(&warnings);
                 Ok(Spec {
                     root,
                     sources: self.sources,
@@ -351,6 +359,7 @@ impl Loader {
                     object_uses,
                     var_defs,
                     files,
+                    warnings,
                 })
             }
             _ => {

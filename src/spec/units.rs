@@ -134,12 +134,35 @@ pub fn angle_tolerance<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error>
     Ok(x)
 }
 
+/// One coordinate of a point or an offset, metres: finite and at most `limit` from 0, checked
+/// while it is read so that an error points at the number itself (or at the subtree argument it
+/// came from).
+struct Coordinate<const POINT: bool>(f64);
+
+impl<'de, const POINT: bool> Deserialize<'de> for Coordinate<POINT> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let x = number(d, "a coordinate (m)")?;
+        // A point's coordinate beyond the reach plus the shoulder's height is out of reach
+        // whatever the others are; an offset's beyond the reach is too long.
+        let limit = if POINT {
+            MAX_REACH + SHOULDER_HEIGHT
+        } else {
+            MAX_REACH
+        };
+        if x.abs() > limit {
+            return Err(de::Error::custom(format!(
+                "a coordinate of {x} m is beyond the arm's full reach of {MAX_REACH:.2} m{}lengths are in metres: write {} for {x} cm",
+                super::de::HELP_SEPARATOR,
+                x / 100.0
+            )));
+        }
+        Ok(Coordinate(x))
+    }
+}
+
 /// Three finite lengths `[x, y, z]` in metres.
 pub fn vec3<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
-    let v = <[f64; 3]>::deserialize(d)?;
-    for x in v {
-        finite::<D::Error>(x, "a coordinate (m)")?;
-    }
+    let v = <[Coordinate<false>; 3]>::deserialize(d)?.map(|c| c.0);
     let length = v.iter().map(|x| x * x).sum::<f64>().sqrt();
     within_reach(length, || format!("an offset of {length:.3} m"))?;
     Ok(v)
@@ -184,8 +207,37 @@ pub fn parse_angle_text(s: &str) -> Result<f64, String> {
     }
 }
 
-/// An angle in radians. YAML accepts a plain number (radians) or `deg(x)` / `rad(x)` (and simple
-/// expressions such as `rad(pi/2)`).
+/// Largest bare angle accepted, radians (one full turn): a plain number beyond ±2π is almost
+/// certainly degrees written without `deg(..)`.
+pub const MAX_BARE_ANGLE: f64 = std::f64::consts::TAU;
+
+/// A plain number read as an angle in radians: an error beyond ±2π (with help to write `deg(..)`),
+/// and a warning for a whole number beyond ±π (`yaw: 5` is 286°, probably meant as degrees).
+fn bare_angle<E: de::Error>(x: f64, integer: bool) -> Result<f64, E> {
+    let x = finite(x, "an angle (rad)")?;
+    if x.abs() > MAX_BARE_ANGLE {
+        return Err(E::custom(format!(
+            "`{x}` is more than a full turn as an angle in radians ({:.0}°){}write deg({x}) for degrees, or rad({x}) if you really mean radians",
+            x.to_degrees(),
+            super::de::HELP_SEPARATOR
+        )));
+    }
+    if integer && x.abs() > std::f64::consts::PI {
+        super::de::warn(
+            format!(
+                "`{x}` is read as {x} rad ({:.1}°): plain numbers are radians",
+                x.to_degrees()
+            ),
+            Some(format!(
+                "write deg({x}) if you meant degrees; write rad({x}) or {x}.0 to keep radians and silence this warning"
+            )),
+        );
+    }
+    Ok(x)
+}
+
+/// An angle in radians. YAML accepts a plain number (radians, within ±2π) or `deg(x)` / `rad(x)`
+/// (and simple expressions such as `rad(pi/2)`).
 #[derive(Copy, Clone, Debug, PartialEq, Serialize)]
 #[serde(transparent)]
 pub struct Angle(pub f64);
@@ -198,13 +250,13 @@ impl Visitor<'_> for AngleVisitor {
         f.write_str("an angle: radians as a number, or `deg(90)` / `rad(1.57)`")
     }
     fn visit_i64<E: de::Error>(self, v: i64) -> Result<Angle, E> {
-        Ok(Angle(v as f64))
+        bare_angle(v as f64, true).map(Angle)
     }
     fn visit_u64<E: de::Error>(self, v: u64) -> Result<Angle, E> {
-        Ok(Angle(v as f64))
+        bare_angle(v as f64, true).map(Angle)
     }
     fn visit_f64<E: de::Error>(self, v: f64) -> Result<Angle, E> {
-        finite(v, "an angle (rad)").map(Angle)
+        bare_angle(v, false).map(Angle)
     }
     fn visit_str<E: de::Error>(self, v: &str) -> Result<Angle, E> {
         parse_angle_text(v).map(Angle).map_err(|m| {
@@ -278,10 +330,10 @@ impl<'de> Visitor<'de> for TargetVisitor {
     fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Target, A::Error> {
         let mut p = [0.0; 3];
         for (i, slot) in p.iter_mut().enumerate() {
-            let x: f64 = seq
+            let x: Coordinate<true> = seq
                 .next_element()?
                 .ok_or_else(|| de::Error::invalid_length(i, &"a point [x, y, z] in metres"))?;
-            *slot = finite(x, "a coordinate (m)")?;
+            *slot = x.0;
         }
         if seq.next_element::<de::IgnoredAny>()?.is_some() {
             return Err(de::Error::invalid_length(4, &"a point [x, y, z] in metres"));
@@ -359,13 +411,13 @@ impl Visitor<'_> for YawVisitor {
         f.write_str("`object`, `keep`, or an angle (radians, or `deg(90)`)")
     }
     fn visit_i64<E: de::Error>(self, v: i64) -> Result<Yaw, E> {
-        Ok(Yaw::Angle(v as f64))
+        bare_angle(v as f64, true).map(Yaw::Angle)
     }
     fn visit_u64<E: de::Error>(self, v: u64) -> Result<Yaw, E> {
-        Ok(Yaw::Angle(v as f64))
+        bare_angle(v as f64, true).map(Yaw::Angle)
     }
     fn visit_f64<E: de::Error>(self, v: f64) -> Result<Yaw, E> {
-        finite(v, "a yaw angle (rad)").map(Yaw::Angle)
+        bare_angle(v, false).map(Yaw::Angle)
     }
     fn visit_str<E: de::Error>(self, v: &str) -> Result<Yaw, E> {
         match v {

@@ -301,11 +301,11 @@ pub fn parse_yaml(text: &str, file: FileId) -> Result<Value, Issue> {
             }
             Ok(v)
         }
-        Err(e) => Err(yaml_error(&e, file)),
+        Err(e) => Err(yaml_error(&e, text, file)),
     }
 }
 
-fn yaml_error(e: &serde_saphyr::Error, file: FileId) -> Issue {
+fn yaml_error(e: &serde_saphyr::Error, text: &str, file: FileId) -> Issue {
     let loc = e.location().map_or(Loc::file_start(file), |l| {
         let mut loc = loc_of(&l);
         loc.file = file;
@@ -335,6 +335,9 @@ fn yaml_error(e: &serde_saphyr::Error, file: FileId) -> Issue {
     if let Some((message, help)) = plain_message(e, &msg) {
         return Issue::new(loc, message).help(help);
     }
+    if let Some(issue) = indentation_issue(text, loc, &msg) {
+        return issue;
+    }
     let lower = msg.to_lowercase();
     let help = if lower.contains("budget")
         || lower.contains("alias")
@@ -346,6 +349,181 @@ fn yaml_error(e: &serde_saphyr::Error, file: FileId) -> Issue {
         "fix the YAML syntax here (indentation, a missing `:` or an unclosed bracket or quote)"
     };
     Issue::new(loc, format!("invalid YAML: {msg}")).help(help)
+}
+
+/// One non-blank, non-comment line of a YAML file.
+#[derive(Clone, Copy)]
+struct Line<'a> {
+    /// 1-based line number.
+    no: u32,
+    /// Leading spaces.
+    indent: usize,
+    /// The text after the indentation, without a trailing comment's spaces.
+    text: &'a str,
+}
+
+impl Line<'_> {
+    /// The line opens a block whose content follows on deeper lines (`key:`, `- key:`, `-`).
+    fn opens_block(&self) -> bool {
+        let t = self.text.split(" #").next().unwrap_or("").trim_end();
+        t.ends_with(':') || t == "-" || t.ends_with('|') || t.ends_with('>')
+    }
+    /// The line is a list item (`- …`).
+    fn is_item(&self) -> bool {
+        self.text == "-" || self.text.starts_with("- ")
+    }
+    fn loc(&self, file: FileId) -> Loc {
+        Loc {
+            file,
+            line: self.no,
+            col: self.indent as u32 + 1,
+            len: self.text.chars().count().max(1) as u32,
+        }
+    }
+}
+
+fn content_lines(text: &str) -> Vec<Line<'_>> {
+    text.lines()
+        .enumerate()
+        .filter_map(|(i, raw)| {
+            let text = raw.trim_start_matches(' ');
+            let t = text.trim();
+            (!t.is_empty() && !t.starts_with('#') && !t.starts_with('\t')).then(|| Line {
+                no: u32::try_from(i + 1).unwrap_or(u32::MAX),
+                indent: raw.len() - text.len(),
+                text: text.trim_end(),
+            })
+        })
+        .collect()
+}
+
+/// The parser's indentation errors (`did not find expected key`, `mapping values are not
+/// allowed in this context`, …) in our words, pointing at the line whose indentation is wrong:
+/// often the line the parser stopped at, sometimes the one before it (the first child of a
+/// mapping sets its indentation; a sibling written at the usual indentation after it is where
+/// the parser notices). `None` when the lines do not show an indentation mistake.
+fn indentation_issue(text: &str, at: Loc, raw: &str) -> Option<Issue> {
+    const SYNTAX: [&str; 4] = [
+        "did not find expected key",
+        "mapping values are not allowed",
+        "did not find expected '-' indicator",
+        "block sequence entries are not allowed",
+    ];
+    if !SYNTAX.iter().any(|s| raw.contains(s)) || at.line == 0 {
+        return None;
+    }
+    let file = at.file;
+    let lines = content_lines(text);
+    let upto: Vec<Line> = lines.iter().copied().filter(|l| l.no <= at.line).collect();
+    let (e, before) = upto.split_last()?;
+    let p = before.last()?;
+    let shown = |l: &Line| -> String { l.text.chars().take(40).collect() };
+    // The usual indentation step of the file (2 unless most nested lines say otherwise).
+    let step = {
+        let mut counts = std::collections::BTreeMap::new();
+        for w in lines.windows(2) {
+            if w[1].indent > w[0].indent && w[0].opens_block() {
+                *counts.entry(w[1].indent - w[0].indent).or_insert(0u32) += 1;
+            }
+        }
+        counts
+            .into_iter()
+            .max_by_key(|&(d, c)| (c, std::cmp::Reverse(d)))
+            .map_or(2, |(d, _)| d)
+    };
+    // A line at a list's indentation without "- ".
+    if !e.is_item()
+        && let Some(sib) = before.iter().rev().find(|l| l.indent <= e.indent)
+        && sib.indent == e.indent
+        && sib.is_item()
+    {
+        return Some(
+            Issue::new(e.loc(file), "a list item needs \"- \"")
+                .label(format!(
+                    "the items of this list start with `- ` (line {})",
+                    sib.no
+                ))
+                .help(format!("write `- {}`", shown(e))),
+        );
+    }
+    if e.indent > p.indent && !p.opens_block() {
+        return Some(
+            Issue::new(e.loc(file), "this line is indented deeper than its siblings")
+                .label(format!(
+                    "{} spaces here, {} on line {} above",
+                    e.indent, p.indent, p.no
+                ))
+                .help(format!(
+                    "indent it by {} spaces like line {} (`{}`); if it belongs inside the line above, end that line with `:` and put its value on the lines below",
+                    p.indent,
+                    p.no,
+                    shown(p)
+                )),
+        );
+    }
+    if e.indent < p.indent {
+        // The open blocks around the line above: each ancestor, from the innermost.
+        let mut chain = vec![*p];
+        for l in before.iter().rev() {
+            if l.indent < chain.last().map_or(0, |c| c.indent) {
+                chain.push(*l);
+            }
+        }
+        if chain.iter().any(|c| c.indent == e.indent) {
+            return None;
+        }
+        let sibling = chain.iter().rev().find(|c| c.indent > e.indent)?;
+        let parent = chain.iter().find(|c| c.indent < e.indent);
+        let first_child = parent.is_some_and(|par| {
+            lines
+                .iter()
+                .find(|l| l.no > par.no)
+                .is_some_and(|l| l.no == sibling.no)
+        });
+        if let Some(par) = parent
+            && first_child
+            && e.indent == par.indent + step
+        {
+            // The first child set a deeper indentation than its parent's usual step.
+            return Some(
+                Issue::new(
+                    sibling.loc(file),
+                    "this line is indented deeper than its siblings",
+                )
+                .label(format!(
+                    "{} spaces here, {} on line {} (`{}`)",
+                    sibling.indent,
+                    e.indent,
+                    e.no,
+                    shown(e)
+                ))
+                .help(format!(
+                    "indent it by {} spaces, like the other entries of line {} (`{}`)",
+                    e.indent,
+                    par.no,
+                    shown(par)
+                )),
+            );
+        }
+        let mut help = format!(
+            "indent it by {} spaces like line {} (`{}`)",
+            sibling.indent,
+            sibling.no,
+            shown(sibling)
+        );
+        if let Some(par) = parent {
+            help += &format!(", or by {} to end the block of line {}", par.indent, par.no);
+        }
+        return Some(
+            Issue::new(e.loc(file), "this line is indented shallower than its siblings")
+                .label(format!(
+                    "{} spaces here, {} on line {}",
+                    e.indent, sibling.indent, sibling.no
+                ))
+                .help(help),
+        );
+    }
+    None
 }
 
 /// Our own words (message, help) for the parser's limits and duplicate keys, whose own messages
@@ -453,6 +631,66 @@ mod tests {
         let e = parse_yaml("main:\n  a: [1, 2\n", 0).unwrap_err();
         assert!(e.message.starts_with("invalid YAML"), "{e:?}");
         assert!(e.loc.line >= 2, "{e:?}");
+    }
+
+    /// (line, message) of the parse error of `text`.
+    fn indentation(text: &str) -> (u32, String) {
+        let e = parse_yaml(text, 0).unwrap_err();
+        (e.loc.line, e.message)
+    }
+
+    #[test]
+    fn indentation_mistakes_are_explained_at_the_wrong_line() {
+        let deeper = "this line is indented deeper than its siblings";
+        let shallower = "this line is indented shallower than its siblings";
+        let item = "a list item needs \"- \"";
+        let cases = [
+            // A second item indented under the first.
+            (
+                "main:\n  sequence:\n    children:\n      - home: {}\n        - reach: {target: cube}\n",
+                5,
+                deeper,
+            ),
+            // An item one space short.
+            (
+                "main:\n  sequence:\n    children:\n      - home: {}\n     - reach: {target: cube}\n",
+                5,
+                shallower,
+            ),
+            // A list item without its dash.
+            (
+                "main:\n  sequence:\n    children:\n      - home: {}\n      reach: {target: cube}\n",
+                5,
+                item,
+            ),
+            // A key one space too deep after a sibling.
+            (
+                "main:\n  sequence:\n    name: x\n     children:\n      - home: {}\n",
+                4,
+                deeper,
+            ),
+            // A key one space short.
+            (
+                "main:\n  sequence:\n    name: x\n   children:\n      - home: {}\n",
+                4,
+                shallower,
+            ),
+            // The first key too deep: the parser stops at its sibling, one line later.
+            (
+                "main:\n  sequence:\n     name: x\n    children:\n      - home: {}\n",
+                3,
+                deeper,
+            ),
+            // A decorator's key too deep.
+            (
+                "main:\n  retry:\n    attempts: 3\n      child: {home: {}}\n",
+                4,
+                deeper,
+            ),
+        ];
+        for (text, line, message) in cases {
+            assert_eq!(indentation(text), (line, message.to_string()), "{text}");
+        }
     }
 
     #[test]

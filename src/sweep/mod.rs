@@ -28,7 +28,7 @@ use std::ops::ControlFlow;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::str::FromStr;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::time::Instant;
 
@@ -206,6 +206,9 @@ pub struct SweepConfig {
     pub substitutions: Vec<Substitution>,
     /// The scenario file of `macrotree test` this sweep belongs to, if any.
     pub suite: Option<String>,
+    /// How reproduction commands name the program (`macrotree` when it is on `PATH`, else the
+    /// path of the binary that ran, e.g. `target/release/macrotree`), shell-quoted.
+    pub program: String,
 }
 
 impl Default for SweepConfig {
@@ -222,6 +225,7 @@ impl Default for SweepConfig {
             tree: String::new(),
             substitutions: Vec::new(),
             suite: None,
+            program: "macrotree".to_string(),
         }
     }
 }
@@ -524,12 +528,14 @@ impl ScenarioResult {
         serde_json::to_string(self).expect("a scenario result serializes")
     }
 
-    /// The `macrotree run …` command that reproduces this scenario bit for bit. Floats are
+    /// The `macrotree run …` command that reproduces this scenario bit for bit (the program
+    /// named as [`SweepConfig::program`] says). Floats are
     /// printed with Rust's shortest round-trip formatting, so they parse back to the same bits.
     pub fn reproduce(&self, tree: &str, config: &SweepConfig) -> String {
         let mut cmd = match &self.layout {
             Some(l) => format!(
-                "macrotree run {} --cube {},{},{} --bowl {},{} --seed {}",
+                "{} run {} --cube {},{},{} --bowl {},{} --seed {}",
+                config.program,
                 shell_quote(tree),
                 l.cube[0],
                 l.cube[1],
@@ -539,7 +545,8 @@ impl ScenarioResult {
                 self.seed
             ),
             None => format!(
-                "macrotree run {} --sweep-seed {} --scenario {}",
+                "{} run {} --sweep-seed {} --scenario {}",
+                config.program,
                 shell_quote(tree),
                 self.sweep_seed,
                 self.index
@@ -620,6 +627,8 @@ pub struct SweepRun {
     pub wall_time_s: f64,
     /// Worker threads used.
     pub jobs: usize,
+    /// Wall-clock time the workers spent inside `mj_step`, summed over workers, seconds.
+    pub physics_time_s: f64,
 }
 
 /// Runs the sweep on `config.jobs` worker threads (one [`Cell`] each) and calls `on_result` on
@@ -658,16 +667,24 @@ pub fn run_sweep_from(
     let mut results = Vec::with_capacity(indices.len().min(4096));
     let (tx, rx) = mpsc::channel::<(usize, ScenarioResult)>();
     let stop = AtomicBool::new(false);
+    let physics_ns = AtomicU64::new(0);
     std::thread::scope(|s| {
         let stop = &stop;
+        let physics_ns = &physics_ns;
         s.spawn(move || {
             let new_cell = || Cell::new(scene, &Layout::default(), CONTROL_PERIOD);
             pool.install(|| {
                 // par_bridge hands out scenarios in index order, so results arrive nearly in order.
                 let todo = indices.take_while(|_| !stop.load(Ordering::Relaxed)).enumerate();
                 todo.par_bridge().for_each_init(new_cell, |cell, (pos, index)| {
+                    let before = cell.sim().physics_time();
                     let outcome =
                         catch_unwind(AssertUnwindSafe(|| run_scene_scenario(cell, plan, config, index)));
+                    let spent = cell.sim().physics_time().saturating_sub(before);
+                    physics_ns.fetch_add(
+                        u64::try_from(spent.as_nanos()).unwrap_or(u64::MAX),
+                        Ordering::Relaxed,
+                    );
                     let result = outcome.unwrap_or_else(|payload| {
                         *cell = new_cell();
                         let s = config.scene_scenario(scene, index).ok();
@@ -706,6 +723,7 @@ pub fn run_sweep_from(
         results,
         wall_time_s: wall.elapsed().as_secs_f64(),
         jobs,
+        physics_time_s: physics_ns.load(Ordering::Relaxed) as f64 * 1e-9,
     })
 }
 

@@ -186,6 +186,7 @@ fn merge_group(mut lines: Vec<(Origin, ScenarioResult)>) -> Result<Merged, Merge
         tree: first.tree.clone(),
         substitutions: first.substitutions.clone(),
         suite: first.suite.clone(),
+        ..SweepConfig::default()
     };
     Ok(Merged {
         config,

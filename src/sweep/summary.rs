@@ -73,6 +73,18 @@ pub struct Summary {
     pub wall_time_s: f64,
     /// Scenarios per minute of wall-clock time.
     pub scenarios_per_minute: f64,
+    /// Wall-clock time the workers spent inside `mj_step`, summed over workers, seconds (`None`
+    /// until [`Summary::with_physics`] sets it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub physics_time_s: Option<f64>,
+    /// Wall-clock time of the whole process up to the end of the sweep (start-up, loading and
+    /// compiling the model included), seconds.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub process_wall_time_s: Option<f64>,
+    /// `physics_time_s / (jobs × process_wall_time_s)`: the share of the workers' time that was
+    /// physics (1 would be a sweep that does nothing but `mj_step`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub physics_share: Option<f64>,
     /// Every failing scenario, by index.
     pub failures: Vec<Failure>,
     /// Failures grouped by (node path, failure kind), most frequent first.
@@ -246,7 +258,25 @@ impl Summary {
             substitutions: config.substitutions.iter().map(|s| s.to_string()).collect(),
             nodes,
             coverage,
+            physics_time_s: None,
+            process_wall_time_s: None,
+            physics_share: None,
         }
+    }
+
+    /// Adds how much of the sweep was physics: `physics_time_s` (time inside `mj_step`, summed
+    /// over the workers) over `jobs × process_wall_time_s` (the whole process up to now).
+    #[must_use]
+    pub fn with_physics(mut self, physics_time_s: f64, process_wall_time_s: f64) -> Self {
+        self.physics_time_s = Some(physics_time_s);
+        self.process_wall_time_s = Some(process_wall_time_s);
+        let capacity = self.jobs as f64 * process_wall_time_s;
+        self.physics_share = Some(if capacity > 0.0 {
+            physics_time_s / capacity
+        } else {
+            0.0
+        });
+        self
     }
 
     /// Every scenario run succeeded (true for an empty shard).
@@ -312,6 +342,15 @@ impl Summary {
             if c.never_ran.len() > 20 {
                 let _ = writeln!(s, "    … and {} more (see --json)", c.never_ran.len() - 20);
             }
+        }
+        if let (Some(share), Some(physics), Some(process)) =
+            (self.physics_share, self.physics_time_s, self.process_wall_time_s)
+        {
+            let _ = writeln!(
+                s,
+                "  physics share {:.3}: {physics:.2} s inside mj_step over {} job(s) × {process:.2} s of the whole process",
+                share, self.jobs
+            );
         }
         if !self.failure_groups.is_empty() {
             let _ = writeln!(s, "  failures by node and kind:");

@@ -117,10 +117,13 @@ impl From<std::io::Error> for ViewerError {
     }
 }
 
-/// Where the default camera looks (Z-up world), metres.
-pub const CAMERA_TARGET: [f64; 3] = [0.3, -0.05, 0.18];
-/// Default camera position relative to [`CAMERA_TARGET`] (Z-up world), metres.
-pub const CAMERA_OFFSET: [f64; 3] = [0.5, -0.55, 0.42];
+/// Where the default camera looks (Z-up world), metres: the middle of the table's work area,
+/// where the scenes put their objects.
+pub const CAMERA_TARGET: [f64; 3] = [0.38, -0.04, 0.06];
+/// Default camera position relative to [`CAMERA_TARGET`] (Z-up world), metres: in front of the
+/// work area (the robot behind it) and about 48° above the table, so that a container's rim or
+/// the arm does not hide a block on the table.
+pub const CAMERA_OFFSET: [f64; 3] = [0.62, -0.42, 0.84];
 
 /// The scene tree a browser starts from: view settings (camera, hidden grid) and one object per
 /// drawn geom. Body transforms follow with the first poses.
