@@ -25,15 +25,18 @@
 
 pub mod actions;
 pub mod cli;
+pub mod dataset;
 pub mod episode;
 pub mod faults;
 pub mod motion;
 pub mod output;
 pub mod plan;
+pub mod render;
 pub mod runtime;
 pub mod scene;
 pub mod sim;
 pub mod spec;
 pub mod sweep;
+pub mod video;
 pub mod viewer;
 pub mod world;
