@@ -25,6 +25,9 @@ pub const CHUNKS_SIZE: u64 = 1000;
 pub const DATA_FILE_MB: u64 = 100;
 /// `robot_type` in `meta/info.json`.
 pub const ROBOT_TYPE: &str = "ur5e_robotiq_2f85";
+/// The staging folder's subfolder for clips being recorded.
+const CLIPS: &str = ".clips";
+
 /// The marker file that says a folder is a dataset macrotree wrote.
 pub const MARKER: &str = "meta/macrotree.json";
 
@@ -179,6 +182,8 @@ impl DatasetWriter {
         let name = dir.file_name().expect("checked").to_string_lossy().into_owned();
         let stage = parent.join(format!(".{name}.{:016x}.partial", random_u64()));
         std::fs::create_dir(&stage).map_err(io_err(format!("cannot create {}", stage.display())))?;
+        std::fs::create_dir(stage.join(CLIPS))
+            .map_err(io_err(format!("cannot create a folder in {}", stage.display())))?;
         let row_bytes = 8 * 5 + 4 * (14 + 7 * opts.objects.len() as u64) + 64;
         let cams = opts.cameras.len();
         Ok(Self {
@@ -196,9 +201,10 @@ impl DatasetWriter {
         })
     }
 
-    /// The staging folder: recorders write their clips here (then [`add`](Self::add) moves them).
-    pub fn staging_dir(&self) -> &Path {
-        &self.stage
+    /// The folder where recorders write their clips ([`add`](Self::add) moves them into the
+    /// dataset; it is removed before the dataset is installed).
+    pub fn clips_dir(&self) -> PathBuf {
+        self.stage.join(CLIPS)
     }
 
     /// Episodes written so far.
@@ -535,6 +541,7 @@ impl DatasetWriter {
         let mut provenance = self.opts.provenance.clone();
         provenance["episodes"] = Value::Array(episodes);
         self.write_json(MARKER, &provenance)?;
+        std::fs::remove_dir_all(self.stage.join(CLIPS)).map_err(io_err("cannot remove the clips folder"))?;
         self.install()?;
         self.finished = true;
         Ok((self.episodes.len() as u64, self.frames))
