@@ -28,7 +28,10 @@ impl EpisodeObserver for RenderEveryTick {
         if self.ticks % 8 != 1 {
             return;
         }
-        let size = FrameSize { width: 96, height: 72 };
+        let size = FrameSize {
+            width: 96,
+            height: 72,
+        };
         let model = &cell.sim().scene().model;
         let sums = with_thread_renderer(model, size, |r| {
             r.sync(cell.sim().data());
@@ -67,7 +70,10 @@ fn rendering_never_changes_the_physics_bits() {
     let distinct: std::collections::BTreeSet<_> = observer.sums.iter().collect();
     assert!(distinct.len() > 100, "only {} distinct images", distinct.len());
     // Bit-identical physics: qpos, qvel, ctrl and time.
-    assert_eq!(plain.sim().state_fingerprint(), rendered.sim().state_fingerprint());
+    assert_eq!(
+        plain.sim().state_fingerprint(),
+        rendered.sim().state_fingerprint()
+    );
     assert_eq!(a.physics_steps, b.physics_steps);
 }
 
@@ -102,7 +108,10 @@ fn run_video_writes_an_h264_mp4_with_one_frame_per_sample() {
     assert_eq!(n, rows);
     assert_eq!(size, (320, 240));
     assert!(distinct > rows / 2, "{distinct} distinct frames of {n}");
-    assert!(stderr.contains(&format!("video written to {}", video.display())), "{stderr}");
+    assert!(
+        stderr.contains(&format!("video written to {}", video.display())),
+        "{stderr}"
+    );
     // Nothing but the two outputs is left in the folder (no temporary file).
     let mut names: Vec<_> = std::fs::read_dir(&dir)
         .unwrap()
@@ -134,9 +143,17 @@ fn the_same_episode_gives_the_same_video_bytes() {
     for f in ["a.mp4", "b.mp4"] {
         let a = args(f);
         let out = macrotree(&a.iter().map(String::as_str).collect::<Vec<_>>());
-        assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+        assert_eq!(
+            out.status.code(),
+            Some(1),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
     }
-    assert_eq!(std::fs::read(dir.join("a.mp4")).unwrap(), std::fs::read(dir.join("b.mp4")).unwrap());
+    assert_eq!(
+        std::fs::read(dir.join("a.mp4")).unwrap(),
+        std::fs::read(dir.join("b.mp4")).unwrap()
+    );
 }
 
 #[test]
@@ -147,7 +164,10 @@ fn bad_video_options_are_refused_before_simulating() {
         (vec!["--size", "641x480"], "both even"),
         (vec!["--size", "2000x100"], "width 16…1280"),
         (vec!["--fps", "0"], "between 1 and 250"),
-        (vec!["--camera", "nope"], "its cameras are: overview, front, wrist"),
+        (
+            vec!["--camera", "nope"],
+            "its cameras are: overview, front, wrist",
+        ),
     ] {
         let mut all = vec!["run", "trees/cube_to_bowl.yaml", "--video", s(&video)];
         all.extend(args.iter().copied());
@@ -182,7 +202,14 @@ fn without_opengl_run_works_and_asking_for_pixels_says_what_to_install() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("cannot render camera images"), "{stderr}");
-    assert!(stderr.contains("apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri"), "{stderr}");
+    assert!(
+        stderr.contains("apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri"),
+        "{stderr}"
+    );
     assert!(!video.exists());
-    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "no temporary file left");
+    assert_eq!(
+        std::fs::read_dir(&dir).unwrap().count(),
+        0,
+        "no temporary file left"
+    );
 }

@@ -16,13 +16,20 @@ fn missing(what: &str) -> Option<PathBuf> {
 /// The pinned ffmpeg, if present.
 pub fn ffmpeg() -> Option<PathBuf> {
     let p = macrotree::video::ffmpeg_path();
-    if p.is_file() { Some(p) } else { missing(&format!("ffmpeg ({})", p.display())) }
+    if p.is_file() {
+        Some(p)
+    } else {
+        missing(&format!("ffmpeg ({})", p.display()))
+    }
 }
 
 /// Whether an offscreen OpenGL context can be made here.
 pub fn gl() -> bool {
     let scene = macrotree::sim::Scene::load().expect("scene loads");
-    let size = macrotree::render::FrameSize { width: 64, height: 48 };
+    let size = macrotree::render::FrameSize {
+        width: 64,
+        height: 48,
+    };
     match macrotree::render::CameraRenderer::new(&scene.model, size) {
         Ok(_) => true,
         Err(e) => missing(&format!("OpenGL/EGL ({e})")).is_some(),
@@ -35,7 +42,11 @@ pub fn pyarrow() -> Option<PathBuf> {
         Some(p) if !p.is_empty() => PathBuf::from(p),
         _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("third_party/pyarrow"),
     };
-    if p.join("pyarrow/parquet/__init__.py").is_file() { Some(p) } else { missing(&format!("pyarrow ({})", p.display())) }
+    if p.join("pyarrow/parquet/__init__.py").is_file() {
+        Some(p)
+    } else {
+        missing(&format!("pyarrow ({})", p.display()))
+    }
 }
 
 /// Decodes `video` to the end with ffmpeg: (frames, (width, height), distinct frames).
@@ -47,8 +58,15 @@ pub fn decode(ffmpeg: &Path, video: &Path) -> (usize, (u32, u32), usize) {
         .output()
         .expect("ffmpeg runs");
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "ffmpeg cannot decode {}: {err}", video.display());
-    let line = err.lines().find(|l| l.contains("Video: h264")).unwrap_or_else(|| panic!("not H.264: {err}"));
+    assert!(
+        out.status.success(),
+        "ffmpeg cannot decode {}: {err}",
+        video.display()
+    );
+    let line = err
+        .lines()
+        .find(|l| l.contains("Video: h264"))
+        .unwrap_or_else(|| panic!("not H.264: {err}"));
     let size = line
         .split([',', ' '])
         .find_map(|w| {
