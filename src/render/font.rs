@@ -189,7 +189,7 @@ mod tests {
             GLYPHS['A' as usize - 32]
                 .iter()
                 .map(|r| r.count_ones() as usize)
-                .sum()
+                .sum::<usize>()
         );
         assert!(img[..band * w * 3].iter().all(|&v| v == 50 || v == 255));
         assert!(img[band * w * 3..].iter().all(|&v| v == 200));
