@@ -55,6 +55,7 @@ impl DatasetRecorder {
 }
 
 /// A dataset being written by a sweep.
+#[cfg_attr(not(feature = "dataset"), allow(dead_code))]
 pub(super) struct SweepDataset {
     #[cfg(feature = "dataset")]
     writer: crate::dataset::DatasetWriter,
