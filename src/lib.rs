@@ -128,6 +128,7 @@ pub mod actions;
 pub mod app;
 #[cfg(feature = "cli")]
 pub mod cli;
+pub mod dataset;
 pub mod episode;
 pub mod error;
 pub mod faults;
@@ -135,6 +136,7 @@ pub mod motion;
 pub mod output;
 pub mod plan;
 pub mod registry;
+pub mod render;
 pub mod runtime;
 pub mod scene;
 pub mod sim;
@@ -143,6 +145,7 @@ pub mod spec;
 pub mod suite;
 #[cfg(feature = "sweep")]
 pub mod sweep;
+pub mod video;
 #[cfg(feature = "viewer")]
 pub mod viewer;
 pub mod world;

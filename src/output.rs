@@ -1,5 +1,6 @@
-//! Safe output files: every file the command line writes (`run --record`, `sweep --out`,
-//! `schema --out`, `graph --out`) goes through [`OutputFile`].
+//! Safe output files: every file the command line writes (`run --record`, `run --video`,
+//! `run --frames`, `sweep --out`, `schema --out`, `graph --out`) goes through [`OutputFile`];
+//! `sweep --dataset` folders follow the same rules (see `crate::dataset`).
 //!
 //! The rule, checked by [`OutputFile::check`] before any work starts:
 //!
@@ -17,7 +18,8 @@
 //! unpredictable name, flushed to disk (`fsync`), then renamed over `PATH` (an existing regular
 //! file keeps its permission bits). Any error removes the temporary file and leaves `PATH` as it
 //! was. Streams ([`OutputFile::stream`]) install their file the same way before the first line,
-//! then append whole lines to it.
+//! then append whole lines to it. Files another program writes (`run --video`: ffmpeg) are
+//! written to such a temporary file ([`OutputFile::pending`]) and installed the same way.
 
 use std::collections::hash_map::RandomState;
 use std::ffi::OsString;
@@ -243,6 +245,23 @@ impl OutputFile {
         }
     }
 
+    /// A new, empty temporary file next to the path for another program to fill (see
+    /// [`PendingFile`]); refused for standard output and error.
+    pub fn pending(&self) -> Result<PendingFile<'_>, OutputError> {
+        if self.stream_fd.is_some() {
+            return Err(OutputError::NotRegular {
+                path: self.path.clone(),
+                what: "an output stream (this output needs a file it can seek in)",
+            });
+        }
+        let (tmp, _) = self.create_temp()?;
+        Ok(PendingFile {
+            out: self,
+            tmp,
+            installed: false,
+        })
+    }
+
     fn io(&self, action: &'static str) -> impl FnOnce(io::Error) -> OutputError + '_ {
         move |source| OutputError::Io {
             path: self.path.clone(),
@@ -306,6 +325,52 @@ impl OutputFile {
             let _ = d.sync_all();
         }
         Ok(file)
+    }
+}
+
+/// A temporary file next to an [`OutputFile`]'s path, filled by someone else (an ffmpeg
+/// process), then [`install`](Self::install)ed over the path; removed if dropped before.
+#[derive(Debug)]
+pub struct PendingFile<'a> {
+    out: &'a OutputFile,
+    tmp: PathBuf,
+    installed: bool,
+}
+
+impl PendingFile<'_> {
+    /// The temporary file to fill.
+    pub fn path(&self) -> &Path {
+        &self.tmp
+    }
+
+    /// Syncs the filled temporary file and renames it over the output path.
+    pub fn install(mut self) -> Result<(), OutputError> {
+        let file = File::open(&self.tmp).map_err(self.out.io("cannot reopen the new file"))?;
+        if let Some(mode) = self.out.existing_mode {
+            file.set_permissions(std::fs::Permissions::from_mode(mode & 0o7777))
+                .map_err(self.out.io("cannot set permissions"))?;
+        }
+        file.sync_all().map_err(self.out.io("cannot flush it to disk"))?;
+        match std::fs::symlink_metadata(&self.out.path) {
+            Ok(meta) => refuse_non_regular(&self.out.path, &meta)?,
+            Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+            Err(e) => return Err(self.out.io("cannot inspect it")(e)),
+        }
+        std::fs::rename(&self.tmp, &self.out.path)
+            .map_err(self.out.io("cannot rename the new file over it"))?;
+        self.installed = true;
+        if let Ok(d) = File::open(&self.out.dir) {
+            let _ = d.sync_all();
+        }
+        Ok(())
+    }
+}
+
+impl Drop for PendingFile<'_> {
+    fn drop(&mut self) {
+        if !self.installed {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
     }
 }
 

@@ -6,6 +6,7 @@
 
 mod args;
 mod bench;
+mod dataset;
 mod graph;
 mod limits;
 mod logging;

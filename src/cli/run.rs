@@ -7,7 +7,8 @@ use clap::Args;
 
 use super::args::{CubeArg, XyArg};
 use super::{CliError, load_task};
-use crate::episode::{EpisodeConfig, Goal, NoObserver, run_episode};
+use crate::dataset::EpisodeRecorder;
+use crate::episode::{EpisodeConfig, EpisodeObserver, Goal, NoObserver, run_episode};
 use crate::sim::{Layout, Scene};
 use crate::viewer::{LiveViewer, Recorder, ViewObserver, ViewerOptions};
 
@@ -38,6 +39,33 @@ pub struct RunArgs {
     /// new path, never the tree itself (see docs/security.md).
     #[arg(long, value_name = "FILE.html")]
     pub record: Option<PathBuf>,
+    /// Write an H.264 MP4 of the episode from one camera, with the simulated time and the
+    /// running leaf drawn on it (needs EGL/OpenGL and the pinned ffmpeg; see README).
+    #[arg(long, value_name = "FILE.mp4", conflicts_with = "view")]
+    pub video: Option<PathBuf>,
+    /// Camera of --video: `front`, `overview` or `wrist`.
+    #[arg(long, value_name = "NAME", default_value = "front", requires = "video")]
+    pub camera: String,
+    /// Image size of --video, WxH pixels (even, at most 1280x960).
+    #[arg(long, value_name = "WxH", default_value = "640x480", requires = "video")]
+    pub size: crate::render::FrameSize,
+    /// Frames per second of simulated time of --video and --frames (1…250).
+    #[arg(long, value_name = "N", default_value_t = 30, value_parser = crate::video::parse_fps)]
+    pub fps: u32,
+    /// Write the episode sampled at --fps as JSON lines (state, action, object poses, running
+    /// leaf), the same frames `sweep --dataset` writes (see docs/datasets.md).
+    #[arg(long, value_name = "FILE.jsonl", conflicts_with = "view")]
+    pub frames: Option<PathBuf>,
+}
+
+/// Calls two episode observers in turn.
+struct Both<'a>(&'a mut dyn EpisodeObserver, &'a mut dyn EpisodeObserver);
+
+impl EpisodeObserver for Both<'_> {
+    fn on_tick(&mut self, cell: &crate::actions::Cell, runner: &mut crate::runtime::TreeRunner) {
+        self.0.on_tick(cell, runner);
+        self.1.on_tick(cell, runner);
+    }
 }
 
 /// Layout and limits shared by `run` and `bench`.
@@ -172,6 +200,36 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
     let record_out = (args.record.as_deref())
         .map(|p| super::outputs::check_output(p, &inputs))
         .transpose()?;
+    let video_out = (args.video.as_deref())
+        .map(|p| super::outputs::check_output(p, &inputs))
+        .transpose()?;
+    let frames_out = (args.frames.as_deref())
+        .map(|p| super::outputs::check_output(p, &inputs))
+        .transpose()?;
+    let pending_video = video_out
+        .as_ref()
+        .map(|o| o.pending())
+        .transpose()
+        .map_err(super::outputs::output_error)?;
+    let mut recorder_for_frames = if video_out.is_some() || frames_out.is_some() {
+        let rec = EpisodeRecorder::new(plan.clone(), args.fps);
+        Some(match &pending_video {
+            Some(tmp) => {
+                let camera = crate::render::camera_ids(&scene, std::slice::from_ref(&args.camera))
+                    .map_err(|e| CliError::Input(format!("error: --camera: {e}")))?[0];
+                crate::video::find_ffmpeg().map_err(|e| CliError::Input(format!("error: {e}")))?;
+                // Fail before simulating when there is no OpenGL.
+                crate::render::with_thread_renderer(&scene.model, args.size, |_| ())
+                    .map_err(|e| CliError::Input(format!("error: {e}")))?;
+                rec.with_camera(camera, args.size, tmp.path().to_path_buf())
+                    .map_err(|e| CliError::Input(format!("error: {e}")))?
+                    .with_overlay(true)
+            }
+            None => rec,
+        })
+    } else {
+        None
+    };
     tracing::info!(tree = %args.tree.display(), scene = %scene.spec.name, seed = config.seed, "episode start");
     let speed = match (args.realtime, args.speed) {
         (true, _) => Some(1.0),
@@ -205,9 +263,13 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
         })?;
     }
     let recorder = args.record.as_ref().map(|_| Recorder::new(&scene.model));
+    let mut frame_recorder = recorder_for_frames.take();
     let report = if live.is_some() || recorder.is_some() || speed.is_some() {
         let mut view = ViewObserver::new(&plan, live, recorder, speed);
-        let report = run_episode(&scene, plan.clone(), &config, &mut view);
+        let report = match frame_recorder.as_mut() {
+            Some(frames) => run_episode(&scene, plan.clone(), &config, &mut Both(&mut view, frames)),
+            None => run_episode(&scene, plan.clone(), &config, &mut view),
+        };
         let (live, recorder) = view.finish();
         if let (Some(rec), Some(out)) = (recorder, &record_out) {
             rec.write_to(out)
@@ -221,10 +283,45 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
         }
         report
     } else {
-        let report = run_episode(&scene, plan, &config, &mut NoObserver);
+        let report = match frame_recorder.as_mut() {
+            Some(frames) => run_episode(&scene, plan, &config, frames),
+            None => run_episode(&scene, plan, &config, &mut NoObserver),
+        };
         finish_report(&report, args.episode.goal, args.json);
         report
     };
+    if let Some(rec) = frame_recorder {
+        let recording = rec.finish().map_err(|e| CliError::Input(format!("error: {e}")))?;
+        if let (Some(tmp), Some(out)) = (pending_video, &video_out) {
+            tmp.install().map_err(super::outputs::output_error)?;
+            let per = |s: f64| s * 1e3 / recording.renders.max(1) as f64;
+            let (wall, cpu) = (
+                per(recording.render_time.as_secs_f64()),
+                per(recording.render_cpu_s),
+            );
+            eprintln!(
+                "video written to {} ({} frames, {} at {} fps; rendering {wall:.1} ms wall, {cpu:.1} ms CPU per frame)",
+                out.path().display(),
+                recording.clips.first().map_or(0, |c| c.frames),
+                args.size,
+                args.fps
+            );
+        }
+        if let Some(out) = &frames_out {
+            let mut text = String::new();
+            for f in &recording.frames {
+                text += &serde_json::to_string(f).expect("a frame serializes");
+                text.push('\n');
+            }
+            out.write_all(text.as_bytes())
+                .map_err(super::outputs::output_error)?;
+            eprintln!(
+                "{} frames written to {}",
+                recording.frames.len(),
+                out.path().display()
+            );
+        }
+    }
     if report.success {
         Ok(())
     } else {

@@ -13,7 +13,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use super::{CliError, load_task};
 use crate::episode::Goal;
 use crate::faults::FaultKind;
-use crate::sweep::{Summary, SweepConfig, run_sweep_from};
+use crate::sweep::{Summary, SweepConfig, run_sweep_with};
 
 /// Arguments of `sweep`.
 #[derive(Debug, Args)]
@@ -65,6 +65,31 @@ pub struct SweepArgs {
     /// Stop each episode (as a failure) after this much simulated time, seconds (at most 3600).
     #[arg(long, default_value_t = 60.0, value_name = "S", value_parser = super::limits::max_sim_time)]
     pub max_sim_time: f64,
+    /// Write the episodes, in scenario order, as a LeRobot v3.0 dataset in this folder (new or
+    /// empty; see docs/datasets.md).
+    #[arg(long, value_name = "DIR", conflicts_with = "resume")]
+    pub dataset: Option<PathBuf>,
+    /// Cameras of --dataset, comma-separated (`front`, `wrist`, `overview`), or `none` for the
+    /// episode data without videos.
+    #[arg(
+        long,
+        value_name = "LIST",
+        default_value = "front,wrist",
+        requires = "dataset"
+    )]
+    pub cameras: String,
+    /// Frames per second of simulated time of --dataset (1…250).
+    #[arg(long, value_name = "N", default_value_t = 15, requires = "dataset", value_parser = crate::video::parse_fps)]
+    pub fps: u32,
+    /// Image size of --dataset's cameras, WxH pixels (even, at most 1280x960).
+    #[arg(long, value_name = "WxH", default_value = "320x240", requires = "dataset")]
+    pub size: crate::render::FrameSize,
+    /// Write only the episodes that met the goal into --dataset.
+    #[arg(long, requires = "dataset")]
+    pub only_success: bool,
+    /// Replace the dataset macrotree wrote earlier at --dataset DIR.
+    #[arg(long, requires = "dataset")]
+    pub overwrite: bool,
 }
 
 /// Runs `macrotree sweep`.
@@ -114,6 +139,10 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
         None => (None, Default::default()),
     };
     let done = resumed.results.len() as u64;
+    let mut dataset = match &args.dataset {
+        Some(dir) => Some(super::dataset::start(&args, dir, &scene, &plan, &config)?),
+        None => None,
+    };
     let bar = if std::io::stderr().is_terminal() {
         ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
     } else {
@@ -133,11 +162,29 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
     bar.set_position(done);
     let mut failures = 0u64;
     let mut write_error = None;
-    let run = run_sweep_from(&scene, &plan, &config, done, |r| {
+    let mut dataset_error = None;
+    let recorder = dataset.as_ref().map(|d| d.recorder());
+    let episode = |cell: &mut crate::actions::Cell, index: u64| match &recorder {
+        Some(rec) => {
+            let (r, recording) = rec.run(cell, &plan, &config, index);
+            (r, Some(recording))
+        }
+        None => (
+            crate::sweep::run_scene_scenario(cell, &plan, &config, index),
+            None,
+        ),
+    };
+    let run = run_sweep_with(&scene, &config, done, episode, |r, recording| {
         if let Some(w) = out.as_mut()
             && let Err(e) = w.write_line(&r.to_jsonl())
         {
             write_error = Some(e);
+            return ControlFlow::Break(());
+        }
+        if let Some(d) = dataset.as_mut()
+            && let Err(e) = d.add(r, recording.flatten())
+        {
+            dataset_error = Some(e);
             return ControlFlow::Break(());
         }
         if !r.success {
@@ -158,6 +205,14 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
     }
     if let Some(w) = out {
         w.finish().map_err(super::outputs::output_error)?;
+    }
+    if let Some(e) = dataset_error {
+        return Err(CliError::Input(format!(
+            "error: {e}\nthe sweep stopped; the dataset was not written"
+        )));
+    }
+    if let Some(d) = dataset {
+        d.finish()?;
     }
     let mut results = resumed.results;
     results.extend(run.results);

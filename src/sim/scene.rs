@@ -273,10 +273,57 @@ pub fn compile_model(xml: &str, ur5e: &Path, gripper: &Path) -> Result<MjModel, 
         .ok_or_else(|| SimError::Scene("ur5e/attachment_site not found in ur5e.xml".into()))?
         .attach_by_deep_copy(&mut hand, "gripper/", "")
         .map_err(|e| spec_err("attaching the 2F-85", e))?;
+    add_wrist_camera(&mut scene)?;
     scene.compile().map_err(|e| spec_err("compiling the scene", e))
 }
 
+/// Name of the wrist camera added to the 2F-85's base (see [`add_wrist_camera`]).
+pub const WRIST_CAMERA: &str = "wrist";
+
+/// Adds the camera [`WRIST_CAMERA`] to the attached 2F-85's `gripper/base` body (Menagerie's
+/// file stays unmodified): 10 cm to the side of the tool axis (across the fingers' travel),
+/// 2 cm below the base, looking down the fingers at a point 1.5 cm past the pinch point, fingers
+/// opening left–right in the image, 75° vertical field of view. Cameras do not take part in the
+/// physics.
+fn add_wrist_camera(spec: &mut MjSpec) -> Result<(), SimError> {
+    use nalgebra::{Rotation3, UnitQuaternion, Vector3};
+    // In the base's frame z runs from the base to the pinch point (0, 0, 0.145) and the fingers
+    // open along y; a MuJoCo camera looks along its -z with +y up in the image.
+    let pos = Vector3::new(0.1, 0.0, 0.02);
+    let look_at = Vector3::new(0.0, 0.0, 0.16);
+    let z = (pos - look_at).normalize();
+    let x = Vector3::y();
+    let y = z.cross(&x);
+    let q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_basis_unchecked(&[x, y, z]));
+    spec.body_mut("gripper/base")
+        .ok_or_else(|| SimError::Scene("gripper/base not found in 2f85.xml".into()))?
+        .add_camera()
+        .with_name(WRIST_CAMERA)
+        .with_pos([pos.x, pos.y, pos.z])
+        .with_quat([q.w, q.i, q.j, q.k])
+        .with_fovy(75.0);
+    Ok(())
+}
+
 impl Scene {
+    /// The names of the model's cameras, in id order (`overview`, `front`, `wrist`).
+    pub fn camera_names(&self) -> Vec<String> {
+        let n = self.model.ffi().ncam as usize;
+        (0..n)
+            .map(|i| {
+                self.model
+                    .id_to_name(MjtObjBase::mjOBJ_CAMERA, i)
+                    .unwrap_or_default()
+                    .to_string()
+            })
+            .collect()
+    }
+
+    /// The id of the camera called `name`.
+    pub fn camera_id(&self, name: &str) -> Option<usize> {
+        self.camera_names().iter().position(|n| n == name)
+    }
+
     /// The scene's default placement: every object's `pose:`; objects with only `random:` as
     /// scenario 0 of sweep seed 0 draws them.
     pub fn default_placement(&self) -> Placement {

@@ -607,15 +607,7 @@ pub fn run_scene_scenario(
     config: &SweepConfig,
     index: u64,
 ) -> ScenarioResult {
-    match config.scene_scenario(cell.sim().scene(), index) {
-        Ok(scenario) => {
-            let episode = config.scene_episode_config(&scenario);
-            let report = run_in_cell(cell, plan.clone(), &episode, &mut NoObserver);
-            ScenarioResult::of_scene(&scenario, config.fault, report).for_sweep(config)
-        }
-        Err(e) => ScenarioResult::not_run(index, config.seed, 0, None, config.fault, format!("layout: {e}"))
-            .for_sweep(config),
-    }
+    run_scene_scenario_observed(cell, plan, config, index, &mut NoObserver)
 }
 
 /// The outcome of a sweep.
@@ -656,7 +648,48 @@ pub fn run_sweep_from(
     skip: u64,
     mut on_result: impl FnMut(&ScenarioResult) -> ControlFlow<()>,
 ) -> Result<SweepRun, rayon::ThreadPoolBuildError> {
+    run_sweep_with(
+        scene,
+        config,
+        skip,
+        |cell, index| (run_scene_scenario(cell, plan, config, index), ()),
+        |r, _| on_result(r),
+    )
+}
+
+/// Runs scenario `index` of `config` on the cell's scene (reset first), with `observer` seeing
+/// every control tick (e.g. a dataset recorder).
+pub fn run_scene_scenario_observed(
+    cell: &mut Cell,
+    plan: &Arc<Plan>,
+    config: &SweepConfig,
+    index: u64,
+    observer: &mut dyn crate::episode::EpisodeObserver,
+) -> ScenarioResult {
+    match config.scene_scenario(cell.sim().scene(), index) {
+        Ok(scenario) => {
+            let episode = config.scene_episode_config(&scenario);
+            let report = run_in_cell(cell, plan.clone(), &episode, observer);
+            ScenarioResult::of_scene(&scenario, config.fault, report).for_sweep(config)
+        }
+        Err(e) => ScenarioResult::not_run(index, config.seed, 0, None, config.fault, format!("layout: {e}"))
+            .for_sweep(config),
+    }
+}
+
+/// [`run_sweep_from`] with a per-episode payload: `episode` runs scenario `index` in a worker's
+/// cell and returns its result with a payload of any kind (a dataset recording), and
+/// `on_result` receives both in scenario order (the payload is `None` for an episode that
+/// panicked).
+pub fn run_sweep_with<T: Send>(
+    scene: &Scene,
+    config: &SweepConfig,
+    skip: u64,
+    episode: impl Fn(&mut Cell, u64) -> (ScenarioResult, T) + Sync,
+    mut on_result: impl FnMut(&ScenarioResult, Option<T>) -> ControlFlow<()>,
+) -> Result<SweepRun, rayon::ThreadPoolBuildError> {
     let wall = Instant::now();
+    let episode = &episode;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(config.jobs)
         .thread_name(|i| format!("sweep-{i}"))
@@ -665,7 +698,7 @@ pub fn run_sweep_from(
     let indices = config.indices().skip_first(skip);
     // Memory grows with the results, not with the size of the sweep.
     let mut results = Vec::with_capacity(indices.len().min(4096));
-    let (tx, rx) = mpsc::channel::<(usize, ScenarioResult)>();
+    let (tx, rx) = mpsc::channel::<(usize, ScenarioResult, Option<T>)>();
     let stop = AtomicBool::new(false);
     let physics_ns = AtomicU64::new(0);
     std::thread::scope(|s| {
@@ -678,39 +711,42 @@ pub fn run_sweep_from(
                 let todo = indices.take_while(|_| !stop.load(Ordering::Relaxed)).enumerate();
                 todo.par_bridge().for_each_init(new_cell, |cell, (pos, index)| {
                     let before = cell.sim().physics_time();
-                    let outcome =
-                        catch_unwind(AssertUnwindSafe(|| run_scene_scenario(cell, plan, config, index)));
+                    let outcome = catch_unwind(AssertUnwindSafe(|| episode(cell, index)));
                     let spent = cell.sim().physics_time().saturating_sub(before);
                     physics_ns.fetch_add(
                         u64::try_from(spent.as_nanos()).unwrap_or(u64::MAX),
                         Ordering::Relaxed,
                     );
-                    let result = outcome.unwrap_or_else(|payload| {
-                        *cell = new_cell();
-                        let s = config.scene_scenario(scene, index).ok();
-                        ScenarioResult::not_run(
-                            index,
-                            config.seed,
-                            s.as_ref().map_or(0, |s| s.seed),
-                            s.and_then(|s| s.layout),
-                            config.fault,
-                            format!("panicked: {}", panic_message(&*payload)),
-                        )
-                        .for_sweep(config)
-                    });
+                    let (result, payload) = match outcome {
+                        Ok((r, t)) => (r, Some(t)),
+                        Err(payload) => {
+                            *cell = new_cell();
+                            let s = config.scene_scenario(scene, index).ok();
+                            let r = ScenarioResult::not_run(
+                                index,
+                                config.seed,
+                                s.as_ref().map_or(0, |s| s.seed),
+                                s.and_then(|s| s.layout),
+                                config.fault,
+                                format!("panicked: {}", panic_message(&*payload)),
+                            )
+                            .for_sweep(config);
+                            (r, None)
+                        }
+                    };
                     // The receiver lives until every result is in.
-                    let _ = tx.send((pos, result));
+                    let _ = tx.send((pos, result, payload));
                 });
             });
         });
         let mut pending = BTreeMap::new();
-        for (pos, result) in rx {
+        for (pos, result, payload) in rx {
             if stop.load(Ordering::Relaxed) {
                 continue; // draining the scenarios that were running
             }
-            pending.insert(pos, result);
-            while let Some(result) = pending.remove(&results.len()) {
-                let flow = on_result(&result);
+            pending.insert(pos, (result, payload));
+            while let Some((result, payload)) = pending.remove(&results.len()) {
+                let flow = on_result(&result, payload);
                 results.push(result);
                 if flow.is_break() {
                     stop.store(true, Ordering::Relaxed);
