@@ -51,6 +51,9 @@ struct LeafRt {
 struct RunState {
     statuses: Vec<NodeStatus>,
     reasons: Vec<Option<String>>,
+    /// How each node last finished before it was reset to Idle (a retry starting its next
+    /// attempt in the same tick), so a leaf halted by that attempt's end names the real cause.
+    ended_as: Vec<Option<NodeStatus>>,
     touched: Vec<u64>,
     /// Root-first ancestors of each node, excluding the node itself.
     ancestors: Vec<Vec<usize>>,
@@ -114,6 +117,7 @@ impl RunState {
             statuses: vec![NodeStatus::Idle; n],
             instant,
             reasons: vec![None; n],
+            ended_as: vec![None; n],
             touched: vec![0; n],
             ancestors,
             enclosing_retry,
@@ -184,6 +188,9 @@ impl RunState {
     /// Back to Idle (a loop starts its child again), logged at debug level.
     fn reset_node(&mut self, plan: &Plan, node: usize) {
         if self.statuses[node] != NodeStatus::Idle {
+            if self.statuses[node] != NodeStatus::Running {
+                self.ended_as[node] = Some(self.statuses[node]);
+            }
             self.record(plan, node, NodeStatus::Idle, None);
         }
     }
@@ -200,6 +207,7 @@ impl RunState {
                 self.statuses[i],
                 NodeStatus::Success | NodeStatus::Failure | NodeStatus::Halted
             ) {
+                self.ended_as[i] = Some(self.statuses[i]);
                 self.record(plan, i, NodeStatus::Idle, None);
                 n += 1;
             }
@@ -650,22 +658,27 @@ impl RunState {
                         .copied()
                         .take_while(|&a| self.statuses[a] != NodeStatus::Running)
                         .collect();
+                    // A node already reset for the next attempt counts as it finished.
+                    let ended = |a: usize| match self.statuses[a] {
+                        NodeStatus::Idle => self.ended_as[a].unwrap_or(NodeStatus::Idle),
+                        s => s,
+                    };
                     let by = stopped
                         .iter()
                         .copied()
-                        .find(|&a| self.statuses[a] != NodeStatus::Halted)
+                        .find(|&a| ended(a) != NodeStatus::Halted)
                         .or(stopped.last().copied())
                         .unwrap_or(i);
                     let mut reason = format!(
                         "preempted: `{}` {}",
                         plan.nodes[by].path,
-                        match self.statuses[by] {
+                        match ended(by) {
                             NodeStatus::Halted => "was halted",
                             NodeStatus::Success => "succeeded",
                             _ => "failed",
                         }
                     );
-                    if self.statuses[by] == NodeStatus::Failure
+                    if ended(by) == NodeStatus::Failure
                         && let Some(why) = &self.reasons[by]
                     {
                         reason.push_str(&format!(" ({why})"));
