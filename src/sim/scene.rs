@@ -277,7 +277,7 @@ pub fn compile_model(xml: &str, ur5e: &Path, gripper: &Path) -> Result<MjModel, 
     scene.compile().map_err(|e| spec_err("compiling the scene", e))
 }
 
-/// Name of the wrist camera added to the 2F-85's base (see [`add_wrist_camera`]).
+/// Name of the wrist camera on the 2F-85's base, added when the scene is compiled.
 pub const WRIST_CAMERA: &str = "wrist";
 
 /// Adds the camera [`WRIST_CAMERA`] to the attached 2F-85's `gripper/base` body (Menagerie's
