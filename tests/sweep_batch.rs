@@ -138,7 +138,7 @@ fn the_printed_command_reproduces_the_scenario_bit_for_bit() {
         assert_eq!(parsed, config.episode_config(&scenario), "{cmd}");
         // And the same episode, run the way `macrotree run` runs it (a fresh cell).
         let report = run_episode(scene(), plan.clone(), &parsed, &mut NoObserver);
-        let again = ScenarioResult::new(&scenario, None, report).for_sweep(&config);
+        let again = ScenarioResult::new(&scenario, &config, report);
         assert_eq!(again.to_jsonl(), swept.to_jsonl(), "{cmd}");
     }
 }

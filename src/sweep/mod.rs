@@ -389,52 +389,37 @@ pub struct ScenarioResult {
 }
 
 impl ScenarioResult {
-    /// The result of `scenario` (of the built-in scene) from its episode report.
-    pub fn new(scenario: &Scenario, fault: Option<FaultKind>, r: EpisodeReport) -> Self {
-        Self::of(
-            scenario.index,
-            scenario.sweep_seed,
-            scenario.seed,
-            Some(scenario.layout),
-            fault,
-            r,
-        )
+    /// The result of `scenario` (of the built-in scene) of the sweep `config` from its episode
+    /// report.
+    pub fn new(scenario: &Scenario, config: &SweepConfig, r: EpisodeReport) -> Self {
+        Self::of(config, scenario.index, scenario.seed, Some(scenario.layout), r)
     }
 
-    /// The result of a scenario of any scene from its episode report.
-    pub fn of_scene(scenario: &SceneScenario, fault: Option<FaultKind>, r: EpisodeReport) -> Self {
-        Self::of(
-            scenario.index,
-            scenario.sweep_seed,
-            scenario.seed,
-            scenario.layout,
-            fault,
-            r,
-        )
+    /// The result of a scenario of any scene of the sweep `config` from its episode report.
+    pub fn of_scene(scenario: &SceneScenario, config: &SweepConfig, r: EpisodeReport) -> Self {
+        Self::of(config, scenario.index, scenario.seed, scenario.layout, r)
     }
 
     fn of(
+        config: &SweepConfig,
         index: u64,
-        sweep_seed: u64,
         seed: u64,
         layout: Option<ScenarioLayout>,
-        fault: Option<FaultKind>,
         r: EpisodeReport,
     ) -> Self {
         let failure_kind = r.failure_reason.as_deref().map(crate::episode::failure_kind);
-        let defaults = SweepConfig::default();
         Self {
-            suite: None,
-            tree: String::new(),
-            scene_file: None,
-            scenarios: defaults.scenarios,
-            sweep_goal: defaults.goal,
-            max_sim_time: defaults.max_sim_time,
-            substitutions: Vec::new(),
+            suite: config.suite.clone(),
+            tree: config.tree.clone(),
+            scene_file: config.scene_file.clone(),
+            scenarios: config.scenarios,
+            sweep_goal: config.goal,
+            max_sim_time: config.max_sim_time,
+            substitutions: config.substitutions.clone(),
             index,
-            sweep_seed,
+            sweep_seed: config.seed,
             seed,
-            fault,
+            fault: config.fault,
             layout,
             success: r.success,
             tree_status: r.tree_status,
@@ -457,44 +442,27 @@ impl ScenarioResult {
         }
     }
 
-    /// This result as a result of the sweep `config`: its tree, scene file, scenario count,
-    /// goal, time limit, substitutions and suite, which every line carries so that shard
-    /// outputs can be checked and merged ([`report`]).
-    #[must_use]
-    pub fn for_sweep(mut self, config: &SweepConfig) -> Self {
-        self.suite = config.suite.clone();
-        self.tree = config.tree.clone();
-        self.scene_file = config.scene_file.clone();
-        self.scenarios = config.scenarios;
-        self.sweep_goal = config.goal;
-        self.max_sim_time = config.max_sim_time;
-        self.substitutions = config.substitutions.clone();
-        self
-    }
-
-    /// A result for an episode that could not run (it panicked, or its layout could not be
-    /// drawn).
+    /// A result of the sweep `config` for an episode that could not run (it panicked, or its
+    /// layout could not be drawn).
     fn not_run(
+        config: &SweepConfig,
         index: u64,
-        sweep_seed: u64,
         seed: u64,
         layout: Option<ScenarioLayout>,
-        fault: Option<FaultKind>,
         reason: String,
     ) -> Self {
-        let defaults = SweepConfig::default();
         Self {
-            suite: None,
-            tree: String::new(),
-            scene_file: None,
-            scenarios: defaults.scenarios,
-            sweep_goal: defaults.goal,
-            max_sim_time: defaults.max_sim_time,
-            substitutions: Vec::new(),
+            suite: config.suite.clone(),
+            tree: config.tree.clone(),
+            scene_file: config.scene_file.clone(),
+            scenarios: config.scenarios,
+            sweep_goal: config.goal,
+            max_sim_time: config.max_sim_time,
+            substitutions: config.substitutions.clone(),
             index,
-            sweep_seed,
+            sweep_seed: config.seed,
             seed,
-            fault,
+            fault: config.fault,
             layout,
             success: false,
             tree_status: "failure",
@@ -597,7 +565,7 @@ pub fn run_scenario(
 ) -> ScenarioResult {
     let episode = config.episode_config(scenario);
     let report = run_in_cell(cell, plan.clone(), &episode, &mut NoObserver);
-    ScenarioResult::new(scenario, config.fault, report).for_sweep(config)
+    ScenarioResult::new(scenario, config, report)
 }
 
 /// Runs scenario `index` of `config` on the cell's scene (reset first).
@@ -670,10 +638,9 @@ pub fn run_scene_scenario_observed(
         Ok(scenario) => {
             let episode = config.scene_episode_config(&scenario);
             let report = run_in_cell(cell, plan.clone(), &episode, observer);
-            ScenarioResult::of_scene(&scenario, config.fault, report).for_sweep(config)
+            ScenarioResult::of_scene(&scenario, config, report)
         }
-        Err(e) => ScenarioResult::not_run(index, config.seed, 0, None, config.fault, format!("layout: {e}"))
-            .for_sweep(config),
+        Err(e) => ScenarioResult::not_run(config, index, 0, None, format!("layout: {e}")),
     }
 }
 
@@ -723,14 +690,12 @@ pub fn run_sweep_with<T: Send>(
                             *cell = new_cell();
                             let s = config.scene_scenario(scene, index).ok();
                             let r = ScenarioResult::not_run(
+                                config,
                                 index,
-                                config.seed,
                                 s.as_ref().map_or(0, |s| s.seed),
                                 s.and_then(|s| s.layout),
-                                config.fault,
                                 format!("panicked: {}", panic_message(&*payload)),
-                            )
-                            .for_sweep(config);
+                            );
                             (r, None)
                         }
                     };
