@@ -1,22 +1,20 @@
 //! The example trees in `trees/` on real physics, each on the default layout and on others, with
 //! the outcome its task asks for; and every tree of `docs/tutorial.md` compiles.
 
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
 use macrotree::actions::{CONTROL_PERIOD, Cell};
 use macrotree::episode::{EpisodeConfig, EpisodeObserver, EpisodeReport, run_in_cell};
 use macrotree::faults::FaultKind;
 use macrotree::plan::Plan;
 use macrotree::runtime::{NodeStatus, Transition, TreeRunner};
-use macrotree::sim::{Layout, Scene};
+use macrotree::sim::Layout;
 
+#[path = "support/flagship.rs"]
+mod flagship;
 #[path = "support/oracle.rs"]
 mod oracle;
-
-fn scene() -> &'static Scene {
-    static SCENE: OnceLock<Scene> = OnceLock::new();
-    SCENE.get_or_init(|| Scene::load().expect("scene (run tools/bootstrap)"))
-}
+use flagship::scene;
 
 fn tree(file: &str) -> Arc<Plan> {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -1,30 +1,20 @@
 //! `--fault nudge` (and the other faults) on real physics: the cube is really pushed as the
 //! gripper closes, and a seeded batch of 10 all still succeed.
 
-use std::sync::{Arc, OnceLock};
-
 use macrotree::actions::{CONTROL_PERIOD, Cell};
 use macrotree::episode::{EpisodeConfig, EpisodeObserver, run_in_cell};
 use macrotree::faults::{FaultKind, injector_with_log};
-use macrotree::plan::Plan;
 use macrotree::runtime::TreeRunner;
-use macrotree::sim::{Layout, Scene};
+use macrotree::sim::Layout;
 use macrotree::sweep::{SweepConfig, run_sweep};
 
+#[path = "support/flagship.rs"]
+mod flagship;
 #[path = "support/logs.rs"]
 mod logs;
 #[path = "support/oracle.rs"]
 mod oracle;
-
-fn scene() -> &'static Scene {
-    static SCENE: OnceLock<Scene> = OnceLock::new();
-    SCENE.get_or_init(|| Scene::load().expect("scene (run tools/bootstrap)"))
-}
-
-fn plan() -> Arc<Plan> {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/trees/cube_to_bowl.yaml");
-    Arc::new(macrotree::plan::load_plan(std::path::Path::new(path)).expect("flagship tree is valid"))
-}
+use flagship::{plan, scene};
 
 #[test]
 fn ten_seeded_nudges_all_succeed() {

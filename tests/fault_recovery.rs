@@ -3,31 +3,20 @@
 //! bowl where the bowl now is (judged by the independent oracle), and seeded batches of 20
 //! recover.
 
-use std::sync::{Arc, OnceLock};
-
 use macrotree::actions::{CONTROL_PERIOD, Cell};
 use macrotree::episode::{EpisodeConfig, EpisodeObserver, run_in_cell};
 use macrotree::faults::{FaultKind, injector_with_log};
-use macrotree::plan::Plan;
 use macrotree::runtime::TreeRunner;
-use macrotree::sim::Scene;
 use macrotree::sweep::{SweepConfig, run_sweep, sample_scenario};
 use nalgebra::Vector3;
 
+#[path = "support/flagship.rs"]
+mod flagship;
 #[path = "support/logs.rs"]
 mod logs;
 #[path = "support/oracle.rs"]
 mod oracle;
-
-fn scene() -> &'static Scene {
-    static SCENE: OnceLock<Scene> = OnceLock::new();
-    SCENE.get_or_init(|| Scene::load().expect("scene (run tools/bootstrap)"))
-}
-
-fn plan() -> Arc<Plan> {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/trees/cube_to_bowl.yaml");
-    Arc::new(macrotree::plan::load_plan(std::path::Path::new(path)).expect("flagship tree is valid"))
-}
+use flagship::{plan, scene};
 
 /// The cube's and the bowl's positions after every tick.
 #[derive(Default)]

@@ -2,32 +2,22 @@
 //! carry, the trace reads grasp lost → carry fails → retry → re-grasp where the cube now lies →
 //! success, and a seeded batch of 10 all recover with a second grasp.
 
-use std::sync::{Arc, OnceLock};
-
 use macrotree::actions::{CONTROL_PERIOD, Cell};
 use macrotree::episode::{EpisodeConfig, EpisodeObserver, run_in_cell};
 use macrotree::faults::{FaultKind, injector_with_log};
-use macrotree::plan::Plan;
 use macrotree::runtime::{NodeStatus, Transition, TreeRunner};
-use macrotree::sim::{Layout, Scene};
+use macrotree::sim::Layout;
 use macrotree::sweep::{SweepConfig, run_sweep, sample_scenario};
 use macrotree::world::CUBE_HALF;
 use nalgebra::Vector3;
 
+#[path = "support/flagship.rs"]
+mod flagship;
 #[path = "support/logs.rs"]
 mod logs;
 #[path = "support/oracle.rs"]
 mod oracle;
-
-fn scene() -> &'static Scene {
-    static SCENE: OnceLock<Scene> = OnceLock::new();
-    SCENE.get_or_init(|| Scene::load().expect("scene (run tools/bootstrap)"))
-}
-
-fn plan() -> Arc<Plan> {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/trees/cube_to_bowl.yaml");
-    Arc::new(macrotree::plan::load_plan(std::path::Path::new(path)).expect("flagship tree is valid"))
-}
+use flagship::{plan, scene};
 
 /// Records the transitions and the cube's position at every tick.
 #[derive(Default)]

@@ -4,21 +4,19 @@
 //! mid-motion (the arm and the gripper then hold where they are). Every episode is checked for
 //! MuJoCo warnings.
 
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
 use macrotree::actions::{CONTROL_PERIOD, Cell};
 use macrotree::episode::{EpisodeConfig, EpisodeObserver, EpisodeReport, run_in_cell};
 use macrotree::runtime::{NodeStatus, Transition, TreeRunner};
-use macrotree::sim::{HOME_Q, Layout, Scene};
+use macrotree::sim::{HOME_Q, Layout};
 use nalgebra::Vector3;
 
+#[path = "support/flagship.rs"]
+mod flagship;
 #[path = "support/oracle.rs"]
 mod oracle;
-
-fn scene() -> &'static Scene {
-    static SCENE: OnceLock<Scene> = OnceLock::new();
-    SCENE.get_or_init(|| Scene::load().expect("scene (run tools/bootstrap)"))
-}
+use flagship::scene;
 
 /// One sample per control tick.
 #[derive(Debug, Clone)]

@@ -2,7 +2,7 @@
 //! is identical for 1 and 2 jobs; the shards of a sweep together are the full sweep; a scenario's
 //! printed `macrotree run …` command parses to exactly the sweep's episode and reproduces it.
 
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
 use clap::Parser;
 use macrotree::actions::{CONTROL_PERIOD, Cell};
@@ -10,17 +10,16 @@ use macrotree::cli::{Cli, Command};
 use macrotree::episode::{Goal, NoObserver, run_episode};
 use macrotree::faults::FaultKind;
 use macrotree::plan::Plan;
-use macrotree::sim::{Layout, Scene};
+use macrotree::sim::Layout;
 use macrotree::sweep::{
     ScenarioResult, Shard, Summary, SweepConfig, run_scenario, run_sweep, sample_scenario,
 };
 
 const TREE: &str = "trees/cube_to_bowl.yaml";
 
-fn scene() -> &'static Scene {
-    static SCENE: OnceLock<Scene> = OnceLock::new();
-    SCENE.get_or_init(|| Scene::load().expect("scene (run tools/bootstrap)"))
-}
+#[path = "support/flagship.rs"]
+mod flagship;
+use flagship::scene;
 
 fn plan() -> Arc<Plan> {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(TREE);
