@@ -20,8 +20,8 @@ use macrotree::motion::{
     CLOSED_CTRL, CartesianMove, JointMove, MotionLimits, Trajectory, down_pose, ik_down,
 };
 use macrotree::spec::ObjectRef;
-use macrotree::spec::units::Angle;
 use macrotree::world::World;
+use macrotree::yaml::units::Angle;
 use macrotree::{App, Error, Params};
 use nalgebra::Vector3;
 use schemars::JsonSchema;
@@ -73,13 +73,13 @@ struct Push {
     #[schemars(range(min = MIN_PUSH, max = MAX_PUSH))]
     distance: f64,
     /// Tool speed while pushing, m/s (> 0). Default 0.1.
-    #[serde(default = "default_speed", deserialize_with = "macrotree::spec::units::speed")]
+    #[serde(default = "default_speed", deserialize_with = "macrotree::yaml::units::speed")]
     #[schemars(range(min = 0.0))]
     speed: f64,
     /// Give up after this many simulated seconds (> 0). Default 10.
     #[serde(
         default = "default_timeout",
-        deserialize_with = "macrotree::spec::units::time_limit"
+        deserialize_with = "macrotree::yaml::units::time_limit"
     )]
     #[schemars(range(min = 0.0))]
     timeout: f64,
@@ -95,7 +95,7 @@ fn default_timeout() -> f64 {
 
 /// A distance in metres between [`MIN_PUSH`] and [`MAX_PUSH`]: an error points at the value.
 fn push_distance<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-    let v = macrotree::spec::units::distance(d)?;
+    let v = macrotree::yaml::units::distance(d)?;
     if (MIN_PUSH..=MAX_PUSH).contains(&v) {
         Ok(v)
     } else {
@@ -129,12 +129,12 @@ struct Near {
     /// The block (a name or `{var}`).
     object: ObjectRef,
     /// The point, `[x, y]` on the table, world metres.
-    #[serde(deserialize_with = "macrotree::spec::units::vec2")]
+    #[serde(deserialize_with = "macrotree::yaml::units::vec2")]
     point: [f64; 2],
     /// Largest horizontal distance of the block's centre from `point`, metres (≥ 0). Default 0.01.
     #[serde(
         default = "default_tolerance",
-        deserialize_with = "macrotree::spec::units::distance"
+        deserialize_with = "macrotree::yaml::units::distance"
     )]
     #[schemars(range(min = 0.0))]
     tolerance: f64,

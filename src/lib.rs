@@ -53,7 +53,7 @@
 //!     /// The block (a name or `{var}`).
 //!     object: ObjectRef,
 //!     /// How far its centre moves, metres.
-//!     #[serde(deserialize_with = "macrotree::spec::units::distance")]
+//!     #[serde(deserialize_with = "macrotree::yaml::units::distance")]
 //!     distance: f64,
 //! }
 //!
@@ -149,3 +149,4 @@ pub mod video;
 #[cfg(feature = "viewer")]
 pub mod viewer;
 pub mod world;
+pub mod yaml;

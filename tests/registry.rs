@@ -20,10 +20,10 @@ struct Probe {
     /// The object (a name or `{var}`).
     object: ObjectRef,
     /// How deep, metres.
-    #[serde(deserialize_with = "macrotree::spec::units::distance")]
+    #[serde(deserialize_with = "macrotree::yaml::units::distance")]
     depth: f64,
     /// Shallowest allowed, metres. Default 0.
-    #[serde(default, deserialize_with = "macrotree::spec::units::distance")]
+    #[serde(default, deserialize_with = "macrotree::yaml::units::distance")]
     min_depth: f64,
 }
 

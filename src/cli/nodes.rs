@@ -29,7 +29,7 @@ pub fn nodes(args: NodesArgs) -> Result<(), CliError> {
         Some(kind) => match all.iter().find(|d| d.kind == kind.as_str()) {
             Some(d) => vec![d],
             None => {
-                let hint = crate::spec::suggest::did_you_mean(kind, all.iter().map(|d| d.kind))
+                let hint = crate::yaml::suggest::did_you_mean(kind, all.iter().map(|d| d.kind))
                     .map(|s| format!("\n  = help: {s}"))
                     .unwrap_or_default();
                 return Err(CliError::Input(format!(

@@ -111,13 +111,13 @@ pub fn validate(args: ValidateArgs) -> Result<(), CliError> {
 /// True for a scene file: a YAML mapping with `objects:` and without `main:` (read cheaply: a
 /// file that cannot be read is left to the tree loader, which reports why).
 fn is_scene_file(path: &std::path::Path) -> bool {
-    let Ok(bytes) = crate::spec::load::read_limited(path) else {
+    let Ok(bytes) = crate::yaml::read_limited(path) else {
         return false;
     };
     let Ok(text) = std::str::from_utf8(&bytes) else {
         return false;
     };
-    match crate::spec::value::parse_yaml(text, 0) {
+    match crate::yaml::value::parse_yaml(text, 0) {
         Ok(v) => v.get("objects").is_some() && v.get("main").is_none(),
         Err(_) => false,
     }

@@ -28,11 +28,11 @@ use serde::de::DeserializeOwned;
 use crate::actions::MacroAction;
 use crate::error::Error;
 use crate::spec::catalog::{ParamDoc, parse_node_doc};
-use crate::spec::de::DeError;
 use crate::spec::leaves::{Leaf, Select, Wait};
 use crate::spec::objects::ObjectRef;
-use crate::spec::value::Value;
 use crate::world::World;
+use crate::yaml::de::DeError;
+use crate::yaml::value::Value;
 
 pub(crate) use control::SchemaCtx;
 
@@ -72,8 +72,8 @@ impl Category {
 /// `PartialEq`; document every field with its unit (the doc comments become the parameter docs
 /// of `macrotree nodes` and of the JSON Schema). Fields may use the crate's own parameter types
 /// and unit parsers: [`ObjectRef`] (an object name or a `{variable}`),
-/// [`Target`](crate::spec::Target), [`Angle`](crate::spec::units::Angle), and
-/// `#[serde(deserialize_with = "macrotree::spec::units::distance")]` and friends for range-checked
+/// [`Target`](crate::spec::Target), [`Angle`](crate::yaml::units::Angle), and
+/// `#[serde(deserialize_with = "macrotree::yaml::units::distance")]` and friends for range-checked
 /// metres, seconds and `deg(..)` angles.
 ///
 /// Every method has a default; override the ones that apply.
@@ -187,7 +187,7 @@ impl<P: Params, F: Fn(&World, &P) -> Result<bool, String> + Send + Sync> Conditi
 type ParseParams = fn(&Value) -> Result<Arc<dyn DynParams>, DeError>;
 
 fn parse_params<P: Params>(v: &Value) -> Result<Arc<dyn DynParams>, DeError> {
-    crate::spec::de::from_value::<P>(v).map(|p| Arc::new(p) as Arc<dyn DynParams>)
+    crate::yaml::de::from_value::<P>(v).map(|p| Arc::new(p) as Arc<dyn DynParams>)
 }
 
 /// Adds `P`'s schema to the generator and answers its definition name.
@@ -268,8 +268,8 @@ impl NodeType {
             Imp::Control { .. } => return None,
             Imp::Action { parse, .. } => call(*parse).map(Leaf::Action),
             Imp::Condition { parse, .. } => call(*parse).map(Leaf::Condition),
-            Imp::Wait => crate::spec::de::from_value::<Wait>(body).map(Leaf::Wait),
-            Imp::Select => crate::spec::de::from_value::<Select>(body).map(Leaf::Select),
+            Imp::Wait => crate::yaml::de::from_value::<Wait>(body).map(Leaf::Wait),
+            Imp::Select => crate::yaml::de::from_value::<Select>(body).map(Leaf::Select),
         })
     }
 

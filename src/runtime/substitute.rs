@@ -322,8 +322,8 @@ fn close_paths(plan: &Plan, pattern: &str) -> Vec<String> {
         .iter()
         .map(|l| {
             let seg = l.path.rsplit('/').next().unwrap_or(&l.path);
-            let d = crate::spec::suggest::edit_distance(last, seg)
-                .min(crate::spec::suggest::edit_distance(pattern, &l.path));
+            let d = crate::yaml::suggest::edit_distance(last, seg)
+                .min(crate::yaml::suggest::edit_distance(pattern, &l.path));
             (d, l.path.as_str())
         })
         .collect();

@@ -7,7 +7,7 @@ use schemars::{JsonSchema, Schema, SchemaGenerator, json_schema};
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize, Serializer};
 
-use crate::spec::suggest::did_you_mean;
+use crate::yaml::suggest::did_you_mean;
 
 /// The named colours, with their RGB (0…1).
 pub const COLOR_NAMES: &[(&str, [f64; 3])] = &[

@@ -11,11 +11,11 @@ use super::color::Color;
 use super::goal::{Goal, GoalAtom};
 use super::sample::{Placement, sample_placement};
 use super::types::{ObjectKind, ObjectSpec, Pose, RandomPlacement, SceneSpec, Shape};
-use crate::spec::de::from_value;
-use crate::spec::diag::{Diagnostic, Issue, Loc, Sources};
-use crate::spec::suggest::did_you_mean;
-use crate::spec::units::Angle;
-use crate::spec::value::{Value, ValueKind, decode_utf8, parse_yaml};
+use crate::yaml::de::from_value;
+use crate::yaml::diag::{Diagnostic, Issue, Loc, Sources};
+use crate::yaml::suggest::did_you_mean;
+use crate::yaml::units::Angle;
+use crate::yaml::value::{Value, ValueKind, decode_utf8, parse_yaml};
 
 /// The built-in scene `cube_bowl` (the reference tutorial's cell), used when a tree names no
 /// scene. The same text as `scenes/cube_bowl.yaml`.
@@ -223,7 +223,7 @@ pub fn load_scene_file(path: &Path) -> Result<SceneSpec, Vec<Diagnostic>> {
         let id = sources.add(name.clone(), "");
         Err(sources.diagnostics(&[Issue::new(Loc::file_start(id), msg).help(help)]))
     };
-    let bytes = match crate::spec::load::read_limited(path) {
+    let bytes = match crate::yaml::read_limited(path) {
         Ok(b) => b,
         Err((msg, help)) => return fail(msg, help),
     };

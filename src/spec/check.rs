@@ -4,11 +4,11 @@
 
 use serde::Serialize;
 
-use super::diag::{Issue, Loc};
 use super::leaves::Select;
 use super::objects::ObjectRef;
-use super::suggest::{closest, did_you_mean};
 use crate::scene::{ObjectKind, SceneSpec};
+use crate::yaml::diag::{Issue, Loc};
+use crate::yaml::suggest::{closest, did_you_mean};
 
 /// What kind of object a parameter needs.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize)]

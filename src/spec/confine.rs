@@ -12,9 +12,9 @@
 use std::path::{Component, Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use super::diag::{Issue, Loc};
 use super::file::{TOP_LEVEL_KEYS, TreeFile, parse_tree_file};
-use super::value::{Value, ValueKind};
+use crate::yaml::diag::{Issue, Loc};
+use crate::yaml::value::{Value, ValueKind};
 
 static ANYWHERE: AtomicBool = AtomicBool::new(false);
 

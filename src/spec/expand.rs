@@ -9,14 +9,14 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use super::check::{ObjectUse, Role, VarDef};
-use super::de::DeError;
-use super::diag::{Issue, Loc, Sources};
 use super::file::{SubtreeDef, param_ref};
 use super::leaves::{Leaf, Select};
 use super::node::{Node, NodeKind};
-use super::suggest::did_you_mean;
-use super::value::{Value, ValueKind};
 use crate::registry::{Category, NodeType, Registry};
+use crate::yaml::de::DeError;
+use crate::yaml::diag::{Issue, Loc, Sources};
+use crate::yaml::suggest::did_you_mean;
+use crate::yaml::value::{Value, ValueKind};
 
 /// Deepest node nesting accepted after subtree expansion.
 pub const MAX_TREE_DEPTH: usize = 64;
@@ -208,7 +208,7 @@ impl<'a> Expander<'a> {
             .as_ref()
             .and_then(|t| parse_leaf_reporting_all(t, without_name(body)))
         {
-            for w in super::de::take_warnings() {
+            for w in crate::yaml::de::take_warnings() {
                 let mut issue = Issue::new(w.loc, format!("{} in `{k}`", w.message)).maybe_help(w.help);
                 if let Some(via) = w.via {
                     issue = issue.note(format!(
@@ -608,7 +608,7 @@ impl<'a> Expander<'a> {
                         );
                         None
                     }
-                    Some(v) => match super::de::from_value::<Secs>(v) {
+                    Some(v) => match crate::yaml::de::from_value::<Secs>(v) {
                         Ok(s) => Some(s.0),
                         Err(e) => {
                             let issue = e.into_issue(v.loc, |l| self.sources.describe(l));
@@ -669,7 +669,7 @@ impl<'a> Expander<'a> {
             entries.push((key("goal_as"), (*g).clone()));
         }
         let v = Value::new(ValueKind::Map(entries), loc);
-        match super::de::from_value::<Select>(&v) {
+        match crate::yaml::de::from_value::<Select>(&v) {
             Ok(s) => {
                 self.var_defs.extend(VarDef::from_select(
                     &s,
@@ -837,7 +837,7 @@ struct Secs(f64);
 
 impl<'de> serde::Deserialize<'de> for Secs {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        super::units::time_limit(d).map(Secs)
+        crate::yaml::units::time_limit(d).map(Secs)
     }
 }
 

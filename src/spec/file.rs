@@ -1,8 +1,8 @@
 //! The top level of a tree file: `include:`, `subtrees:` and `main:`.
 
-use super::diag::{Issue, Loc};
-use super::suggest::did_you_mean;
-use super::value::{Value, ValueKind};
+use crate::yaml::diag::{Issue, Loc};
+use crate::yaml::suggest::did_you_mean;
+use crate::yaml::value::{Value, ValueKind};
 
 /// Keys allowed at the top level of a tree file.
 pub const TOP_LEVEL_KEYS: &[&str] = &["description", "scene", "include", "subtrees", "main"];

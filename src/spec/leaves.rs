@@ -10,10 +10,11 @@ use serde::{Deserialize, Serialize};
 use schemars::JsonSchema;
 
 use super::objects::{ObjectRef, opt_var_name, var_name};
-use super::units::{self, Angle, PathKind, Target, Yaw};
+use super::targets::{PathKind, Target, Yaw};
 pub use crate::registry::{LeafCall, Params};
 use crate::world::conditions::Tolerances;
 use crate::world::query::{Filter, KindFilter, Order, Query};
+use crate::yaml::units::{self, Angle};
 
 fn d_zero3() -> [f64; 3] {
     [0.0, 0.0, 0.0]

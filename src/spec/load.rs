@@ -1,19 +1,20 @@
 //! Loading tree files: read, follow `include:`, collect subtrees, expand `main:`.
 
 use std::collections::{HashMap, HashSet};
-use std::io::Read;
+
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use super::confine::{IncludeScope, parse_top_level};
-use super::diag::{Diagnostic, FileId, Issue, Loc, Sources};
 use super::expand::{Expander, undefined_params};
 use super::file::{SubtreeDef, TreeFile};
 use super::node::Node;
-use super::suggest::closest;
-use super::value::{MAX_FILE_BYTES, decode_utf8, parse_yaml};
 use crate::registry::Registry;
 use crate::scene::SceneSpec;
+use crate::yaml::diag::{Diagnostic, FileId, Issue, Loc, Sources};
+use crate::yaml::read_limited;
+use crate::yaml::suggest::closest;
+use crate::yaml::value::{decode_utf8, parse_yaml};
 
 /// Deepest chain of includes.
 pub const MAX_INCLUDE_DEPTH: usize = 16;
@@ -138,55 +139,6 @@ fn load_bytes_at(
     l.finish(text, &name, path.parent())
 }
 
-/// Read a tree file of at most [`MAX_FILE_BYTES`]. Only regular files are read, and never more
-/// than the limit: a device (`/dev/zero`), a FIFO or a `/proc` file whose size is reported as 0
-/// would otherwise be read forever, or block.
-pub(crate) fn read_limited(path: &Path) -> Result<Vec<u8>, (String, String)> {
-    let meta = std::fs::metadata(path).map_err(|e| {
-        (
-            format!("cannot read `{}`: {e}", path.display()),
-            "check the path (include paths are relative to the including file)".to_string(),
-        )
-    })?;
-    if meta.is_dir() {
-        return Err((
-            format!("`{}` is a folder, not a tree file", path.display()),
-            "give the path of a `.yaml` file".to_string(),
-        ));
-    }
-    if !meta.is_file() {
-        return Err((
-            format!("`{}` is not a regular file", path.display()),
-            "give the path of a `.yaml` file (devices, pipes and sockets are not read)".to_string(),
-        ));
-    }
-    let too_large = |size: String| {
-        (
-            format!("file is too large: {size} bytes (limit {MAX_FILE_BYTES} bytes)"),
-            "a behavior tree file is a few kilobytes; is this the right file?".to_string(),
-        )
-    };
-    if meta.len() > MAX_FILE_BYTES as u64 {
-        return Err(too_large(meta.len().to_string()));
-    }
-    let cannot = |e: std::io::Error| {
-        (
-            format!("cannot read `{}`: {e}", path.display()),
-            "check the path and permissions".to_string(),
-        )
-    };
-    let file = std::fs::File::open(path).map_err(cannot)?;
-    let mut bytes = Vec::new();
-    // One byte past the limit tells "too large" from "exactly at the limit".
-    file.take(MAX_FILE_BYTES as u64 + 1)
-        .read_to_end(&mut bytes)
-        .map_err(cannot)?;
-    if bytes.len() > MAX_FILE_BYTES {
-        return Err(too_large(format!("more than {MAX_FILE_BYTES}")));
-    }
-    Ok(bytes)
-}
-
 #[derive(Default)]
 struct Loader {
     sources: Sources,
@@ -212,7 +164,7 @@ impl Loader {
     fn finish(mut self, text: &str, name: &str, base: Option<&Path>) -> Result<Spec, Vec<Diagnostic>> {
         self.scope = IncludeScope::for_base(base);
         // Warnings left over from reading something else on this thread (a scene file).
-        let _ = super::de::take_warnings();
+        let _ = crate::yaml::de::take_warnings();
         let mut warnings = Vec::new();
         let id = self.sources.add(name, text);
         let (root_file, is_tree) = match parse_yaml(text, id).map(|v| parse_top_level(&v, &mut self.issues)) {
@@ -326,13 +278,22 @@ impl Loader {
             }
             let mut ex = Expander::new(&registry, &table, &self.sources);
             ex.reported.clone_from(&reported);
-            let call = super::value::Value::new(
-                super::value::ValueKind::Map(vec![(
-                    super::value::Value::new(super::value::ValueKind::Str("subtree".into()), d.loc),
-                    super::value::Value::new(
-                        super::value::ValueKind::Map(vec![(
-                            super::value::Value::new(super::value::ValueKind::Str("ref".into()), d.loc),
-                            super::value::Value::new(super::value::ValueKind::Str(n.clone()), d.loc),
+            let call = crate::yaml::value::Value::new(
+                crate::yaml::value::ValueKind::Map(vec![(
+                    crate::yaml::value::Value::new(
+                        crate::yaml::value::ValueKind::Str("subtree".into()),
+                        d.loc,
+                    ),
+                    crate::yaml::value::Value::new(
+                        crate::yaml::value::ValueKind::Map(vec![(
+                            crate::yaml::value::Value::new(
+                                crate::yaml::value::ValueKind::Str("ref".into()),
+                                d.loc,
+                            ),
+                            crate::yaml::value::Value::new(
+                                crate::yaml::value::ValueKind::Str(n.clone()),
+                                d.loc,
+                            ),
                         )]),
                         d.loc,
                     ),

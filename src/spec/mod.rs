@@ -1,6 +1,6 @@
 //! YAML → typed, spanned spec.
 //!
-//! The pipeline is: text → [`value::Value`] (generic YAML with a location on every node, read by
+//! The pipeline is: text → [`crate::yaml::value::Value`] (generic YAML with a location on every node, read by
 //! serde-saphyr under resource limits) → [`file::TreeFile`] (`include:`, `subtrees:`, `main:`)
 //! → [`node::Node`] (typed tree, subtrees expanded with their arguments, every node located).
 //! Every problem is an [`Issue`] turned into a [`Diagnostic`] with file:line:column.
@@ -12,21 +12,17 @@
 pub mod catalog;
 pub mod check;
 mod confine;
-pub mod de;
-pub mod diag;
 pub mod expand;
 pub mod file;
 pub mod leaves;
 pub mod load;
 pub mod node;
 pub mod objects;
-pub mod suggest;
-pub mod units;
-pub mod value;
+mod targets;
 
+pub use crate::yaml::{Diagnostic, Issue, Loc, Sources};
 pub use catalog::{NodeDoc, ParamDoc, catalog, json_schema};
 pub use confine::{includes_anywhere, set_includes_anywhere};
-pub use diag::{Diagnostic, Issue, Loc, Sources};
 pub use leaves::{
     At, AtHome, Carry, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, GoalMet, Grasp, Grasped,
     GripperOpen, Home, In, Leaf, LeafCall, Lifted, MoveJoints, On, OnTable, Params, Reach, Release, Select,
@@ -35,4 +31,4 @@ pub use leaves::{
 pub use load::{Spec, load_bytes, load_file, load_str};
 pub use node::{Node, NodeKind};
 pub use objects::ObjectRef;
-pub use units::{PathKind, Target, Yaw};
+pub use targets::{PathKind, Target, Yaw};

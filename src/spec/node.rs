@@ -1,7 +1,7 @@
 //! The typed tree: one [`Node`] per YAML node, subtrees already expanded.
 
-use super::diag::Loc;
 use super::leaves::Leaf;
+use crate::yaml::diag::Loc;
 
 /// A node of the behavior tree as written (after subtree expansion), with its source location.
 #[derive(Clone, Debug, PartialEq)]

@@ -27,11 +27,11 @@ use crate::episode::Goal;
 use crate::faults::FaultKind;
 use crate::plan::Plan;
 use crate::runtime::substitute::{Substitution, glob_match};
-use crate::spec::de::from_value;
-use crate::spec::diag::{Diagnostic, Issue, Loc, Sources};
-use crate::spec::suggest::did_you_mean;
-use crate::spec::value::{Value, decode_utf8, parse_yaml};
 use crate::sweep::{ScenarioResult, Summary, SweepConfig};
+use crate::yaml::de::from_value;
+use crate::yaml::diag::{Diagnostic, Issue, Loc, Sources};
+use crate::yaml::suggest::did_you_mean;
+use crate::yaml::value::{Value, decode_utf8, parse_yaml};
 
 /// Most scenarios in one scenario file (suites are for CI; sweeps are for studies).
 pub const MAX_COUNT: u64 = 100_000;
@@ -222,7 +222,7 @@ pub fn join_clean(base: &Path, rel: &str) -> PathBuf {
 pub fn load_scenario_file(path: &Path) -> Result<ScenarioFile, Vec<Diagnostic>> {
     let name = path.display().to_string();
     let mut sources = Sources::new();
-    let bytes = match crate::spec::load::read_limited(path) {
+    let bytes = match crate::yaml::read_limited(path) {
         Ok(b) => b,
         Err((msg, help)) => {
             let id = sources.add(name, "");

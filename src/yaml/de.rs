@@ -504,7 +504,7 @@ impl<'de> VariantAccess<'de> for VariantAcc<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::spec::value::parse_yaml;
+    use crate::yaml::value::parse_yaml;
     use serde::Deserialize;
 
     #[derive(Deserialize, Debug, PartialEq)]

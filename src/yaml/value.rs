@@ -3,7 +3,7 @@
 //! Tree files are first read into this form (with serde-saphyr and hard resource limits), so
 //! that `$param` substitution in subtrees can happen *before* typed deserialization while every
 //! value keeps its own file:line:column. Typed parameters are then read from it with
-//! [`crate::spec::de`].
+//! [`crate::yaml::de`].
 
 use std::fmt;
 

@@ -1,0 +1,19 @@
+//! The located-YAML base every input format is read with: a YAML value tree in which every node
+//! remembers its file, line and column ([`value`]); typed deserialization from it with located
+//! errors ([`de`]); diagnostics in rustc's style ([`diag`]); did-you-mean suggestions
+//! ([`suggest`]); range-checked unit parsers for metres, seconds and `deg(..)` angles
+//! ([`units`]); and reading input files with hard limits ([`read`]).
+//!
+//! Tree files ([`crate::spec`]), scene files ([`crate::scene`]) and scenario files
+//! (`crate::suite`) are all read through it; it depends on nothing else in the crate but the
+//! robot's constants in [`crate::motion`] (for the reach and joint-limit checks).
+
+pub mod de;
+pub mod diag;
+mod read;
+pub mod suggest;
+pub mod units;
+pub mod value;
+
+pub use diag::{Diagnostic, Issue, Loc, Sources};
+pub use read::read_limited;
