@@ -5,6 +5,10 @@
 
 fn main() {
     println!("cargo:rerun-if-env-changed=MUJOCO_DYNAMIC_LINK_DIR");
+    // Without the `sim` feature nothing links MuJoCo.
+    if std::env::var_os("CARGO_FEATURE_SIM").is_none() {
+        return;
+    }
     match std::env::var("MUJOCO_DYNAMIC_LINK_DIR") {
         Ok(dir) => {
             if !std::path::Path::new(&dir).join("libmujoco.so").exists() {

@@ -16,10 +16,10 @@ use std::process::ExitCode;
 
 use macrotree::actions::{Cell, MacroAction, Progress, object_index};
 use macrotree::episode::{EpisodeConfig, Goal};
+use macrotree::kinds::ObjectRef;
 use macrotree::motion::{
     CLOSED_CTRL, CartesianMove, JointMove, MotionLimits, Trajectory, down_pose, ik_down,
 };
-use macrotree::spec::ObjectRef;
 use macrotree::world::World;
 use macrotree::yaml::units::Angle;
 use macrotree::{App, Error, Params};

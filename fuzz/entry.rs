@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use macrotree::plan::{Plan, compile_bytes};
+use macrotree::plan::{Loader, Plan};
 use macrotree::spec::Diagnostic;
 
 /// The name fuzz inputs are loaded under: a file (that does not exist) in
@@ -17,7 +17,7 @@ pub fn input_name(repo_root: &Path) -> PathBuf {
 /// it. Panics only if the loader, the compiler or the rendering panics.
 pub fn load_tree(data: &[u8], repo_root: &Path) -> Result<Plan, Vec<Diagnostic>> {
     let name = input_name(repo_root);
-    let result = compile_bytes(data, &name.to_string_lossy());
+    let result = Loader::default().compile_bytes(data, &name.to_string_lossy());
     match &result {
         Ok(plan) => {
             std::hint::black_box(plan.behavior_size());

@@ -8,8 +8,9 @@ use std::sync::Arc;
 use crate::actions::MacroAction;
 use crate::episode::{EpisodeConfig, EpisodeReport, NoObserver};
 use crate::error::Error;
-use crate::plan::Plan;
-use crate::registry::{Params, Registry};
+use crate::factory::Factory;
+use crate::kinds::{Params, Registry};
+use crate::plan::{Loader, Plan};
 use crate::sim::Scene;
 use crate::world::World;
 
@@ -29,9 +30,20 @@ pub const MAX_SIM_TIME_S: f64 = 3600.0;
 /// println!("{}", report.tree_status);
 /// # Ok::<(), macrotree::Error>(())
 /// ```
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct App {
-    registry: Arc<Registry>,
+    loader: Loader,
+    factory: Arc<Factory>,
+}
+
+impl Default for App {
+    /// The built-in node kinds, bound to the built-in controllers and checks.
+    fn default() -> Self {
+        App {
+            loader: Loader::default(),
+            factory: Factory::builtin(),
+        }
+    }
 }
 
 impl App {
@@ -40,22 +52,36 @@ impl App {
         App::default()
     }
 
-    /// An app with the node kinds of `registry`.
-    pub fn with_registry(registry: Registry) -> App {
-        App {
-            registry: Arc::new(registry),
-        }
-    }
-
-    /// The node kinds.
+    /// The node kinds trees may use.
     pub fn registry(&self) -> &Registry {
-        &self.registry
+        self.loader.registry()
     }
 
-    /// Adds an action leaf kind; see [`Registry::register_action`].
+    /// How this app reads trees (its node kinds, where includes may come from).
+    pub fn loader(&self) -> &Loader {
+        &self.loader
+    }
+
+    /// How this app runs each action and condition kind.
+    pub fn factory(&self) -> &Arc<Factory> {
+        &self.factory
+    }
+
+    /// Lets `include:` read files outside the main tree file's folder (`true`) or not
+    /// (`false`, the default; see `docs/security.md`).
+    pub fn includes_anywhere(mut self, allow: bool) -> Self {
+        self.loader = self.loader.includes_anywhere(allow);
+        self
+    }
+
+    /// Registers an action leaf: declares the kind `name` with parameters `P` and `doc` (see
+    /// [`Registry::declare_action`]) and binds `start`, which makes a new controller from the
+    /// parameters each time the leaf starts (its `start` runs on the first tick, `update` on
+    /// every tick after, `halt` when the tree preempts it).
     ///
     /// # Errors
-    /// [`Error::Registry`] for an invalid or duplicate name, or an incomplete doc.
+    /// [`Error::Registry`] when the name is not a lower-case identifier, is already registered,
+    /// or the doc lacks its summary, halt paragraph or example.
     pub fn register_action<P, F>(
         &mut self,
         name: &'static str,
@@ -66,11 +92,21 @@ impl App {
         P: Params,
         F: Fn(&P) -> Box<dyn MacroAction> + Send + Sync + 'static,
     {
-        Arc::make_mut(&mut self.registry).register_action(name, doc, start)?;
+        let mut registry = Registry::clone(self.loader.registry());
+        registry.declare_action::<P>(name, doc)?;
+        let mut factory = Factory::clone(&self.factory);
+        factory.bind_action(name, start).map_err(|e| Error::Registry {
+            kind: name.to_string(),
+            message: e.0,
+        })?;
+        self.replace(registry, factory);
         Ok(self)
     }
 
-    /// Adds a condition leaf kind; see [`Registry::register_condition`].
+    /// Registers a condition leaf: declares the kind `name` with parameters `P` and `doc` and
+    /// binds `check`, which answers from the world snapshot alone (a pure function: called every
+    /// tick the condition is checked, it must not keep state). `Ok(false)` fails the leaf with
+    /// `not satisfied`, `Err(reason)` fails it with the reason (e.g. an unknown object).
     ///
     /// # Errors
     /// As for [`register_action`](Self::register_action).
@@ -84,90 +120,98 @@ impl App {
         P: Params,
         F: Fn(&World, &P) -> Result<bool, String> + Send + Sync + 'static,
     {
-        Arc::make_mut(&mut self.registry).register_condition(name, doc, check)?;
+        let mut registry = Registry::clone(self.loader.registry());
+        registry.declare_condition::<P>(name, doc)?;
+        let mut factory = Factory::clone(&self.factory);
+        factory.bind_condition(name, check).map_err(|e| Error::Registry {
+            kind: name.to_string(),
+            message: e.0,
+        })?;
+        self.replace(registry, factory);
         Ok(self)
     }
 
-    /// Reads, validates and compiles a tree from text. `file_name` appears in diagnostics, and
-    /// its folder (if any) is the base for relative `include:` and `scene:` paths.
+    fn replace(&mut self, registry: Registry, factory: Factory) {
+        let anywhere = self.loader.allows_includes_anywhere();
+        self.loader = Loader::new(Arc::new(registry)).includes_anywhere(anywhere);
+        self.factory = Arc::new(factory);
+    }
+
+    /// Reads, validates and compiles a tree from text (`file_name` appears in diagnostics and
+    /// is the base of relative includes).
     ///
     /// # Errors
-    /// [`Error::Tree`] with located diagnostics.
+    /// [`Error::Tree`] with every located diagnostic.
     pub fn compile_str(&self, yaml: &str, file_name: &str) -> Result<Plan, Error> {
-        crate::spec::load::load_str_in(&self.registry, yaml, file_name)
-            .and_then(|spec| crate::plan::compile_spec(&spec))
+        self.loader
+            .compile_str(yaml, file_name)
             .map_err(|diagnostics| Error::Tree {
                 file: file_name.to_string(),
                 diagnostics,
             })
     }
 
-    /// Reads, validates and compiles a tree file (following its `include:`s) for its own
-    /// `scene:` (or the built-in `cube_bowl` scene).
+    /// Reads, validates and compiles a tree file (following its includes) for its own `scene:`.
     ///
     /// # Errors
-    /// [`Error::Tree`] with located diagnostics.
+    /// [`Error::Tree`] with every located diagnostic.
     pub fn load_tree(&self, path: &Path) -> Result<Plan, Error> {
-        crate::spec::load::load_file_in(&self.registry, path, None)
-            .and_then(|spec| crate::plan::compile_spec(&spec))
-            .map_err(|diagnostics| Error::Tree {
-                file: path.display().to_string(),
-                diagnostics,
-            })
+        self.loader.load(path).map_err(|diagnostics| Error::Tree {
+            file: path.display().to_string(),
+            diagnostics,
+        })
     }
 
-    /// Like [`load_tree`](Self::load_tree), for the scene file `scene` instead of the tree's own.
+    /// Reads a scene file and a tree file, and compiles the tree for that scene (instead of the
+    /// tree's own `scene:`).
     ///
     /// # Errors
-    /// [`Error::Scene`] when the scene is invalid, [`Error::Tree`] when the tree is (or names
-    /// objects the scene does not have).
+    /// [`Error::Scene`] or [`Error::Tree`] with every located diagnostic.
     pub fn load_tree_for_scene(&self, path: &Path, scene: &Path) -> Result<Plan, Error> {
         let spec = crate::scene::load_scene_file(scene).map_err(|diagnostics| Error::Scene {
             file: scene.display().to_string(),
             diagnostics,
         })?;
-        crate::spec::load::load_file_in(&self.registry, path, Some(Arc::new(spec)))
-            .and_then(|spec| crate::plan::compile_spec(&spec))
+        self.loader
+            .load_for(path, Some(Arc::new(spec)))
             .map_err(|diagnostics| Error::Tree {
                 file: path.display().to_string(),
                 diagnostics,
             })
     }
 
-    /// Builds the simulation of `plan`'s scene (the robot and the scene's objects).
+    /// Builds the simulation of the plan's scene (the robot and the scene's objects).
     ///
     /// # Errors
-    /// [`Error::Simulator`] when the robot's model files are missing (run `tools/bootstrap`) or
-    /// MuJoCo refuses the model.
+    /// [`Error::Simulator`] when the robot assets are missing or MuJoCo refuses the model.
     pub fn simulator(&self, plan: &Plan) -> Result<Scene, Error> {
         Scene::load_spec(&plan.scene).map_err(|e| Error::Simulator {
             message: e.to_string(),
         })
     }
 
-    /// Runs one episode of `plan` on physics, in a fresh cell of its scene, and reports it.
+    /// Runs one episode of `plan` on a fresh simulation of its scene.
     ///
     /// # Errors
-    /// [`Error::Config`] when `config`'s time limit is not in (0, [`MAX_SIM_TIME_S`]] or its
-    /// control period is not a positive whole number of 2 ms physics steps up to 0.1 s;
-    /// [`Error::Simulator`] as for [`simulator`](Self::simulator).
+    /// [`Error::Config`] for settings out of range, [`Error::Simulator`] when the simulation
+    /// cannot be built.
     pub fn run_episode(&self, plan: &Plan, config: &EpisodeConfig) -> Result<EpisodeReport, Error> {
         check_config(config)?;
         let scene = self.simulator(plan)?;
         Ok(crate::episode::run_episode(
             &scene,
             Arc::new(plan.clone()),
+            &self.factory,
             config,
             &mut NoObserver,
         ))
     }
 
-    /// Runs the `macrotree` command line (`run`, `validate`, `nodes`, `schema`, `graph`,
-    /// `sweep`, …) with this app's node kinds, on the process's arguments, and answers its exit
-    /// code (0 success, 1 task failed, 2 bad input).
+    /// Runs the `macrotree` command line with this app's node kinds in it (`nodes`, `schema`,
+    /// `validate`, `run`, `sweep`, `test`, `graph`). Returns the process exit code.
     #[cfg(feature = "cli")]
     pub fn run_cli(self) -> std::process::ExitCode {
-        crate::cli::main_with(Arc::unwrap_or_clone(self.registry))
+        crate::cli::main_with(self)
     }
 }
 

@@ -1,10 +1,10 @@
-//! [`Error`]: what the library's public entry points ([`crate::App`], [`crate::registry`])
+//! [`Error`]: what the library's public entry points ([`crate::App`], [`crate::kinds`])
 //! answer when they cannot do what was asked, with a stable [`kind`](Error::kind) and a human
 //! message.
 
 use std::fmt;
 
-use crate::spec::Diagnostic;
+use crate::yaml::Diagnostic;
 
 /// A failure of a public entry point. Match on the variant, or group by [`Error::kind`].
 #[derive(Debug, Clone)]

@@ -40,7 +40,7 @@
 //! ```no_run
 //! use macrotree::actions::{Cell, MacroAction, Progress, object_index};
 //! use macrotree::episode::{EpisodeConfig, Goal};
-//! use macrotree::spec::ObjectRef;
+//! use macrotree::kinds::ObjectRef;
 //! use macrotree::world::World;
 //! use macrotree::{App, Params};
 //! use schemars::JsonSchema;
@@ -120,31 +120,42 @@
 
 #![warn(missing_docs)]
 
+#[cfg(feature = "sim")]
 pub use app::App;
 pub use error::Error;
-pub use registry::{Category, Params, Registry};
+pub use kinds::{Category, Params, Registry};
 
+#[cfg(feature = "sim")]
 pub mod actions;
+#[cfg(feature = "sim")]
 pub mod app;
 #[cfg(feature = "cli")]
 pub mod cli;
+#[cfg(feature = "sim")]
 pub mod dataset;
+#[cfg(feature = "sim")]
 pub mod episode;
 pub mod error;
+#[cfg(feature = "sim")]
+pub mod factory;
+#[cfg(feature = "sim")]
 pub mod faults;
+pub mod kinds;
 pub mod motion;
 pub mod output;
 pub mod plan;
-pub mod registry;
+#[cfg(feature = "sim")]
 pub mod render;
 pub mod runtime;
 pub mod scene;
+#[cfg(feature = "sim")]
 pub mod sim;
 pub mod spec;
 #[cfg(feature = "sweep")]
 pub mod suite;
 #[cfg(feature = "sweep")]
 pub mod sweep;
+#[cfg(feature = "sim")]
 pub mod video;
 #[cfg(feature = "viewer")]
 pub mod viewer;

@@ -77,7 +77,9 @@ fn graph_dot_has_one_edge_per_non_root_node() {
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     let dot = stdout(&out);
     assert!(dot.starts_with("digraph tree {"), "{dot}");
-    let plan = macrotree::plan::load_plan(&Path::new(ROOT).join("trees/cube_to_bowl.yaml")).unwrap();
+    let plan = macrotree::plan::Loader::default()
+        .load(&Path::new(ROOT).join("trees/cube_to_bowl.yaml"))
+        .unwrap();
     assert_eq!(dot.matches(" -> ").count(), plan.nodes.len() - 1);
     assert!(dot.contains("retry ×3"), "{dot}");
     assert!(
@@ -124,7 +126,7 @@ fn nodes_lists_every_kind_with_parameters_and_examples() {
     let out = macrotree(&["nodes"]);
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     let text = stdout(&out);
-    let catalog = macrotree::spec::catalog();
+    let catalog = macrotree::Registry::builtin().catalog();
     for doc in &catalog {
         assert!(
             text.contains(&format!("\n  {} — {}", doc.kind, doc.summary)),

@@ -87,10 +87,20 @@ fn bench_replay_ends_in_the_episodes_exact_final_state() {
     );
     // The same episode in this process ends in the same state, bit for bit.
     let scene = macrotree::sim::Scene::load().expect("scene");
-    let plan = Arc::new(macrotree::plan::load_plan(std::path::Path::new(TREE)).expect("valid"));
+    let plan = Arc::new(
+        macrotree::plan::Loader::default()
+            .load(std::path::Path::new(TREE))
+            .expect("valid"),
+    );
     let config = macrotree::episode::EpisodeConfig::default();
     let mut cell = macrotree::actions::Cell::new(&scene, &config.layout, config.control_period);
-    let r = macrotree::episode::run_in_cell(&mut cell, plan, &config, &mut macrotree::episode::NoObserver);
+    let r = macrotree::episode::run_in_cell(
+        &mut cell,
+        plan,
+        &macrotree::factory::Factory::builtin(),
+        &config,
+        &mut macrotree::episode::NoObserver,
+    );
     assert!(r.success);
     assert_eq!(
         v["state_fingerprint"].as_str(),

@@ -39,11 +39,21 @@ main:
               child: {reach: {target: [0.45, -0.25, 0.25]}}
       - wait: {seconds: 1.0}
 "#;
-    let plan = Arc::new(macrotree::plan::compile_str(yaml, "halt.yaml").expect("valid"));
+    let plan = Arc::new(
+        macrotree::plan::Loader::default()
+            .compile_str(yaml, "halt.yaml")
+            .expect("valid"),
+    );
     let scene = Scene::load().expect("scene");
     let mut cell = Cell::new(&scene, &Layout::default(), macrotree::actions::CONTROL_PERIOD);
     let mut trace = Trace::default();
-    let report = run_in_cell(&mut cell, plan, &EpisodeConfig::default(), &mut trace);
+    let report = run_in_cell(
+        &mut cell,
+        plan,
+        &macrotree::factory::Factory::builtin(),
+        &EpisodeConfig::default(),
+        &mut trace,
+    );
     assert_eq!(report.tree_status, "success");
     assert_eq!(report.halts, 1, "exactly one leaf halted");
     let halted: Vec<&Transition> = trace

@@ -13,7 +13,11 @@ use macrotree::sim::{Layout, Scene};
 
 fn flagship() -> Arc<macrotree::plan::Plan> {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/trees/cube_to_bowl.yaml");
-    Arc::new(macrotree::plan::load_plan(std::path::Path::new(path)).expect("flagship tree is valid"))
+    Arc::new(
+        macrotree::plan::Loader::default()
+            .load(std::path::Path::new(path))
+            .expect("flagship tree is valid"),
+    )
 }
 
 /// Runs the flagship on every layout; after each episode, checks MuJoCo raised no warning and
@@ -30,7 +34,13 @@ fn run_all(layouts: &[Layout]) -> Vec<(EpisodeReport, oracle::Verdict)> {
                 layout: *layout,
                 ..EpisodeConfig::default()
             };
-            let r = run_in_cell(&mut cell, plan.clone(), &config, &mut NoObserver);
+            let r = run_in_cell(
+                &mut cell,
+                plan.clone(),
+                &macrotree::factory::Factory::builtin(),
+                &config,
+                &mut NoObserver,
+            );
             oracle::assert_no_warning(cell.sim(), &format!("{layout:?}"));
             let v = oracle::settle_and_judge(cell.sim_mut(), "cube", "bowl");
             (r, v)
@@ -138,9 +148,27 @@ fn same_tree_layout_and_seed_give_a_bit_identical_episode() {
         layout: Layout::default(),
         ..config.clone()
     };
-    run_in_cell(&mut b, plan.clone(), &other, &mut NoObserver);
-    let mut ra = run_in_cell(&mut a, plan.clone(), &config, &mut NoObserver);
-    let mut rb = run_in_cell(&mut b, plan, &config, &mut NoObserver);
+    run_in_cell(
+        &mut b,
+        plan.clone(),
+        &macrotree::factory::Factory::builtin(),
+        &other,
+        &mut NoObserver,
+    );
+    let mut ra = run_in_cell(
+        &mut a,
+        plan.clone(),
+        &macrotree::factory::Factory::builtin(),
+        &config,
+        &mut NoObserver,
+    );
+    let mut rb = run_in_cell(
+        &mut b,
+        plan,
+        &macrotree::factory::Factory::builtin(),
+        &config,
+        &mut NoObserver,
+    );
     assert!(ra.success);
     oracle::assert_no_warning(a.sim(), "episode a");
     oracle::assert_no_warning(b.sim(), "episode b");

@@ -20,7 +20,11 @@ fn tree(file: &str) -> Arc<Plan> {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("trees")
         .join(file);
-    Arc::new(macrotree::plan::load_plan(&path).unwrap_or_else(|e| panic!("{file} is invalid: {e:?}")))
+    Arc::new(
+        macrotree::plan::Loader::default()
+            .load(&path)
+            .unwrap_or_else(|e| panic!("{file} is invalid: {e:?}")),
+    )
 }
 
 /// What the `squeeze` grasp of `recenter_and_grasp.yaml` did.
@@ -101,7 +105,13 @@ fn run(plan: &Arc<Plan>, layout: Layout, fault: Option<(FaultKind, u64)>) -> Out
         ..EpisodeConfig::default()
     };
     let mut trace = Trace::default();
-    let report = run_in_cell(&mut cell, plan.clone(), &config, &mut trace);
+    let report = run_in_cell(
+        &mut cell,
+        plan.clone(),
+        &macrotree::factory::Factory::builtin(),
+        &config,
+        &mut trace,
+    );
     let cube_yaw = cell.world().cube_yaw();
     oracle::assert_no_warning(cell.sim(), &format!("{layout:?} {fault:?}"));
     let verdict = oracle::settle_and_judge(cell.sim_mut(), "cube", "bowl");
@@ -287,7 +297,8 @@ fn every_tree_in_the_tutorial_compiles() {
     for (line, body) in &blocks {
         // Named as if it were in trees/, so an `include:` resolves against trees/.
         let name = format!("{}/trees/tutorial_line_{line}.yaml", env!("CARGO_MANIFEST_DIR"));
-        let plan = macrotree::plan::compile_str(body, &name)
+        let plan = macrotree::plan::Loader::default()
+            .compile_str(body, &name)
             .unwrap_or_else(|e| panic!("docs/tutorial.md:{line}: the tree does not compile: {e:?}"));
         // The multi-object step names its own scene; the cube-to-bowl steps run on the built-in one.
         if !body.lines().any(|l| l.starts_with("scene:")) {

@@ -25,7 +25,14 @@ fn ten_seeded_nudges_all_succeed() {
         fault: Some(FaultKind::Nudge),
         ..SweepConfig::default()
     };
-    let run = run_sweep(scene(), &plan(), &config, |_| {}).expect("thread pool");
+    let run = run_sweep(
+        scene(),
+        &plan(),
+        &macrotree::factory::Factory::builtin(),
+        &config,
+        |_| {},
+    )
+    .expect("thread pool");
     for r in &run.results {
         assert!(r.success, "#{} {:?}: {:?}", r.index, r.layout, r.failure_reason);
     }
@@ -65,7 +72,13 @@ fn a_nudge_really_moves_the_cube_as_the_gripper_closes() {
             ..EpisodeConfig::default()
         };
         let mut moved = Moved::default();
-        let report = run_in_cell(&mut cell, plan(), &config, &mut moved);
+        let report = run_in_cell(
+            &mut cell,
+            plan(),
+            &macrotree::factory::Factory::builtin(),
+            &config,
+            &mut moved,
+        );
         let event = log.lock().unwrap().clone().expect("the nudge fired");
         eprintln!(
             "seed {seed}: {}; moved {:.1} mm; {} grasp(s)",
@@ -103,8 +116,15 @@ fn every_fault_fires_exactly_once_in_an_episode() {
             seed: 7,
             ..EpisodeConfig::default()
         };
-        let (report, lines) =
-            logs::capture(|| run_in_cell(&mut cell, plan(), &config, &mut macrotree::episode::NoObserver));
+        let (report, lines) = logs::capture(|| {
+            run_in_cell(
+                &mut cell,
+                plan(),
+                &macrotree::factory::Factory::builtin(),
+                &config,
+                &mut macrotree::episode::NoObserver,
+            )
+        });
         cell.observers.clear();
         oracle::assert_no_warning(cell.sim(), kind.name());
         let event = log.lock().unwrap().clone();

@@ -73,7 +73,15 @@ fn episode(kind: FaultKind, index: u64) -> Episode {
     let (fault, log) = injector_with_log(kind, config.seed);
     cell.observers.push(fault);
     let mut track = Track::default();
-    let (report, lines) = logs::capture(|| run_in_cell(&mut cell, plan(), &config, &mut track));
+    let (report, lines) = logs::capture(|| {
+        run_in_cell(
+            &mut cell,
+            plan(),
+            &macrotree::factory::Factory::builtin(),
+            &config,
+            &mut track,
+        )
+    });
     let event = log
         .lock()
         .unwrap()
@@ -150,7 +158,14 @@ fn batch(kind: FaultKind) {
         fault: Some(kind),
         ..SweepConfig::default()
     };
-    let run = run_sweep(scene(), &plan(), &config, |_| {}).expect("thread pool");
+    let run = run_sweep(
+        scene(),
+        &plan(),
+        &macrotree::factory::Factory::builtin(),
+        &config,
+        |_| {},
+    )
+    .expect("thread pool");
     assert_eq!(run.results.len(), 20);
     let ok = run.results.iter().filter(|r| r.success).count();
     eprintln!("{kind}: {ok}/20 recovered");

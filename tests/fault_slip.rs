@@ -50,7 +50,15 @@ fn a_slip_drops_the_cube_and_the_tree_picks_it_up_where_it_fell() {
     let (slip, log) = injector_with_log(FaultKind::Slip, config.seed);
     cell.observers.push(slip);
     let mut trace = Trace::default();
-    let (report, lines) = logs::capture(|| run_in_cell(&mut cell, plan(), &config, &mut trace));
+    let (report, lines) = logs::capture(|| {
+        run_in_cell(
+            &mut cell,
+            plan(),
+            &macrotree::factory::Factory::builtin(),
+            &config,
+            &mut trace,
+        )
+    });
     assert!(report.success, "{:?}", report.failure_reason);
     assert_eq!(report.grasp_attempts, 2);
     oracle::assert_no_warning(cell.sim(), "slip episode");
@@ -137,7 +145,14 @@ fn ten_seeded_slips_all_recover_with_a_second_grasp() {
         fault: Some(FaultKind::Slip),
         ..SweepConfig::default()
     };
-    let run = run_sweep(scene(), &plan(), &config, |_| {}).expect("thread pool");
+    let run = run_sweep(
+        scene(),
+        &plan(),
+        &macrotree::factory::Factory::builtin(),
+        &config,
+        |_| {},
+    )
+    .expect("thread pool");
     for r in &run.results {
         eprintln!(
             "#{}: success {} after {} grasp(s)",
@@ -168,7 +183,13 @@ fn a_slip_is_deterministic_and_fires_once() {
             seed,
             ..EpisodeConfig::default()
         };
-        let mut report = run_in_cell(&mut cell, plan(), &config, &mut macrotree::episode::NoObserver);
+        let mut report = run_in_cell(
+            &mut cell,
+            plan(),
+            &macrotree::factory::Factory::builtin(),
+            &config,
+            &mut macrotree::episode::NoObserver,
+        );
         oracle::assert_no_warning(cell.sim(), &format!("seed {seed}"));
         report.wall_time_s = 0.0;
         let event = log.lock().unwrap().clone().expect("fired");

@@ -16,8 +16,18 @@ use macrotree::sim::scene::{SCENE_XML, menagerie_dir};
 use macrotree::sim::{ModelOrigin, Scene};
 
 fn episode(scene: &Scene) -> EpisodeReport {
-    let plan = Arc::new(macrotree::plan::load_plan("trees/cube_to_bowl.yaml".as_ref()).expect("tree"));
-    run_episode(scene, plan, &EpisodeConfig::default(), &mut NoObserver)
+    let plan = Arc::new(
+        macrotree::plan::Loader::default()
+            .load("trees/cube_to_bowl.yaml".as_ref())
+            .expect("tree"),
+    );
+    run_episode(
+        scene,
+        plan,
+        &macrotree::factory::Factory::builtin(),
+        &EpisodeConfig::default(),
+        &mut NoObserver,
+    )
 }
 
 /// The report without its wall-clock time, as JSON (every float printed round-trip exact).

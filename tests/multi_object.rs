@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use macrotree::actions::{CONTROL_PERIOD, Cell};
 use macrotree::episode::{EpisodeConfig, EpisodeReport, NoObserver, run_episode, run_in_cell};
-use macrotree::plan::load_plan;
+use macrotree::plan::Loader;
 use macrotree::sim::{Layout, Scene, Sim};
 use macrotree::sweep::SweepConfig;
 
@@ -24,7 +24,11 @@ fn run_scenario(
     k: u64,
     fault: Option<macrotree::faults::FaultKind>,
 ) -> (EpisodeReport, Cell) {
-    let plan = Arc::new(load_plan(&Path::new(ROOT).join(tree)).unwrap_or_else(|d| panic!("{}", d[0])));
+    let plan = Arc::new(
+        Loader::default()
+            .load(&Path::new(ROOT).join(tree))
+            .unwrap_or_else(|d| panic!("{}", d[0])),
+    );
     let scene = Scene::load_spec(&plan.scene).expect("scene compiles");
     let sweep = SweepConfig {
         seed: s,
@@ -36,6 +40,7 @@ fn run_scenario(
     let r = run_in_cell(
         &mut cell,
         plan,
+        &macrotree::factory::Factory::builtin(),
         &sweep.scene_episode_config(&scenario),
         &mut NoObserver,
     );
@@ -148,9 +153,19 @@ fn a_tree_that_succeeds_without_doing_the_job_is_caught() {
         format!("scene: {ROOT}/scenes/sort_three.yaml\nmain: {{home: {{}}}}\n"),
     )
     .unwrap();
-    let plan = Arc::new(load_plan(&tree).unwrap_or_else(|d| panic!("{}", d[0])));
+    let plan = Arc::new(
+        Loader::default()
+            .load(&tree)
+            .unwrap_or_else(|d| panic!("{}", d[0])),
+    );
     let scene = Scene::load_spec(&plan.scene).unwrap();
-    let r = run_episode(&scene, plan, &EpisodeConfig::default(), &mut NoObserver);
+    let r = run_episode(
+        &scene,
+        plan,
+        &macrotree::factory::Factory::builtin(),
+        &EpisodeConfig::default(),
+        &mut NoObserver,
+    );
     assert_eq!(r.tree_status, "success");
     assert!(!r.success);
     let reason = r.failure_reason.unwrap();
@@ -170,9 +185,15 @@ fn a_carry_that_would_lower_the_fingers_onto_the_bowl_names_it() {
         "main:\n  sequence:\n    children:\n      - release: {width: 0.065, retreat: 0}\n      - reach: {target: cube, offset: [0, 0, 0.12]}\n      - reach: {target: cube, path: cartesian}\n      - grasp: {}\n      - carry: {to: [0.45, -0.02, 0.0], lift: 0.15}\n",
     )
     .unwrap();
-    let plan = Arc::new(load_plan(&tree).unwrap());
+    let plan = Arc::new(Loader::default().load(&tree).unwrap());
     let scene = Scene::load().unwrap();
-    let r = run_episode(&scene, plan, &EpisodeConfig::default(), &mut NoObserver);
+    let r = run_episode(
+        &scene,
+        plan,
+        &macrotree::factory::Factory::builtin(),
+        &EpisodeConfig::default(),
+        &mut NoObserver,
+    );
     let reason = r.failure_reason.unwrap_or_default();
     assert!(
         reason.contains("no clear way down") && reason.contains("would hit bowl"),

@@ -91,8 +91,11 @@ impl Trace {
 
 /// Runs `yaml` on the default layout in a fresh cell; asserts MuJoCo raised no warning.
 fn run(yaml: &str) -> (EpisodeReport, Trace, Cell) {
-    let plan =
-        Arc::new(macrotree::plan::compile_str(yaml, "physics.yaml").unwrap_or_else(|d| panic!("{}", d[0])));
+    let plan = Arc::new(
+        macrotree::plan::Loader::default()
+            .compile_str(yaml, "physics.yaml")
+            .unwrap_or_else(|d| panic!("{}", d[0])),
+    );
     let layout = Layout::default();
     let mut cell = Cell::new(scene(), &layout, CONTROL_PERIOD);
     let config = EpisodeConfig {
@@ -100,7 +103,13 @@ fn run(yaml: &str) -> (EpisodeReport, Trace, Cell) {
         ..EpisodeConfig::default()
     };
     let mut trace = Trace::default();
-    let report = run_in_cell(&mut cell, plan, &config, &mut trace);
+    let report = run_in_cell(
+        &mut cell,
+        plan,
+        &macrotree::factory::Factory::builtin(),
+        &config,
+        &mut trace,
+    );
     oracle::assert_no_warning(cell.sim(), yaml);
     (report, trace, cell)
 }

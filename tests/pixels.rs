@@ -51,17 +51,33 @@ fn rendering_never_changes_the_physics_bits() {
         return;
     }
     let scene = Scene::load().unwrap();
-    let plan = Arc::new(macrotree::plan::load_plan("trees/cube_to_bowl.yaml".as_ref()).unwrap());
+    let plan = Arc::new(
+        macrotree::plan::Loader::default()
+            .load("trees/cube_to_bowl.yaml".as_ref())
+            .unwrap(),
+    );
     let config = EpisodeConfig::default();
     let mut plain = Cell::new(&scene, &Layout::default(), CONTROL_PERIOD);
-    let a = run_in_cell(&mut plain, plan.clone(), &config, &mut NoObserver);
+    let a = run_in_cell(
+        &mut plain,
+        plan.clone(),
+        &macrotree::factory::Factory::builtin(),
+        &config,
+        &mut NoObserver,
+    );
     let mut observer = RenderEveryTick {
         cameras: macrotree::render::camera_ids(&scene, &["front".into(), "wrist".into()]).unwrap(),
         sums: Vec::new(),
         ticks: 0,
     };
     let mut rendered = Cell::new(&scene, &Layout::default(), CONTROL_PERIOD);
-    let b = run_in_cell(&mut rendered, plan, &config, &mut observer);
+    let b = run_in_cell(
+        &mut rendered,
+        plan,
+        &macrotree::factory::Factory::builtin(),
+        &config,
+        &mut observer,
+    );
     assert!(a.success && b.success);
     // Every 8th tick rendered both cameras, and the images changed along the episode.
     let ticks = b.physics_steps / 2;

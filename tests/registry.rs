@@ -5,9 +5,9 @@
 use std::sync::Arc;
 
 use macrotree::actions::{Cell, MacroAction, Progress};
+use macrotree::kinds::{Leaf, ObjectRef};
 use macrotree::plan::LeafId;
 use macrotree::runtime::{LeafDriver, LeafOutcome, Selection, TreeRunner, TreeStatus};
-use macrotree::spec::{Leaf, ObjectRef};
 use macrotree::world::World;
 use macrotree::{App, Category, Params, Registry};
 use schemars::JsonSchema;
@@ -109,24 +109,20 @@ fn the_built_in_kinds_are_registry_entries() {
 fn registration_refuses_bad_names_duplicates_and_incomplete_docs() {
     let mut r = Registry::builtin();
     let e = r
-        .register_condition("reach", TOUCHING_DOC, |_: &World, _: &Touching| Ok(true))
+        .declare_condition::<Touching>("reach", TOUCHING_DOC)
         .unwrap_err();
     assert_eq!(e.kind(), "registry");
     assert!(e.message().contains("already registered"), "{e}");
     let e = r
-        .register_condition("Touching!", TOUCHING_DOC, |_: &World, _: &Touching| Ok(true))
+        .declare_condition::<Touching>("Touching!", TOUCHING_DOC)
         .unwrap_err();
     assert!(e.message().contains("not a valid node kind"), "{e}");
     let e = r
-        .register_condition(
-            "touching",
-            "The gripper touches it.\n",
-            |_: &World, _: &Touching| Ok(true),
-        )
+        .declare_condition::<Touching>("touching", "The gripper touches it.\n")
         .unwrap_err();
     assert!(e.message().contains("Halt"), "{e}");
     let e = r
-        .register_condition("touching", PROBE_DOC, |_: &World, _: &Touching| Ok(true))
+        .declare_condition::<Touching>("touching", PROBE_DOC)
         .unwrap_err();
     assert!(e.message().contains("example that uses `touching:`"), "{e}");
     // Nothing was added by the refused calls.
@@ -205,7 +201,10 @@ fn custom_leaves_are_in_the_catalog_and_the_schema() {
     )));
     assert!(!validator.is_valid(&tree("main: {probe: {object: cube, deep: 0.01}}")));
     // The built-in schema is unchanged by a user's registration.
-    assert_eq!(Registry::builtin().json_schema(), macrotree::spec::json_schema());
+    assert_eq!(
+        Registry::builtin().json_schema(),
+        macrotree::plan::Loader::default().registry().json_schema()
+    );
 }
 
 /// Answers every leaf with Success, records the `object` each custom leaf was ticked with, and

@@ -167,7 +167,9 @@ fn placements_are_seeded_and_keep_every_constraint() {
 
 fn tree_errors(text: &str) -> Vec<Diagnostic> {
     let path = Path::new(ROOT).join("trees").join("check_test.yaml");
-    macrotree::spec::load_str(text, path.to_str().unwrap()).expect_err("the tree is invalid")
+    macrotree::plan::Loader::default()
+        .compile_str(text, path.to_str().unwrap())
+        .expect_err("the tree is invalid")
 }
 
 #[test]
@@ -201,7 +203,7 @@ fn blackboard_variables_are_checked_when_the_tree_is_loaded() {
     );
     find(&d, "variable `x` is written as a container here");
     // Bare `{var}` in YAML flow style reads as the variable too.
-    let ok = macrotree::spec::load_str(
+    let ok = macrotree::plan::Loader::default().compile_str(
         "scene: ../scenes/sort_three.yaml\nmain:\n  sequence:\n    children:\n      - select: {as: block}\n      - reach: {target: {block}, offset: [0, 0, 0.1]}\n",
         Path::new(ROOT).join("trees/x.yaml").to_str().unwrap(),
     );

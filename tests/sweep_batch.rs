@@ -23,12 +23,23 @@ use flagship::scene;
 
 fn plan() -> Arc<Plan> {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(TREE);
-    Arc::new(macrotree::plan::load_plan(&path).expect("flagship tree is valid"))
+    Arc::new(
+        macrotree::plan::Loader::default()
+            .load(&path)
+            .expect("flagship tree is valid"),
+    )
 }
 
 fn sweep(config: &SweepConfig) -> Vec<ScenarioResult> {
     let mut streamed = Vec::new();
-    let run = run_sweep(scene(), &plan(), config, |r| streamed.push(r.index)).expect("thread pool");
+    let run = run_sweep(
+        scene(),
+        &plan(),
+        &macrotree::factory::Factory::builtin(),
+        config,
+        |r| streamed.push(r.index),
+    )
+    .expect("thread pool");
     let indices: Vec<u64> = run.results.iter().map(|r| r.index).collect();
     assert_eq!(
         indices,
@@ -127,16 +138,34 @@ fn the_printed_command_reproduces_the_scenario_bit_for_bit() {
     let config = SweepConfig::default();
     let mut cell = Cell::new(scene(), &Layout::default(), CONTROL_PERIOD);
     // A worker cell that already ran another scenario, as in a sweep.
-    run_scenario(&mut cell, &plan, &config, &sample_scenario(77, 0));
+    run_scenario(
+        &mut cell,
+        &plan,
+        &macrotree::factory::Factory::builtin(),
+        &config,
+        &sample_scenario(77, 0),
+    );
     for index in [1, 2] {
         let scenario = sample_scenario(77, index);
-        let swept = run_scenario(&mut cell, &plan, &config, &scenario);
+        let swept = run_scenario(
+            &mut cell,
+            &plan,
+            &macrotree::factory::Factory::builtin(),
+            &config,
+            &scenario,
+        );
         let cmd = swept.reproduce(TREE, &config);
         let parsed = parse_run_command(&cmd);
         // Bit-exact: the same layout (floats compared with ==), seed, limits.
         assert_eq!(parsed, config.episode_config(&scenario), "{cmd}");
         // And the same episode, run the way `macrotree run` runs it (a fresh cell).
-        let report = run_episode(scene(), plan.clone(), &parsed, &mut NoObserver);
+        let report = run_episode(
+            scene(),
+            plan.clone(),
+            &macrotree::factory::Factory::builtin(),
+            &parsed,
+            &mut NoObserver,
+        );
         let again = ScenarioResult::new(&scenario, &config, report);
         assert_eq!(again.to_jsonl(), swept.to_jsonl(), "{cmd}");
     }
@@ -152,7 +181,13 @@ fn reproduction_commands_spell_the_fault_the_goal_and_the_time_limit() {
         ..SweepConfig::default()
     };
     let mut cell = Cell::new(scene(), &Layout::default(), CONTROL_PERIOD);
-    let r = run_scenario(&mut cell, &plan(), &config, &scenario);
+    let r = run_scenario(
+        &mut cell,
+        &plan(),
+        &macrotree::factory::Factory::builtin(),
+        &config,
+        &scenario,
+    );
     let cmd = r.reproduce(TREE, &config);
     assert!(
         cmd.ends_with(" --fault late_bowl --goal tree --max-sim-time 12.5"),

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use macrotree::plan::compile_bytes;
+use macrotree::plan::Loader;
 use macrotree::spec::Diagnostic;
 
 #[path = "../fuzz/entry.rs"]
@@ -140,10 +140,9 @@ fn fuzz_entry_reports_bad_utf8_located() {
 
 /// The include tests below pin what the loader does with files outside the tree's folder when
 /// includes may read anywhere (`--allow-include-outside`); by default such includes are refused
-/// before they are opened (tests/include_confinement.rs). The setting is process-wide, and no
-/// test in this file depends on the default.
-fn allow_includes_anywhere() {
-    macrotree::spec::set_includes_anywhere(true);
+/// before they are opened (tests/include_confinement.rs).
+fn anywhere() -> Loader {
+    Loader::default().includes_anywhere(true)
 }
 
 /// Bug (found reviewing what the fuzz target can reach): `include:` of a device was read to its
@@ -152,8 +151,9 @@ fn allow_includes_anywhere() {
 #[cfg(unix)]
 #[test]
 fn include_of_dev_zero_is_rejected_not_read() {
-    allow_includes_anywhere();
-    let d = compile_bytes(b"include: [/dev/zero]\nmain: {home: {}}\n", "t.yaml").unwrap_err();
+    let d = anywhere()
+        .compile_bytes(b"include: [/dev/zero]\nmain: {home: {}}\n", "t.yaml")
+        .unwrap_err();
     assert_eq!(d.len(), 1, "{d:?}");
     assert_eq!(d[0].message, "`/dev/zero` is not a regular file");
     assert_eq!((d[0].line, d[0].column), (1, 11));
@@ -163,7 +163,6 @@ fn include_of_dev_zero_is_rejected_not_read() {
 #[cfg(unix)]
 #[test]
 fn include_of_a_fifo_does_not_block() {
-    allow_includes_anywhere();
     let dir = std::env::temp_dir().join(format!("macrotree-fuzz-fifo-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let fifo = dir.join("pipe.yaml");
@@ -171,7 +170,7 @@ fn include_of_a_fifo_does_not_block() {
     let status = std::process::Command::new("mkfifo").arg(&fifo).status().unwrap();
     assert!(status.success(), "mkfifo failed");
     let src = format!("include: [{}]\nmain: {{home: {{}}}}\n", fifo.display());
-    let d = compile_bytes(src.as_bytes(), "t.yaml").unwrap_err();
+    let d = anywhere().compile_bytes(src.as_bytes(), "t.yaml").unwrap_err();
     let _ = std::fs::remove_dir_all(&dir);
     assert_eq!(d.len(), 1, "{d:?}");
     assert!(d[0].message.ends_with("is not a regular file"), "{}", d[0]);
@@ -185,10 +184,11 @@ fn include_of_a_fifo_does_not_block() {
 #[cfg(target_os = "linux")]
 #[test]
 fn include_of_an_endless_proc_file_stops_at_the_size_limit() {
-    allow_includes_anywhere();
     let pagemap = Path::new("/proc/self/pagemap");
     assert!(pagemap.is_file(), "/proc/self/pagemap is missing");
-    let d = compile_bytes(b"include: [/proc/self/pagemap]\nmain: {home: {}}\n", "t.yaml").unwrap_err();
+    let d = anywhere()
+        .compile_bytes(b"include: [/proc/self/pagemap]\nmain: {home: {}}\n", "t.yaml")
+        .unwrap_err();
     assert_eq!(d.len(), 1, "{d:?}");
     assert!(
         d[0].message == "file is too large: more than 1048576 bytes (limit 1048576 bytes)"

@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use macrotree::plan::compile_str;
+use macrotree::plan::Loader;
 use macrotree::runtime::scripted::ScriptedDriver;
 use macrotree::runtime::{LeafOutcome, Selection, TreeRunner, TreeStatus};
 
@@ -41,7 +41,11 @@ fn run(runner: &mut TreeRunner, driver: &mut ScriptedDriver) -> TreeStatus {
 fn setup(src: &str) -> (TreeRunner, ScriptedDriver) {
     // The scripted leaves stand for any scene: check names against the built-in one is not the
     // point here, so only variables are used.
-    let plan = Arc::new(compile_str(src, "loop.yaml").unwrap_or_else(|d| panic!("{}", d[0])));
+    let plan = Arc::new(
+        Loader::default()
+            .compile_str(src, "loop.yaml")
+            .unwrap_or_else(|d| panic!("{}", d[0])),
+    );
     (TreeRunner::new(plan.clone()), ScriptedDriver::new(&plan))
 }
 

@@ -7,11 +7,12 @@ use std::path::Path;
 #[path = "support/cli.rs"]
 mod cli;
 
-use macrotree::plan::{compile_str, load_plan};
-use macrotree::spec::{Diagnostic, Reach, Yaw};
+use macrotree::kinds::{Reach, Yaw};
+use macrotree::plan::Loader;
+use macrotree::spec::Diagnostic;
 
 fn errors(yaml: &str) -> Vec<Diagnostic> {
-    match compile_str(yaml, "bad.yaml") {
+    match Loader::default().compile_str(yaml, "bad.yaml") {
         Ok(_) => panic!("expected errors for:\n{yaml}"),
         Err(d) => d,
     }
@@ -50,14 +51,18 @@ fn a_bare_angle_beyond_a_full_turn_is_an_error_that_suggests_degrees() {
         "main: {reach: {target: cube, yaw: -6.2}}\n",
         "main: {reach: {target: cube, yaw: rad(10)}}\n",
     ] {
-        let plan = compile_str(yaml, "ok.yaml").unwrap_or_else(|d| panic!("{yaml}: {}", show(&d)));
+        let plan = Loader::default()
+            .compile_str(yaml, "ok.yaml")
+            .unwrap_or_else(|d| panic!("{yaml}: {}", show(&d)));
         assert!(plan.warnings.is_empty(), "{yaml}: {}", show(&plan.warnings));
     }
 }
 
 #[test]
 fn a_whole_number_of_radians_beyond_a_half_turn_is_a_warning() {
-    let plan = compile_str("main: {reach: {target: cube, yaw: 5}}\n", "w.yaml").expect("accepted");
+    let plan = Loader::default()
+        .compile_str("main: {reach: {target: cube, yaw: 5}}\n", "w.yaml")
+        .expect("accepted");
     let Some(r) = plan.leaves[0].kind.params::<Reach>() else {
         panic!("not a reach")
     };
@@ -77,7 +82,14 @@ fn a_whole_number_of_radians_beyond_a_half_turn_is_a_warning() {
         "main: {reach: {target: cube, yaw: 3}}\n",
         "main: {reach: {target: cube, yaw: 5.0}}\n",
     ] {
-        assert!(compile_str(yaml, "w.yaml").unwrap().warnings.is_empty(), "{yaml}");
+        assert!(
+            Loader::default()
+                .compile_str(yaml, "w.yaml")
+                .unwrap()
+                .warnings
+                .is_empty(),
+            "{yaml}"
+        );
     }
 }
 
@@ -100,7 +112,7 @@ fn validate_prints_warnings_and_still_accepts_the_tree() {
 
 #[test]
 fn a_range_error_in_a_subtree_argument_points_at_the_call() {
-    let d = match load_plan(Path::new("tests/fixtures/trees/newcomer/handover.yaml")) {
+    let d = match Loader::default().load(Path::new("tests/fixtures/trees/newcomer/handover.yaml")) {
         Ok(_) => panic!("x: 55 must be refused"),
         Err(d) => d,
     };
@@ -167,11 +179,12 @@ fn a_condition_given_a_timeout_explains_that_conditions_are_instantaneous() {
     assert!(help.contains("timeout: {seconds: 2, child: {retry:"), "{help}");
     assert!(help.contains("guard: {condition: {cube_in_bowl: {}}"), "{help}");
     // The suggested wrapping is itself a valid tree.
-    compile_str(
-        "main: {timeout: {seconds: 2, child: {retry: {attempts: 1000, child: {cube_in_bowl: {}}}}}}\n",
-        "ok.yaml",
-    )
-    .unwrap_or_else(|d| panic!("{}", show(&d)));
+    Loader::default()
+        .compile_str(
+            "main: {timeout: {seconds: 2, child: {retry: {attempts: 1000, child: {cube_in_bowl: {}}}}}}\n",
+            "ok.yaml",
+        )
+        .unwrap_or_else(|d| panic!("{}", show(&d)));
     // An action keeps the ordinary help.
     let d = errors("main: {home: {timeot: 2}}\n");
     assert!(!d[0].help.as_deref().unwrap_or("").contains("instantaneous"));
@@ -186,8 +199,11 @@ fn cube_at_checks_the_yaw_of_a_placement() {
         let yaml = format!(
             "main: {{cube_at: {{point: [0.45, -0.18], tolerance: 0.01, yaw: {yaw}, yaw_tolerance: deg(3)}}}}\n"
         );
-        let plan =
-            std::sync::Arc::new(compile_str(&yaml, "at.yaml").unwrap_or_else(|d| panic!("{}", show(&d))));
+        let plan = std::sync::Arc::new(
+            Loader::default()
+                .compile_str(&yaml, "at.yaml")
+                .unwrap_or_else(|d| panic!("{}", show(&d))),
+        );
         let config = EpisodeConfig {
             layout: Layout {
                 cube_yaw: cube_yaw_deg.to_radians(),
@@ -196,7 +212,14 @@ fn cube_at_checks_the_yaw_of_a_placement() {
             goal: Goal::Tree,
             ..EpisodeConfig::default()
         };
-        run_episode(&scene, plan, &config, &mut NoObserver).success
+        run_episode(
+            &scene,
+            plan,
+            &macrotree::factory::Factory::builtin(),
+            &config,
+            &mut NoObserver,
+        )
+        .success
     };
     assert!(check("deg(30)", 30.0), "a cube turned 30° is at 30°");
     assert!(

@@ -3,11 +3,11 @@
 
 use std::path::PathBuf;
 
-use macrotree::plan::{compile_str, load_plan};
+use macrotree::plan::Loader;
 use macrotree::spec::Diagnostic;
 
 fn errors(src: &str) -> Vec<Diagnostic> {
-    match compile_str(src, "hostile.yaml") {
+    match Loader::default().compile_str(src, "hostile.yaml") {
         Ok(_) => panic!("expected an error"),
         Err(d) => d,
     }
@@ -146,7 +146,9 @@ fn exponential_subtree_expansion_is_capped() {
 #[test]
 fn nested_retries_compile_without_copies() {
     let src = "main: {retry: {attempts: 1000, child: {repeat: {times: 1000, child: {home: {}}}}}}";
-    let plan = macrotree::plan::compile_str(src, "t.yaml").expect("compiles");
+    let plan = macrotree::plan::Loader::default()
+        .compile_str(src, "t.yaml")
+        .expect("compiles");
     assert!(plan.behavior_size() < 40, "{} bonsai nodes", plan.behavior_size());
 }
 
@@ -163,7 +165,7 @@ fn binary_garbage() {
         })
         .collect();
     let p = temp_file("garbage.yaml", &bytes);
-    let d = load_plan(&p).unwrap_err();
+    let d = Loader::default().load(&p).unwrap_err();
     assert_eq!(d.len(), 1);
     assert!(d[0].message.contains("not valid UTF-8"), "{}", d[0]);
     let text = String::from_utf8_lossy(&bytes);
@@ -181,7 +183,7 @@ fn binary_garbage() {
 #[test]
 fn non_utf8_is_located() {
     let p = temp_file("latin1.yaml", b"main:\n  reach: {target: caf\xe9}\n");
-    let d = load_plan(&p).unwrap_err();
+    let d = Loader::default().load(&p).unwrap_err();
     assert_eq!(d.len(), 1);
     assert!(d[0].message.contains("not valid UTF-8"), "{}", d[0]);
     assert_eq!((d[0].line, d[0].column), (2, 22));
@@ -208,16 +210,20 @@ fn fifty_megabyte_file_is_rejected_before_parsing() {
     assert_eq!(d.len(), 1);
     assert!(d[0].message.starts_with("file is too large"), "{}", d[0]);
     let p = temp_file("big.yaml", big.as_bytes());
-    let d = load_plan(&p).unwrap_err();
+    let d = Loader::default().load(&p).unwrap_err();
     assert!(d[0].message.starts_with("file is too large"), "{}", d[0]);
     let _ = std::fs::remove_file(p);
 }
 
 #[test]
 fn missing_file_and_folder() {
-    let d = load_plan(std::path::Path::new("tests/fixtures/trees/does_not_exist.yaml")).unwrap_err();
+    let d = Loader::default()
+        .load(std::path::Path::new("tests/fixtures/trees/does_not_exist.yaml"))
+        .unwrap_err();
     assert!(d[0].message.starts_with("cannot read"), "{}", d[0]);
-    let d = load_plan(std::path::Path::new("tests/fixtures/trees")).unwrap_err();
+    let d = Loader::default()
+        .load(std::path::Path::new("tests/fixtures/trees"))
+        .unwrap_err();
     assert!(d[0].message.contains("is a folder"), "{}", d[0]);
 }
 
@@ -232,7 +238,7 @@ fn truncations_and_corruptions_never_panic() {
         let Ok(prefix) = std::str::from_utf8(&bytes[..cut]) else {
             continue;
         };
-        if let Err(d) = compile_str(prefix, "cut.yaml") {
+        if let Err(d) = Loader::default().compile_str(prefix, "cut.yaml") {
             assert!(d.iter().all(|d| d.line >= 1), "{d:?}");
         }
     }
@@ -245,7 +251,7 @@ fn truncations_and_corruptions_never_panic() {
         let mut b = bytes.to_vec();
         b[pos] = ch;
         if let Ok(s) = std::str::from_utf8(&b)
-            && let Err(d) = compile_str(s, "mutant.yaml")
+            && let Err(d) = Loader::default().compile_str(s, "mutant.yaml")
         {
             assert!(!d.is_empty());
         }

@@ -2,7 +2,7 @@
 
 use std::sync::Arc;
 
-use macrotree::plan::{Plan, compile_str};
+use macrotree::plan::{Loader, Plan};
 use macrotree::runtime::scripted::{Call, ScriptedDriver};
 use macrotree::runtime::{LeafOutcome, NodeStatus, TreeRunner, TreeStatus};
 
@@ -13,7 +13,7 @@ fn fail(why: &str) -> LeafOutcome {
 }
 
 fn plan(yaml: &str) -> Arc<Plan> {
-    match compile_str(yaml, "test.yaml") {
+    match Loader::default().compile_str(yaml, "test.yaml") {
         Ok(p) => Arc::new(p),
         Err(diags) => {
             for d in &diags {
@@ -521,7 +521,7 @@ fn subtree_arguments_reach_the_leaves() {
     let offsets: Vec<f64> = p
         .leaves
         .iter()
-        .filter_map(|l| l.kind.params::<macrotree::spec::Reach>().map(|r| r.offset[2]))
+        .filter_map(|l| l.kind.params::<macrotree::kinds::Reach>().map(|r| r.offset[2]))
         .collect();
     assert_eq!(offsets, [0.12, 0.15]);
     assert_eq!(p.nodes[1].path, "main/sequence/subtree[pick]#1");

@@ -4,7 +4,15 @@
 //! Regenerate after changing a node kind or parameter:
 //! `UPDATE_SCHEMA=1 cargo test --test tree_schema`
 
-use macrotree::spec::{catalog, json_schema};
+use macrotree::kinds::{NodeDoc, Registry};
+
+fn catalog() -> Vec<NodeDoc> {
+    Registry::builtin().catalog()
+}
+
+fn json_schema() -> serde_json::Value {
+    Registry::builtin().json_schema()
+}
 
 #[path = "support/files.rs"]
 mod files;
@@ -83,7 +91,7 @@ fn catalog_documents_every_node() {
         );
         // Every example is a valid node.
         let yaml = example_tree(d.example);
-        if let Err(e) = macrotree::plan::compile_str(&yaml, "example.yaml") {
+        if let Err(e) = macrotree::plan::Loader::default().compile_str(&yaml, "example.yaml") {
             panic!("example of `{}` does not compile: {}", d.kind, e[0]);
         }
     }
@@ -110,7 +118,7 @@ fn docs_nodes_holds_one_file_per_kind_and_nothing_else() {
 
 #[test]
 fn node_doc_parts_are_read_from_the_markdown() {
-    let (summary, details, halt, example) = macrotree::spec::catalog::parse_node_doc(
+    let (summary, details, halt, example) = macrotree::kinds::catalog::parse_node_doc(
         "Do a thing\nin two lines.\n\nMore about it.\n\nHalt: it stops.\n\n```yaml\nthing: {}\n```\n",
     );
     assert_eq!(summary, "Do a thing in two lines.");
@@ -162,7 +170,9 @@ fn the_schema_flags_what_the_loader_rejects() {
         ("mian: {home: {}}", "unknown top-level key"),
     ] {
         assert!(
-            macrotree::plan::compile_str(yaml, "t.yaml").is_err(),
+            macrotree::plan::Loader::default()
+                .compile_str(yaml, "t.yaml")
+                .is_err(),
             "the loader accepts {what}: {yaml}"
         );
         assert!(

@@ -2,11 +2,12 @@
 
 use std::path::Path;
 
-use macrotree::plan::{compile_str, load_plan};
-use macrotree::spec::{Carry, Diagnostic, Grasp, Leaf, MoveJoints, PathKind, Reach, Target, Yaw};
+use macrotree::kinds::{Carry, Grasp, Leaf, MoveJoints, PathKind, Reach, Target, Yaw};
+use macrotree::plan::Loader;
+use macrotree::spec::Diagnostic;
 
 fn errors(yaml: &str) -> Vec<Diagnostic> {
-    match compile_str(yaml, "bad.yaml") {
+    match Loader::default().compile_str(yaml, "bad.yaml") {
         Ok(_) => panic!("expected errors for:\n{yaml}"),
         Err(d) => d,
     }
@@ -33,12 +34,14 @@ fn at(d: &Diagnostic) -> (u32, u32) {
 
 #[test]
 fn fixture_with_include_and_subtrees_compiles() {
-    let plan = load_plan(Path::new("tests/fixtures/trees/pick_place.yaml")).unwrap_or_else(|d| {
-        panic!(
-            "{}",
-            d.iter().map(|d| d.to_string()).collect::<Vec<_>>().join("\n")
-        );
-    });
+    let plan = Loader::default()
+        .load(Path::new("tests/fixtures/trees/pick_place.yaml"))
+        .unwrap_or_else(|d| {
+            panic!(
+                "{}",
+                d.iter().map(|d| d.to_string()).collect::<Vec<_>>().join("\n")
+            );
+        });
     let paths: Vec<&str> = plan.leaves.iter().map(|l| l.path.as_str()).collect();
     assert_eq!(
         paths,
@@ -77,13 +80,17 @@ fn fixture_with_include_and_subtrees_compiles() {
 
 #[test]
 fn includes_that_include_each_other_are_loaded_once() {
-    let plan = load_plan(Path::new("tests/fixtures/trees/include_cycle.yaml")).unwrap();
+    let plan = Loader::default()
+        .load(Path::new("tests/fixtures/trees/include_cycle.yaml"))
+        .unwrap();
     assert_eq!(plan.leaves.len(), 1);
 }
 
 #[test]
 fn missing_include_is_located_at_the_include_entry() {
-    let d = load_plan(Path::new("tests/fixtures/trees/bad/missing_include.yaml")).unwrap_err();
+    let d = Loader::default()
+        .load(Path::new("tests/fixtures/trees/bad/missing_include.yaml"))
+        .unwrap_err();
     let e = find(&d, "cannot include");
     assert_eq!(at(e), (1, 11));
     assert!(e.file.ends_with("missing_include.yaml"));
@@ -91,7 +98,9 @@ fn missing_include_is_located_at_the_include_entry() {
 
 #[test]
 fn duplicate_subtree_across_files_is_an_error() {
-    let d = load_plan(Path::new("tests/fixtures/trees/bad/dup_subtree.yaml")).unwrap_err();
+    let d = Loader::default()
+        .load(Path::new("tests/fixtures/trees/bad/dup_subtree.yaml"))
+        .unwrap_err();
     let e = find(&d, "defined twice");
     assert!(e.file.ends_with("bad/lib/dup.yaml"), "{e}");
     assert_eq!(at(e), (2, 3));
@@ -100,7 +109,7 @@ fn duplicate_subtree_across_files_is_an_error() {
 
 #[test]
 fn angles_in_degrees_and_radians() {
-    let plan = compile_str(
+    let plan = Loader::default().compile_str(
         "main:\n  sequence:\n    children:\n      - move_joints: {joints: [0, deg(-90), rad(1.5), -1.57, deg(90), 0]}\n      - reach: {target: [0.5, 0, 0.3], yaw: deg(45)}\n      - at_home: {tolerance: deg(2)}\n",
         "t.yaml",
     )
@@ -120,11 +129,12 @@ fn angles_in_degrees_and_radians() {
 
 #[test]
 fn defaults_are_filled_in() {
-    let plan = compile_str(
-        "main: {sequence: {children: [{carry: {}}, {grasp: }, {release: {retreat: 0.05}}]}}",
-        "t.yaml",
-    )
-    .unwrap();
+    let plan = Loader::default()
+        .compile_str(
+            "main: {sequence: {children: [{carry: {}}, {grasp: }, {release: {retreat: 0.05}}]}}",
+            "t.yaml",
+        )
+        .unwrap();
     let Some(c) = plan.leaves[0].kind.params::<Carry>() else {
         panic!()
     };
@@ -276,7 +286,7 @@ fn undefined_and_misplaced_params_are_errors() {
 #[test]
 fn whole_offset_can_be_a_parameter() {
     let src = "subtrees:\n  above:\n    params: {off: [0, 0, 0.2]}\n    root: {reach: {target: bowl, offset: $off}}\nmain: {subtree: {ref: above, args: {off: [0.1, 0, 0.3]}}}\n";
-    let plan = compile_str(src, "t.yaml").unwrap();
+    let plan = Loader::default().compile_str(src, "t.yaml").unwrap();
     let Some(r) = plan.leaves[0].kind.params::<Reach>() else {
         panic!()
     };
@@ -368,7 +378,7 @@ fn diagnostic_display_is_rustc_like() {
 #[test]
 fn regression_yaml11_boolean_words_are_plain_names() {
     let src = "subtrees:\n  s:\n    params: {off: 0.1, on: 0.2, yes: 0.3, no: 0.4}\n    root: {reach: {target: cube, offset: [$off, $on, $yes]}}\nmain: {subtree: {ref: s, args: {no: 1}}}\n";
-    let plan = compile_str(src, "t.yaml").unwrap();
+    let plan = Loader::default().compile_str(src, "t.yaml").unwrap();
     let Some(r) = plan.leaves[0].kind.params::<Reach>() else {
         panic!()
     };
@@ -386,9 +396,9 @@ fn regression_non_finite_numbers_reach_the_parameter_check() {
 
 #[test]
 fn condition_tolerances_are_overridable_and_checked() {
-    use macrotree::spec::{CubeGrasped, CubeInBowl};
+    use macrotree::kinds::{CubeGrasped, CubeInBowl};
     let yaml = "main:\n  sequence:\n    children:\n      - cube_grasped: {off_axis: 0.01}\n      - cube_in_bowl: {rest_speed: 0.02}\n      - cube_in_bowl: {}\n";
-    let plan = compile_str(yaml, "t.yaml").unwrap();
+    let plan = Loader::default().compile_str(yaml, "t.yaml").unwrap();
     let conds: Vec<&Leaf> = plan
         .leaves
         .iter()

@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use macrotree::plan::{Plan, compile_str};
+use macrotree::plan::{Loader, Plan};
 use macrotree::runtime::substitute::{Resolved, Substitution, resolve};
 use macrotree::runtime::{LeafOutcome, NodeCounts, TreeRunner, TreeStatus, scripted::ScriptedDriver};
 
@@ -34,7 +34,11 @@ main:
 "#;
 
 fn plan() -> Arc<Plan> {
-    Arc::new(compile_str(TREE, "t.yaml").unwrap_or_else(|d| panic!("{}", d[0])))
+    Arc::new(
+        Loader::default()
+            .compile_str(TREE, "t.yaml")
+            .unwrap_or_else(|d| panic!("{}", d[0])),
+    )
 }
 
 fn subs(plan: &Plan, rules: &[&str]) -> Resolved {
@@ -153,7 +157,11 @@ fn running_n_takes_n_ticks_then_succeeds() {
 
 #[test]
 fn halts_are_counted() {
-    let plan = Arc::new(compile_str("main: {timeout: {seconds: 0.2, child: {home: {}}}}", "t.yaml").unwrap());
+    let plan = Arc::new(
+        Loader::default()
+            .compile_str("main: {timeout: {seconds: 0.2, child: {home: {}}}}", "t.yaml")
+            .unwrap(),
+    );
     let mut driver = ScriptedDriver::new(&plan);
     driver.set_default(LeafOutcome::Running);
     let mut runner = TreeRunner::new(plan.clone());

@@ -2,7 +2,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use macrotree::plan::compile_str;
+use macrotree::plan::Loader;
 use macrotree::runtime::scripted::ScriptedDriver;
 use macrotree::runtime::{LeafOutcome, NodeStatus, TreeRunner, TreeStatus};
 use tracing::field::{Field, Visit};
@@ -52,7 +52,7 @@ impl Recorded {
 #[test]
 fn one_event_per_transition_with_fields() {
     let plan = Arc::new(
-        compile_str(
+        Loader::default().compile_str(
             "main:\n  retry:\n    attempts: 2\n    child:\n      guard:\n        condition: {cube_grasped: {}}\n        child: {carry: {}}\n",
             "t.yaml",
         )

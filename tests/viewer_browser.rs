@@ -528,10 +528,25 @@ fn flagship_episode(
     let (cpu, queued) = thread_sched();
     let started = Instant::now();
     let (report, live) = match live {
-        None => (run_episode(scene, plan.clone(), &config, &mut NoObserver), None),
+        None => (
+            run_episode(
+                scene,
+                plan.clone(),
+                &macrotree::factory::Factory::builtin(),
+                &config,
+                &mut NoObserver,
+            ),
+            None,
+        ),
         Some(live) => {
             let mut view = ViewObserver::new(plan, Some(live), None, None);
-            let report = run_episode(scene, plan.clone(), &config, &mut view);
+            let report = run_episode(
+                scene,
+                plan.clone(),
+                &macrotree::factory::Factory::builtin(),
+                &config,
+                &mut view,
+            );
             (report, view.finish().0)
         }
     };
@@ -609,8 +624,11 @@ fn measure_episode_overhead_with_one_browser() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(21);
     let scene = Scene::load().unwrap();
-    let plan =
-        Arc::new(macrotree::plan::load_plan(Path::new("trees/cube_to_bowl.yaml")).expect("flagship tree"));
+    let plan = Arc::new(
+        macrotree::plan::Loader::default()
+            .load(Path::new("trees/cube_to_bowl.yaml"))
+            .expect("flagship tree"),
+    );
     let load_before = load_average();
     for _ in 0..3 {
         flagship_episode(&scene, &plan, None); // warm-up: caches, allocator, CPU frequency

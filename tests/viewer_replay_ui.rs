@@ -50,7 +50,11 @@ fn record(path: &std::path::Path) {
         .unwrap()
         .replace("name: carry while held", &format!("name: {LONG_NAME}"));
     assert!(yaml.contains(LONG_NAME));
-    let plan = Arc::new(macrotree::plan::compile_str(&yaml, "trees/long_names.yaml").expect("tree"));
+    let plan = Arc::new(
+        macrotree::plan::Loader::default()
+            .compile_str(&yaml, "trees/long_names.yaml")
+            .expect("tree"),
+    );
     let scene = Scene::load().unwrap();
     let config = EpisodeConfig {
         fault: Some(FaultKind::Slip),
@@ -58,7 +62,13 @@ fn record(path: &std::path::Path) {
         ..EpisodeConfig::default()
     };
     let mut view = ViewObserver::new(&plan, None, Some(Recorder::new(&scene.model)), None);
-    let report = run_episode(&scene, plan.clone(), &config, &mut view);
+    let report = run_episode(
+        &scene,
+        plan.clone(),
+        &macrotree::factory::Factory::builtin(),
+        &config,
+        &mut view,
+    );
     assert!(report.success && report.grasp_attempts == 2, "{report:?}");
     let (_, rec) = view.finish();
     rec.unwrap().write(path).unwrap();

@@ -6,9 +6,9 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
 use super::targets::{resolve, segment_distance, target_object};
+use crate::kinds::Carry as CarrySpec;
 use crate::motion::{CartesianMove, JointMove, MotionLimits, Trajectory};
 use crate::scene::ObjectKind;
-use crate::spec::Carry as CarrySpec;
 use crate::world::World;
 use crate::world::conditions::Tolerances;
 

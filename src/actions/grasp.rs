@@ -3,8 +3,8 @@
 use super::cell::Cell;
 use super::macro_action::{MacroAction, Progress};
 use super::targets::object_index;
+use crate::kinds::Grasp as GraspSpec;
 use crate::motion::gripper::{CLOSED_CTRL, ctrl_for_width};
-use crate::spec::Grasp as GraspSpec;
 use crate::world::conditions::Tolerances;
 
 /// Driver-joint speed below which the fingers count as stalled, rad/s.

@@ -8,7 +8,6 @@
 mod carry;
 mod cell;
 mod checks;
-mod driver;
 mod grasp;
 mod joints;
 mod macro_action;
@@ -19,7 +18,6 @@ mod targets;
 pub(crate) use carry::Carry as CarryAction;
 pub use cell::{CONTROL_PERIOD, Cell, StepObserver};
 pub use checks::{Checks, ChecksRecorder, pad_cube_distance};
-pub use driver::{Collision, LeafCounters, MacroDriver};
 pub(crate) use grasp::Grasp as GraspAction;
 pub(crate) use joints::MoveJoints as MoveJointsAction;
 pub use macro_action::{Arrival, MacroAction, Progress};

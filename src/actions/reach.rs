@@ -5,8 +5,8 @@ use nalgebra::{Isometry3, Translation3, Vector3};
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
 use super::targets::{resolve, segment_distance, target_block, target_object, tool_yaw};
+use crate::kinds::{PathKind, Reach as ReachSpec, Yaw};
 use crate::motion::{CartesianMove, JointMove, MotionLimits, Trajectory, down_pose, fk, ik_down};
-use crate::spec::{PathKind, Reach as ReachSpec, Yaw};
 use crate::world::World;
 
 /// How far from an object's footprint the open fingers reach around the pinch, metres.

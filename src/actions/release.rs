@@ -4,9 +4,9 @@ use nalgebra::Vector3;
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
+use crate::kinds::Release as ReleaseSpec;
 use crate::motion::gripper::{OPEN_CTRL, ctrl_for_width, width_for_ctrl};
 use crate::motion::{CartesianMove, MotionLimits, Trajectory};
-use crate::spec::Release as ReleaseSpec;
 
 /// How close the opening must come to its target, metres.
 const WIDTH_TOLERANCE: f64 = 0.002;

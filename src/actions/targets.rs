@@ -3,15 +3,15 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+use crate::kinds::ObjectRef;
 use crate::scene::ObjectKind;
-use crate::spec::ObjectRef;
 use crate::world::World;
 
 /// Where a target is now, metres: a block's centre, the centre of a container floor's top
 /// surface (the legacy `bowl`: the bowl target), the centre of an obstacle's top, or a fixed
 /// point. Fails for a name the scene does not have (or a variable the runtime did not resolve).
-pub fn resolve(target: &crate::spec::Target, w: &World) -> Result<Vector3<f64>, String> {
-    use crate::spec::Target;
+pub fn resolve(target: &crate::kinds::Target, w: &World) -> Result<Vector3<f64>, String> {
+    use crate::kinds::Target;
     match target {
         Target::Cube => Ok(w.cube_pos),
         Target::Bowl => Ok(w.bowl_target),
@@ -44,8 +44,8 @@ pub fn object_index(o: &ObjectRef, w: &World) -> Result<usize, String> {
 }
 
 /// The block a target names, if it names one (the legacy `cube` is the scene's cube).
-pub fn target_block(target: &crate::spec::Target, w: &World) -> Option<usize> {
-    use crate::spec::Target;
+pub fn target_block(target: &crate::kinds::Target, w: &World) -> Option<usize> {
+    use crate::kinds::Target;
     match target {
         Target::Cube => w.scene.legacy_cube(),
         Target::Object(o) => object_index(o, w)
@@ -56,8 +56,8 @@ pub fn target_block(target: &crate::spec::Target, w: &World) -> Option<usize> {
 }
 
 /// The object a target names (the legacy names included), if any.
-pub fn target_object(target: &crate::spec::Target, w: &World) -> Option<usize> {
-    use crate::spec::Target;
+pub fn target_object(target: &crate::kinds::Target, w: &World) -> Option<usize> {
+    use crate::kinds::Target;
     match target {
         Target::Cube => w.scene.legacy_cube(),
         Target::Bowl => w.scene.legacy_bowl(),

@@ -86,9 +86,9 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 /// Runs `macrotree bench`.
-pub fn bench(args: BenchArgs) -> Result<(), CliError> {
+pub fn bench(app: &crate::App, args: BenchArgs) -> Result<(), CliError> {
     args.episode.config()?;
-    let (plan, scene) = load_task(&args.tree, args.episode.scene.as_deref())?;
+    let (plan, scene) = load_task(app, &args.tree, args.episode.scene.as_deref())?;
     let plan = Arc::new(plan);
     let config = args.episode.config_on(&scene)?;
     super::check_substitutions(&plan, &config.substitutions)?;
@@ -108,7 +108,7 @@ pub fn bench(args: BenchArgs) -> Result<(), CliError> {
         // charged to the episode (conservative).
         cell.observers.push(Box::new(Recorder(controls.clone())));
         let t = Instant::now();
-        let report = run_in_cell(&mut cell, plan.clone(), &config, &mut NoObserver);
+        let report = run_in_cell(&mut cell, plan.clone(), app.factory(), &config, &mut NoObserver);
         episode_times.push(t.elapsed().as_secs_f64());
         let controls = controls.lock().expect("recorder lock").clone();
         let (wall, replayed) = replay(&scene, &placement, &controls);

@@ -29,6 +29,7 @@ impl DatasetRecorder {
         &self,
         cell: &mut Cell,
         plan: &Arc<Plan>,
+        factory: &crate::factory::Factory,
         config: &SweepConfig,
         index: u64,
     ) -> (ScenarioResult, Result<Recording, String>) {
@@ -45,7 +46,7 @@ impl DatasetRecorder {
                 }
             }
         }
-        let result = run_scene_scenario_observed(cell, plan, config, index, &mut rec);
+        let result = run_scene_scenario_observed(cell, plan, factory, config, index, &mut rec);
         let recording = match start_error {
             Some(e) => Err(e),
             None => rec.finish(),

@@ -31,15 +31,15 @@ pub struct GraphArgs {
 }
 
 /// Runs `macrotree graph`: validates the tree (exit 2 with located errors) and prints it.
-pub fn graph(args: GraphArgs) -> Result<(), CliError> {
-    let plan = load_plan_or_exit(&args.tree)?;
+pub fn graph(app: &crate::App, args: GraphArgs) -> Result<(), CliError> {
+    let plan = load_plan_or_exit(app, &args.tree)?;
     let text = match args.format {
         GraphFormat::Dot => crate::plan::to_dot(&plan),
         GraphFormat::Mermaid => crate::plan::to_mermaid(&plan),
     };
     write_output(
         args.out.as_deref(),
-        &super::outputs::tree_inputs(&args.tree),
+        &super::outputs::tree_inputs(&args.tree, &plan),
         &text,
     )
 }

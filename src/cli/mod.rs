@@ -76,13 +76,9 @@ pub enum CliError {
     TaskFailed,
 }
 
-/// Entry point of a `macrotree`-like program whose trees may use the node kinds of `registry`
-/// (the built-in ones plus its own): installs it (see [`crate::registry::Registry::install`])
-/// and runs [`main`]. `nodes`, `schema`, `validate`, `run`, `sweep` and `graph` all know its
-/// kinds.
-pub fn main_with(registry: crate::registry::Registry) -> ExitCode {
-    registry.install();
-    main()
+/// Entry point of the `macrotree` binary: the command line with the built-in node kinds.
+pub fn main() -> ExitCode {
+    main_with(crate::App::new())
 }
 
 /// How a command printed for people to run (a sweep's reproduction commands) names this
@@ -120,8 +116,10 @@ fn process_elapsed_s() -> f64 {
         .as_secs_f64()
 }
 
-/// Entry point of the `macrotree` binary.
-pub fn main() -> ExitCode {
+/// Entry point of a `macrotree`-like program whose trees may use the node kinds of `app` (the
+/// built-in ones plus its own): `nodes`, `schema`, `validate`, `run`, `sweep`, `test` and
+/// `graph` all know its kinds.
+pub fn main_with(app: crate::App) -> ExitCode {
     STARTED.get_or_init(std::time::Instant::now);
     let cli = Cli::parse();
     let quiet = matches!(
@@ -129,16 +127,17 @@ pub fn main() -> ExitCode {
         Command::Bench(_) | Command::Sweep(_) | Command::Test(_) | Command::Report(_)
     );
     logging::init(cli.verbose, cli.log_format, quiet);
-    crate::spec::set_includes_anywhere(cli.allow_include_outside);
+    let app = app.includes_anywhere(cli.allow_include_outside);
+    let app = &app;
     let result = match cli.command {
-        Command::Run(args) => run::run(args),
-        Command::Validate(args) => validate::validate(args),
-        Command::Bench(args) => bench::bench(args),
-        Command::Sweep(args) => sweep::sweep(args),
-        Command::Schema(args) => schema::schema(args),
-        Command::Graph(args) => graph::graph(args),
-        Command::Nodes(args) => nodes::nodes(args),
-        Command::Test(args) => test::test(args),
+        Command::Run(args) => run::run(app, args),
+        Command::Validate(args) => validate::validate(app, args),
+        Command::Bench(args) => bench::bench(app, args),
+        Command::Sweep(args) => sweep::sweep(app, args),
+        Command::Schema(args) => schema::schema(app, args),
+        Command::Graph(args) => graph::graph(app, args),
+        Command::Nodes(args) => nodes::nodes(app, args),
+        Command::Test(args) => test::test(app, args),
         Command::Report(args) => report::report(args),
     };
     match result {
@@ -165,8 +164,11 @@ fn invalid(diags: Vec<crate::spec::Diagnostic>, what: String) -> CliError {
 
 /// Loads and compiles a tree, or returns its diagnostics as a bad-input error. Warnings are
 /// printed on stderr.
-fn load_plan_or_exit(path: &std::path::Path) -> Result<crate::plan::Plan, CliError> {
-    let plan = crate::plan::load_plan(path).map_err(|diags| invalid(diags, path.display().to_string()))?;
+fn load_plan_or_exit(app: &crate::App, path: &std::path::Path) -> Result<crate::plan::Plan, CliError> {
+    let plan = app
+        .loader()
+        .load(path)
+        .map_err(|diags| invalid(diags, path.display().to_string()))?;
     print_warnings(&plan);
     Ok(plan)
 }
@@ -182,6 +184,7 @@ fn print_warnings(plan: &crate::plan::Plan) {
 /// the tree's own `scene:` or the built-in scene — and compiles that scene with the robot.
 /// Diagnostics of either file are a bad-input error.
 fn load_task(
+    app: &crate::App,
     tree: &std::path::Path,
     scene_file: Option<&std::path::Path>,
 ) -> Result<(crate::plan::Plan, crate::sim::Scene), CliError> {
@@ -189,14 +192,16 @@ fn load_task(
         Some(path) => {
             let scene = crate::scene::load_scene_file(path)
                 .map_err(|diags| invalid(diags, path.display().to_string()))?;
-            let plan =
-                crate::plan::load_plan_for(tree, Some(std::sync::Arc::new(scene))).map_err(|diags| {
+            let plan = app
+                .loader()
+                .load_for(tree, Some(std::sync::Arc::new(scene)))
+                .map_err(|diags| {
                     invalid(diags, format!("{} for scene {}", tree.display(), path.display()))
                 })?;
             print_warnings(&plan);
             plan
         }
-        None => load_plan_or_exit(tree)?,
+        None => load_plan_or_exit(app, tree)?,
     };
     let scene =
         crate::sim::Scene::load_spec(&plan.scene).map_err(|e| CliError::Input(format!("error: {e}")))?;

@@ -1,7 +1,7 @@
 //! `macrotree nodes [KIND] [--json]`: the catalog of node kinds — composites, decorators,
 //! actions and conditions — with parameters, units, defaults, halt behaviour and an example.
 //!
-//! The text is [`crate::spec::catalog`], generated from the same documentation as each node's
+//! The text is [`crate::kinds::catalog`], generated from the same documentation as each node's
 //! rustdoc.
 
 use std::fmt::Write as _;
@@ -9,7 +9,7 @@ use std::fmt::Write as _;
 use clap::Args;
 
 use super::{CliError, write_output};
-use crate::spec::{NodeDoc, catalog};
+use crate::kinds::NodeDoc;
 
 /// Arguments of `nodes`.
 #[derive(Debug, Args)]
@@ -22,8 +22,8 @@ pub struct NodesArgs {
 }
 
 /// Runs `macrotree nodes`; an unknown KIND is bad input (exit 2) with a suggestion.
-pub fn nodes(args: NodesArgs) -> Result<(), CliError> {
-    let all = catalog();
+pub fn nodes(app: &crate::App, args: NodesArgs) -> Result<(), CliError> {
+    let all = app.registry().catalog();
     let shown: Vec<&NodeDoc> = match &args.kind {
         None => all.iter().collect(),
         Some(kind) => match all.iter().find(|d| d.kind == kind.as_str()) {

@@ -17,16 +17,11 @@ pub(super) fn check_output(path: &Path, inputs: &[PathBuf]) -> Result<OutputFile
     Ok(out)
 }
 
-/// The files a tree reads: the tree file, every file it includes and the scene file it names
-/// (just the tree file when it cannot be loaded; the caller reports that).
-pub(super) fn tree_inputs(tree: &Path) -> Vec<PathBuf> {
+/// The files a loaded tree read: the tree file as given, every file it includes and the scene
+/// file it names.
+pub(super) fn tree_inputs(tree: &Path, plan: &crate::plan::Plan) -> Vec<PathBuf> {
     let mut files = vec![tree.to_path_buf()];
-    if let Ok(spec) = crate::spec::load_file(tree) {
-        files.extend(spec.files);
-        if let Some((rel, _)) = &spec.scene {
-            files.push(tree.parent().unwrap_or(Path::new(".")).join(rel));
-        }
-    }
+    files.extend(plan.inputs.iter().cloned());
     files
 }
 

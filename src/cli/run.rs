@@ -189,13 +189,13 @@ impl EpisodeArgs {
 }
 
 /// Runs `macrotree run`.
-pub fn run(args: RunArgs) -> Result<(), CliError> {
+pub fn run(app: &crate::App, args: RunArgs) -> Result<(), CliError> {
     args.episode.config()?;
-    let (plan, scene) = load_task(&args.tree, args.episode.scene.as_deref())?;
+    let (plan, scene) = load_task(app, &args.tree, args.episode.scene.as_deref())?;
     let plan = Arc::new(plan);
     let config = args.episode.config_on(&scene)?;
     super::check_substitutions(&plan, &config.substitutions)?;
-    let mut inputs = super::outputs::tree_inputs(&args.tree);
+    let mut inputs = super::outputs::tree_inputs(&args.tree, &plan);
     inputs.extend(args.episode.scene.clone());
     let record_out = (args.record.as_deref())
         .map(|p| super::outputs::check_output(p, &inputs))
@@ -267,8 +267,14 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
     let report = if live.is_some() || recorder.is_some() || speed.is_some() {
         let mut view = ViewObserver::new(&plan, live, recorder, speed);
         let report = match frame_recorder.as_mut() {
-            Some(frames) => run_episode(&scene, plan.clone(), &config, &mut Both(&mut view, frames)),
-            None => run_episode(&scene, plan.clone(), &config, &mut view),
+            Some(frames) => run_episode(
+                &scene,
+                plan.clone(),
+                app.factory(),
+                &config,
+                &mut Both(&mut view, frames),
+            ),
+            None => run_episode(&scene, plan.clone(), app.factory(), &config, &mut view),
         };
         let (live, recorder) = view.finish();
         if let (Some(rec), Some(out)) = (recorder, &record_out) {
@@ -284,8 +290,8 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
         report
     } else {
         let report = match frame_recorder.as_mut() {
-            Some(frames) => run_episode(&scene, plan, &config, frames),
-            None => run_episode(&scene, plan, &config, &mut NoObserver),
+            Some(frames) => run_episode(&scene, plan, app.factory(), &config, frames),
+            None => run_episode(&scene, plan, app.factory(), &config, &mut NoObserver),
         };
         finish_report(&report, args.episode.goal, args.json);
         report

@@ -39,19 +39,19 @@ pub fn scene_schema_text() -> String {
 }
 
 /// The schema as pretty JSON with a final newline (the committed file's exact bytes).
-pub fn schema_text() -> String {
-    let schema = crate::spec::json_schema();
+pub fn schema_text(registry: &crate::kinds::Registry) -> String {
+    let schema = registry.json_schema();
     serde_json::to_string_pretty(&schema).expect("a serde_json::Value always serializes") + "\n"
 }
 
 /// Runs `macrotree schema`.
-pub fn schema(args: SchemaArgs) -> Result<(), CliError> {
+pub fn schema(app: &crate::App, args: SchemaArgs) -> Result<(), CliError> {
     let text = if args.scenario {
         crate::suite::schema_text()
     } else if args.scene {
         scene_schema_text()
     } else {
-        schema_text()
+        schema_text(app.registry())
     };
     write_output(args.out.as_deref(), &[], &text)
 }

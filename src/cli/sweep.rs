@@ -93,7 +93,7 @@ pub struct SweepArgs {
 }
 
 /// Runs `macrotree sweep`.
-pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
+pub fn sweep(app: &crate::App, args: SweepArgs) -> Result<(), CliError> {
     if !(args.max_sim_time.is_finite() && args.max_sim_time > 0.0) {
         return Err(CliError::Input(format!(
             "error: --max-sim-time must be a positive number of seconds, got {}",
@@ -101,7 +101,7 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
         )));
     }
     let shard = super::resolve_shard(args.shard, args.shard_count)?;
-    let (plan, scene) = load_task(&args.tree, args.scene.as_deref())?;
+    let (plan, scene) = load_task(app, &args.tree, args.scene.as_deref())?;
     super::check_substitutions(&plan, &args.substitute)?;
     let plan = Arc::new(plan);
     let config = SweepConfig {
@@ -132,8 +132,15 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
     }
     let (mut out, resumed) = match &args.out {
         Some(path) => {
-            let (file, resumed) =
-                super::sweep_out::open(path, args.resume, &args.tree, &config, &scene, &plan)?;
+            let (file, resumed) = super::sweep_out::open(
+                path,
+                args.resume,
+                &args.tree,
+                &config,
+                &scene,
+                &plan,
+                app.factory(),
+            )?;
             (Some(file), resumed)
         }
         None => (None, Default::default()),
@@ -166,11 +173,11 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
     let recorder = dataset.as_ref().map(|d| d.recorder());
     let episode = |cell: &mut crate::actions::Cell, index: u64| match &recorder {
         Some(rec) => {
-            let (r, recording) = rec.run(cell, &plan, &config, index);
+            let (r, recording) = rec.run(cell, &plan, app.factory(), &config, index);
             (r, Some(recording))
         }
         None => (
-            crate::sweep::run_scene_scenario(cell, &plan, &config, index),
+            crate::sweep::run_scene_scenario(cell, &plan, app.factory(), &config, index),
             None,
         ),
     };

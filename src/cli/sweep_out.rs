@@ -22,8 +22,9 @@ pub(super) fn open(
     config: &SweepConfig,
     scene: &Scene,
     plan: &Arc<Plan>,
+    factory: &crate::factory::Factory,
 ) -> Result<(LineFile, Resumed), CliError> {
-    let inputs = tree_inputs(tree);
+    let inputs = tree_inputs(tree, plan);
     let inputs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
     let out = OutputFile::check(path, &inputs).map_err(output_error)?;
     let resumed = if resume && out.is_stream() {
@@ -35,7 +36,7 @@ pub(super) fn open(
     } else if resume {
         let resumed =
             read_existing(path, scene, config).map_err(|e| CliError::Input(format!("error: {e}")))?;
-        spot_check(scene, plan, config, &resumed).map_err(|reason| {
+        spot_check(scene, plan, factory, config, &resumed).map_err(|reason| {
             CliError::Input(format!(
                 "error: cannot resume from {}: {reason}; resume with the same options, or run \
                  without --resume to start over",

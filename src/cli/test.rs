@@ -62,7 +62,7 @@ pub(super) struct TestReport {
 }
 
 /// Runs `macrotree test`.
-pub fn test(args: TestArgs) -> Result<(), CliError> {
+pub fn test(app: &crate::App, args: TestArgs) -> Result<(), CliError> {
     let shard = super::resolve_shard(args.shard, args.shard_count)?;
     let paths = if args.paths.is_empty() {
         vec![PathBuf::from("scenarios")]
@@ -95,7 +95,7 @@ pub fn test(args: TestArgs) -> Result<(), CliError> {
     let mut inputs: Vec<PathBuf> = files.clone();
     let mut tasks = Vec::new();
     for s in &mut suites {
-        let (plan, scene) = load_task(&s.tree, s.scene.as_deref()).map_err(|e| match e {
+        let (plan, scene) = load_task(app, &s.tree, s.scene.as_deref()).map_err(|e| match e {
             CliError::Input(m) => CliError::Input(format!("{m}\n  (named by {})", s.path.display())),
             other => other,
         })?;
@@ -106,7 +106,7 @@ pub fn test(args: TestArgs) -> Result<(), CliError> {
         s.sweep.shard = shard;
         s.sweep.jobs = args.jobs.map_or(0, |j| j as usize);
         s.sweep.program = super::program_name();
-        inputs.extend(tree_inputs(&s.tree));
+        inputs.extend(tree_inputs(&s.tree, &plan));
         inputs.extend(s.scene.clone());
         tasks.push((Arc::new(plan), scene));
     }
@@ -134,7 +134,7 @@ pub fn test(args: TestArgs) -> Result<(), CliError> {
     for (s, (plan, scene)) in suites.iter().zip(&tasks) {
         bar.set_message(s.path.display().to_string());
         let mut write_error = None;
-        let run = run_sweep_from(scene, plan, &s.sweep, 0, |r| {
+        let run = run_sweep_from(scene, plan, app.factory(), &s.sweep, 0, |r| {
             if let Some(w) = out.as_mut()
                 && let Err(e) = w.write_line(&r.to_jsonl())
             {

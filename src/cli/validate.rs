@@ -37,7 +37,7 @@ pub enum DiagnosticFormat {
 }
 
 /// Runs `macrotree validate`: every error of every file, exit 2 if any.
-pub fn validate(args: ValidateArgs) -> Result<(), CliError> {
+pub fn validate(app: &crate::App, args: ValidateArgs) -> Result<(), CliError> {
     let mut failed = 0;
     let override_scene = match &args.scene {
         Some(path) => Some(std::sync::Arc::new(crate::scene::load_scene_file(path).map_err(
@@ -53,7 +53,7 @@ pub fn validate(args: ValidateArgs) -> Result<(), CliError> {
         let result = if is_scene_file(tree) {
             crate::scene::load_scene_file(tree).map(|s| (s.objects.len(), s.goal.atoms.len()))
         } else {
-            crate::plan::load_plan_for(tree, override_scene.clone()).map(|p| {
+            app.loader().load_for(tree, override_scene.clone()).map(|p| {
                 warnings.clone_from(&p.warnings);
                 (p.nodes.len(), p.leaves.len())
             })

@@ -2,14 +2,17 @@
 //! layout to a report. This is where tree logic ([`crate::runtime`]) meets physics
 //! ([`crate::actions`], [`crate::sim`]).
 
+mod driver;
 mod report;
 
 use std::sync::Arc;
 use std::time::Instant;
 
+pub use driver::{Collision, LeafCounters, MacroDriver};
 pub use report::{EpisodeReport, NodeReport, ObjectReport};
 
-use crate::actions::{Cell, MacroDriver};
+use crate::actions::Cell;
+use crate::factory::Factory;
 use crate::plan::Plan;
 use crate::runtime::{TreeRunner, TreeStatus};
 use crate::scene::Placement;
@@ -140,21 +143,25 @@ pub trait EpisodeObserver {
 pub struct NoObserver;
 impl EpisodeObserver for NoObserver {}
 
-/// Runs one episode of `plan` in a fresh cell of `scene`.
+/// Runs one episode of `plan` in a fresh cell of `scene`, each leaf running as `factory` binds
+/// its kind.
 pub fn run_episode(
     scene: &Scene,
     plan: Arc<Plan>,
+    factory: &Factory,
     config: &EpisodeConfig,
     observer: &mut dyn EpisodeObserver,
 ) -> EpisodeReport {
     let mut cell = Cell::new(scene, &config.layout, config.control_period);
-    run_in_cell(&mut cell, plan, config, observer)
+    run_in_cell(&mut cell, plan, factory, config, observer)
 }
 
-/// Runs one episode of `plan` in `cell`, which is reset to the configured layout first.
+/// Runs one episode of `plan` in `cell`, which is reset to the configured layout first; each
+/// leaf runs as `factory` binds its kind.
 pub fn run_in_cell(
     cell: &mut Cell,
     plan: Arc<Plan>,
+    factory: &Factory,
     config: &EpisodeConfig,
     observer: &mut dyn EpisodeObserver,
 ) -> EpisodeReport {
@@ -174,7 +181,7 @@ pub fn run_in_cell(
         Err(e) => (Default::default(), Some(e.to_string())),
     };
     let mut runner = TreeRunner::with_substitutions(plan, subs);
-    let mut driver = MacroDriver::new(cell);
+    let mut driver = MacroDriver::new(cell, factory);
     let mut status = if bad_subs.is_some() {
         TreeStatus::Failure
     } else {

@@ -2,8 +2,9 @@
 
 use serde::Serialize;
 
+use super::{Collision, LeafCounters};
 use super::{EpisodeConfig, Goal};
-use crate::actions::{Checks, Collision, LeafCounters};
+use crate::actions::Checks;
 use crate::runtime::TreeStatus;
 use crate::scene::ObjectKind;
 use crate::world::World;

@@ -5,8 +5,9 @@ use std::collections::HashMap;
 use bonsai_bt::Behavior;
 
 use super::{Check, Internal, LeafId, LeafInfo, NodeInfo, Plan};
-use crate::spec::leaves::fmt_num;
-use crate::spec::{Diagnostic, Issue, Leaf, Node, NodeKind, Sources, Spec};
+use crate::kinds::Leaf;
+use crate::kinds::leaves::fmt_num;
+use crate::spec::{Diagnostic, Issue, Node, NodeKind, Sources, Spec};
 
 /// Validate and compile a loaded spec.
 pub fn compile_spec(spec: &Spec) -> Result<Plan, Vec<Diagnostic>> {
@@ -30,6 +31,7 @@ pub fn compile_spec(spec: &Spec) -> Result<Plan, Vec<Diagnostic>> {
         description: spec.description.clone(),
         scene: spec.scene_spec.clone(),
         warnings: spec.warnings.clone(),
+        inputs: spec.inputs(),
     })
 }
 
@@ -339,11 +341,11 @@ impl Compiler<'_> {
 
 #[cfg(test)]
 mod tests {
-    use crate::plan::compile_str;
+    use crate::plan::Loader;
 
     #[test]
     fn paths_are_unique_and_readable() {
-        let plan = compile_str(
+        let plan = Loader::default().compile_str(
             "main:\n  sequence:\n    children:\n      - home: {}\n      - retry:\n          attempts: 3\n          child:\n            sequence:\n              name: pick\n              children:\n                - reach: {target: cube, offset: [0, 0, 0.15]}\n                - reach: {target: cube}\n                - grasp: {}\n      - home: {}\n",
             "t.yaml",
         )

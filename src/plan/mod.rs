@@ -40,15 +40,16 @@
 #![warn(missing_docs)]
 
 mod compile;
+mod loader;
 mod render;
-
-use std::path::Path;
 
 use serde::Serialize;
 
-use crate::spec::{self, Diagnostic, Leaf};
+use crate::kinds::Leaf;
+use crate::yaml::Diagnostic;
 
 pub use compile::compile_spec;
+pub use loader::Loader;
 pub use render::{to_dot, to_mermaid};
 
 /// Index of a leaf: `plan.leaves[id.index()]` for ordinary leaves; internal leaves (probes and
@@ -107,7 +108,7 @@ pub struct NodeInfo {
     /// The YAML node kind (`sequence`, `retry`, `reach`, …).
     pub kind: &'static str,
     /// What the node is (composite, decorator, action, condition, runtime leaf).
-    pub category: crate::registry::Category,
+    pub category: crate::kinds::Category,
     /// The `name:` given in YAML (for a subtree call without a name: the subtree's name).
     pub name: Option<String>,
     /// Parent node index (`None` for the root).
@@ -162,7 +163,7 @@ pub enum Internal {
         /// The `for_each` node.
         node: usize,
         /// What to select, and where to write it.
-        select: crate::spec::Select,
+        select: crate::kinds::Select,
         /// Iterations allowed.
         limit: u32,
     },
@@ -187,6 +188,10 @@ pub struct Plan {
     pub scene: std::sync::Arc<crate::scene::SceneSpec>,
     /// Warnings about the tree file: accepted, but probably not what was meant.
     pub warnings: Vec<Diagnostic>,
+    /// Every file the tree was read from: the main file and its includes (canonical paths,
+    /// sorted), then the scene file its `scene:` names, if any. A command's outputs may
+    /// name none of them.
+    pub inputs: Vec<std::path::PathBuf>,
 }
 
 impl Plan {
@@ -225,36 +230,4 @@ impl Plan {
     pub fn behavior_size(&self) -> usize {
         compile::behavior_size(&self.behavior)
     }
-}
-
-/// Read, validate and compile a tree file (following its `include:`s), for its own `scene:` (or
-/// the built-in scene).
-pub fn load_plan(path: &Path) -> Result<Plan, Vec<Diagnostic>> {
-    let spec = spec::load_file(path)?;
-    compile_spec(&spec)
-}
-
-/// Read, validate and compile a tree file for `scene` (a `--scene` override) when given,
-/// else for the tree's own `scene:` (or the built-in scene).
-pub fn load_plan_for(
-    path: &Path,
-    scene: Option<std::sync::Arc<crate::scene::SceneSpec>>,
-) -> Result<Plan, Vec<Diagnostic>> {
-    let spec = spec::load::load_file_with(path, scene)?;
-    compile_spec(&spec)
-}
-
-/// Read, validate and compile a tree from text. `file_name` appears in diagnostics, and its
-/// folder (if any) is the base for relative `include:` paths.
-pub fn compile_str(src: &str, file_name: &str) -> Result<Plan, Vec<Diagnostic>> {
-    let spec = spec::load_str(src, file_name)?;
-    compile_spec(&spec)
-}
-
-/// Read, validate and compile a tree from raw bytes (a file's content), the way [`load_plan`]
-/// treats what it read: invalid UTF-8 is a located error. `file_name` plays the same role as in
-/// [`compile_str`]. This is the entry point of the loader's fuzz target (`fuzz/`).
-pub fn compile_bytes(bytes: &[u8], file_name: &str) -> Result<Plan, Vec<Diagnostic>> {
-    let spec = spec::load_bytes(bytes, file_name)?;
-    compile_spec(&spec)
 }

@@ -103,13 +103,13 @@ pub fn to_mermaid(plan: &Plan) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::plan::compile_str;
+    use crate::plan::Loader;
 
     const TREE: &str = "main:\n  sequence:\n    name: pick \"it\"\n    children:\n      - retry: {attempts: 3, child: {reach: {target: cube, offset: [0, 0, 0.15]}}}\n      - guard: {condition: {cube_grasped: {}}, child: {carry: {}}}\n";
 
     #[test]
     fn dot_has_every_node_and_edge() {
-        let plan = compile_str(TREE, "t.yaml").unwrap();
+        let plan = Loader::default().compile_str(TREE, "t.yaml").unwrap();
         let dot = to_dot(&plan);
         assert!(dot.starts_with("digraph tree {"));
         assert!(
@@ -124,7 +124,7 @@ mod tests {
 
     #[test]
     fn mermaid_has_every_node_and_edge() {
-        let plan = compile_str(TREE, "t.yaml").unwrap();
+        let plan = Loader::default().compile_str(TREE, "t.yaml").unwrap();
         let m = to_mermaid(&plan);
         assert!(m.starts_with("flowchart TD\n"));
         assert!(m.contains("n1{{\"retry ×3\"}}"), "{m}");

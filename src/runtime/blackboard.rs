@@ -6,7 +6,7 @@
 use std::borrow::Cow;
 use std::collections::BTreeMap;
 
-use crate::spec::{Leaf, ObjectRef};
+use crate::kinds::{Leaf, ObjectRef};
 
 /// Variable values by name. A variable is unset until written (and a `goal_as` variable is
 /// unset again when the selected object has no goal).

@@ -9,10 +9,10 @@
 //!
 //! ```
 //! use std::sync::Arc;
-//! use macrotree::plan::compile_str;
+//! use macrotree::plan::Loader;
 //! use macrotree::runtime::{TreeRunner, TreeStatus, scripted::ScriptedDriver, LeafOutcome};
 //!
-//! let plan = Arc::new(compile_str("main: {sequence: {children: [{home: {}}, {wait: {seconds: 0.25}}]}}", "t.yaml").unwrap());
+//! let plan = Arc::new(Loader::default().compile_str("main: {sequence: {children: [{home: {}}, {wait: {seconds: 0.25}}]}}", "t.yaml").unwrap());
 //! let mut driver = ScriptedDriver::new(&plan);
 //! driver.script("home", [LeafOutcome::Running, LeafOutcome::Success]);
 //! let mut runner = TreeRunner::new(plan);
@@ -39,8 +39,8 @@ use std::fmt;
 
 use serde::Serialize;
 
+use crate::kinds::Leaf;
 use crate::plan::LeafId;
-use crate::spec::Leaf;
 
 pub use blackboard::Blackboard;
 pub use runner::TreeRunner;

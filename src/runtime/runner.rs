@@ -8,8 +8,8 @@ use tracing::Level;
 use super::blackboard::Blackboard;
 use super::substitute::{Resolved, Scripted};
 use super::{LeafDriver, LeafOutcome, NodeCounts, NodeStatus, Transition, TreeStatus};
+use crate::kinds::{Leaf, Select};
 use crate::plan::{Internal, LeafId, Plan};
-use crate::spec::{Leaf, Select};
 
 /// Pending transitions kept when nobody drains them; older ones are dropped (and counted).
 const MAX_PENDING_TRANSITIONS: usize = 100_000;

@@ -6,10 +6,10 @@
 //! match several leaves; scripts and counters then apply to each of them.
 //!
 //! ```
-//! use macrotree::plan::compile_str;
+//! use macrotree::plan::Loader;
 //! use macrotree::runtime::{LeafOutcome, scripted::ScriptedDriver};
 //!
-//! let plan = compile_str("main: {sequence: {children: [{grasp: {}}, {cube_grasped: {}}]}}", "t.yaml").unwrap();
+//! let plan = Loader::default().compile_str("main: {sequence: {children: [{grasp: {}}, {cube_grasped: {}}]}}", "t.yaml").unwrap();
 //! let mut d = ScriptedDriver::new(&plan);
 //! d.script("grasp", [LeafOutcome::Running, LeafOutcome::Success]); // 2 ticks, then done
 //! d.set("cube_grasped", LeafOutcome::Failure("slipped".into()));   // every tick from now on
@@ -18,8 +18,8 @@
 use std::collections::{HashMap, VecDeque};
 
 use super::{LeafDriver, LeafOutcome, Selection};
+use crate::kinds::Leaf;
 use crate::plan::{LeafId, Plan};
-use crate::spec::Leaf;
 
 /// One call the driver received.
 #[derive(Clone, Debug, PartialEq, Eq)]

@@ -26,8 +26,8 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
+use crate::kinds::Leaf;
 use crate::plan::Plan;
-use crate::spec::Leaf;
 
 /// Largest `N` of `running:N` (ticks) and `fail_first:N` (activations).
 pub const MAX_SCRIPTED_COUNT: u32 = 100_000;

@@ -4,8 +4,8 @@
 
 use serde::Serialize;
 
-use super::leaves::Select;
-use super::objects::ObjectRef;
+use crate::kinds::leaves::Select;
+use crate::kinds::objects::ObjectRef;
 use crate::scene::{ObjectKind, SceneSpec};
 use crate::yaml::diag::{Issue, Loc};
 use crate::yaml::suggest::{closest, did_you_mean};

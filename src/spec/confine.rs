@@ -3,31 +3,17 @@
 //! An include must resolve (after `..` and symbolic links are resolved) to a file inside the
 //! folder of the main tree file or one of its subfolders — the *tree folder*. Anything else
 //! (`/etc/shadow`, `/proc/self/environ`, `../../secret.yaml`, a link pointing out of the folder)
-//! is refused before it is opened, unless [`set_includes_anywhere`] allowed it for the whole
-//! process (the command line's `--allow-include-outside`).
+//! is refused before it is opened, unless the loader allows it (`Loader::includes_anywhere`,
+//! the command line's `--allow-include-outside`).
 //!
 //! A file that is not a tree (not a mapping, or a mapping without any of `include:`,
 //! `subtrees:` and `main:`) gets one diagnostic, which shows at most the one line it points at.
 
 use std::path::{Component, Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
 
 use super::file::{TOP_LEVEL_KEYS, TreeFile, parse_tree_file};
 use crate::yaml::diag::{Issue, Loc};
 use crate::yaml::value::{Value, ValueKind};
-
-static ANYWHERE: AtomicBool = AtomicBool::new(false);
-
-/// Lets `include:` read files outside the tree folder (`true`) or not (`false`, the default),
-/// for every tree loaded afterwards in this process.
-pub fn set_includes_anywhere(allow: bool) {
-    ANYWHERE.store(allow, Ordering::Relaxed);
-}
-
-/// Whether `include:` may read files outside the tree folder (see [`set_includes_anywhere`]).
-pub fn includes_anywhere() -> bool {
-    ANYWHERE.load(Ordering::Relaxed)
-}
 
 /// The folder includes are confined to, fixed when a tree starts loading.
 #[derive(Clone, Debug, Default)]
@@ -40,14 +26,14 @@ pub(crate) struct IncludeScope {
 
 impl IncludeScope {
     /// The scope of a main file whose folder is `base` (`None` or empty: the current folder).
-    pub(crate) fn for_base(base: Option<&Path>) -> Self {
+    pub(crate) fn for_base(base: Option<&Path>, anywhere: bool) -> Self {
         let dir = match base {
             Some(b) if !b.as_os_str().is_empty() => b,
             _ => Path::new("."),
         };
         Self {
             root: dir.canonicalize().ok(),
-            anywhere: includes_anywhere(),
+            anywhere,
         }
     }
 

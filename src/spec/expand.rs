@@ -10,9 +10,9 @@ use std::sync::Arc;
 
 use super::check::{ObjectUse, Role, VarDef};
 use super::file::{SubtreeDef, param_ref};
-use super::leaves::{Leaf, Select};
 use super::node::{Node, NodeKind};
-use crate::registry::{Category, NodeType, Registry};
+use crate::kinds::leaves::{Leaf, Select};
+use crate::kinds::{Category, NodeType, Registry};
 use crate::yaml::de::DeError;
 use crate::yaml::diag::{Issue, Loc, Sources};
 use crate::yaml::suggest::did_you_mean;
@@ -305,14 +305,14 @@ impl<'a> Expander<'a> {
             let reference = match &v.kind {
                 ValueKind::Str(s) if s == "cube" && key != "object" => Some(super::check::Named::LegacyCube),
                 ValueKind::Str(s) if s == "bowl" && key != "object" => Some(super::check::Named::LegacyBowl),
-                ValueKind::Str(s) => super::objects::ObjectRef::parse(s)
+                ValueKind::Str(s) => crate::kinds::objects::ObjectRef::parse(s)
                     .ok()
                     .map(super::check::Named::Ref),
                 ValueKind::Map(m) if m.len() == 1 => m[0]
                     .0
                     .as_str()
-                    .and_then(super::objects::Ident::new)
-                    .map(|k| super::check::Named::Ref(super::objects::ObjectRef::Var(k))),
+                    .and_then(crate::kinds::objects::Ident::new)
+                    .map(|k| super::check::Named::Ref(crate::kinds::objects::ObjectRef::Var(k))),
                 _ => None,
             };
             if let Some(reference) = reference {

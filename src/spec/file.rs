@@ -1,6 +1,7 @@
 //! The top level of a tree file: `include:`, `subtrees:` and `main:`.
 
 use crate::yaml::diag::{Issue, Loc};
+use crate::yaml::is_identifier;
 use crate::yaml::suggest::did_you_mean;
 use crate::yaml::value::{Value, ValueKind};
 
@@ -59,14 +60,6 @@ pub struct TreeFile {
     pub scene: Option<(String, Loc)>,
     /// `description:`: what the tree does, one line (the task string of datasets and reports).
     pub description: Option<String>,
-}
-
-/// True for names usable as subtree and parameter names: `[A-Za-z_][A-Za-z0-9_]*`.
-pub fn is_identifier(s: &str) -> bool {
-    let mut chars = s.chars();
-    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
-        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
-        && s.len() <= 64
 }
 
 /// If `s` is a parameter reference `$name`, return `name`.

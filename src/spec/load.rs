@@ -9,7 +9,7 @@ use super::confine::{IncludeScope, parse_top_level};
 use super::expand::{Expander, undefined_params};
 use super::file::{SubtreeDef, TreeFile};
 use super::node::Node;
-use crate::registry::Registry;
+use crate::kinds::Registry;
 use crate::scene::SceneSpec;
 use crate::yaml::diag::{Diagnostic, FileId, Issue, Loc, Sources};
 use crate::yaml::read_limited;
@@ -48,85 +48,79 @@ pub struct Spec {
     pub warnings: Vec<Diagnostic>,
 }
 
-/// Load a tree file from disk (following includes relative to it), checking the objects it
-/// names against its `scene:` (or the built-in `cube_bowl` scene when it names none).
-pub fn load_file(path: &Path) -> Result<Spec, Vec<Diagnostic>> {
-    load_file_with(path, None)
-}
-
-/// Load a tree file from disk like [`load_file`], checking the objects it names against `scene`
-/// when given (a `--scene` override) instead of the tree's own `scene:`.
-pub fn load_file_with(path: &Path, scene: Option<Arc<SceneSpec>>) -> Result<Spec, Vec<Diagnostic>> {
-    load_file_in(&crate::registry::installed(), path, scene)
-}
-
-/// Load a tree file like [`load_file_with`], for the node kinds of `registry`.
-pub fn load_file_in(
-    registry: &Arc<Registry>,
-    path: &Path,
-    scene: Option<Arc<SceneSpec>>,
-) -> Result<Spec, Vec<Diagnostic>> {
-    let name = path.display().to_string();
-    match read_limited(path) {
-        Ok(bytes) => load_bytes_at(registry, &bytes, name, path, scene),
-        Err((msg, help)) => {
-            let mut l = Loader::default();
-            let id = l.sources.add(name, "");
-            l.issues.push(Issue::new(Loc::file_start(id), msg).help(help));
-            Err(l.sources.diagnostics(&l.issues))
+impl Spec {
+    /// Every file the tree was read from: [`files`](Self::files), then the scene file its
+    /// `scene:` names (relative to the main file's folder), if any.
+    pub fn inputs(&self) -> Vec<PathBuf> {
+        let mut inputs = self.files.clone();
+        if let Some((rel, _)) = &self.scene {
+            let main = Path::new(self.sources.name(0));
+            inputs.push(main.parent().unwrap_or(Path::new(".")).join(rel));
         }
+        inputs
     }
 }
 
-/// Load a tree from text. `file_name` is used in diagnostics and, when it has a folder part,
-/// as the base for relative `include:` paths (otherwise the current folder).
-pub fn load_str(text: &str, file_name: &str) -> Result<Spec, Vec<Diagnostic>> {
-    load_str_in(&crate::registry::installed(), text, file_name)
+/// How a tree is read: the node kinds it may use, the scene its object names are checked
+/// against, and where its includes may come from. [`crate::plan::Loader`] is the public face of
+/// this.
+#[derive(Clone, Debug)]
+pub(crate) struct LoadOptions<'a> {
+    /// The node kinds.
+    pub registry: &'a Arc<Registry>,
+    /// Check object names against this scene (a `--scene` override) instead of the tree's own
+    /// `scene:` (or the built-in `cube_bowl`).
+    pub scene: Option<Arc<SceneSpec>>,
+    /// Let `include:` read files outside the main file's folder (see [`super::confine`]).
+    pub includes_anywhere: bool,
 }
 
-/// Load a tree from text like [`load_str`], for the node kinds of `registry`.
-pub fn load_str_in(registry: &Arc<Registry>, text: &str, file_name: &str) -> Result<Spec, Vec<Diagnostic>> {
-    let mut l = Loader {
-        registry: Some(registry.clone()),
-        ..Loader::default()
+/// Where the tree's text comes from.
+pub(crate) enum Source<'a> {
+    /// A file on disk (read with the limits of [`read_limited`]).
+    File(&'a Path),
+    /// Text; `name` appears in diagnostics and its folder (if any) is the base for relative
+    /// `include:` paths.
+    Text { text: &'a str, name: &'a str },
+    /// Raw bytes (a file's content), treated exactly as a file's: invalid UTF-8 is a located
+    /// error.
+    Bytes { bytes: &'a [u8], name: &'a str },
+}
+
+/// Reads a tree, follows its includes, expands its subtrees and checks its object names.
+pub(crate) fn load(opts: &LoadOptions<'_>, source: Source<'_>) -> Result<Spec, Vec<Diagnostic>> {
+    let reader = || TreeReader {
+        scene_override: opts.scene.clone(),
+        registry: Some(opts.registry.clone()),
+        includes_anywhere: opts.includes_anywhere,
+        ..TreeReader::default()
     };
-    let path = Path::new(file_name);
-    if let Ok(c) = path.canonicalize() {
-        l.loaded.insert(c);
-    }
-    l.finish(text, file_name, path.parent())
-}
-
-/// Load a tree from raw bytes (a file's content), exactly as [`load_file`] treats what it read:
-/// invalid UTF-8 is a located error, the rest is [`load_str`]. `file_name` plays the same role
-/// as in [`load_str`].
-pub fn load_bytes(bytes: &[u8], file_name: &str) -> Result<Spec, Vec<Diagnostic>> {
-    load_bytes_at(
-        &crate::registry::installed(),
-        bytes,
-        file_name.to_string(),
-        Path::new(file_name),
-        None,
-    )
-}
-
-fn load_bytes_at(
-    registry: &Arc<Registry>,
-    bytes: &[u8],
-    name: String,
-    path: &Path,
-    scene: Option<Arc<SceneSpec>>,
-) -> Result<Spec, Vec<Diagnostic>> {
-    let mut l = Loader {
-        scene_override: scene,
-        registry: Some(registry.clone()),
-        ..Loader::default()
+    let (bytes, name, path): (std::borrow::Cow<'_, [u8]>, String, &Path) = match source {
+        Source::Text { text, name } => {
+            let mut l = reader();
+            let path = Path::new(name);
+            if let Ok(c) = path.canonicalize() {
+                l.loaded.insert(c);
+            }
+            return l.finish(text, name, path.parent());
+        }
+        Source::File(path) => match read_limited(path) {
+            Ok(bytes) => (bytes.into(), path.display().to_string(), path),
+            Err((msg, help)) => {
+                let mut l = TreeReader::default();
+                let id = l.sources.add(path.display().to_string(), "");
+                l.issues.push(Issue::new(Loc::file_start(id), msg).help(help));
+                return Err(l.sources.diagnostics(&l.issues));
+            }
+        },
+        Source::Bytes { bytes, name } => (bytes.into(), name.to_string(), Path::new(name)),
     };
-    let text = match std::str::from_utf8(bytes) {
+    let mut l = reader();
+    let text = match std::str::from_utf8(&bytes) {
         Ok(t) => t,
         Err(_) => {
-            let id = l.sources.add(name, String::from_utf8_lossy(bytes).into_owned());
-            let issue = decode_utf8(bytes, id)
+            let id = l.sources.add(name, String::from_utf8_lossy(&bytes).into_owned());
+            let issue = decode_utf8(&bytes, id)
                 .err()
                 .unwrap_or_else(|| Issue::new(Loc::file_start(id), "not UTF-8"));
             l.issues.push(issue);
@@ -140,7 +134,7 @@ fn load_bytes_at(
 }
 
 #[derive(Default)]
-struct Loader {
+struct TreeReader {
     sources: Sources,
     issues: Vec<Issue>,
     loaded: HashSet<PathBuf>,
@@ -150,8 +144,10 @@ struct Loader {
     /// Diagnostics of a scene file the tree names (reported with the tree's).
     scene_diagnostics: Vec<Diagnostic>,
     scope: IncludeScope,
-    /// The node kinds (`None`: the installed registry).
+    /// The node kinds.
     registry: Option<Arc<Registry>>,
+    /// Whether `include:` may read outside the main file's folder.
+    includes_anywhere: bool,
 }
 
 /// The built-in `cube_bowl` scene, parsed once.
@@ -160,9 +156,9 @@ pub fn builtin_scene() -> Arc<SceneSpec> {
     BUILTIN.get_or_init(|| Arc::new(SceneSpec::builtin())).clone()
 }
 
-impl Loader {
+impl TreeReader {
     fn finish(mut self, text: &str, name: &str, base: Option<&Path>) -> Result<Spec, Vec<Diagnostic>> {
-        self.scope = IncludeScope::for_base(base);
+        self.scope = IncludeScope::for_base(base, self.includes_anywhere);
         // Warnings left over from reading something else on this thread (a scene file).
         let _ = crate::yaml::de::take_warnings();
         let mut warnings = Vec::new();
@@ -247,7 +243,10 @@ impl Loader {
         }
 
         let reported: Vec<Loc> = self.issues.iter().map(|i| i.loc).collect();
-        let registry = self.registry.clone().unwrap_or_else(crate::registry::installed);
+        let registry = self
+            .registry
+            .clone()
+            .unwrap_or_else(|| Arc::new(Registry::builtin()));
         let mut ex = Expander::new(&registry, &table, &self.sources);
         ex.reported.clone_from(&reported);
         let root = ex.node(&main, 0);

@@ -9,26 +9,14 @@
 
 #![warn(missing_docs)]
 
-pub mod catalog;
 pub mod check;
 mod confine;
 pub mod expand;
 pub mod file;
-pub mod leaves;
 pub mod load;
 pub mod node;
-pub mod objects;
-mod targets;
 
 pub use crate::yaml::{Diagnostic, Issue, Loc, Sources};
-pub use catalog::{NodeDoc, ParamDoc, catalog, json_schema};
-pub use confine::{includes_anywhere, set_includes_anywhere};
-pub use leaves::{
-    At, AtHome, Carry, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, GoalMet, Grasp, Grasped,
-    GripperOpen, Home, In, Leaf, LeafCall, Lifted, MoveJoints, On, OnTable, Params, Reach, Release, Select,
-    Wait,
-};
-pub use load::{Spec, load_bytes, load_file, load_str};
+pub use load::Spec;
+pub(crate) use load::{LoadOptions, Source, load};
 pub use node::{Node, NodeKind};
-pub use objects::ObjectRef;
-pub use targets::{PathKind, Target, Yaw};

@@ -1,6 +1,6 @@
 //! The typed tree: one [`Node`] per YAML node, subtrees already expanded.
 
-use super::leaves::Leaf;
+use crate::kinds::leaves::Leaf;
 use crate::yaml::diag::Loc;
 
 /// A node of the behavior tree as written (after subtree expansion), with its source location.
@@ -54,7 +54,7 @@ pub enum NodeKind {
     #[doc = include_str!("../../docs/nodes/for_each.md")]
     ForEach {
         /// What each iteration selects, and the variables it writes.
-        select: super::leaves::Select,
+        select: crate::kinds::leaves::Select,
         /// Most iterations (≥ 1); more matches after that fail the loop.
         max_iterations: u32,
         /// The node run once per selected object.
@@ -89,8 +89,8 @@ pub enum NodeKind {
 impl NodeKind {
     /// What the node is: composite, decorator (a subtree call counts as one), action, condition
     /// or runtime leaf.
-    pub fn category(&self) -> crate::registry::Category {
-        use crate::registry::Category;
+    pub fn category(&self) -> crate::kinds::Category {
+        use crate::kinds::Category;
         match self {
             NodeKind::Sequence(_)
             | NodeKind::Fallback(_)

@@ -40,8 +40,10 @@ pub use layout::{Region, Scenario, ScenarioLayout, sample_scenario, sample_scena
 pub use report::{MergeError, Merged, merge_results};
 pub use summary::{Coverage, Failure, FailureGroup, NodeTotals, Summary, percentile, wilson_interval};
 
-use crate::actions::{CONTROL_PERIOD, Cell, Checks, Collision};
+use crate::actions::{CONTROL_PERIOD, Cell, Checks};
+use crate::episode::Collision;
 use crate::episode::{EpisodeConfig, EpisodeReport, Goal, NoObserver, NodeReport, ObjectReport, run_in_cell};
+use crate::factory::Factory;
 use crate::faults::FaultKind;
 use crate::plan::Plan;
 use crate::runtime::substitute::Substitution;
@@ -560,11 +562,12 @@ pub(crate) fn shell_quote(s: &str) -> String {
 pub fn run_scenario(
     cell: &mut Cell,
     plan: &Arc<Plan>,
+    factory: &Factory,
     config: &SweepConfig,
     scenario: &Scenario,
 ) -> ScenarioResult {
     let episode = config.episode_config(scenario);
-    let report = run_in_cell(cell, plan.clone(), &episode, &mut NoObserver);
+    let report = run_in_cell(cell, plan.clone(), factory, &episode, &mut NoObserver);
     ScenarioResult::new(scenario, config, report)
 }
 
@@ -572,10 +575,11 @@ pub fn run_scenario(
 pub fn run_scene_scenario(
     cell: &mut Cell,
     plan: &Arc<Plan>,
+    factory: &Factory,
     config: &SweepConfig,
     index: u64,
 ) -> ScenarioResult {
-    run_scene_scenario_observed(cell, plan, config, index, &mut NoObserver)
+    run_scene_scenario_observed(cell, plan, factory, config, index, &mut NoObserver)
 }
 
 /// The outcome of a sweep.
@@ -597,10 +601,11 @@ pub struct SweepRun {
 pub fn run_sweep(
     scene: &Scene,
     plan: &Arc<Plan>,
+    factory: &Factory,
     config: &SweepConfig,
     mut on_result: impl FnMut(&ScenarioResult),
 ) -> Result<SweepRun, rayon::ThreadPoolBuildError> {
-    run_sweep_from(scene, plan, config, 0, |r| {
+    run_sweep_from(scene, plan, factory, config, 0, |r| {
         on_result(r);
         ControlFlow::Continue(())
     })
@@ -612,6 +617,7 @@ pub fn run_sweep(
 pub fn run_sweep_from(
     scene: &Scene,
     plan: &Arc<Plan>,
+    factory: &Factory,
     config: &SweepConfig,
     skip: u64,
     mut on_result: impl FnMut(&ScenarioResult) -> ControlFlow<()>,
@@ -620,7 +626,7 @@ pub fn run_sweep_from(
         scene,
         config,
         skip,
-        |cell, index| (run_scene_scenario(cell, plan, config, index), ()),
+        |cell, index| (run_scene_scenario(cell, plan, factory, config, index), ()),
         |r, _| on_result(r),
     )
 }
@@ -630,6 +636,7 @@ pub fn run_sweep_from(
 pub fn run_scene_scenario_observed(
     cell: &mut Cell,
     plan: &Arc<Plan>,
+    factory: &Factory,
     config: &SweepConfig,
     index: u64,
     observer: &mut dyn crate::episode::EpisodeObserver,
@@ -637,7 +644,7 @@ pub fn run_scene_scenario_observed(
     match config.scene_scenario(cell.sim().scene(), index) {
         Ok(scenario) => {
             let episode = config.scene_episode_config(&scenario);
-            let report = run_in_cell(cell, plan.clone(), &episode, observer);
+            let report = run_in_cell(cell, plan.clone(), factory, &episode, observer);
             ScenarioResult::of_scene(&scenario, config, report)
         }
         Err(e) => ScenarioResult::not_run(config, index, 0, None, format!("layout: {e}")),

@@ -136,6 +136,7 @@ pub fn read_existing(path: &Path, scene: &Scene, config: &SweepConfig) -> Result
 pub fn spot_check(
     scene: &Scene,
     plan: &Arc<Plan>,
+    factory: &crate::factory::Factory,
     config: &SweepConfig,
     resumed: &Resumed,
 ) -> Result<(), String> {
@@ -143,7 +144,7 @@ pub fn spot_check(
         return Ok(());
     };
     let mut cell = Cell::new(scene, &Layout::default(), CONTROL_PERIOD);
-    let again = run_scene_scenario(&mut cell, plan, config, last.index);
+    let again = run_scene_scenario(&mut cell, plan, factory, config, last.index);
     if again.to_jsonl() == last.to_jsonl() {
         Ok(())
     } else {

@@ -10,10 +10,12 @@
 
 pub mod de;
 pub mod diag;
+mod ident;
 mod read;
 pub mod suggest;
 pub mod units;
 pub mod value;
 
 pub use diag::{Diagnostic, Issue, Loc, Sources};
+pub use ident::is_identifier;
 pub use read::read_limited;

@@ -16,5 +16,9 @@ pub fn scene() -> &'static Scene {
 /// `trees/cube_to_bowl.yaml`, compiled.
 pub fn plan() -> Arc<Plan> {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/trees/cube_to_bowl.yaml");
-    Arc::new(macrotree::plan::load_plan(std::path::Path::new(path)).expect("flagship tree is valid"))
+    Arc::new(
+        macrotree::plan::Loader::default()
+            .load(std::path::Path::new(path))
+            .expect("flagship tree is valid"),
+    )
 }

@@ -4,7 +4,7 @@
 
 use serde_json::{Value, json};
 
-use crate::spec::catalog::ParamDoc;
+use crate::kinds::catalog::ParamDoc;
 
 /// What the schema of a control node's body refers to.
 pub(crate) struct SchemaCtx {

@@ -5,7 +5,7 @@ use schemars::generate::{SchemaGenerator, SchemaSettings};
 use serde::Serialize;
 use serde_json::{Value, json};
 
-use crate::registry::{Category, Registry, SchemaCtx};
+use super::{Category, Registry, SchemaCtx};
 use crate::world::query::Query;
 
 /// One parameter of a node kind.
@@ -127,13 +127,6 @@ fn params_from_schema(def: &Value) -> Vec<ParamDoc> {
     out
 }
 
-/// Every node kind of the installed registry (see [`crate::registry::installed`]) with its
-/// parameters (units, defaults), one-line description, halt behaviour and a YAML example
-/// (for `macrotree nodes`).
-pub fn catalog() -> Vec<NodeDoc> {
-    crate::registry::installed().catalog()
-}
-
 impl Registry {
     /// Every node kind with its parameters (units, defaults), one-line description, halt
     /// behaviour and a YAML example, generated from the Rust types and the kinds' docs.
@@ -145,7 +138,7 @@ impl Registry {
             .zip(leaves)
             .map(|(t, leaf)| {
                 let params = match (t.imp(), leaf) {
-                    (crate::registry::Imp::Control { params, .. }, _) => params(),
+                    (crate::kinds::Imp::Control { params, .. }, _) => params(),
                     (_, Some(name)) => defs.get(&name).map(params_from_schema).unwrap_or_default(),
                     _ => vec![],
                 };
@@ -162,16 +155,6 @@ impl Registry {
             })
             .collect()
     }
-}
-
-/// The JSON Schema (draft 2020-12) of a tree file, generated from the Rust spec types.
-///
-/// Committed as `schema/tree.schema.json` (editors use it through a
-/// `# yaml-language-server: $schema=…` first line). Regenerate with
-/// `UPDATE_SCHEMA=1 cargo test --test tree_schema`. Inside `subtrees:` bodies every parameter
-/// value may also be a `$param` reference.
-pub fn json_schema() -> Value {
-    crate::registry::installed().json_schema()
 }
 
 impl Registry {
@@ -209,7 +192,7 @@ impl Registry {
                 let kind = t.name();
                 let (summary, details, halt, example) = parse_node_doc(t.doc());
                 let b = match (t.imp(), leaf) {
-                    (crate::registry::Imp::Control { schema, .. }, _) => schema(&ctx),
+                    (crate::kinds::Imp::Control { schema, .. }, _) => schema(&ctx),
                     (_, def_name) => {
                         let def_name = def_name.clone().unwrap_or_default();
                         let def = defs.get(&def_name).cloned().unwrap_or(json!({}));

@@ -11,7 +11,7 @@ use schemars::JsonSchema;
 
 use super::objects::{ObjectRef, opt_var_name, var_name};
 use super::targets::{PathKind, Target, Yaw};
-pub use crate::registry::{LeafCall, Params};
+pub use crate::kinds::{LeafCall, Params};
 use crate::world::conditions::Tolerances;
 use crate::world::query::{Filter, KindFilter, Order, Query};
 use crate::yaml::units::{self, Angle};
@@ -502,7 +502,7 @@ impl Select {
 ///
 /// Drivers see only [`Leaf::Action`] and [`Leaf::Condition`]; [`Leaf::Wait`] and
 /// [`Leaf::Select`] are handled by the runtime. Actions and conditions are [`LeafCall`]s of a
-/// registered kind (see [`crate::registry`]): read their parameters with
+/// registered kind (see [`crate::kinds`]): read their parameters with
 /// [`Leaf::params`], e.g. `leaf.params::<Reach>()`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(untagged)]

@@ -9,7 +9,7 @@ use schemars::{JsonSchema, Schema, SchemaGenerator, json_schema};
 use serde::de::{self, Deserializer, MapAccess, Visitor};
 use serde::{Deserialize, Serialize, Serializer};
 
-use super::file::is_identifier;
+use crate::yaml::is_identifier;
 
 /// A short name (object or variable, at most [`Ident::MAX`] bytes) stored inline, so that the
 /// leaf parameters holding it stay `Copy`.

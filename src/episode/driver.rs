@@ -3,13 +3,12 @@
 
 use std::collections::HashMap;
 
-use super::cell::Cell;
-use super::checks::ChecksRecorder;
-use super::macro_action::{MacroAction, Progress};
+use crate::actions::{Cell, ChecksRecorder, MacroAction, Progress};
+use crate::factory::Factory;
+use crate::kinds::{Leaf, LeafCall};
 use crate::plan::LeafId;
 use crate::runtime::{LeafDriver, LeafOutcome, Selection};
 use crate::scene::ObjectKind;
-use crate::spec::{Leaf, LeafCall};
 use crate::world::conditions as cond;
 use crate::world::query::{self, Query};
 use crate::world::{Part, Piece, goal};
@@ -35,6 +34,7 @@ pub struct LeafCounters {
 /// Executes leaves against a [`Cell`].
 pub struct MacroDriver<'a> {
     cell: &'a mut Cell,
+    factory: &'a Factory,
     active: HashMap<LeafId, Active>,
     /// The tutorial checks, accumulated.
     pub checks: ChecksRecorder,
@@ -56,10 +56,11 @@ pub struct Collision {
 }
 
 impl<'a> MacroDriver<'a> {
-    /// A driver acting on `cell`.
-    pub fn new(cell: &'a mut Cell) -> Self {
+    /// A driver acting on `cell`, running each leaf as `factory` binds its kind.
+    pub fn new(cell: &'a mut Cell, factory: &'a Factory) -> Self {
         Self {
             cell,
+            factory,
             active: HashMap::new(),
             checks: ChecksRecorder::default(),
             counters: LeafCounters::default(),
@@ -90,7 +91,7 @@ impl<'a> MacroDriver<'a> {
             "release" => self.checks.on_open(),
             _ => {}
         }
-        action.start_action()
+        self.factory.start(action)
     }
 
     /// Notes contacts that should not happen: the fingers on a container or an obstacle, and the
@@ -149,7 +150,7 @@ impl LeafDriver for MacroDriver<'_> {
     fn tick(&mut self, id: LeafId, leaf: &Leaf, first: bool) -> LeafOutcome {
         let action = match leaf {
             Leaf::Condition(c) => {
-                return match c.check(self.cell.world()) {
+                return match self.factory.check(c, self.cell.world()) {
                     Some(Ok(true)) => LeafOutcome::Success,
                     Some(Ok(false)) => LeafOutcome::Failure("not satisfied".into()),
                     Some(Err(e)) => LeafOutcome::Failure(e),

@@ -1,0 +1,146 @@
+//! How each node kind *runs*: the controller an action leaf starts and the check a condition
+//! leaf answers, bound to the kind's name and looked up when the tree runs.
+//!
+//! What a kind *is* (name, category, doc, parameter type) is declared apart, in
+//! [`crate::kinds::Registry`]; a parsed tree holds a kind and its parameters and nothing that
+//! runs. [`Factory::builtin`] binds the built-in leaves; [`crate::App::register_action`] and
+//! [`crate::App::register_condition`] declare a user's kind and bind it in one call.
+//!
+//! This sits above [`crate::actions`] (the controllers) and needs the `sim` feature.
+
+mod builtin;
+
+use std::collections::BTreeMap;
+use std::fmt;
+use std::sync::{Arc, OnceLock};
+
+use crate::actions::MacroAction;
+use crate::kinds::{Category, LeafCall, Params, Registry};
+use crate::world::World;
+
+type StartFn = dyn Fn(&LeafCall) -> Option<Box<dyn MacroAction>> + Send + Sync;
+type CheckFn = dyn Fn(&World, &LeafCall) -> Option<Result<bool, String>> + Send + Sync;
+
+/// The bindings of action and condition kinds to how they run, by kind name.
+#[derive(Clone, Default)]
+pub struct Factory {
+    actions: BTreeMap<&'static str, Arc<StartFn>>,
+    conditions: BTreeMap<&'static str, Arc<CheckFn>>,
+}
+
+impl fmt::Debug for Factory {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Factory")
+            .field("actions", &self.actions.keys().collect::<Vec<_>>())
+            .field("conditions", &self.conditions.keys().collect::<Vec<_>>())
+            .finish()
+    }
+}
+
+/// A kind bound twice, or bound with no declaration.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct BindError(pub String);
+
+impl fmt::Display for BindError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl Factory {
+    /// The built-in actions' controllers and conditions' checks (shared, cheap to clone).
+    pub fn builtin() -> Arc<Factory> {
+        static BUILTIN: OnceLock<Arc<Factory>> = OnceLock::new();
+        BUILTIN.get_or_init(|| Arc::new(builtin::factory())).clone()
+    }
+
+    /// Binds the action kind `name` (declared with parameters `P`) to `start`, which makes a new
+    /// controller from the parameters each time the leaf starts.
+    ///
+    /// # Errors
+    /// When `name` is already bound.
+    pub fn bind_action<P, F>(&mut self, name: &'static str, start: F) -> Result<&mut Self, BindError>
+    where
+        P: Params,
+        F: Fn(&P) -> Box<dyn MacroAction> + Send + Sync + 'static,
+    {
+        if self.actions.contains_key(name) || self.conditions.contains_key(name) {
+            return Err(BindError(format!("node kind `{name}` is already bound")));
+        }
+        let f = move |call: &LeafCall| call.params::<P>().map(&start);
+        self.actions.insert(name, Arc::new(f));
+        Ok(self)
+    }
+
+    /// Binds the condition kind `name` (declared with parameters `P`) to `check`, a pure
+    /// function of the world snapshot.
+    ///
+    /// # Errors
+    /// When `name` is already bound.
+    pub fn bind_condition<P, F>(&mut self, name: &'static str, check: F) -> Result<&mut Self, BindError>
+    where
+        P: Params,
+        F: Fn(&World, &P) -> Result<bool, String> + Send + Sync + 'static,
+    {
+        if self.actions.contains_key(name) || self.conditions.contains_key(name) {
+            return Err(BindError(format!("node kind `{name}` is already bound")));
+        }
+        let f = move |w: &World, call: &LeafCall| call.params::<P>().map(|p| check(w, p));
+        self.conditions.insert(name, Arc::new(f));
+        Ok(self)
+    }
+
+    /// A new controller for the action leaf `call`; `None` when its kind has no controller here
+    /// (not an action, or declared but never bound).
+    pub fn start(&self, call: &LeafCall) -> Option<Box<dyn MacroAction>> {
+        self.actions.get(call.kind()).and_then(|f| f(call))
+    }
+
+    /// The answer of the condition leaf `call` in `world`; `None` when its kind has no check
+    /// here.
+    pub fn check(&self, call: &LeafCall, world: &World) -> Option<Result<bool, String>> {
+        self.conditions.get(call.kind()).and_then(|f| f(world, call))
+    }
+
+    /// The action and condition kinds of `registry` that have nothing bound here, in
+    /// registration order (a tree using one of them cannot run).
+    pub fn unbound<'r>(&self, registry: &'r Registry) -> Vec<&'r str> {
+        registry
+            .types()
+            .filter(|t| match t.category() {
+                Category::Action => !self.actions.contains_key(t.name()),
+                Category::Condition => !self.conditions.contains_key(t.name()),
+                _ => false,
+            })
+            .map(|t| t.name())
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_builtin_action_and_condition_is_bound_and_nothing_else() {
+        let registry = Registry::builtin();
+        let factory = Factory::builtin();
+        assert_eq!(factory.unbound(&registry), Vec::<&str>::new());
+        let declared: Vec<&str> = registry
+            .types()
+            .filter(|t| matches!(t.category(), Category::Action | Category::Condition))
+            .map(|t| t.name())
+            .collect();
+        let bound = factory.actions.len() + factory.conditions.len();
+        assert_eq!(bound, declared.len(), "bound {:?}", factory);
+    }
+
+    #[test]
+    fn a_kind_is_bound_once() {
+        let mut f = Factory::default();
+        f.bind_condition("near", |_: &World, _: &crate::kinds::GripperOpen| Ok(true))
+            .unwrap();
+        let again = f.bind_condition("near", |_: &World, _: &crate::kinds::GripperOpen| Ok(true));
+        assert!(again.unwrap_err().0.contains("already bound"));
+    }
+}

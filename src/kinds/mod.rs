@@ -1,0 +1,38 @@
+//! What each node kind *is*: its name, [`Category`], documentation, parameter type (read from
+//! YAML with located errors, with its JSON Schema) and the objects its parameters name. How a kind
+//! *runs* — action controllers and condition checks — is bound apart, above the actions
+//! (`crate::factory`), and looked up when the tree runs: a parsed tree holds a kind and its
+//! parameters, never a controller.
+//!
+//! Everything that needs to know which node kinds exist reads the [`Registry`]: parsing (and the
+//! did-you-mean suggestions for misspelled kinds), the JSON Schema of tree files,
+//! `macrotree nodes`, the `graph` labels and the docs. The built-in leaves are declared through
+//! the same [`Registry::declare_action`] / [`Registry::declare_condition`] calls a crate user's
+//! leaves go through (`src/kinds/builtin.rs`, `docs/custom_nodes.md`).
+//!
+//! A leaf's parameters are a type implementing [`Params`] (`Deserialize` + `JsonSchema`): the
+//! YAML body of the node is read into it with located errors, its doc comments become the
+//! parameter documentation, and the schema is generated from it.
+
+mod builtin;
+pub mod catalog;
+mod control;
+mod leaf_call;
+pub mod leaves;
+pub mod objects;
+mod params;
+mod registry;
+mod targets;
+
+pub use catalog::{NodeDoc, ParamDoc};
+pub(crate) use control::SchemaCtx;
+pub use leaf_call::LeafCall;
+pub use leaves::{
+    At, AtHome, Carry, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, GoalMet, Grasp, Grasped,
+    GripperOpen, Home, In, Leaf, Lifted, MoveJoints, On, OnTable, Reach, Release, Select, Wait,
+};
+pub use objects::ObjectRef;
+pub use params::Params;
+pub(crate) use registry::Imp;
+pub use registry::{Category, NodeType, Registry};
+pub use targets::{PathKind, Target, Yaw};

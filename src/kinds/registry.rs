@@ -1,0 +1,302 @@
+//! The [`Registry`] of node kinds: one [`NodeType`] per kind — composites, decorators,
+//! actions, conditions and the runtime leaves — with its name, [`Category`], documentation and
+//! parameter type.
+
+use std::fmt;
+use std::sync::{Arc, OnceLock};
+
+use schemars::JsonSchema;
+use schemars::generate::SchemaGenerator;
+use serde::Serialize;
+
+use super::builtin;
+use super::catalog::{ParamDoc, parse_node_doc};
+use super::control::SchemaCtx;
+use super::leaf_call::LeafCall;
+use super::leaves::{Leaf, Select, Wait};
+use super::params::{DynParams, Params};
+use crate::error::Error;
+use crate::yaml::de::DeError;
+use crate::yaml::value::Value;
+
+/// What a node kind is.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Category {
+    /// Takes `children:` (`sequence`, `fallback`, …).
+    Composite,
+    /// Takes a `child:` (`retry`, `timeout`, …), or calls a subtree.
+    Decorator,
+    /// A macro action: runs over several ticks on the cell (`reach`, `grasp`, …).
+    Action,
+    /// An instantaneous check of the world (`grasped`, `in`, …).
+    Condition,
+    /// A leaf handled by the runtime itself (`wait`, `select`).
+    Runtime,
+}
+
+impl Category {
+    /// Lower-case name (`composite`, `action`, …), as `macrotree nodes` prints it.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Category::Composite => "composite",
+            Category::Decorator => "decorator",
+            Category::Action => "action",
+            Category::Condition => "condition",
+            Category::Runtime => "runtime",
+        }
+    }
+}
+
+type ParseParams = fn(&Value) -> Result<Arc<dyn DynParams>, DeError>;
+
+fn parse_params<P: Params>(v: &Value) -> Result<Arc<dyn DynParams>, DeError> {
+    crate::yaml::de::from_value::<P>(v).map(|p| Arc::new(p) as Arc<dyn DynParams>)
+}
+
+/// Adds `P`'s schema to the generator and answers its definition name.
+fn schema_of<P: JsonSchema>(g: &mut SchemaGenerator) -> String {
+    let _ = g.subschema_for::<P>();
+    P::schema_name().into_owned()
+}
+
+/// How a kind is read and run.
+pub(crate) enum Imp {
+    /// A composite or decorator: parsed by the tree reader; its parameters and schema are given.
+    Control {
+        params: fn() -> Vec<ParamDoc>,
+        schema: fn(&SchemaCtx) -> serde_json::Value,
+    },
+    Action {
+        parse: ParseParams,
+        schema: fn(&mut SchemaGenerator) -> String,
+    },
+    Condition {
+        parse: ParseParams,
+        schema: fn(&mut SchemaGenerator) -> String,
+    },
+    Wait,
+    Select,
+}
+
+/// One registered node kind.
+pub struct NodeType {
+    pub(super) name: &'static str,
+    pub(super) category: Category,
+    pub(super) doc: &'static str,
+    pub(super) imp: Imp,
+}
+
+impl fmt::Debug for NodeType {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("NodeType")
+            .field("name", &self.name)
+            .field("category", &self.category)
+            .finish_non_exhaustive()
+    }
+}
+
+impl NodeType {
+    /// The YAML kind (`reach`, `push`, …).
+    pub fn name(&self) -> &'static str {
+        self.name
+    }
+
+    /// What it is.
+    pub fn category(&self) -> Category {
+        self.category
+    }
+
+    /// Its documentation: a one-line summary paragraph, optional details, a `Halt: …`
+    /// paragraph and a ```` ```yaml ```` example (the format of `docs/nodes/*.md`).
+    pub fn doc(&self) -> &'static str {
+        self.doc
+    }
+
+    pub(crate) fn imp(&self) -> &Imp {
+        &self.imp
+    }
+
+    /// Reads a leaf of this kind from its YAML body (without `name:`); `None` for composites and
+    /// decorators.
+    pub(crate) fn parse_leaf(self: &Arc<Self>, body: &Value) -> Option<Result<Leaf, DeError>> {
+        let call = |parse: ParseParams| {
+            parse(body).map(|params| LeafCall {
+                ty: self.clone(),
+                params,
+            })
+        };
+        Some(match &self.imp {
+            Imp::Control { .. } => return None,
+            Imp::Action { parse, .. } => call(*parse).map(Leaf::Action),
+            Imp::Condition { parse, .. } => call(*parse).map(Leaf::Condition),
+            Imp::Wait => crate::yaml::de::from_value::<Wait>(body).map(Leaf::Wait),
+            Imp::Select => crate::yaml::de::from_value::<Select>(body).map(Leaf::Select),
+        })
+    }
+
+    /// The parameter type's schema definition name, after adding it to `g` (leaves only).
+    pub(crate) fn leaf_schema(&self, g: &mut SchemaGenerator) -> Option<String> {
+        match &self.imp {
+            Imp::Action { schema, .. } | Imp::Condition { schema, .. } => Some(schema(g)),
+            Imp::Wait => Some(schema_of::<Wait>(g)),
+            Imp::Select => Some(schema_of::<Select>(g)),
+            Imp::Control { .. } => None,
+        }
+    }
+}
+
+/// Every node kind a tree may use. [`Registry::builtin`] has the crate's own; add yours with
+/// [`declare_action`](Self::declare_action) and
+/// [`declare_condition`](Self::declare_condition).
+#[derive(Clone, Debug)]
+pub struct Registry {
+    types: Vec<Arc<NodeType>>,
+}
+
+impl Default for Registry {
+    /// The built-in node kinds.
+    fn default() -> Self {
+        Self::builtin()
+    }
+}
+
+/// Longest node kind name, bytes.
+const MAX_KIND_LEN: usize = 40;
+
+impl Registry {
+    /// The built-in node kinds (composites, decorators, actions, conditions, `wait`, `select`).
+    pub fn builtin() -> Registry {
+        static BUILTIN: OnceLock<Registry> = OnceLock::new();
+        BUILTIN.get_or_init(builtin::registry).clone()
+    }
+
+    pub(super) fn empty() -> Registry {
+        Registry { types: Vec::new() }
+    }
+
+    /// The kind called `name`.
+    pub fn get(&self, name: &str) -> Option<&NodeType> {
+        self.entry(name).map(|t| &**t)
+    }
+
+    pub(crate) fn entry(&self, name: &str) -> Option<&Arc<NodeType>> {
+        self.types.iter().find(|t| t.name == name)
+    }
+
+    /// Every kind, in registration order (built-ins first, in documentation order).
+    pub fn types(&self) -> impl Iterator<Item = &NodeType> {
+        self.types.iter().map(|t| &**t)
+    }
+
+    /// Every kind's name, in registration order.
+    pub fn names(&self) -> impl Iterator<Item = &'static str> + '_ {
+        self.types.iter().map(|t| t.name)
+    }
+
+    /// The names of the kinds of `category`, in registration order.
+    pub fn names_of(&self, category: Category) -> Vec<&'static str> {
+        self.types
+            .iter()
+            .filter(|t| t.category == category)
+            .map(|t| t.name)
+            .collect()
+    }
+
+    /// Declares an action leaf `name` whose parameters are `P`. `doc` is Markdown in the format
+    /// of `docs/nodes/*.md`: a one-line summary, optional details, a `Halt: …` paragraph and a
+    /// ```` ```yaml ```` example that uses the kind. How the action runs is bound apart from
+    /// this declaration (`Factory::bind_action`; `App::register_action` does both).
+    ///
+    /// # Errors
+    /// [`Error::Registry`] when the name is not a lower-case identifier, is already registered,
+    /// or the doc lacks its summary, halt paragraph or example.
+    pub fn declare_action<P: Params>(
+        &mut self,
+        name: &'static str,
+        doc: &'static str,
+    ) -> Result<&mut Self, Error> {
+        self.add(
+            name,
+            Category::Action,
+            doc,
+            Imp::Action {
+                parse: parse_params::<P>,
+                schema: schema_of::<P>,
+            },
+        )
+    }
+
+    /// Declares a condition leaf `name` whose parameters are `P` (an instantaneous check of the
+    /// world, bound apart with `Factory::bind_condition`). `doc` as for
+    /// [`declare_action`](Self::declare_action).
+    ///
+    /// # Errors
+    /// As for [`declare_action`](Self::declare_action).
+    pub fn declare_condition<P: Params>(
+        &mut self,
+        name: &'static str,
+        doc: &'static str,
+    ) -> Result<&mut Self, Error> {
+        self.add(
+            name,
+            Category::Condition,
+            doc,
+            Imp::Condition {
+                parse: parse_params::<P>,
+                schema: schema_of::<P>,
+            },
+        )
+    }
+
+    pub(crate) fn add(
+        &mut self,
+        name: &'static str,
+        category: Category,
+        doc: &'static str,
+        imp: Imp,
+    ) -> Result<&mut Self, Error> {
+        let bad = |why: String| {
+            Err(Error::Registry {
+                kind: name.to_string(),
+                message: why,
+            })
+        };
+        let valid = !name.is_empty()
+            && name.len() <= MAX_KIND_LEN
+            && name.starts_with(|c: char| c.is_ascii_lowercase())
+            && name
+                .chars()
+                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
+        if !valid {
+            return bad(format!(
+                "`{name}` is not a valid node kind: use 1–{MAX_KIND_LEN} lower-case letters, digits and `_`, starting with a letter"
+            ));
+        }
+        if name == "name" {
+            return bad("`name` is reserved (every node accepts `name:`)".into());
+        }
+        if self.entry(name).is_some() {
+            return bad(format!("node kind `{name}` is already registered"));
+        }
+        let (summary, _, halt, example) = parse_node_doc(doc);
+        if summary.is_empty() {
+            return bad("its doc has no summary (a first paragraph of one line)".into());
+        }
+        if halt.is_empty() {
+            return bad("its doc has no `Halt: …` paragraph (what halting it does)".into());
+        }
+        if !example.contains(&format!("{name}:")) {
+            return bad(format!(
+                "its doc has no ```yaml example that uses `{name}:` (e.g. `{name}: {{…}}`)"
+            ));
+        }
+        self.types.push(Arc::new(NodeType {
+            name,
+            category,
+            doc,
+            imp,
+        }));
+        Ok(self)
+    }
+}
