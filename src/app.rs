@@ -206,13 +206,6 @@ impl App {
             &mut NoObserver,
         ))
     }
-
-    /// Runs the `macrotree` command line with this app's node kinds in it (`nodes`, `schema`,
-    /// `validate`, `run`, `sweep`, `test`, `graph`). Returns the process exit code.
-    #[cfg(feature = "cli")]
-    pub fn run_cli(self) -> std::process::ExitCode {
-        crate::cli::main_with(self)
-    }
 }
 
 /// The physics step the control period must be a multiple of, seconds.

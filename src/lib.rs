@@ -3,30 +3,44 @@
 //! Behavior trees written in YAML that drive a MuJoCo simulation of a Universal Robots UR5e
 //! arm with a Robotiq 2F-85 gripper through pick-and-place macro actions.
 //!
-//! The crate is layered the way the data flows:
+//! The crate is layered the way the data flows. A module uses only modules of lower layers
+//! (`tests/module_layers.rs` reads this table and fails on any `use crate::` that goes sideways
+//! or up, so the table stays true):
 //!
-//! | layer | module | depends on MuJoCo? |
-//! |---|---|---|
-//! | YAML tree → typed spec (with source spans) | [`spec`] | no |
-//! | spec → validated, compiled plan (a bonsai `Behavior`) | [`plan`] | no |
-//! | plan → running tree (ticks, halts, trace events) | [`runtime`] | no |
-//! | scene files: named objects, placements, goal | [`scene`] | no |
-//! | typed world snapshot, condition leaves, goal, queries | [`world`] | no |
-//! | kinematics, IK, trajectories, gripper calibration | [`motion`] | no |
-//! | MuJoCo scene, stepping, world extraction | [`sim`] | yes |
-//! | macro-action leaves (reach, grasp, carry, …) | [`actions`] | through [`sim`] |
-//! | one episode: tree + cell → report | [`episode`] | yes |
-//! | scenario suites (`macrotree test`): files, expectations, JUnit | [`suite`] | through [`sweep`] |
-//! | command-line interface | [`cli`] | yes |
-//! | safe output files (every file the CLI writes) | [`output`] | no |
+//! | layer | module | what it holds | MuJoCo? |
+//! |---|---|---|---|
+//! | 0 | [`motion`] | UR5e kinematics, closed-form IK, trajectories, gripper calibration | no |
+//! | 0 | [`output`] | safe output files (every file the CLI writes) | no |
+//! | 1 | [`yaml`] | located YAML: values with file:line:column, typed reads, diagnostics, units | no |
+//! | 2 | [`scene`] | scene files: named objects, placements, the goal | no |
+//! | 2 | [`error`] | the library's typed [`Error`] | no |
+//! | 3 | [`world`] | typed world snapshot, condition predicates, goal, object queries | no |
+//! | 4 | [`kinds`] | what each node kind *is*: name, category, doc, parameters, schema | no |
+//! | 5 | [`spec`] | tree files → typed, expanded spec (includes, subtrees, object checks) | no |
+//! | 6 | [`plan`] | spec → validated, compiled plan (a bonsai `Behavior`); the [`plan::Loader`] | no |
+//! | 7 | [`runtime`] | the running tree: ticks, halts, blackboard, scripted leaves, trace events | no |
+//! | 8 | `sim` | the MuJoCo adapter: scene composition, stepping, world extraction | yes |
+//! | 9 | `actions` | the macro-action controllers (reach, grasp, carry, …) on the cell | yes |
+//! | 9 | `render` | camera images through MuJoCo's offscreen renderer | yes |
+//! | 10 | `factory` | how each node kind *runs*: controllers and condition checks by kind | yes |
+//! | 10 | `faults` | faults injected through physics | yes |
+//! | 10 | `video` | H.264 through the pinned ffmpeg | yes |
+//! | 11 | `episode` | one episode: tree + cell → report; the leaf driver | yes |
+//! | 12 | `app` | the library entry point: register, load, run | yes |
+//! | 12 | `sweep` | parallel seeded sweeps, summaries, shards, resume | yes |
+//! | 12 | `viewer` | MeshCat in the browser, live and replay | yes |
+//! | 13 | `dataset` | LeRobot v3.0 datasets | yes |
+//! | 13 | `suite` | scenario suites (`macrotree test`): files, expectations, JUnit | yes |
+//! | 14 | `cli` | the command line | yes |
 //!
-//! | the registry of node kinds (built-in and yours) | [`registry`] | no |
-//! | the library entry point: register, load, run, CLI | [`App`] | yes |
+//! Layers 8 and up need the cargo feature `sim` (on by default); without it (`cargo build
+//! --no-default-features`) the library loads, validates and compiles trees and scenes, gives the
+//! JSON Schema and the diagrams, and ticks trees on scripted leaves — and links no MuJoCo.
 //!
 //! Units everywhere: metres, radians, seconds, unless a name says otherwise.
 //!
-//! The command line, the viewer and the sweep are behind the cargo features `cli`, `viewer` and
-//! `sweep` (all on by default); `default-features = false` gives the library alone.
+//! The command line, the viewer, the sweep, rendering and datasets are behind the cargo features
+//! `cli`, `viewer`, `sweep`, `render` and `dataset` (all on by default, each with `sim`).
 //!
 //! # Your own nodes
 //!

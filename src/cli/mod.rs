@@ -76,6 +76,14 @@ pub enum CliError {
     TaskFailed,
 }
 
+impl crate::App {
+    /// Runs the `macrotree` command line with this app's node kinds in it (`nodes`, `schema`,
+    /// `validate`, `run`, `sweep`, `test`, `graph`). Returns the process exit code.
+    pub fn run_cli(self) -> ExitCode {
+        main_with(self)
+    }
+}
+
 /// Entry point of the `macrotree` binary: the command line with the built-in node kinds.
 pub fn main() -> ExitCode {
     main_with(crate::App::new())
