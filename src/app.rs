@@ -6,17 +6,14 @@ use std::path::Path;
 use std::sync::Arc;
 
 use crate::actions::MacroAction;
+use crate::episode::MAX_SIM_TIME_S;
 use crate::episode::{EpisodeConfig, EpisodeReport, NoObserver};
 use crate::error::Error;
 use crate::factory::Factory;
 use crate::kinds::{Params, Registry};
 use crate::plan::{Loader, Plan};
-use crate::sim::Scene;
+use crate::sim::{Scene, TIMESTEP};
 use crate::world::World;
-
-/// Largest [`EpisodeConfig::max_sim_time`] [`App::run_episode`] accepts, seconds (one hour, as
-/// on the command line).
-pub const MAX_SIM_TIME_S: f64 = 3600.0;
 
 /// The node kinds a program knows, and what it does with trees of them.
 ///
@@ -208,9 +205,6 @@ impl App {
     }
 }
 
-/// The physics step the control period must be a multiple of, seconds.
-const PHYSICS_STEP: f64 = 0.002;
-
 fn check_config(c: &EpisodeConfig) -> Result<(), Error> {
     if !(c.max_sim_time.is_finite() && c.max_sim_time > 0.0 && c.max_sim_time <= MAX_SIM_TIME_S) {
         return Err(Error::Config {
@@ -220,7 +214,7 @@ fn check_config(c: &EpisodeConfig) -> Result<(), Error> {
             ),
         });
     }
-    let steps = c.control_period / PHYSICS_STEP;
+    let steps = c.control_period / TIMESTEP;
     if !(c.control_period.is_finite()
         && c.control_period > 0.0
         && c.control_period <= 0.1

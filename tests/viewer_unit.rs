@@ -551,38 +551,3 @@ fn hostile_names_cannot_change_the_replay_markup() {
     assert_eq!(back, meta);
     assert_eq!(page::script_json(&meta).find(['<', '>', '&']), None);
 }
-
-/// The acceptor's pauses after failed accepts double up to a bound and reset on success; it
-/// warns at the first failure, then at most once per interval, and logs one recovery per warning.
-#[test]
-fn accept_backoff_doubles_up_to_its_bound_and_warns_sparingly() {
-    use macrotree::viewer::server::{
-        ACCEPT_BACKOFF_MAX, ACCEPT_BACKOFF_MIN, ACCEPT_WARN_INTERVAL, AcceptBackoff,
-    };
-    use std::time::Instant;
-    let mut b = AcceptBackoff::default();
-    let pauses: Vec<_> = (0..12).map(|_| b.failed()).collect();
-    assert_eq!(pauses[0], ACCEPT_BACKOFF_MIN);
-    assert_eq!(pauses[1], ACCEPT_BACKOFF_MIN * 2);
-    assert!(pauses.windows(2).all(|w| w[1] >= w[0]));
-    assert_eq!(*pauses.last().unwrap(), ACCEPT_BACKOFF_MAX);
-    assert_eq!(b.failures(), 12);
-    for _ in 0..100_000 {
-        assert!(b.failed() <= ACCEPT_BACKOFF_MAX);
-    }
-    // Logging: failures and successes in turns (near the descriptor limit).
-    let t0 = Instant::now();
-    let mut b = AcceptBackoff::default();
-    assert!(!b.succeeded(), "nothing to recover from");
-    b.failed();
-    assert!(b.warn_now(t0), "the first failure is logged");
-    assert!(b.succeeded(), "and so is the recovery");
-    assert_eq!(b.failed(), ACCEPT_BACKOFF_MIN, "a success starts the pauses over");
-    assert!(
-        !b.warn_now(t0 + ACCEPT_WARN_INTERVAL / 2),
-        "not again within the interval"
-    );
-    assert!(!b.succeeded(), "no recovery line without a warning");
-    b.failed();
-    assert!(b.warn_now(t0 + ACCEPT_WARN_INTERVAL), "again after the interval");
-}

@@ -1,8 +1,9 @@
 //! Bounds of the numeric options, as `clap` value parsers: a value out of range is a usage error
 //! (exit 2) that names the range, before anything runs.
 
-/// Largest `--max-sim-time`, seconds of simulated time (one hour; the flagship task takes ~6 s).
-pub const MAX_SIM_TIME_S: f64 = 3600.0;
+/// Largest `--max-sim-time`, seconds of simulated time (one hour; the flagship task takes ~6 s);
+/// defined with the episode.
+pub use crate::episode::MAX_SIM_TIME_S;
 /// Slowest `--speed` (a hundredth of real time).
 pub const MIN_SPEED: f64 = 0.01;
 /// Fastest `--speed` (a thousand times real time; faster than the simulation runs anyway).

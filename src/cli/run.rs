@@ -91,7 +91,7 @@ pub struct EpisodeArgs {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Stop the episode (as a failure) after this much simulated time, seconds (at most 3600).
-    #[arg(long, default_value_t = 60.0, value_name = "S", value_parser = super::limits::max_sim_time)]
+    #[arg(long, default_value_t = crate::episode::DEFAULT_MAX_SIM_TIME_S, value_name = "S", value_parser = super::limits::max_sim_time)]
     pub max_sim_time: f64,
     /// Inject a fault through physics (see docs/faults.md).
     #[arg(long, value_parser = super::limits::fault())]

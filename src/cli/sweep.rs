@@ -63,7 +63,7 @@ pub struct SweepArgs {
     #[arg(long = "substitute", value_name = "PATTERN=OUTCOME")]
     pub substitute: Vec<crate::runtime::substitute::Substitution>,
     /// Stop each episode (as a failure) after this much simulated time, seconds (at most 3600).
-    #[arg(long, default_value_t = 60.0, value_name = "S", value_parser = super::limits::max_sim_time)]
+    #[arg(long, default_value_t = crate::episode::DEFAULT_MAX_SIM_TIME_S, value_name = "S", value_parser = super::limits::max_sim_time)]
     pub max_sim_time: f64,
     /// Write the episodes, in scenario order, as a LeRobot v3.0 dataset in this folder (new or
     /// empty; see docs/datasets.md).

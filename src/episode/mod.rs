@@ -18,6 +18,12 @@ use crate::runtime::{TreeRunner, TreeStatus};
 use crate::scene::Placement;
 use crate::sim::{Layout, Scene};
 
+/// Longest episode accepted anywhere (API, command line, scenario files), simulated seconds.
+pub const MAX_SIM_TIME_S: f64 = 3600.0;
+
+/// Length of an episode when none is given, simulated seconds.
+pub const DEFAULT_MAX_SIM_TIME_S: f64 = 60.0;
+
 /// How to run an episode.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EpisodeConfig {
@@ -90,7 +96,7 @@ impl Default for EpisodeConfig {
             layout: Layout::default(),
             placement: None,
             seed: 0,
-            max_sim_time: 60.0,
+            max_sim_time: DEFAULT_MAX_SIM_TIME_S,
             control_period: crate::actions::CONTROL_PERIOD,
             fault: None,
             goal: Goal::Scene,

@@ -70,7 +70,7 @@ pub struct Expect {
     pub failed_node: Option<String>,
     /// Every scenario takes at most this much simulated time, seconds.
     #[serde(default)]
-    #[schemars(range(min = 0.0, max = 3600.0))]
+    #[schemars(range(min = 0.0, max = crate::episode::MAX_SIM_TIME_S))]
     pub max_sim_time: Option<f64>,
     /// Node path globs of which some node ran (was activated) at least once over the suite.
     #[serde(default)]
@@ -119,7 +119,7 @@ pub struct ScenarioFileRaw {
     pub goal: Option<GoalName>,
     /// Per-episode simulated time limit, seconds (0 … 3600]. Default 60.
     #[serde(default)]
-    #[schemars(range(min = 0.0, max = 3600.0))]
+    #[schemars(range(min = 0.0, max = crate::episode::MAX_SIM_TIME_S))]
     pub max_sim_time: Option<f64>,
     /// Leaves replaced by scripted outcomes (test doubles), in every scenario.
     #[serde(default)]
@@ -324,12 +324,15 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>) -> Option<ScenarioFile>
             .label("number of scenarios"),
         );
     }
-    let max_sim_time = raw.max_sim_time.unwrap_or(60.0);
-    if !(max_sim_time.is_finite() && max_sim_time > 0.0 && max_sim_time <= 3600.0) {
+    let max_sim_time = raw.max_sim_time.unwrap_or(crate::episode::DEFAULT_MAX_SIM_TIME_S);
+    if !(max_sim_time.is_finite() && max_sim_time > 0.0 && max_sim_time <= crate::episode::MAX_SIM_TIME_S) {
         issues.push(
             Issue::new(
                 at(&["max_sim_time"]),
-                format!("`max_sim_time` must be more than 0 and at most 3600 s, got {max_sim_time}"),
+                format!(
+                    "`max_sim_time` must be more than 0 and at most {} s, got {max_sim_time}",
+                    crate::episode::MAX_SIM_TIME_S
+                ),
             )
             .label("seconds of simulated time"),
         );
@@ -372,12 +375,15 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>) -> Option<ScenarioFile>
         );
     }
     if let Some(t) = e.max_sim_time
-        && !(t.is_finite() && t > 0.0 && t <= 3600.0)
+        && !(t.is_finite() && t > 0.0 && t <= crate::episode::MAX_SIM_TIME_S)
     {
         issues.push(
             Issue::new(
                 at(&["expect", "max_sim_time"]),
-                format!("`max_sim_time` must be more than 0 and at most 3600 s, got {t}"),
+                format!(
+                    "`max_sim_time` must be more than 0 and at most {} s, got {t}",
+                    crate::episode::MAX_SIM_TIME_S
+                ),
             )
             .label("seconds of simulated time"),
         );

@@ -11,9 +11,10 @@
 //! use macrotree::sweep::{SweepConfig, run_sweep};
 //!
 //! let scene = macrotree::sim::Scene::load().unwrap();
-//! let plan = Arc::new(macrotree::plan::load_plan("trees/cube_to_bowl.yaml".as_ref()).unwrap());
+//! let app = macrotree::App::new();
+//! let plan = Arc::new(app.load_tree("trees/cube_to_bowl.yaml".as_ref()).unwrap());
 //! let config = SweepConfig { scenarios: 100, seed: 1, ..SweepConfig::default() };
-//! let run = run_sweep(&scene, &plan, &config, |r| println!("{}", r.to_jsonl())).unwrap();
+//! let run = run_sweep(&scene, &plan, app.factory(), &config, |r| println!("{}", r.to_jsonl())).unwrap();
 //! println!("{} of {} succeeded", run.results.iter().filter(|r| r.success).count(), run.results.len());
 //! ```
 

@@ -19,7 +19,7 @@ pub mod panel;
 pub mod proto;
 pub mod record;
 pub mod scene;
-pub mod server;
+mod server;
 mod slots;
 pub mod tree;
 

@@ -11,7 +11,8 @@
 //! # fn demo(scene: &macrotree::sim::Scene, plan: Arc<macrotree::plan::Plan>) {
 //! let live = LiveViewer::start(&scene.model, &ViewerOptions::default()).unwrap();
 //! let mut view = ViewObserver::new(&plan, Some(live), None, None);
-//! let report = run_episode(scene, plan.clone(), &EpisodeConfig::default(), &mut view);
+//! let factory = macrotree::factory::Factory::builtin();
+//! let report = run_episode(scene, plan.clone(), &factory, &EpisodeConfig::default(), &mut view);
 //! let (live, _recorder) = view.finish();
 //! # }
 //! ```
