@@ -204,11 +204,11 @@ impl<'a> Expander<'a> {
             self.composite(k, loc, body, depth)?
         } else if category == Some(Category::Decorator) {
             self.decorator(k, loc, body, depth)?
-        } else if let Some(parsed) = ty
-            .as_ref()
-            .and_then(|t| parse_leaf_reporting_all(t, without_name(body)))
-        {
-            for w in crate::yaml::de::take_warnings() {
+        } else if let (Some(parsed), warnings) = crate::yaml::de::collect_warnings(|| {
+            ty.as_ref()
+                .and_then(|t| parse_leaf_reporting_all(t, without_name(body)))
+        }) {
+            for w in warnings {
                 let mut issue = Issue::new(w.loc, format!("{} in `{k}`", w.message)).maybe_help(w.help);
                 if let Some(via) = w.via {
                     issue = issue.note(format!(

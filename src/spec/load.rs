@@ -159,8 +159,6 @@ pub fn builtin_scene() -> Arc<SceneSpec> {
 impl TreeReader {
     fn finish(mut self, text: &str, name: &str, base: Option<&Path>) -> Result<Spec, Vec<Diagnostic>> {
         self.scope = IncludeScope::for_base(base, self.includes_anywhere);
-        // Warnings left over from reading something else on this thread (a scene file).
-        let _ = crate::yaml::de::take_warnings();
         let mut warnings = Vec::new();
         let id = self.sources.add(name, text);
         let (root_file, is_tree) = match parse_yaml(text, id).map(|v| parse_top_level(&v, &mut self.issues)) {

@@ -53,22 +53,44 @@ pub struct DeWarning {
 }
 
 thread_local! {
-    /// Warnings raised by the value being read, not yet located.
+    /// Warnings raised by the value being read, not yet located; only inside
+    /// [`collect_warnings`].
     static PENDING: std::cell::RefCell<Vec<(String, Option<String>)>> = const { std::cell::RefCell::new(Vec::new()) };
-    /// Located warnings, until [`take_warnings`] collects them.
+    /// Located warnings of the innermost [`collect_warnings`] call.
     static LOCATED: std::cell::RefCell<Vec<DeWarning>> = const { std::cell::RefCell::new(Vec::new()) };
+    /// How many [`collect_warnings`] calls are running on this thread.
+    static DEPTH: std::cell::Cell<u32> = const { std::cell::Cell::new(0) };
 }
 
 /// Raise a warning about the value being read (located by the deserializer once it returns).
-/// Outside [`from_value`] the warning is dropped.
+/// Only a read inside [`collect_warnings`] keeps it; elsewhere it is dropped.
 pub fn warn(message: impl Into<String>, help: Option<String>) {
-    PENDING.with(|p| p.borrow_mut().push((message.into(), help)));
+    if DEPTH.with(std::cell::Cell::get) > 0 {
+        PENDING.with(|p| p.borrow_mut().push((message.into(), help)));
+    }
 }
 
-/// The warnings raised since the last call, in order (and forget them).
-pub fn take_warnings() -> Vec<DeWarning> {
-    PENDING.with(|p| p.borrow_mut().clear());
-    LOCATED.with(|l| std::mem::take(&mut *l.borrow_mut()))
+/// Runs `read` (which reads values with [`from_value`]) and returns its result with the warnings
+/// raised while it ran, located and in order. Nothing outlives the call: serde's `Deserialize`
+/// cannot be handed a sink, so the warnings travel through per-thread storage that this call
+/// empties before and after (and restores for an enclosing call).
+pub fn collect_warnings<R>(read: impl FnOnce() -> R) -> (R, Vec<DeWarning>) {
+    let outer_pending = PENDING.with(|p| std::mem::take(&mut *p.borrow_mut()));
+    let outer_located = LOCATED.with(|l| std::mem::take(&mut *l.borrow_mut()));
+    DEPTH.with(|d| d.set(d.get() + 1));
+    struct Restore(Vec<(String, Option<String>)>, Vec<DeWarning>);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            DEPTH.with(|d| d.set(d.get() - 1));
+            PENDING.with(|p| *p.borrow_mut() = std::mem::take(&mut self.0));
+            LOCATED.with(|l| *l.borrow_mut() = std::mem::take(&mut self.1));
+        }
+    }
+    let restore = Restore(outer_pending, outer_located);
+    let r = read();
+    let warnings = LOCATED.with(|l| std::mem::take(&mut *l.borrow_mut()));
+    drop(restore);
+    (r, warnings)
 }
 
 /// Locate the pending warnings at `v`.
@@ -541,5 +563,28 @@ mod tests {
         let e = from_value::<P>(v.get("c").unwrap()).unwrap_err();
         let loc = e.loc.unwrap();
         assert_eq!((loc.line, loc.col), (3, 12), "{e:?}");
+    }
+
+    /// Bug (issue 18): read warnings lived in per-thread storage until the next tree load took
+    /// them, so a scene file read between two trees leaked its warnings into the next tree, and
+    /// reads outside a tree load piled up for the life of the thread.
+    #[test]
+    fn warnings_belong_to_the_read_that_raised_them() {
+        let v = parse_yaml("yaw: 5", 0).unwrap();
+        let yaw = |v: &Value| from_value::<std::collections::BTreeMap<String, crate::yaml::units::Angle>>(v);
+        // Outside a collecting call: dropped, not kept for later.
+        assert!(yaw(&v).is_ok());
+        let ((), w) = collect_warnings(|| ());
+        assert!(w.is_empty(), "{w:?}");
+        // Inside: collected, and a nested call keeps its own.
+        let ((inner, r), outer) = collect_warnings(|| {
+            let _ = yaw(&v);
+            let (r, inner) = collect_warnings(|| yaw(&v));
+            (inner, r)
+        });
+        assert!(r.is_ok());
+        assert_eq!(inner.len(), 1, "{inner:?}");
+        assert_eq!(outer.len(), 1, "{outer:?}");
+        assert_eq!(outer[0].loc, inner[0].loc);
     }
 }
