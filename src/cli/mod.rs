@@ -8,6 +8,7 @@ mod args;
 mod bench;
 mod dataset;
 mod graph;
+mod human;
 mod limits;
 mod logging;
 mod nodes;

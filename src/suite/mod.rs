@@ -17,6 +17,7 @@
 //! ```
 
 pub mod junit;
+pub mod names;
 
 use std::path::{Component, Path, PathBuf};
 
