@@ -32,6 +32,9 @@ pub const MAX_SIM_TIME_S: f64 = 3600.0;
 #[derive(Clone, Debug, Default)]
 pub struct App {
     registry: Arc<Registry>,
+    /// How [`App::run_cli`] presents the program (name, description, version).
+    #[cfg(feature = "cli")]
+    cli: crate::cli::CliInfo,
 }
 
 impl App {
@@ -44,6 +47,7 @@ impl App {
     pub fn with_registry(registry: Registry) -> App {
         App {
             registry: Arc::new(registry),
+            ..App::default()
         }
     }
 
@@ -165,9 +169,36 @@ impl App {
     /// Runs the `macrotree` command line (`run`, `validate`, `nodes`, `schema`, `graph`,
     /// `sweep`, …) with this app's node kinds, on the process's arguments, and answers its exit
     /// code (0 success, 1 task failed, 2 bad input).
+    ///
+    /// `--help` and `--version` show macrotree's name, description and version unless the app
+    /// sets its own with [`App::cli_name`], [`App::cli_about`] and [`App::cli_version`].
     #[cfg(feature = "cli")]
     pub fn run_cli(self) -> std::process::ExitCode {
-        crate::cli::main_with(Arc::unwrap_or_clone(self.registry))
+        crate::cli::main_as(Arc::unwrap_or_clone(self.registry), self.cli)
+    }
+
+    /// The program's name in [`App::run_cli`]'s `--help`, usage lines and `--version`
+    /// (default `macrotree`).
+    #[cfg(feature = "cli")]
+    pub fn cli_name(&mut self, name: &'static str) -> &mut Self {
+        self.cli.name = Some(name);
+        self
+    }
+
+    /// The one-line description at the top of [`App::run_cli`]'s `--help` (default:
+    /// macrotree's).
+    #[cfg(feature = "cli")]
+    pub fn cli_about(&mut self, about: &'static str) -> &mut Self {
+        self.cli.about = Some(about);
+        self
+    }
+
+    /// The version [`App::run_cli`]'s `--version` prints (default: macrotree's), e.g.
+    /// `env!("CARGO_PKG_VERSION")` of your crate.
+    #[cfg(feature = "cli")]
+    pub fn cli_version(&mut self, version: &'static str) -> &mut Self {
+        self.cli.version = Some(version);
+        self
     }
 }
 

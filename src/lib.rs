@@ -122,7 +122,7 @@
 
 pub use app::App;
 pub use error::Error;
-pub use registry::{Category, Params, Registry};
+pub use registry::{Category, ParamError, Params, Registry};
 
 pub mod actions;
 pub mod app;

@@ -9,6 +9,7 @@ mod bench;
 mod dataset;
 mod graph;
 mod human;
+mod info;
 mod limits;
 mod logging;
 mod nodes;
@@ -26,6 +27,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 pub use args::{CubeArg, XyArg};
+pub use info::CliInfo;
 
 /// Behavior trees in YAML driving a simulated UR5e + Robotiq 2F-85 (MuJoCo).
 #[derive(Debug, Parser)]
@@ -82,8 +84,13 @@ pub enum CliError {
 /// and runs [`main`]. `nodes`, `schema`, `validate`, `run`, `sweep` and `graph` all know its
 /// kinds.
 pub fn main_with(registry: crate::registry::Registry) -> ExitCode {
+    main_as(registry, CliInfo::default())
+}
+
+/// As [`main_with`], presenting the program as `info` says in `--help` and `--version`.
+pub fn main_as(registry: crate::registry::Registry, info: CliInfo) -> ExitCode {
     registry.install();
-    main()
+    run_main(info)
 }
 
 /// How a command printed for people to run (a sweep's reproduction commands) names this
@@ -123,8 +130,12 @@ fn process_elapsed_s() -> f64 {
 
 /// Entry point of the `macrotree` binary.
 pub fn main() -> ExitCode {
+    run_main(CliInfo::default())
+}
+
+fn run_main(info: CliInfo) -> ExitCode {
     STARTED.get_or_init(std::time::Instant::now);
-    let cli = Cli::parse();
+    let cli = info.parse();
     let quiet = matches!(
         cli.command,
         Command::Bench(_) | Command::Sweep(_) | Command::Test(_) | Command::Report(_)

@@ -15,6 +15,7 @@
 
 mod builtin;
 mod control;
+mod param_error;
 
 use std::any::Any;
 use std::fmt;
@@ -35,6 +36,7 @@ use crate::spec::value::Value;
 use crate::world::World;
 
 pub(crate) use control::SchemaCtx;
+pub use param_error::ParamError;
 
 /// What a node kind is.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, Serialize)]
@@ -102,9 +104,17 @@ pub trait Params:
     }
 
     /// Checks across parameters that the types alone cannot express (a range that depends on
-    /// another parameter, …). An `Err` is reported at the node, with the message as given.
+    /// another parameter, …). An `Err` is reported at the node, with the message as given; to
+    /// point at one parameter's value instead, implement [`Params::validate_fields`].
     fn validate(&self) -> Result<(), String> {
         Ok(())
+    }
+
+    /// Like [`Params::validate`], but the error can name the parameter it is about
+    /// ([`ParamError::at`]`("max_tilt", "must be between 0 and 45°, found 60.0°")`), and is then
+    /// reported at that value in the file. Default: [`Params::validate`], reported at the node.
+    fn validate_fields(&self) -> Result<(), ParamError> {
+        self.validate().map_err(ParamError::new)
     }
 }
 
@@ -117,7 +127,7 @@ pub(crate) trait DynParams: Send + Sync + fmt::Debug {
     fn map_objects(&self, f: &mut dyn FnMut(&ObjectRef) -> Option<ObjectRef>) -> Option<Arc<dyn DynParams>>;
     fn label(&self, kind: &str) -> Option<String>;
     fn timeout(&self) -> Option<f64>;
-    fn validate(&self) -> Result<(), String>;
+    fn validate(&self) -> Result<(), ParamError>;
 }
 
 impl<T: Params> DynParams for T {
@@ -151,8 +161,8 @@ impl<T: Params> DynParams for T {
     fn timeout(&self) -> Option<f64> {
         Params::timeout(self)
     }
-    fn validate(&self) -> Result<(), String> {
-        Params::validate(self)
+    fn validate(&self) -> Result<(), ParamError> {
+        Params::validate_fields(self)
     }
 }
 
@@ -363,7 +373,7 @@ impl LeafCall {
             })
     }
 
-    pub(crate) fn validate(&self) -> Result<(), String> {
+    pub(crate) fn validate(&self) -> Result<(), ParamError> {
         self.params.validate()
     }
 
