@@ -20,22 +20,37 @@ fn empty_dpkg_db(name: &str) -> PathBuf {
         std::fs::create_dir_all(dir.join(sub)).unwrap();
     }
     std::fs::write(dir.join("status"), "").unwrap();
+    // Readable by `nobody` too.
+    use std::os::unix::fs::PermissionsExt as _;
+    for p in [dir.clone(), dir.join("info"), dir.join("updates")] {
+        std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o755)).unwrap();
+    }
     dir
 }
 
 fn setup(args: &[&str], dpkg_db: Option<&Path>, as_nobody: bool) -> Output {
-    let script = Path::new(ROOT).join("tools/setup");
     let mut c = if as_nobody {
+        // `nobody` may not be able to enter the checkout (e.g. under /root): run a copy of the
+        // script from a world-readable folder (it stops before it would need the checkout).
+        let dir = std::env::temp_dir().join(format!("macrotree-test-setup-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("tools")).unwrap();
+        let copy = dir.join("tools/setup");
+        std::fs::copy(Path::new(ROOT).join("tools/setup"), &copy).unwrap();
+        use std::os::unix::fs::PermissionsExt as _;
+        for p in [dir.clone(), dir.join("tools"), copy.clone()] {
+            std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o755)).unwrap();
+        }
         let mut c = Command::new("setpriv");
         c.args(["--reuid=65534", "--regid=65534", "--clear-groups"])
-            .arg(&script);
+            .arg(&copy)
+            .current_dir(&dir);
         c
     } else {
-        Command::new(&script)
+        let mut c = Command::new(Path::new(ROOT).join("tools/setup"));
+        c.current_dir(ROOT);
+        c
     };
-    c.args(args)
-        .current_dir(ROOT)
-        .env_remove("MACROTREE_SKIP_BROWSER_TESTS");
+    c.args(args).env_remove("MACROTREE_SKIP_BROWSER_TESTS");
     if let Some(db) = dpkg_db {
         c.env("DPKG_ADMINDIR", db);
     }
