@@ -135,3 +135,23 @@ fn setup_with_every_package_installed_goes_on_to_the_bootstrap() {
     let out = setup(&["--bogus"], None, false);
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn ci_runs_exactly_the_readme_test_command_and_it_sets_up_first() {
+    let readme = std::fs::read_to_string(Path::new(ROOT).join("README.md")).unwrap();
+    let ci = std::fs::read_to_string(Path::new(ROOT).join(".ci/run")).unwrap();
+    let command = readme
+        .lines()
+        .find(|l| l.ends_with("cargo test --release"))
+        .expect("the README's test command");
+    assert_eq!(command, "tools/setup && cargo test --release");
+    assert!(
+        ci.lines().any(|l| l == command),
+        ".ci/run does not run the README's test command `{command}`"
+    );
+    // What the README says it installs is what the script installs.
+    let script = std::fs::read_to_string(Path::new(ROOT).join("tools/setup")).unwrap();
+    for p in PACKAGES.split(' ') {
+        assert!(readme.contains(p) && script.contains(p), "{p}");
+    }
+}
