@@ -47,7 +47,8 @@ impl App {
     pub fn with_registry(registry: Registry) -> App {
         App {
             registry: Arc::new(registry),
-            ..App::default()
+            #[cfg(feature = "cli")]
+            cli: crate::cli::CliInfo::default(),
         }
     }
 
