@@ -7,7 +7,7 @@
 //! package's target folder, the same compiler, `Cargo.lock`, dependency features and release
 //! profile, so that every dependency of macrotree is reused. macrotree itself is compiled once
 //! more as a dependency (cargo's hash of a path dependency includes its place relative to the
-//! workspace root): about 1.5 min on 2 busy cores after macrotree's sources change, 2.6 s when
+//! workspace root): 1.5 to 3 min on 2 busy cores after macrotree's sources change, 2.6 s when
 //! they have not. Nothing is downloaded (`--offline`).
 
 #[path = "support/cli.rs"]
