@@ -1,5 +1,5 @@
-//! Your own nodes in Rust: a `push` action and a `near` condition, registered next to the
-//! built-in ones and used from YAML.
+//! Your own nodes in Rust: a `push` action and the `near` and `upright` conditions, registered
+//! next to the built-in ones and used from YAML.
 //!
 //! ```text
 //! cargo run --release --example custom_leaf                 # run the demo tree on physics, print the report
@@ -9,8 +9,8 @@
 //!
 //! `push` slides a block along the table: it closes the gripper, comes down behind the block
 //! at low height and moves the fingers along the push direction until the block has moved
-//! `distance`, then backs off and rises. `near` checks where a block's centre is. See
-//! `docs/custom_nodes.md` for the walk-through.
+//! `distance`, then backs off and rises. `near` checks where a block's centre is; `upright`
+//! reads a block's orientation and its contacts. See `docs/custom_nodes.md` for the walk-through.
 
 use std::process::ExitCode;
 
@@ -20,9 +20,10 @@ use macrotree::kinds::ObjectRef;
 use macrotree::motion::{
     CLOSED_CTRL, CartesianMove, JointMove, MotionLimits, Trajectory, down_pose, ik_down,
 };
+use macrotree::world::Part;
 use macrotree::world::World;
 use macrotree::yaml::units::Angle;
-use macrotree::{App, Error, Params};
+use macrotree::{App, Error, ParamError, Params};
 use nalgebra::Vector3;
 use schemars::JsonSchema;
 use serde::{Deserialize, Deserializer, Serialize};
@@ -52,6 +53,20 @@ Halt: nothing to halt (instantaneous).
 
 ```yaml
 near: {object: cube, point: [0.45, -0.28], tolerance: 0.015}
+```
+";
+
+/// The documentation of `upright`.
+const UPRIGHT_DOC: &str =
+    "The block rests on a face, tilted at most `max_tilt`, and nothing holds or leans on it.
+
+Reads the block's orientation (the tilt of its most vertical axis from world z) and the cell's
+contacts: no pad and no other object touches it (the table does not count).
+
+Halt: nothing to halt (instantaneous).
+
+```yaml
+upright: {object: cube, max_tilt: deg(5)}
 ```
 ";
 
@@ -148,6 +163,60 @@ impl Params for Near {
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
         vec![&mut self.object]
     }
+}
+
+/// Largest `max_tilt` of `upright`, degrees.
+const MAX_TILT_DEG: f64 = 45.0;
+
+/// Parameters of `upright`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+struct Upright {
+    /// The block (a name or `{var}`).
+    object: ObjectRef,
+    /// Largest tilt of the block from resting flat, radians (or `deg(..)`), 0 … 45°. Default
+    /// deg(10).
+    #[serde(default = "ten_degrees")]
+    max_tilt: Angle,
+}
+
+fn ten_degrees() -> Angle {
+    Angle(10f64.to_radians())
+}
+
+impl Params for Upright {
+    fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
+        vec![&mut self.object]
+    }
+    /// A range the type cannot express, reported at the `max_tilt` value in the file.
+    fn validate_fields(&self) -> Result<(), ParamError> {
+        let deg = self.max_tilt.0.to_degrees();
+        if (0.0..=MAX_TILT_DEG).contains(&deg) {
+            Ok(())
+        } else {
+            Err(ParamError::at(
+                "max_tilt",
+                format!("must be between 0 and {MAX_TILT_DEG}°, found {deg:.1}°"),
+            ))
+        }
+    }
+}
+
+/// `upright`: reads orientation (`objects[i].quat`) and contacts (the pads' flags and
+/// `touches`).
+fn upright(w: &World, p: &Upright) -> Result<bool, String> {
+    let i = object_index(&p.object, w)?;
+    let o = &w.objects[i];
+    // The block's axis closest to world z, and its angle from it (a block may rest on any face).
+    let r = o.quat.to_rotation_matrix();
+    let up = (0..3).map(|k| r[(2, k)].abs()).fold(0.0, f64::max);
+    let tilt = up.clamp(-1.0, 1.0).acos();
+    let held = o.left_pad_contact || o.right_pad_contact;
+    let touched = w.touches.iter().any(|&(a, b)| {
+        let is_i = |p: Part| matches!(p, Part::Object { index, .. } if index == i);
+        is_i(a) || is_i(b)
+    });
+    Ok(tilt <= p.max_tilt.0 && !held && !touched)
 }
 
 /// `near`: a pure function of the world snapshot and the parameters.
@@ -289,21 +358,24 @@ impl MacroAction for PushAction {
     }
 }
 
-/// The demo tree: push the cube 10 cm away from the bowl, check it got there, go home.
-const TREE: &str = "description: push the cube 10 cm along -y, check where it is, go home
+/// The demo tree: push the cube 10 cm away from the bowl, check it got there, go home, check
+/// the cube still stands flat and free.
+const TREE: &str = "description: push the cube 10 cm along -y, check where it is, go home, check it stands
 main:
   sequence:
     children:
       - push: {object: cube, direction: deg(-90), distance: 0.10}
       - near: {object: cube, point: [0.45, -0.28], tolerance: 0.01}
       - home: {}
+      - upright: {object: cube}
 ";
 
-/// The built-in node kinds plus `push` and `near`.
+/// The built-in node kinds plus `push`, `near` and `upright`.
 fn app() -> Result<App, Error> {
     let mut app = App::new();
     app.register_action("push", PUSH_DOC, |p: &Push| Box::new(PushAction::new(p.clone())))?
-        .register_condition("near", NEAR_DOC, near)?;
+        .register_condition("near", NEAR_DOC, near)?
+        .register_condition("upright", UPRIGHT_DOC, upright)?;
     Ok(app)
 }
 
@@ -317,6 +389,12 @@ fn main() -> ExitCode {
     };
     // With arguments: the `macrotree` command line, knowing `push` and `near`.
     if std::env::args_os().len() > 1 {
+        let mut app = app;
+        app.cli_name("custom_leaf")
+            .cli_about(
+                "The macrotree command line with a `push` action and the `near` and `upright` conditions",
+            )
+            .cli_version(env!("CARGO_PKG_VERSION"));
         return app.run_cli();
     }
     // Without: run the demo tree on physics and print its report.

@@ -15,6 +15,18 @@ use crate::plan::{Loader, Plan};
 use crate::sim::{Scene, TIMESTEP};
 use crate::world::World;
 
+/// The name, one-line description and version a `macrotree`-like program shows in `--help`,
+/// usage lines and `--version` (`App::run_cli`); `None` keeps macrotree's own.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ProgramInfo {
+    /// The program's name (default `macrotree`).
+    pub name: Option<&'static str>,
+    /// The description at the top of `--help` (default: macrotree's).
+    pub about: Option<&'static str>,
+    /// The version `--version` prints (default: macrotree's).
+    pub version: Option<&'static str>,
+}
+
 /// The node kinds a program knows, and what it does with trees of them.
 ///
 /// ```no_run
@@ -31,6 +43,7 @@ use crate::world::World;
 pub struct App {
     loader: Loader,
     factory: Arc<Factory>,
+    program: ProgramInfo,
 }
 
 impl Default for App {
@@ -39,6 +52,7 @@ impl Default for App {
         App {
             loader: Loader::default(),
             factory: Factory::builtin(),
+            program: ProgramInfo::default(),
         }
     }
 }
@@ -202,6 +216,32 @@ impl App {
             config,
             &mut NoObserver,
         ))
+    }
+
+    /// How [`App::run_cli`] presents the program (name, description, version).
+    pub fn program(&self) -> &ProgramInfo {
+        &self.program
+    }
+
+    /// The program's name in `App::run_cli`'s `--help`, usage lines and `--version`
+    /// (default `macrotree`).
+    pub fn cli_name(&mut self, name: &'static str) -> &mut Self {
+        self.program.name = Some(name);
+        self
+    }
+
+    /// The one-line description at the top of `App::run_cli`'s `--help` (default:
+    /// macrotree's).
+    pub fn cli_about(&mut self, about: &'static str) -> &mut Self {
+        self.program.about = Some(about);
+        self
+    }
+
+    /// The version `App::run_cli`'s `--version` prints (default: macrotree's), e.g.
+    /// `env!("CARGO_PKG_VERSION")` of your crate.
+    pub fn cli_version(&mut self, version: &'static str) -> &mut Self {
+        self.program.version = Some(version);
+        self
     }
 }
 

@@ -137,7 +137,7 @@
 #[cfg(feature = "sim")]
 pub use app::App;
 pub use error::Error;
-pub use kinds::{Category, Params, Registry};
+pub use kinds::{Category, ParamError, Params, Registry};
 
 #[cfg(feature = "sim")]
 pub mod actions;

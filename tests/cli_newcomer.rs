@@ -61,11 +61,9 @@ fn a_timeout_says_what_the_leaf_waited_for_and_which_node_failed() {
         width > 0.0 && width < 0.085,
         "a real width, between closed and open: {reason}"
     );
-    assert!(
-        stdout.contains("  failed node: main/sequence/grasp[close]"),
-        "{stdout}"
-    );
     let err = text(&out.stderr);
+    // With --json the summary for people is on stderr (stdout holds only the report).
+    assert!(err.contains("  failed node: main/sequence/grasp[close]"), "{err}");
     assert!(err.contains("node=main/sequence/grasp[close]"), "{err}");
 }
 

@@ -1,6 +1,7 @@
-//! `examples/custom_leaf.rs`: a user's `push` action and `near` condition, registered next to the
-//! built-in kinds. The example's demo pushes the cube on physics; its command line knows the new
-//! kinds everywhere (`nodes`, `schema`, `validate` with located errors and suggestions).
+//! `examples/custom_leaf.rs`: a user's `push` action and `near` and `upright` conditions,
+//! registered next to the built-in kinds. The example's demo pushes the cube on physics and checks
+//! it stands (orientation and contacts); its command line knows the new kinds everywhere
+//! (`nodes`, `schema`, `validate` with located errors and suggestions) and shows its own name.
 
 #[path = "support/cli.rs"]
 mod cli;
@@ -140,4 +141,59 @@ fn trees_with_the_new_kinds_are_validated_with_located_errors() {
     assert!(text.contains("bad.yaml:6:24"), "{text}");
     assert!(text.contains("`cbe`"), "{text}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn validate_error_of_a_params_type_was_placed_at_the_node_kind_not_the_value() {
+    let dir = scratch("custom-leaf-validate-fields");
+    let bad = dir.join("tilt.yaml");
+    std::fs::write(
+        &bad,
+        "main:\n  sequence:\n    children:\n      - home: {}\n      - upright: {object: cube, max_tilt: deg(60)}\n",
+    )
+    .unwrap();
+    let out = run(&["validate", s(&bad)]);
+    assert_eq!(out.status.code(), Some(2));
+    let text = String::from_utf8_lossy(&out.stderr);
+    // At the value `deg(60)` (column 43), not at `upright` (column 9).
+    assert!(text.contains("tilt.yaml:5:43"), "{text}");
+    assert!(!text.contains("tilt.yaml:5:9"), "{text}");
+    assert!(
+        text.contains("`max_tilt` must be between 0 and 45°, found 60.0°"),
+        "{text}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn nodes_printed_an_angle_default_in_radians() {
+    let out = run(&["nodes", "upright"]);
+    assert_eq!(out.status.code(), Some(0));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("max_tilt  Angle (default deg(10))"), "{text}");
+    assert!(!text.contains("0.1745"), "{text}");
+}
+
+#[test]
+fn run_cli_showed_macrotrees_own_name_and_description_in_help() {
+    let out = run(&["--help"]);
+    assert_eq!(out.status.code(), Some(0));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.starts_with(
+            "The macrotree command line with a `push` action and the `near` and `upright` conditions"
+        ),
+        "{text}"
+    );
+    assert!(text.contains("Usage: custom_leaf [OPTIONS] <COMMAND>"), "{text}");
+    assert!(!text.contains("Behavior trees in YAML driving"), "{text}");
+    let out = run(&["--version"]);
+    assert_eq!(String::from_utf8_lossy(&out.stdout).trim(), "custom_leaf 0.1.0");
+    // A subcommand's usage names the program too.
+    let out = run(&["validate", "--help"]);
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("Usage: custom_leaf validate"),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
 }

@@ -253,3 +253,72 @@ fn variables_in_custom_leaves_are_resolved_before_each_tick() {
     assert_eq!(status, TreeStatus::Success);
     assert_eq!(driver.seen, ["probe cube", "touching cube"]);
 }
+
+/// `level: {max_tilt, min_tilt}`: a condition whose own check names the parameter it is about.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+struct Level {
+    /// Largest tilt, radians (or `deg(..)`). Default deg(5).
+    #[serde(default = "five_degrees")]
+    max_tilt: macrotree::yaml::units::Angle,
+    /// Smallest tilt, radians (or `deg(..)`). Default deg(-7.5).
+    #[serde(default = "minus_seven_and_a_half_degrees")]
+    min_tilt: macrotree::yaml::units::Angle,
+}
+
+fn five_degrees() -> macrotree::yaml::units::Angle {
+    macrotree::yaml::units::Angle(5f64.to_radians())
+}
+
+fn minus_seven_and_a_half_degrees() -> macrotree::yaml::units::Angle {
+    macrotree::yaml::units::Angle((-7.5f64).to_radians())
+}
+
+impl Params for Level {
+    fn validate_fields(&self) -> Result<(), macrotree::ParamError> {
+        if self.max_tilt.0 > 0.5 {
+            return Err(macrotree::ParamError::at("max_tilt", "must be at most 0.5 rad"));
+        }
+        if self.min_tilt.0 > self.max_tilt.0 {
+            return Err("`min_tilt` is more than `max_tilt`".into());
+        }
+        Ok(())
+    }
+}
+
+const LEVEL_DOC: &str = "The arm is level.\n\nHalt: nothing to halt (instantaneous).\n\n```yaml\nlevel: {max_tilt: deg(3)}\n```\n";
+
+#[test]
+fn validate_fields_errors_point_at_the_value_they_name() {
+    let mut app = App::new();
+    app.register_condition("level", LEVEL_DOC, |_: &World, _: &Level| Ok(true))
+        .unwrap();
+    let errors = |yaml: &str| app.compile_str(yaml, "t.yaml").unwrap_err().to_string();
+    // Named field, written in the file: at its value.
+    let e = errors("main: {level: {max_tilt: deg(40)}}\n");
+    assert!(e.contains("t.yaml:1:26"), "{e}");
+    assert!(e.contains("`max_tilt` must be at most 0.5 rad"), "{e}");
+    // Named through a subtree argument: still the value (where the subtree uses it).
+    let e = errors(
+        "main: {subtree: {ref: s, args: {t: deg(40)}}}\nsubtrees:\n  s:\n    params: {t: ~}\n    root: {level: {max_tilt: $t}}\n",
+    );
+    assert!(e.contains("`max_tilt` must be at most 0.5 rad"), "{e}");
+    assert!(!e.contains("t.yaml:5:12"), "not at the node kind: {e}");
+    // No field named (a plain message): at the node, as before.
+    let e = errors("main: {level: {min_tilt: deg(10)}}\n");
+    assert!(e.contains("t.yaml:1:8"), "{e}");
+    assert!(e.contains("`min_tilt` is more than `max_tilt`"), "{e}");
+
+    // The catalog shows angle defaults as users write them.
+    let catalog = app.registry().catalog();
+    let level = catalog.iter().find(|d| d.kind == "level").unwrap();
+    let default = |name: &str| {
+        level
+            .params
+            .iter()
+            .find(|p| p.name == name)
+            .and_then(|p| p.default.clone())
+    };
+    assert_eq!(default("max_tilt").as_deref(), Some("deg(5)"));
+    assert_eq!(default("min_tilt").as_deref(), Some("deg(-7.5)"));
+}

@@ -204,7 +204,8 @@ fn a_passing_suite_exits_0_with_junit_and_jsonl() {
         "--json",
     ]);
     assert_eq!(out.status.code(), Some(0), "{}{}", stdout(&out), stderr(&out));
-    let text = stdout(&out);
+    // With --json the text for people is on stderr.
+    let text = stderr(&out);
     assert!(
         text.contains("PASS tests/fixtures/scenarios/pass/grasp_fails_once.yaml: 3 of 3 succeeded"),
         "{text}"

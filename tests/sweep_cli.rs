@@ -64,8 +64,8 @@ fn a_successful_sweep_exits_0_with_a_json_summary_and_jsonl() {
     );
     assert!((share - physics / (jobs * process)).abs() < 1e-9, "{s}");
     assert!(
-        String::from_utf8_lossy(&out.stdout).contains("physics share "),
-        "the human summary shows it too"
+        String::from_utf8_lossy(&out.stderr).contains("physics share "),
+        "the human summary (on stderr with --json) shows it too"
     );
     assert_eq!(s["scenarios"], 4);
     assert_eq!(s["successes"], 4);
@@ -120,8 +120,11 @@ fn failures_exit_1_and_their_printed_command_reproduces_them() {
     assert_eq!(f["cube"].as_array().map(Vec::len), Some(3));
     assert_eq!(f["bowl"].as_array().map(Vec::len), Some(2));
     let cmd = f["reproduce"].as_str().expect("reproduce");
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains(cmd), "the human summary prints the command too");
+    let text = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        text.contains(cmd),
+        "the human summary (on stderr with --json) prints the command too"
+    );
     // Run the printed command as printed, from the repository, with a shell (the binary under
     // test is not on PATH, so the command names it by its path), and compare its report with
     // the sweep's.

@@ -27,7 +27,7 @@ pub struct BenchArgs {
     /// Repetitions; the median of each timing is reported.
     #[arg(long, default_value_t = 5)]
     pub repeat: usize,
-    /// Print the result as one JSON object on the last line of stdout.
+    /// Print the result as one JSON object on stdout (the only thing on stdout; the text for people goes to stderr).
     #[arg(long)]
     pub json: bool,
 }
@@ -136,7 +136,9 @@ pub fn bench(app: &crate::App, args: BenchArgs) -> Result<(), CliError> {
         state_fingerprint: fnv1a_hex(&episode_state),
         replay_matches_episode: matches,
     };
-    println!(
+    use super::human::say;
+    say!(
+        args.json,
         "episode {:.4} s wall, replay (bare mj_step) {:.4} s wall, ratio {:.3}; {:.2} s simulated, {} steps, success {}; IK {:.2} µs/solve (median of {repeat})",
         result.episode_wall_time_s,
         result.replay_wall_time_s,
@@ -147,7 +149,8 @@ pub fn bench(app: &crate::App, args: BenchArgs) -> Result<(), CliError> {
         result.ik_us_per_solve
     );
     if let Some(m) = result.replay_matches_episode {
-        println!(
+        say!(
+            args.json,
             "final state {}: the replay {} the episode",
             result.state_fingerprint,
             if m {

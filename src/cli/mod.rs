@@ -8,6 +8,8 @@ mod args;
 mod bench;
 mod dataset;
 mod graph;
+mod human;
+mod info;
 mod limits;
 mod logging;
 mod nodes;
@@ -77,8 +79,13 @@ pub enum CliError {
 }
 
 impl crate::App {
-    /// Runs the `macrotree` command line with this app's node kinds in it (`nodes`, `schema`,
-    /// `validate`, `run`, `sweep`, `test`, `graph`). Returns the process exit code.
+    /// Runs the `macrotree` command line (`run`, `validate`, `nodes`, `schema`, `graph`,
+    /// `sweep`, …) with this app's node kinds, on the process's arguments, and answers its exit
+    /// code (0 success, 1 task failed, 2 bad input).
+    ///
+    /// `--help` and `--version` show macrotree's name, description and version unless the app
+    /// sets its own with [`crate::App::cli_name`], [`crate::App::cli_about`] and
+    /// [`crate::App::cli_version`].
     pub fn run_cli(self) -> ExitCode {
         main_with(self)
     }
@@ -129,7 +136,7 @@ fn process_elapsed_s() -> f64 {
 /// `graph` all know its kinds.
 pub fn main_with(app: crate::App) -> ExitCode {
     STARTED.get_or_init(std::time::Instant::now);
-    let cli = Cli::parse();
+    let cli = info::parse(app.program());
     let quiet = matches!(
         cli.command,
         Command::Bench(_) | Command::Sweep(_) | Command::Test(_) | Command::Report(_)

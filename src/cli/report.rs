@@ -19,7 +19,7 @@ pub struct ReportArgs {
     /// JSONL files written by `sweep --out` or `test --out` (the shards of one run, any order).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
-    /// Print the summary as one JSON object on the last line of stdout.
+    /// Print the summary as one JSON object on stdout (the only thing on stdout; the text for people goes to stderr).
     #[arg(long)]
     pub json: bool,
     /// For `macrotree test` results: write the JUnit XML report here.
@@ -42,7 +42,7 @@ pub fn report(args: ReportArgs) -> Result<(), CliError> {
         }
         let m = &merged[0];
         let summary = Summary::new(&m.config.tree, &m.config, &m.results, 0.0, 0);
-        print!("{}", summary.to_text());
+        super::human::say_text!(args.json, summary.to_text());
         if args.json {
             println!("{}", serde_json::to_string(&summary).expect("summary serializes"));
         }
@@ -86,5 +86,7 @@ pub fn report(args: ReportArgs) -> Result<(), CliError> {
             (f, o, m.results)
         })
         .collect();
-    super::test::finish(&outcomes, junit.as_ref(), args.json)
+    let paths: Vec<PathBuf> = files.iter().map(|f| f.path.clone()).collect();
+    let names = crate::suite::names::shared_folder_names(&paths);
+    super::test::finish(&outcomes, &names, junit.as_ref(), args.json)
 }

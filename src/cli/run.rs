@@ -19,7 +19,7 @@ pub struct RunArgs {
     pub tree: PathBuf,
     #[command(flatten)]
     pub episode: EpisodeArgs,
-    /// Print the episode report as one JSON object on the last line of stdout.
+    /// Print the episode report as one JSON object on stdout (the only thing on stdout; the text for people goes to stderr).
     #[arg(long)]
     pub json: bool,
     /// Serve the live 3D view (MeshCat) and the tree's status on http://127.0.0.1:PORT; keeps
@@ -373,15 +373,17 @@ fn finish_report(report: &crate::episode::EpisodeReport, goal: Goal, json: bool)
             "episode failed"
         );
     }
-    print_summary(report, goal);
+    print_summary(report, goal, json);
     if json {
         println!("{}", serde_json::to_string(report).expect("report serializes"));
     }
 }
 
-fn print_summary(r: &crate::episode::EpisodeReport, goal: Goal) {
+fn print_summary(r: &crate::episode::EpisodeReport, goal: Goal, json: bool) {
+    use super::human::say;
     let c = &r.checks;
-    println!(
+    say!(
+        json,
         "{}: tree {}, {:.2} s simulated in {:.3} s wall ({} physics steps), {} grasp attempt(s)",
         if r.success { "SUCCESS" } else { "FAILURE" },
         r.tree_status,
@@ -391,13 +393,14 @@ fn print_summary(r: &crate::episode::EpisodeReport, goal: Goal) {
         r.grasp_attempts
     );
     if let Some(reason) = &r.failure_reason {
-        println!("  reason: {reason}");
+        say!(json, "  reason: {reason}");
     }
     if let Some(node) = &r.failed_node {
-        println!("  failed node: {node}");
+        say!(json, "  failed node: {node}");
     }
     if goal != Goal::Scene {
-        println!(
+        say!(
+            json,
             "  success judged by --goal {}{}",
             goal.name(),
             if goal == Goal::Tree {
@@ -409,22 +412,26 @@ fn print_summary(r: &crate::episode::EpisodeReport, goal: Goal) {
     }
     for o in &r.objects {
         let [x, y, z, yaw] = o.end;
-        println!(
+        say!(
+            json,
             "  {} {}: final ({x:.3}, {y:.3}, {z:.3}) m, yaw {yaw:.1}°",
-            o.kind, o.name
+            o.kind,
+            o.name
         );
     }
     for g in &r.goal {
-        println!(
+        say!(
+            json,
             "  goal: {} {}",
             g.predicate,
             if g.holds { "holds" } else { "does NOT hold" }
         );
     }
     for c in &r.collisions {
-        println!("  collision at {:.2} s: {}", c.time, c.what);
+        say!(json, "  collision at {:.2} s: {}", c.time, c.what);
     }
-    println!(
+    say!(
+        json,
         "  cube final ({:.3}, {:.3}, {:.3}) m, bowl target ({:.3}, {:.3}, {:.3}) m",
         r.cube_final[0],
         r.cube_final[1],
@@ -433,7 +440,8 @@ fn print_summary(r: &crate::episode::EpisodeReport, goal: Goal) {
         r.bowl_target[1],
         r.bowl_target[2]
     );
-    println!(
+    say!(
+        json,
         "  checks: grasp distance {} m, motion while closed {:.3} m, lift while closed {:.3} m, home error {:.4} rad, in bowl {}",
         c.grasp_distance.map_or("-".into(), |d| format!("{d:.4}")),
         c.cube_motion_while_closed,

@@ -47,7 +47,7 @@ pub struct SweepArgs {
     /// and run only the missing scenarios.
     #[arg(long, requires = "out")]
     pub resume: bool,
-    /// Print the summary as one JSON object on the last line of stdout.
+    /// Print the summary as one JSON object on stdout (the only thing on stdout; the text for people goes to stderr).
     #[arg(long)]
     pub json: bool,
     /// Run only the scenarios with index ≡ K (mod M), 0 ≤ K < M; `auto` takes K and M from a
@@ -226,7 +226,7 @@ pub fn sweep(app: &crate::App, args: SweepArgs) -> Result<(), CliError> {
     let tree = args.tree.display().to_string();
     let summary = Summary::new(&tree, &config, &results, run.wall_time_s, run.jobs)
         .with_physics(run.physics_time_s, super::process_elapsed_s());
-    print!("{}", summary.to_text());
+    super::human::say_text!(args.json, summary.to_text());
     if args.json {
         println!("{}", serde_json::to_string(&summary).expect("summary serializes"));
     }

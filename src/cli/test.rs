@@ -43,7 +43,7 @@ pub struct TestArgs {
     /// Write one JSON line per scenario here (the sweep's lines, each naming its `suite`).
     #[arg(long, value_name = "FILE.jsonl")]
     pub out: Option<PathBuf>,
-    /// Print the outcome as one JSON object on the last line of stdout.
+    /// Print the outcome as one JSON object on stdout (the only thing on stdout; the text for people goes to stderr).
     #[arg(long)]
     pub json: bool,
 }
@@ -159,20 +159,25 @@ pub fn test(app: &crate::App, args: TestArgs) -> Result<(), CliError> {
     if let Some(w) = out {
         w.finish().map_err(output_error)?;
     }
-    finish(&outcomes, junit_out.as_ref(), args.json)
+    let names = crate::suite::names::case_names(&paths, &files);
+    finish(&outcomes, &names, junit_out.as_ref(), args.json)
 }
 
-/// Prints the outcome of every file and the totals, writes the JUnit file, and maps the
-/// verdict to the exit code (shared with `macrotree report`).
+/// Prints the outcome of every file and the totals, writes the JUnit file (test case `names`,
+/// one per outcome: see [`crate::suite::names`]), and maps the verdict to the exit code (shared
+/// with `macrotree report`).
 pub(super) fn finish(
     outcomes: &[(&ScenarioFile, SuiteOutcome, Vec<crate::sweep::ScenarioResult>)],
+    names: &[String],
     junit: Option<&crate::output::OutputFile>,
     json: bool,
 ) -> Result<(), CliError> {
+    use super::human::say;
     let mut cases = Vec::new();
-    for (file, o, results) in outcomes {
+    for ((file, o, results), name) in outcomes.iter().zip(names) {
         let sm = &o.summary;
-        println!(
+        say!(
+            json,
             "{} {}: {} of {} succeeded, sim time median {:.2} s, p95 {:.2} s{}",
             if o.passed { "PASS" } else { "FAIL" },
             o.file,
@@ -186,7 +191,8 @@ pub(super) fn finish(
         );
         let mut details = String::new();
         for c in &o.checks {
-            println!(
+            say!(
+                json,
                 "  {} {}: {}",
                 if c.ok { "ok  " } else { "FAIL" },
                 c.expectation,
@@ -197,31 +203,31 @@ pub(super) fn finish(
             }
         }
         for g in &sm.failure_groups {
-            println!("  failures: {} × {} at {}", g.count, g.kind, g.node);
+            say!(json, "  failures: {} × {} at {}", g.count, g.kind, g.node);
         }
         let cmds = offending_commands(&file.expect, results, &file.sweep);
         if !o.passed && !cmds.is_empty() {
             details += "reproduce:\n";
-            println!("  reproduce:");
+            say!(json, "  reproduce:");
             for c in cmds.iter().take(MAX_LISTED) {
-                println!("    {c}");
+                say!(json, "    {c}");
                 details += &format!("  {c}\n");
             }
             if cmds.len() > MAX_LISTED {
-                println!("    … and {} more (see --out)", cmds.len() - MAX_LISTED);
+                say!(json, "    … and {} more (see --out)", cmds.len() - MAX_LISTED);
                 details += &format!("  … and {} more\n", cmds.len() - MAX_LISTED);
             }
         }
         let failed = o.checks.iter().filter(|c| !c.ok).count();
         cases.push(Case {
-            name: o.file.clone(),
+            name: name.clone(),
             time_s: sm.wall_time_s,
             failure: (!o.passed).then(|| (format!("{failed} expectation(s) failed"), details)),
             out: sm.to_text(),
         });
     }
     let passed = outcomes.iter().filter(|(_, o, _)| o.passed).count();
-    println!("{} of {} scenario file(s) passed", passed, outcomes.len());
+    say!(json, "{} of {} scenario file(s) passed", passed, outcomes.len());
     if let Some(j) = junit {
         j.write_all(to_xml(&cases).as_bytes()).map_err(output_error)?;
     }

@@ -27,7 +27,7 @@ pub struct EpisodeReport {
     pub wall_time_s: f64,
     /// MuJoCo steps taken.
     pub physics_steps: u64,
-    /// Grasp leaves started.
+    /// Grasp leaves started on the arm (a grasp answered by a substitution is not counted).
     pub grasp_attempts: u32,
     /// Leaves preempted while running.
     pub halts: u32,
@@ -49,7 +49,8 @@ pub struct EpisodeReport {
     pub goal: Vec<GoalValue>,
     /// Contacts that should not happen (the fingers on a wall, …), in the order first seen.
     pub collisions: Vec<Collision>,
-    /// The path of the last leaf (or check) that failed, when the episode failed.
+    /// The path of the last leaf (or check) that failed, when the episode failed: the leaf where
+    /// the failure started, not the composite or decorator that passed it up (that is the root).
     pub failed_node: Option<String>,
     /// A stable name for the kind of failure (`grasp_lost`, `timeout`, `substituted`, …; see
     /// [`super::failure_kind`]), for grouping; `None` on success.

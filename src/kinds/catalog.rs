@@ -99,6 +99,21 @@ fn short_type(s: &Value) -> String {
     }
 }
 
+/// A default as users write it: an angle (a parameter of type `Angle`) as `deg(10)`, not its
+/// radians; anything else as JSON.
+fn show_default(param: &Value, default: &Value) -> String {
+    match default.as_f64() {
+        Some(rad) if short_type(param) == "Angle" => {
+            let deg = rad.to_degrees();
+            // Up to 6 decimals, trailing zeros dropped: 0.17453292519943295 rad is `deg(10)`.
+            let text = format!("{:.6}", deg);
+            let text = text.trim_end_matches('0').trim_end_matches('.');
+            format!("deg({})", if text == "-0" { "0" } else { text })
+        }
+        _ => default.to_string(),
+    }
+}
+
 fn params_from_schema(def: &Value) -> Vec<ParamDoc> {
     let required: Vec<&str> = def
         .get("required")
@@ -115,7 +130,7 @@ fn params_from_schema(def: &Value) -> Vec<ParamDoc> {
             name: name.clone(),
             ty: short_type(s),
             required: required.contains(&name.as_str()),
-            default: s.get("default").map(|d| d.to_string()),
+            default: s.get("default").map(|d| show_default(s, d)),
             doc: s
                 .get("description")
                 .and_then(Value::as_str)

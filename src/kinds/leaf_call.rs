@@ -6,6 +6,7 @@ use std::sync::Arc;
 use serde::Serialize;
 
 use super::objects::ObjectRef;
+use super::param_error::ParamError;
 use super::params::{DynParams, Params};
 use super::registry::{Category, NodeType};
 
@@ -88,7 +89,7 @@ impl LeafCall {
             })
     }
 
-    pub(crate) fn validate(&self) -> Result<(), String> {
+    pub(crate) fn validate(&self) -> Result<(), ParamError> {
         self.params.validate()
     }
 }

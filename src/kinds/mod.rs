@@ -20,6 +20,7 @@ mod control;
 mod leaf_call;
 pub mod leaves;
 pub mod objects;
+mod param_error;
 mod params;
 mod registry;
 mod targets;
@@ -32,6 +33,7 @@ pub use leaves::{
     GripperOpen, Home, In, Leaf, Lifted, MoveJoints, On, OnTable, Reach, Release, Select, Wait,
 };
 pub use objects::ObjectRef;
+pub use param_error::ParamError;
 pub use params::Params;
 pub(crate) use registry::Imp;
 pub use registry::{Category, NodeType, Registry};

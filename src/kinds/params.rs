@@ -9,6 +9,7 @@ use serde::Serialize;
 use serde::de::DeserializeOwned;
 
 use super::objects::ObjectRef;
+use super::param_error::ParamError;
 
 /// The parameters of a leaf kind, read from the node's YAML body.
 ///
@@ -47,9 +48,17 @@ pub trait Params:
     }
 
     /// Checks across parameters that the types alone cannot express (a range that depends on
-    /// another parameter, …). An `Err` is reported at the node, with the message as given.
+    /// another parameter, …). An `Err` is reported at the node, with the message as given; to
+    /// point at one parameter's value instead, implement [`Params::validate_fields`].
     fn validate(&self) -> Result<(), String> {
         Ok(())
+    }
+
+    /// Like [`Params::validate`], but the error can name the parameter it is about
+    /// ([`ParamError::at`]`("max_tilt", "must be between 0 and 45°, found 60.0°")`), and is then
+    /// reported at that value in the file. Default: [`Params::validate`], reported at the node.
+    fn validate_fields(&self) -> Result<(), ParamError> {
+        self.validate().map_err(ParamError::new)
     }
 }
 
@@ -62,7 +71,7 @@ pub(crate) trait DynParams: Send + Sync + fmt::Debug {
     fn map_objects(&self, f: &mut dyn FnMut(&ObjectRef) -> Option<ObjectRef>) -> Option<Arc<dyn DynParams>>;
     fn label(&self, kind: &str) -> Option<String>;
     fn timeout(&self) -> Option<f64>;
-    fn validate(&self) -> Result<(), String>;
+    fn validate(&self) -> Result<(), ParamError>;
 }
 
 impl<T: Params> DynParams for T {
@@ -96,7 +105,7 @@ impl<T: Params> DynParams for T {
     fn timeout(&self) -> Option<f64> {
         Params::timeout(self)
     }
-    fn validate(&self) -> Result<(), String> {
-        Params::validate(self)
+    fn validate(&self) -> Result<(), ParamError> {
+        Params::validate_fields(self)
     }
 }

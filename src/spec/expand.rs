@@ -222,9 +222,15 @@ impl<'a> Expander<'a> {
             match parsed {
                 Ok(leaf) => {
                     if let Some(Err(why)) = leaf.call().map(|c| c.validate()) {
+                        // At the value of the parameter the error names, when the body writes it.
+                        let at = why.field().and_then(|f| body.get(f));
+                        let (at, label) = match at {
+                            Some(v) => (v.loc, "this value"),
+                            None => (loc, "the parameters do not fit together"),
+                        };
                         self.err(
-                            Issue::new(loc, format!("invalid parameters in `{k}`: {why}"))
-                                .label("the parameters do not fit together")
+                            Issue::new(at, format!("invalid parameters in `{k}`: {why}"))
+                                .label(label)
                                 .help(format!("see `macrotree nodes {k}` for its parameters and units")),
                         );
                         return None;
@@ -276,7 +282,11 @@ impl<'a> Expander<'a> {
             } else if let Some(h) = did_you_mean(k, self.registry.names()) {
                 issue = issue.help(h);
             } else {
-                issue = issue.help("see docs/tree_format.md (or `macrotree nodes`) for the node kinds");
+                issue = issue
+                    .help("see docs/tree_format.md (or `macrotree nodes`) for the node kinds")
+                    .note(
+                        "a node kind registered by your own program (docs/custom_nodes.md) is validated with that program (`your_program validate FILE`), not the stock `macrotree`",
+                    );
             }
             self.err(issue);
             return None;

@@ -10,7 +10,8 @@ use std::fmt::Write as _;
 /// One test case: a scenario file's outcome.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Case {
-    /// The scenario file (the test case's name).
+    /// The test case's name: the scenario file relative to its suite folder (see
+    /// [`crate::suite::names`]).
     pub name: String,
     /// Wall-clock seconds it took (0 in merged reports).
     pub time_s: f64,

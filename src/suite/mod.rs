@@ -16,7 +16,9 @@
 //!   ran_in_every: ["main/**/subtree[recentre_and_grasp]"]
 //! ```
 
+pub mod counts;
 pub mod junit;
+pub mod names;
 
 use std::path::{Component, Path, PathBuf};
 
@@ -88,6 +90,10 @@ pub struct Expect {
     /// Node path globs whose nodes never failed over the suite.
     #[serde(default)]
     pub never_failed: Vec<String>,
+    /// How many times the nodes matching a glob ran or failed: exactly, at least or at most,
+    /// over the suite or in every scenario (see [`counts`]).
+    #[serde(default)]
+    pub counts: Vec<counts::CountExpect>,
 }
 
 /// A scenario file, as written (the JSON Schema `schema/scenario.schema.json` is generated from
@@ -280,6 +286,7 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>) -> Option<ScenarioFile>
             "failed",
             "never_ran",
             "never_failed",
+            "counts",
         ];
         for (k, _) in e {
             let key = k.as_str().unwrap_or("?");
@@ -395,14 +402,35 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>) -> Option<ScenarioFile>
         .chain(&e.failed)
         .chain(&e.never_ran)
         .chain(&e.never_failed)
-        .chain(&e.failed_node);
+        .chain(&e.failed_node)
+        .chain(e.counts.iter().map(|c| &c.node));
     for p in patterns {
         if let Err(reason) = Substitution::check_pattern(p) {
             issues.push(Issue::new(at(&["expect"]), format!("node pattern: {reason}")));
         }
     }
+    for (i, c) in e.counts.iter().enumerate() {
+        if let Some((key, problem)) = c.problem() {
+            let entry = v
+                .get("expect")
+                .and_then(|x| x.get("counts"))
+                .and_then(Value::as_seq)
+                .and_then(|l| l.get(i));
+            let loc = entry.and_then(|x| x.get(key)).or(entry).map_or(v.loc, |x| x.loc);
+            issues.push(
+                Issue::new(loc, format!("`expect.counts` entry {}: {problem}", i + 1)).help(
+                    "e.g. `- {node: \"main/**/carry\", failed: {exactly: 3}}`; see docs/testing_trees.md",
+                ),
+            );
+        }
+    }
     if raw.substitute.len() > MAX_RULES
-        || e.ran.len() + e.ran_in_every.len() + e.failed.len() + e.never_ran.len() + e.never_failed.len()
+        || e.ran.len()
+            + e.ran_in_every.len()
+            + e.failed.len()
+            + e.never_ran.len()
+            + e.never_failed.len()
+            + e.counts.len()
             > MAX_RULES
     {
         issues.push(Issue::new(
@@ -461,7 +489,11 @@ impl ScenarioFile {
             ("never_failed", &e.never_failed),
         ];
         let failed_node: Vec<String> = e.failed_node.iter().cloned().collect();
-        for (key, list) in lists.into_iter().chain([("failed_node", &failed_node)]) {
+        let counted: Vec<String> = e.counts.iter().map(|c| c.node.clone()).collect();
+        for (key, list) in lists
+            .into_iter()
+            .chain([("failed_node", &failed_node), ("counts", &counted)])
+        {
             for p in list {
                 if !plan.nodes.iter().any(|n| glob_match(p, &n.path)) {
                     return Err(format!(
@@ -649,6 +681,14 @@ pub fn check(expect: &Expect, results: &[ScenarioResult], summary: &Summary) -> 
             measured: format!("{f} failure(s)"),
         });
     }
+    for c in &expect.counts {
+        let (expectation, ok, measured) = c.check(results, summary);
+        out.push(Checked {
+            expectation,
+            ok,
+            measured,
+        });
+    }
     out
 }
 
@@ -656,19 +696,22 @@ pub fn check(expect: &Expect, results: &[ScenarioResult], summary: &Summary) -> 
 pub fn offending_commands(expect: &Expect, results: &[ScenarioResult], config: &SweepConfig) -> Vec<String> {
     results
         .iter()
-        .filter(|r| match expect.outcome {
-            Outcome::Success => !r.success,
-            Outcome::Failure => {
-                r.success
-                    || expect
-                        .failure_kind
-                        .as_deref()
-                        .is_some_and(|k| r.failure_kind != Some(k))
-                    || expect
-                        .failed_node
-                        .as_deref()
-                        .is_some_and(|p| !r.failed_node.as_deref().is_some_and(|n| glob_match(p, n)))
-            }
+        .filter(|r| {
+            expect.counts.iter().any(|c| c.broken_by(r))
+                || match expect.outcome {
+                    Outcome::Success => !r.success,
+                    Outcome::Failure => {
+                        r.success
+                            || expect
+                                .failure_kind
+                                .as_deref()
+                                .is_some_and(|k| r.failure_kind != Some(k))
+                            || expect
+                                .failed_node
+                                .as_deref()
+                                .is_some_and(|p| !r.failed_node.as_deref().is_some_and(|n| glob_match(p, n)))
+                    }
+                }
         })
         .map(|r| r.reproduce(&config.tree, config))
         .collect()

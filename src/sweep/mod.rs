@@ -360,7 +360,7 @@ pub struct ScenarioResult {
     pub failure_reason: Option<String>,
     /// Simulated time, seconds.
     pub sim_time_s: f64,
-    /// Grasp leaves started.
+    /// Grasp leaves started on the arm (a grasp answered by a substitution is not counted).
     pub grasp_attempts: u32,
     /// Leaves preempted while running.
     pub halts: u32,

@@ -40,7 +40,7 @@ pub struct Failure {
     pub reproduce: String,
 }
 
-/// The summary of a sweep (`--json` prints it as the last stdout line).
+/// The summary of a sweep (`--json` prints it as the only thing on stdout).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Summary {
     /// The tree file, as given.
@@ -63,7 +63,9 @@ pub struct Summary {
     pub success_rate: f64,
     /// 95% Wilson score interval of the success rate, [low, high].
     pub success_rate_ci95: [f64; 2],
-    /// Number of scenarios by grasp attempts made (JSON keys are the attempt counts).
+    /// Number of scenarios by physical grasp attempts made (JSON keys are the attempt counts):
+    /// a grasp answered by a substitution never reaches the arm and is not counted; its node's
+    /// `activations` in `nodes` count it.
     pub attempts_histogram: BTreeMap<u32, u64>,
     /// Median simulated time over all scenarios (nearest rank), seconds.
     pub median_sim_time_s: f64,
@@ -312,7 +314,13 @@ impl Summary {
             .iter()
             .map(|(a, c)| format!("{a}: {c}"))
             .collect();
-        let _ = writeln!(s, "  grasp attempts: {}", hist.join(", "));
+        // Substituted leaves never reach the arm: the histogram counts physical grasps only.
+        let label = if self.substitutions.is_empty() {
+            "grasp attempts"
+        } else {
+            "grasp attempts (physical only; grasps answered by a substitution are not counted)"
+        };
+        let _ = writeln!(s, "  {label}: {}", hist.join(", "));
         let _ = writeln!(
             s,
             "  sim time: median {:.2} s, p95 {:.2} s",

@@ -15,11 +15,11 @@ use crate::scene::{CONTAINER_FLOOR, ObjectKind, ObjectSpec, Shape};
 pub struct ObjectState {
     /// Position, world frame, metres.
     pub pos: Vector3<f64>,
-    /// Orientation.
+    /// Orientation, world frame (unit quaternion; a block's axes are its faces' normals).
     pub quat: UnitQuaternion<f64>,
-    /// Linear velocity, m/s.
+    /// Linear velocity, world frame, m/s.
     pub linvel: Vector3<f64>,
-    /// Angular velocity, rad/s.
+    /// Angular velocity, world frame, rad/s.
     pub angvel: Vector3<f64>,
     /// A left pad touches it.
     pub left_pad_contact: bool,
@@ -58,7 +58,7 @@ pub enum Piece {
     Wall,
 }
 
-/// Two parts in contact.
+/// Two parts in contact (in no particular order: check both sides).
 pub type Touch = (Part, Part);
 
 impl World {

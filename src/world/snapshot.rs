@@ -63,7 +63,8 @@ pub struct World {
     pub gripper_speed: f64,
     /// Pinch point (tool point between the fingertips) position, world frame, metres.
     pub pinch_pos: Vector3<f64>,
-    /// Pinch frame orientation (its z axis points out of the fingers), world frame.
+    /// Pinch frame orientation (its z axis points out of the fingers), world frame (a rotation
+    /// matrix whose columns are the frame's axes).
     pub pinch_rot: Matrix3<f64>,
     /// The left pads touch the cube.
     pub left_pad_contact: bool,
@@ -75,7 +76,7 @@ pub struct World {
     pub right_pad_pos: Vector3<f64>,
     /// Cube centre, world frame, metres.
     pub cube_pos: Vector3<f64>,
-    /// Cube orientation.
+    /// Cube orientation, world frame (unit quaternion).
     pub cube_quat: UnitQuaternion<f64>,
     /// Cube linear velocity, m/s.
     pub cube_linvel: Vector3<f64>,
