@@ -16,7 +16,7 @@ use std::process::ExitCode;
 
 use macrotree::actions::{Cell, MacroAction, Progress, object_index};
 use macrotree::episode::{EpisodeConfig, Goal};
-use macrotree::kinds::ObjectRef;
+use macrotree::kinds::{ObjectRef, ObjectRole};
 use macrotree::motion::{
     CLOSED_CTRL, CartesianMove, JointMove, MotionLimits, Trajectory, down_pose, ik_down,
 };
@@ -121,6 +121,8 @@ fn push_distance<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
 }
 
 impl Params for Push {
+    /// `object:` must name a block of the scene (checked when the tree loads).
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("object", ObjectRole::Block)];
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
         vec![&mut self.object]
     }
@@ -160,6 +162,8 @@ fn default_tolerance() -> f64 {
 }
 
 impl Params for Near {
+    /// `object:` must name a block of the scene (checked when the tree loads).
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("object", ObjectRole::Block)];
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
         vec![&mut self.object]
     }
@@ -185,6 +189,8 @@ fn ten_degrees() -> Angle {
 }
 
 impl Params for Upright {
+    /// `object:` must name a block of the scene (checked when the tree loads).
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("object", ObjectRole::Block)];
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
         vec![&mut self.object]
     }

@@ -54,7 +54,7 @@
 //! ```no_run
 //! use macrotree::actions::{Cell, MacroAction, Progress, object_index};
 //! use macrotree::episode::{EpisodeConfig, Goal};
-//! use macrotree::kinds::ObjectRef;
+//! use macrotree::kinds::{ObjectRef, ObjectRole};
 //! use macrotree::world::World;
 //! use macrotree::{App, Params};
 //! use schemars::JsonSchema;
@@ -72,6 +72,7 @@
 //! }
 //!
 //! impl Params for Push {
+//!     const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("object", ObjectRole::Block)];
 //!     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
 //!         vec![&mut self.object]
 //!     }
@@ -105,6 +106,7 @@
 //! }
 //!
 //! impl Params for Near {
+//!     const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("object", ObjectRole::Block)];
 //!     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
 //!         vec![&mut self.object]
 //!     }

@@ -5,7 +5,7 @@
 use std::sync::Arc;
 
 use macrotree::actions::{Cell, MacroAction, Progress};
-use macrotree::kinds::{Leaf, ObjectRef};
+use macrotree::kinds::{Leaf, ObjectRef, ObjectRole};
 use macrotree::plan::LeafId;
 use macrotree::runtime::{LeafDriver, LeafOutcome, Selection, TreeRunner, TreeStatus};
 use macrotree::world::World;
@@ -28,6 +28,7 @@ struct Probe {
 }
 
 impl Params for Probe {
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("object", ObjectRole::Any)];
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
         vec![&mut self.object]
     }
@@ -58,6 +59,7 @@ struct Touching {
 }
 
 impl Params for Touching {
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("object", ObjectRole::Block)];
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
         vec![&mut self.object]
     }
@@ -322,3 +324,93 @@ fn validate_fields_errors_point_at_the_value_they_name() {
     assert_eq!(default("max_tilt").as_deref(), Some("deg(5)"));
     assert_eq!(default("min_tilt").as_deref(), Some("deg(-7.5)"));
 }
+
+/// `lift_block: {block, height}` — an object parameter whose key is none of the built-in ones.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+struct LiftBlock {
+    /// The block (a name or `{var}`).
+    block: ObjectRef,
+    /// Where to, a container (a name or `{var}`).
+    into: ObjectRef,
+}
+
+impl Params for LiftBlock {
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] =
+        &[("block", ObjectRole::Block), ("into", ObjectRole::Container)];
+    fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
+        vec![&mut self.block, &mut self.into]
+    }
+}
+
+const LIFT_BLOCK_DOC: &str = "Lift a block into a container.\n\nHalt: the arm holds where it is.\n\n```yaml\nlift_block: {block: cube, into: bowl}\n```\n";
+
+/// Bug (issue 18): the loader guessed which parameters name objects from their keys (`object`,
+/// `support`, `container`, `target`, `to`), so `block:` in a custom leaf was never checked against
+/// the scene and a misspelled block name only failed when the leaf ran.
+#[test]
+fn a_custom_leafs_block_parameter_was_never_checked_against_the_scene() {
+    let mut app = App::new();
+    app.register_action("lift_block", LIFT_BLOCK_DOC, |_: &LiftBlock| Box::new(Idle))
+        .unwrap();
+    let ok = app.compile_str("main: {lift_block: {block: cube, into: bowl}}\n", "t.yaml");
+    assert!(ok.is_ok(), "{}", ok.unwrap_err());
+    let e = app
+        .compile_str("main: {lift_block: {block: cueb, into: bowl}}\n", "t.yaml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("t.yaml:1:28") && e.contains("unknown object `cueb`"),
+        "{e}"
+    );
+    assert!(e.contains("did you mean `cube`?"), "{e}");
+    // The declared role is checked too: a container where a block belongs.
+    let e = app
+        .compile_str("main: {lift_block: {block: bowl, into: bowl}}\n", "t.yaml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("t.yaml:1:28") && e.contains("a block"), "{e}");
+    let e = app
+        .compile_str("main: {lift_block: {block: cube, into: cube}}\n", "t.yaml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("t.yaml:1:40") && e.contains("a container"), "{e}");
+}
+
+/// What a kind does not declare is not guessed: an `object:` key of a custom leaf whose
+/// parameter type declares no object parameters is not checked against the scene.
+#[test]
+fn object_parameters_come_from_the_declaration_not_from_key_names() {
+    let registry = Registry::builtin();
+    let roles = |k: &str| registry.get(k).unwrap().object_params().to_vec();
+    assert_eq!(
+        roles("in"),
+        [
+            ("object", ObjectRole::Block),
+            ("container", ObjectRole::Container)
+        ]
+    );
+    assert_eq!(roles("reach"), [("target", ObjectRole::Any)]);
+    assert_eq!(roles("home"), []);
+    let mut app = App::new();
+    app.register_action(
+        "unchecked",
+        LIFT_BLOCK_DOC.replace("lift_block", "unchecked").leak(),
+        |_: &Unchecked| Box::new(Idle),
+    )
+    .unwrap();
+    assert!(
+        app.compile_str("main: {unchecked: {object: nowhere}}\n", "t.yaml")
+            .is_ok()
+    );
+}
+
+/// `unchecked: {object}`, declaring no object parameters.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+struct Unchecked {
+    /// Any text.
+    object: String,
+}
+
+impl Params for Unchecked {}

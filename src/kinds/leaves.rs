@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use schemars::JsonSchema;
 
-use super::objects::{ObjectRef, opt_var_name, var_name};
+use super::objects::{ObjectRef, ObjectRole, opt_var_name, var_name};
 use super::targets::{PathKind, Target, Yaw};
 pub use crate::kinds::{LeafCall, Params};
 use crate::world::conditions::Tolerances;
@@ -612,6 +612,7 @@ pub(crate) fn fmt_vec(v: &[f64]) -> String {
 }
 
 impl Params for Reach {
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("target", ObjectRole::Any)];
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
         target_mut(&mut self.target)
     }
@@ -651,6 +652,7 @@ impl Params for Home {
 }
 
 impl Params for Grasp {
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("object", ObjectRole::Block)];
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
         self.object.iter_mut().collect()
     }
@@ -663,6 +665,7 @@ impl Params for Grasp {
 }
 
 impl Params for Carry {
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("to", ObjectRole::Any)];
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
         target_mut(&mut self.to)
     }
@@ -716,42 +719,53 @@ impl Params for CubeAt {
 }
 
 impl Params for Grasped {
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("object", ObjectRole::Block)];
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
         vec![&mut self.object]
     }
 }
 
 impl Params for Lifted {
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("object", ObjectRole::Block)];
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
         vec![&mut self.object]
     }
 }
 
 impl Params for In {
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[
+        ("object", ObjectRole::Block),
+        ("container", ObjectRole::Container),
+    ];
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
         vec![&mut self.object, &mut self.container]
     }
 }
 
 impl Params for On {
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] =
+        &[("object", ObjectRole::Block), ("support", ObjectRole::Block)];
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
         vec![&mut self.object, &mut self.support]
     }
 }
 
 impl Params for OnTable {
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("object", ObjectRole::Block)];
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
         vec![&mut self.object]
     }
 }
 
 impl Params for At {
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("object", ObjectRole::Block)];
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
         vec![&mut self.object]
     }
 }
 
 impl Params for GoalMet {
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("object", ObjectRole::Block)];
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
         self.object.iter_mut().collect()
     }

@@ -32,7 +32,7 @@ pub use leaves::{
     At, AtHome, Carry, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, GoalMet, Grasp, Grasped,
     GripperOpen, Home, In, Leaf, Lifted, MoveJoints, On, OnTable, Reach, Release, Select, Wait,
 };
-pub use objects::ObjectRef;
+pub use objects::{ObjectRef, ObjectRole};
 pub use param_error::ParamError;
 pub use params::Params;
 pub(crate) use registry::Imp;

@@ -9,6 +9,7 @@ use schemars::{JsonSchema, Schema, SchemaGenerator, json_schema};
 use serde::de::{self, Deserializer, MapAccess, Visitor};
 use serde::{Deserialize, Serialize, Serializer};
 
+use crate::scene::ObjectKind;
 use crate::yaml::is_identifier;
 
 /// A short name (object or variable, at most [`Ident::MAX`] bytes) stored inline, so that the
@@ -188,4 +189,36 @@ pub fn var_name<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
 /// An optional [`var_name`].
 pub fn opt_var_name<'de, D: Deserializer<'de>>(d: D) -> Result<Option<String>, D::Error> {
     var_name(d).map(Some)
+}
+
+/// What kind of object a parameter must name (see [`Params::OBJECT_PARAMS`](super::Params::OBJECT_PARAMS)).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ObjectRole {
+    /// A block (e.g. `object:`, `support:`).
+    Block,
+    /// A container (e.g. `container:`).
+    Container,
+    /// Any object (e.g. `target:`, `to:`).
+    Any,
+}
+
+impl ObjectRole {
+    /// Whether an object of `kind` fits.
+    pub fn accepts(self, kind: ObjectKind) -> bool {
+        match self {
+            ObjectRole::Block => kind == ObjectKind::Block,
+            ObjectRole::Container => kind == ObjectKind::Container,
+            ObjectRole::Any => true,
+        }
+    }
+
+    /// How messages name what fits (`a block`, `a container`, `an object`).
+    pub fn name(self) -> &'static str {
+        match self {
+            ObjectRole::Block => "a block",
+            ObjectRole::Container => "a container",
+            ObjectRole::Any => "an object",
+        }
+    }
 }

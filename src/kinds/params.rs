@@ -8,7 +8,7 @@ use schemars::JsonSchema;
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 
-use super::objects::ObjectRef;
+use super::objects::{ObjectRef, ObjectRole};
 use super::param_error::ParamError;
 
 /// The parameters of a leaf kind, read from the node's YAML body.
@@ -26,10 +26,17 @@ use super::param_error::ParamError;
 pub trait Params:
     Serialize + DeserializeOwned + JsonSchema + Clone + fmt::Debug + PartialEq + Send + Sync + 'static
 {
+    /// The parameters (keys of the node's body) that name objects of the scene, with what each
+    /// must name: checked against the scene when the tree loads, so a misspelled name or a
+    /// container where a block belongs is a located error with a suggestion. Default: none.
+    ///
+    /// ```ignore
+    /// const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("block", ObjectRole::Block)];
+    /// ```
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[];
+
     /// Every object reference among the parameters, so that `{variables}` are resolved before
-    /// each tick. Object names are checked against the scene when the tree loads, by key:
-    /// `object` and `support` must name a block, `container` a container, `target` and `to` any
-    /// object. Default: none.
+    /// each tick. Default: none.
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
         Vec::new()
     }

@@ -14,6 +14,7 @@ use super::catalog::{ParamDoc, parse_node_doc};
 use super::control::SchemaCtx;
 use super::leaf_call::LeafCall;
 use super::leaves::{Leaf, Select, Wait};
+use super::objects::ObjectRole;
 use super::params::{DynParams, Params};
 use crate::error::Error;
 use crate::yaml::de::DeError;
@@ -60,7 +61,7 @@ fn schema_of<P: JsonSchema>(g: &mut SchemaGenerator) -> String {
     P::schema_name().into_owned()
 }
 
-/// How a kind is read and run.
+/// How a kind is read.
 pub(crate) enum Imp {
     /// A composite or decorator: parsed by the tree reader; its parameters and schema are given.
     Control {
@@ -70,10 +71,12 @@ pub(crate) enum Imp {
     Action {
         parse: ParseParams,
         schema: fn(&mut SchemaGenerator) -> String,
+        objects: &'static [(&'static str, ObjectRole)],
     },
     Condition {
         parse: ParseParams,
         schema: fn(&mut SchemaGenerator) -> String,
+        objects: &'static [(&'static str, ObjectRole)],
     },
     Wait,
     Select,
@@ -111,6 +114,15 @@ impl NodeType {
     /// paragraph and a ```` ```yaml ```` example (the format of `docs/nodes/*.md`).
     pub fn doc(&self) -> &'static str {
         self.doc
+    }
+
+    /// The parameters that name objects of the scene, with what each must name
+    /// ([`Params::OBJECT_PARAMS`] of the kind's parameter type; none for other kinds).
+    pub fn object_params(&self) -> &'static [(&'static str, ObjectRole)] {
+        match &self.imp {
+            Imp::Action { objects, .. } | Imp::Condition { objects, .. } => objects,
+            _ => &[],
+        }
     }
 
     pub(crate) fn imp(&self) -> &Imp {
@@ -223,6 +235,7 @@ impl Registry {
             Imp::Action {
                 parse: parse_params::<P>,
                 schema: schema_of::<P>,
+                objects: P::OBJECT_PARAMS,
             },
         )
     }
@@ -245,6 +258,7 @@ impl Registry {
             Imp::Condition {
                 parse: parse_params::<P>,
                 schema: schema_of::<P>,
+                objects: P::OBJECT_PARAMS,
             },
         )
     }

@@ -5,40 +5,10 @@
 use serde::Serialize;
 
 use crate::kinds::leaves::Select;
-use crate::kinds::objects::ObjectRef;
+use crate::kinds::objects::{ObjectRef, ObjectRole};
 use crate::scene::{ObjectKind, SceneSpec};
 use crate::yaml::diag::{Issue, Loc};
 use crate::yaml::suggest::{closest, did_you_mean};
-
-/// What kind of object a parameter needs.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Role {
-    /// A block (`object:`, `support:`).
-    Block,
-    /// A container (`container:`).
-    Container,
-    /// Any object (`target:`, `to:`).
-    Any,
-}
-
-impl Role {
-    fn accepts(self, kind: ObjectKind) -> bool {
-        match self {
-            Role::Block => kind == ObjectKind::Block,
-            Role::Container => kind == ObjectKind::Container,
-            Role::Any => true,
-        }
-    }
-
-    fn name(self) -> &'static str {
-        match self {
-            Role::Block => "a block",
-            Role::Container => "a container",
-            Role::Any => "an object",
-        }
-    }
-}
 
 /// How a leaf names an object.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -57,7 +27,7 @@ pub struct ObjectUse {
     /// The name or variable.
     pub reference: Named,
     /// What it must be.
-    pub role: Role,
+    pub role: ObjectRole,
     /// Where it is written.
     pub loc: Loc,
     /// If it came from a subtree argument, where the `$param` was used.
@@ -77,9 +47,9 @@ pub enum VarType {
 }
 
 impl VarType {
-    fn fits(self, role: Role) -> bool {
+    fn fits(self, role: ObjectRole) -> bool {
         match (self, role) {
-            (_, Role::Any) => true,
+            (_, ObjectRole::Any) => true,
             (VarType::Kind(k), r) => r.accepts(k),
             (VarType::Destination, _) => false,
         }
@@ -186,7 +156,11 @@ pub fn check_scene(uses: &[ObjectUse], scene: &SceneSpec, describe: impl Fn(Loc)
             Named::Ref(ObjectRef::Var(_)) => continue,
             Named::Ref(ObjectRef::Name(n)) => match scene.object(n.as_str()) {
                 None => {
-                    let what = if u.role == Role::Any { "target" } else { "object" };
+                    let what = if u.role == ObjectRole::Any {
+                        "target"
+                    } else {
+                        "object"
+                    };
                     let hint = did_you_mean(n.as_str(), names.iter().copied())
                         .map_or(String::new(), |h| format!(" ({h})"));
                     Issue::new(u.loc, format!("unknown {what} `{n}` in `{}`{hint}", u.leaf))
@@ -194,7 +168,7 @@ pub fn check_scene(uses: &[ObjectUse], scene: &SceneSpec, describe: impl Fn(Loc)
                             "expected an object of scene `{}` ({}), a variable `{{name}}`{}",
                             scene.name,
                             names.join(", "),
-                            if u.role == Role::Any {
+                            if u.role == ObjectRole::Any {
                                 " or `[x, y, z]`"
                             } else {
                                 ""

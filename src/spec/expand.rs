@@ -8,9 +8,10 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use super::check::{ObjectUse, Role, VarDef};
+use super::check::{ObjectUse, VarDef};
 use super::file::{SubtreeDef, param_ref};
 use super::node::{Node, NodeKind};
+use crate::kinds::ObjectRole;
 use crate::kinds::leaves::{Leaf, Select};
 use crate::kinds::{Category, NodeType, Registry};
 use crate::yaml::de::DeError;
@@ -218,7 +219,9 @@ impl<'a> Expander<'a> {
                 }
                 self.warnings.push(issue);
             }
-            self.record_objects(k, body);
+            if let Some(t) = &ty {
+                self.record_objects(t, body);
+            }
             match parsed {
                 Ok(leaf) => {
                     if let Some(Err(why)) = leaf.call().map(|c| c.validate()) {
@@ -300,21 +303,21 @@ impl<'a> Expander<'a> {
 
     /// Notes where leaf `kind` names objects or variables (for the scene and blackboard checks),
     /// even when the leaf has other errors, so that every mistake is reported at once.
-    fn record_objects(&mut self, kind: &str, body: &Value) {
-        if kind == "select" {
-            return;
-        }
-        for (key, role) in [
-            ("object", Role::Block),
-            ("container", Role::Container),
-            ("support", Role::Block),
-            ("target", Role::Any),
-            ("to", Role::Any),
-        ] {
+    /// The parameters that name objects are the ones the kind declares
+    /// ([`crate::kinds::Params::OBJECT_PARAMS`]).
+    fn record_objects(&mut self, ty: &NodeType, body: &Value) {
+        let kind = ty.name();
+        for &(key, role) in ty.object_params() {
             let Some(v) = body.get(key) else { continue };
             let reference = match &v.kind {
-                ValueKind::Str(s) if s == "cube" && key != "object" => Some(super::check::Named::LegacyCube),
-                ValueKind::Str(s) if s == "bowl" && key != "object" => Some(super::check::Named::LegacyBowl),
+                // `cube` and `bowl` are legacy names only where a `Target` is read (any object):
+                // an `ObjectRef` parameter resolves them as plain names when the tree runs.
+                ValueKind::Str(s) if s == "cube" && role == ObjectRole::Any => {
+                    Some(super::check::Named::LegacyCube)
+                }
+                ValueKind::Str(s) if s == "bowl" && role == ObjectRole::Any => {
+                    Some(super::check::Named::LegacyBowl)
+                }
                 ValueKind::Str(s) => crate::kinds::objects::ObjectRef::parse(s)
                     .ok()
                     .map(super::check::Named::Ref),
@@ -339,7 +342,7 @@ impl<'a> Expander<'a> {
         if kind.starts_with("cube_") {
             self.object_uses.push(ObjectUse {
                 reference: super::check::Named::LegacyCube,
-                role: Role::Block,
+                role: ObjectRole::Block,
                 loc: body.loc,
                 via: body.via,
                 leaf: kind.to_string(),
@@ -348,7 +351,7 @@ impl<'a> Expander<'a> {
         if kind == "cube_in_bowl" {
             self.object_uses.push(ObjectUse {
                 reference: super::check::Named::LegacyBowl,
-                role: Role::Container,
+                role: ObjectRole::Container,
                 loc: body.loc,
                 via: body.via,
                 leaf: kind.to_string(),
