@@ -1,5 +1,6 @@
-//! Macro-action leaves executed on the simulated cell: `reach`, `move_joints`, `home`, `grasp`,
-//! `carry`, `release`, plus the condition leaves, through [`MacroDriver`].
+//! The macro-action controllers on the simulated cell: `reach`, `move_joints`, `home`, `grasp`,
+//! `carry`, `release`. `crate::factory` binds them to their node kinds, and the episode's leaf
+//! driver starts them when the tree runs.
 //!
 //! Each action is a small controller ([`MacroAction`]) in its own file: planned on its first
 //! tick from the current world (IK, trajectories from [`crate::motion`]), checked every tick

@@ -173,8 +173,8 @@ impl Registry {
 }
 
 impl Registry {
-    /// The JSON Schema (draft 2020-12) of a tree file using this registry's node kinds (see
-    /// [`json_schema`]).
+    /// The JSON Schema (draft 2020-12) of a tree file using this registry's node kinds (what
+    /// `macrotree schema` prints; `schema/tree.schema.json` for the built-in kinds).
     pub fn json_schema(&self) -> Value {
         let mut g = generator();
         let leaves: Vec<Option<String>> = self.types().map(|t| t.leaf_schema(&mut g)).collect();

@@ -1,6 +1,6 @@
 //! Naming objects in trees: an object of the scene by name (`red`, `bin`) or a blackboard
 //! variable (`{block}`) that a `select` or `for_each` wrote. Names are checked against the scene
-//! and variables against their writers when the tree is loaded ([`super::check`]).
+//! and variables against their writers when the tree is loaded (`crate::spec::check`).
 
 use std::borrow::Cow;
 use std::fmt;

@@ -18,7 +18,7 @@ use super::param_error::ParamError;
 /// `PartialEq`; document every field with its unit (the doc comments become the parameter docs
 /// of `macrotree nodes` and of the JSON Schema). Fields may use the crate's own parameter types
 /// and unit parsers: [`ObjectRef`] (an object name or a `{variable}`),
-/// [`Target`](crate::spec::Target), [`Angle`](crate::yaml::units::Angle), and
+/// [`Target`](crate::kinds::Target), [`Angle`](crate::yaml::units::Angle), and
 /// `#[serde(deserialize_with = "macrotree::yaml::units::distance")]` and friends for range-checked
 /// metres, seconds and `deg(..)` angles.
 ///

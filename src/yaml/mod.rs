@@ -2,7 +2,7 @@
 //! remembers its file, line and column ([`value`]); typed deserialization from it with located
 //! errors ([`de`]); diagnostics in rustc's style ([`diag`]); did-you-mean suggestions
 //! ([`suggest`]); range-checked unit parsers for metres, seconds and `deg(..)` angles
-//! ([`units`]); and reading input files with hard limits ([`read`]).
+//! ([`units`]); and reading input files with hard limits ([`read_limited`]).
 //!
 //! Tree files ([`crate::spec`]), scene files ([`crate::scene`]) and scenario files
 //! (`crate::suite`) are all read through it; it depends on nothing else in the crate but the
