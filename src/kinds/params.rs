@@ -51,6 +51,14 @@ pub trait Params:
     fn validate(&self) -> Result<(), String> {
         Ok(())
     }
+
+    /// The failure kinds of its own this node kind may fail with, besides the built-in ones:
+    /// stable `snake_case` names its controller (or check) uses as
+    /// [`FailureKind::Custom`](crate::failure::FailureKind::Custom). Checked when the kind is
+    /// declared; a failure of an undeclared custom kind is reported as `other`. Default: none.
+    fn failure_kinds() -> &'static [&'static str] {
+        &[]
+    }
 }
 
 /// Type-erased [`Params`].

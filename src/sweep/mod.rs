@@ -44,6 +44,7 @@ use crate::actions::{CONTROL_PERIOD, Cell, Checks};
 use crate::episode::Collision;
 use crate::episode::{EpisodeConfig, EpisodeReport, Goal, NoObserver, NodeReport, ObjectReport, run_in_cell};
 use crate::factory::Factory;
+use crate::failure::FailureKind;
 use crate::faults::FaultKind;
 use crate::plan::Plan;
 use crate::runtime::substitute::Substitution;
@@ -409,7 +410,6 @@ impl ScenarioResult {
         layout: Option<ScenarioLayout>,
         r: EpisodeReport,
     ) -> Self {
-        let failure_kind = r.failure_reason.as_deref().map(crate::episode::failure_kind);
         Self {
             suite: config.suite.clone(),
             tree: config.tree.clone(),
@@ -437,7 +437,7 @@ impl ScenarioResult {
             objects: r.objects,
             goal: r.goal,
             collisions: r.collisions,
-            failure_kind,
+            failure_kind: r.failure_kind,
             failed_node: r.failed_node,
             nodes: r.nodes,
             wall_time_s: r.wall_time_s,
@@ -451,7 +451,7 @@ impl ScenarioResult {
         index: u64,
         seed: u64,
         layout: Option<ScenarioLayout>,
-        reason: String,
+        reason: crate::failure::Failure,
     ) -> Self {
         Self {
             suite: config.suite.clone(),
@@ -468,8 +468,8 @@ impl ScenarioResult {
             layout,
             success: false,
             tree_status: "failure",
-            failure_kind: Some(crate::episode::failure_kind(&reason)),
-            failure_reason: Some(reason),
+            failure_kind: Some(reason.kind.as_str()),
+            failure_reason: Some(reason.message),
             sim_time_s: 0.0,
             grasp_attempts: 0,
             halts: 0,
@@ -647,7 +647,13 @@ pub fn run_scene_scenario_observed(
             let report = run_in_cell(cell, plan.clone(), factory, &episode, observer);
             ScenarioResult::of_scene(&scenario, config, report)
         }
-        Err(e) => ScenarioResult::not_run(config, index, 0, None, format!("layout: {e}")),
+        Err(e) => ScenarioResult::not_run(
+            config,
+            index,
+            0,
+            None,
+            crate::failure::Failure::new(FailureKind::Layout, format!("layout: {e}")),
+        ),
     }
 }
 
@@ -701,7 +707,10 @@ pub fn run_sweep_with<T: Send>(
                                 index,
                                 s.as_ref().map_or(0, |s| s.seed),
                                 s.and_then(|s| s.layout),
-                                format!("panicked: {}", panic_message(&*payload)),
+                                crate::failure::Failure::new(
+                                    FailureKind::Panicked,
+                                    format!("panicked: {}", panic_message(&*payload)),
+                                ),
                             );
                             (r, None)
                         }
