@@ -284,7 +284,9 @@ impl fmt::Display for Failure {
 
 impl std::error::Error for Failure {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        self.cause.as_deref().map(|c| c as &(dyn std::error::Error + 'static))
+        self.cause
+            .as_deref()
+            .map(|c| c as &(dyn std::error::Error + 'static))
     }
 }
 
@@ -352,7 +354,10 @@ mod tests {
         let outer = Failure::new(inner.kind, format!("all 2 attempts failed; last: {inner}"))
             .at("main")
             .caused_by(inner.clone());
-        assert_eq!(outer.to_string(), "all 2 attempts failed; last: grasp lost during transfer");
+        assert_eq!(
+            outer.to_string(),
+            "all 2 attempts failed; last: grasp lost during transfer"
+        );
         assert_eq!(outer.root_cause(), &inner);
         assert_eq!(outer.clone().at("elsewhere").node.as_deref(), Some("main"));
         let source = std::error::Error::source(&outer).unwrap().to_string();

@@ -163,9 +163,9 @@ pub mod dataset;
 #[cfg(feature = "sim")]
 pub mod episode;
 pub mod error;
-pub mod failure;
 #[cfg(feature = "sim")]
 pub mod factory;
+pub mod failure;
 #[cfg(feature = "sim")]
 pub mod faults;
 pub mod kinds;

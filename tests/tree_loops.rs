@@ -96,7 +96,10 @@ fn for_each_fails_when_its_child_fails_and_stops_selecting() {
     let (mut runner, mut d) = setup(TREE);
     d.selections
         .extend([selection("red", "red_bin"), selection("blue", "blue_bin")]);
-    d.set("carry", LeafOutcome::failure(macrotree::FailureKind::GraspLost, "grasp lost"));
+    d.set(
+        "carry",
+        LeafOutcome::failure(macrotree::FailureKind::GraspLost, "grasp lost"),
+    );
     assert_eq!(run(&mut runner, &mut d), TreeStatus::Failure);
     assert_eq!(d.starts("grasp"), 1);
     assert_eq!(d.selections.len(), 1, "no selection after the failed iteration");

@@ -110,7 +110,10 @@ fn fail_first_counts_activations_across_retries() {
 fn failure_and_success_never_reach_the_driver() {
     let plan = plan();
     let mut driver = ScriptedDriver::new(&plan);
-    driver.set_default(LeafOutcome::failure(macrotree::FailureKind::Other, "real leaf ran"));
+    driver.set_default(LeafOutcome::failure(
+        macrotree::FailureKind::Other,
+        "real leaf ran",
+    ));
     let mut runner = TreeRunner::with_substitutions(
         plan.clone(),
         subs(

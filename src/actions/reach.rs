@@ -5,9 +5,9 @@ use nalgebra::{Isometry3, Translation3, Vector3};
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
 use super::targets::{resolve, segment_distance, target_block, target_object, tool_yaw};
+use crate::failure::{Failure, FailureKind};
 use crate::kinds::{PathKind, Reach as ReachSpec, Yaw};
 use crate::motion::{CartesianMove, JointMove, MotionLimits, Trajectory, down_pose, fk, ik_down};
-use crate::failure::{Failure, FailureKind};
 use crate::world::World;
 
 /// A failure of kind `unreachable` (IK or path planning found no way).
@@ -87,7 +87,8 @@ impl MacroAction for Reach {
             (Yaw::Angle(a), _) => (*a, false),
         };
         let from = cell.arm_setpoint();
-        let goal_q = ik_down(&position, yaw, quarter, &from).map_err(|e| unreachable(format!("unreachable: {e}")))?;
+        let goal_q =
+            ik_down(&position, yaw, quarter, &from).map_err(|e| unreachable(format!("unreachable: {e}")))?;
         let limits = MotionLimits {
             tool_speed: self.spec.speed,
             ..MotionLimits::default()
@@ -125,8 +126,8 @@ impl MacroAction for Reach {
             }
             PathKind::Cartesian => {
                 let pose = down_pose(&position, yaw_of_solution(&goal_q));
-                let mv =
-                    CartesianMove::new(from, pose, &limits).map_err(|e| unreachable(format!("unreachable path: {e}")))?;
+                let mv = CartesianMove::new(from, pose, &limits)
+                    .map_err(|e| unreachable(format!("unreachable path: {e}")))?;
                 cell.track(Box::new(mv));
             }
         }

@@ -155,7 +155,9 @@ impl LeafDriver for MacroDriver<'_> {
                     Some(Ok(true)) => LeafOutcome::Success,
                     Some(Ok(false)) => LeafOutcome::failure(FailureKind::ConditionFalse, "not satisfied"),
                     Some(Err(e)) => LeafOutcome::Failure(e),
-                    None => LeafOutcome::Failure(Failure::other(format!("`{}` is not a condition", c.kind()))),
+                    None => {
+                        LeafOutcome::Failure(Failure::other(format!("`{}` is not a condition", c.kind())))
+                    }
                 };
             }
             Leaf::Action(a) => a,

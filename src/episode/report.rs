@@ -53,8 +53,8 @@ pub struct EpisodeReport {
     /// The path of the last leaf (or check) that failed, when the episode failed.
     pub failed_node: Option<String>,
     /// A stable name for the kind of failure (`grasp_lost`, `timeout`, `substituted`, …; see
-    /// [`FailureKind::as_str`]), for grouping; `None` on success.
-    pub failure_kind: Option<&'static str>,
+    /// [`FailureKind`]), for grouping; `None` on success. Serialized as its name.
+    pub failure_kind: Option<FailureKind>,
     /// The failure itself, when the episode failed: its kind, message (`failure_reason`), the
     /// node it happened at and its chain of causes (not written to the JSON, which has
     /// `failure_reason`, `failure_kind` and `failed_node`).
@@ -199,7 +199,7 @@ impl EpisodeReport {
             goal,
             collisions: Vec::new(),
             failed_node: None,
-            failure_kind: failure.as_ref().map(|f| f.kind.as_str()),
+            failure_kind: failure.as_ref().map(|f| f.kind),
             failure,
             nodes: Vec::new(),
         }
@@ -232,7 +232,7 @@ impl EpisodeReport {
     /// Marks the episode failed by `failure`: its reason and kind.
     pub fn set_failure(&mut self, failure: Failure) {
         self.failure_reason = Some(failure.message.clone());
-        self.failure_kind = Some(failure.kind.as_str());
+        self.failure_kind = Some(failure.kind);
         self.failure = Some(failure);
     }
 }

@@ -310,7 +310,11 @@ fn check_failure_kinds<P: Params>(name: &str) -> Result<(), Error> {
     for (i, k) in kinds.iter().enumerate() {
         let why = crate::failure::FailureKind::check_custom_name(k)
             .err()
-            .or_else(|| kinds[..i].contains(k).then(|| format!("failure kind `{k}` is declared twice")));
+            .or_else(|| {
+                kinds[..i]
+                    .contains(k)
+                    .then(|| format!("failure kind `{k}` is declared twice"))
+            });
         if let Some(message) = why {
             return Err(Error::Registry {
                 kind: name.to_string(),

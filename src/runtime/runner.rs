@@ -368,7 +368,10 @@ impl RunState {
                 let out = match (leaf, out) {
                     (Leaf::Condition(c), LeafOutcome::Running) => {
                         tracing::warn!(target: "macrotree::tree", path = %info.path, "condition `{}` answered Running; conditions must answer at once, treating it as Failure", c.kind());
-                        LeafOutcome::Failure(Failure::other(format!("condition `{}` answered Running", c.kind())))
+                        LeafOutcome::Failure(Failure::other(format!(
+                            "condition `{}` answered Running",
+                            c.kind()
+                        )))
                     }
                     (_, o) => o,
                 };
@@ -578,7 +581,9 @@ impl RunState {
                 self.write_selection(plan, node, sel, found);
                 LeafOutcome::Success
             }
-            Ok(None) => LeafOutcome::Failure(Failure::other(format!("no {} matches", sel.query().describe()))),
+            Ok(None) => {
+                LeafOutcome::Failure(Failure::other(format!("no {} matches", sel.query().describe())))
+            }
             Err(reason) => LeafOutcome::Failure(reason),
         }
     }
@@ -625,7 +630,11 @@ impl RunState {
             .last_failure
             .clone()
             .unwrap_or_else(|| Failure::other("a child failed").at(&info.path));
-        let wrap = |message: String| Failure::new(last.kind, message).at(&info.path).caused_by(last.clone());
+        let wrap = |message: String| {
+            Failure::new(last.kind, message)
+                .at(&info.path)
+                .caused_by(last.clone())
+        };
         match info.kind {
             "timeout" => {
                 let child_failed = info.children.first().is_some_and(|&c| {
@@ -637,10 +646,11 @@ impl RunState {
                     Failure::new(FailureKind::Timeout, format!("{} expired", info.label)).at(&info.path)
                 }
             }
-            "retry" => wrap(format!("all {} attempts failed; last: {last}", self.attempts[node].max(1))),
-            "inverter" => {
-                Failure::new(FailureKind::Inverted, "inverter: child succeeded").at(&info.path)
-            }
+            "retry" => wrap(format!(
+                "all {} attempts failed; last: {last}",
+                self.attempts[node].max(1)
+            )),
+            "inverter" => Failure::new(FailureKind::Inverted, "inverter: child succeeded").at(&info.path),
             "force_failure" => {
                 Failure::new(FailureKind::Forced, "force_failure: child succeeded").at(&info.path)
             }

@@ -382,8 +382,8 @@ pub struct ScenarioResult {
     pub collisions: Vec<Collision>,
     /// The path of the node whose failure ended the episode, if one did.
     pub failed_node: Option<String>,
-    /// A stable name for the kind of failure (`timeout`, `grasp_lost`, …), for grouping.
-    pub failure_kind: Option<&'static str>,
+    /// The kind of failure (`timeout`, `grasp_lost`, …; serialized as its name), for grouping.
+    pub failure_kind: Option<FailureKind>,
     /// How often every node ran, in plan order.
     pub nodes: Vec<NodeReport>,
     /// Wall-clock time of the episode, seconds (not written to the JSONL).
@@ -468,7 +468,7 @@ impl ScenarioResult {
             layout,
             success: false,
             tree_status: "failure",
-            failure_kind: Some(reason.kind.as_str()),
+            failure_kind: Some(reason.kind),
             failure_reason: Some(reason.message),
             sim_time_s: 0.0,
             grasp_attempts: 0,

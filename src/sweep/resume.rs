@@ -258,8 +258,9 @@ pub fn parse_line(line: &str) -> Result<ScenarioResult, String> {
         Value::Null => None,
         k => {
             let name = k.as_str().ok_or("`failure_kind` is not text")?;
-            let kind = crate::failure::FailureKind::parse(name).map_err(|e| format!("`failure_kind`: {e}"))?;
-            Some(kind.as_str())
+            let kind =
+                crate::failure::FailureKind::parse(name).map_err(|e| format!("`failure_kind`: {e}"))?;
+            Some(kind)
         }
     };
     let status = field("tree_status")?.as_str().unwrap_or_default();
