@@ -580,3 +580,33 @@ fn every_built_in_kind_is_tested() {
     let all: Vec<&str> = FailureKind::BUILTIN.iter().map(|k| k.as_str()).collect();
     assert_eq!(all, tested);
 }
+
+#[test]
+fn a_resumed_sweep_reads_the_kind_back_from_the_file_custom_kinds_included() {
+    let app = stuck_app(FailureKind::Custom("jammed"));
+    let plan = Arc::new(
+        app.compile_str("main: {stuck: {object: cube}}", "stuck.yaml")
+            .unwrap(),
+    );
+    let config = SweepConfig {
+        scenarios: 1,
+        goal: Goal::Tree,
+        ..SweepConfig::default()
+    };
+    let mut cell = Cell::new(scene(), &Layout::default(), CONTROL_PERIOD);
+    let r = run_scene_scenario(&mut cell, &plan, app.factory(), &config, 0);
+    assert_eq!(r.failure_kind, Some(FailureKind::Custom("jammed")));
+    let line = serde_json::to_string(&r).unwrap();
+    let back = macrotree::sweep::resume::parse_line(&line).unwrap();
+    assert_eq!(back.failure_kind, Some(FailureKind::Custom("jammed")));
+    assert_eq!(serde_json::to_string(&back).unwrap(), line);
+    // The kind is read, not derived from the reason: a reason that reads like another kind
+    // keeps the kind written beside it; a kind that is no name is refused.
+    let relabelled = line.replace("stuck: the block will not move", "grasp lost during transfer");
+    let back = macrotree::sweep::resume::parse_line(&relabelled).unwrap();
+    assert_eq!(back.failure_kind, Some(FailureKind::Custom("jammed")));
+    let bad = line.replace("\"failure_kind\":\"jammed\"", "\"failure_kind\":\"Jammed!\"");
+    assert_ne!(bad, line);
+    let e = macrotree::sweep::resume::parse_line(&bad).unwrap_err();
+    assert!(e.contains("failure_kind"), "{e}");
+}
