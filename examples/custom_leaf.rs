@@ -23,7 +23,7 @@ use macrotree::motion::{
 use macrotree::world::Part;
 use macrotree::world::World;
 use macrotree::yaml::units::Angle;
-use macrotree::{App, Error, ParamError, Params};
+use macrotree::{App, Error, Failure, FailureKind, ParamError, Params};
 use nalgebra::Vector3;
 use schemars::JsonSchema;
 use serde::{Deserialize, Deserializer, Serialize};
@@ -35,7 +35,7 @@ const PUSH_DOC: &str = "Slide a block along the table by a given distance.
 Closes the gripper, comes down behind the block (seen from the push direction) with the
 fingertips low over the table, and moves the closed fingers along `direction` until the block's
 centre has moved `distance`; then backs off 3 cm and rises. Fails when the block is not pushed
-that far before the motion ends (missed or blocked).
+that far before the motion ends (missed or blocked): failure kind `short_push`.
 
 Halt: the arm holds where it is.
 
@@ -137,7 +137,14 @@ impl Params for Push {
     fn timeout(&self) -> Option<f64> {
         Some(self.timeout)
     }
+    /// `push`'s own failure kind, besides the built-in ones (`unreachable`, `timeout`, …).
+    fn failure_kinds() -> &'static [&'static str] {
+        &[SHORT_PUSH]
+    }
 }
+
+/// The failure kind of a push that did not move the block far enough.
+const SHORT_PUSH: &str = "short_push";
 
 /// Parameters of `near`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -210,7 +217,7 @@ impl Params for Upright {
 
 /// `upright`: reads orientation (`objects[i].quat`) and contacts (the pads' flags and
 /// `touches`).
-fn upright(w: &World, p: &Upright) -> Result<bool, String> {
+fn upright(w: &World, p: &Upright) -> Result<bool, Failure> {
     let i = object_index(&p.object, w)?;
     let o = &w.objects[i];
     // The block's axis closest to world z, and its angle from it (a block may rest on any face).
@@ -226,7 +233,7 @@ fn upright(w: &World, p: &Upright) -> Result<bool, String> {
 }
 
 /// `near`: a pure function of the world snapshot and the parameters.
-fn near(w: &World, p: &Near) -> Result<bool, String> {
+fn near(w: &World, p: &Near) -> Result<bool, Failure> {
     let i = object_index(&p.object, w)?;
     let c = w.objects[i].pos;
     Ok((c.x - p.point[0]).hypot(c.y - p.point[1]) <= p.tolerance)
@@ -283,10 +290,10 @@ impl PushAction {
     }
 
     /// A straight move of the pinch to `to`, fingers down at the push yaw.
-    fn line_to(&self, cell: &Cell, to: Vector3<f64>, speed: f64) -> Result<Box<dyn Trajectory>, String> {
+    fn line_to(&self, cell: &Cell, to: Vector3<f64>, speed: f64) -> Result<Box<dyn Trajectory>, Failure> {
         CartesianMove::new(cell.arm_setpoint(), down_pose(&to, self.yaw), &self.limits(speed))
             .map(|m| Box::new(m) as Box<dyn Trajectory>)
-            .map_err(|e| format!("unreachable: {e}"))
+            .map_err(|e| Failure::new(FailureKind::Unreachable, format!("unreachable: {e}")))
     }
 
     /// How far the block's centre has moved along the push, metres.
@@ -296,7 +303,7 @@ impl PushAction {
 }
 
 impl MacroAction for PushAction {
-    fn start(&mut self, cell: &mut Cell) -> Result<(), String> {
+    fn start(&mut self, cell: &mut Cell) -> Result<(), Failure> {
         let w = cell.world();
         self.block = object_index(&self.params.object, w)?;
         self.start = w.objects[self.block].pos;
@@ -308,7 +315,8 @@ impl MacroAction for PushAction {
         let behind = self.start - self.dir * (w.half(self.block) + STANDOFF);
         let above = Vector3::new(behind.x, behind.y, APPROACH_HEIGHT);
         let from = cell.arm_setpoint();
-        let goal = ik_down(&above, self.yaw, false, &from).map_err(|e| format!("unreachable: {e}"))?;
+        let goal = ik_down(&above, self.yaw, false, &from)
+            .map_err(|e| Failure::new(FailureKind::Unreachable, format!("unreachable: {e}")))?;
         cell.set_gripper(CLOSED_CTRL);
         cell.track(Box::new(JointMove::new(from, goal, &self.limits(0.5))));
         self.phase = Phase::Approach;
@@ -341,10 +349,13 @@ impl MacroAction for PushAction {
             }
             Phase::Push => {
                 if self.pushed < self.params.distance - 0.002 {
-                    return Progress::Failed(format!(
-                        "the block moved {:.1} mm of {:.1} mm (missed or blocked)",
-                        self.pushed * 1e3,
-                        self.params.distance * 1e3
+                    return Progress::Failed(Failure::new(
+                        FailureKind::Custom(SHORT_PUSH),
+                        format!(
+                            "the block moved {:.1} mm of {:.1} mm (missed or blocked)",
+                            self.pushed * 1e3,
+                            self.params.distance * 1e3
+                        ),
                     ));
                 }
                 let mut back = w.pinch_pos - self.dir * BACK_OFF;

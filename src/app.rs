@@ -10,6 +10,7 @@ use crate::episode::MAX_SIM_TIME_S;
 use crate::episode::{EpisodeConfig, EpisodeReport, NoObserver};
 use crate::error::Error;
 use crate::factory::Factory;
+use crate::failure::Failure;
 use crate::kinds::{Params, Registry};
 use crate::plan::{Loader, Plan};
 use crate::sim::{Scene, TIMESTEP};
@@ -88,11 +89,14 @@ impl App {
     /// Registers an action leaf: declares the kind `name` with parameters `P` and `doc` (see
     /// [`Registry::declare_action`]) and binds `start`, which makes a new controller from the
     /// parameters each time the leaf starts (its `start` runs on the first tick, `update` on
-    /// every tick after, `halt` when the tree preempts it).
+    /// every tick after, `halt` when the tree preempts it). Its failures are typed
+    /// ([`Failure`]): of a built-in [`FailureKind`](crate::FailureKind), or of a custom kind `P`
+    /// declares in [`Params::failure_kinds`].
     ///
     /// # Errors
     /// [`Error::Registry`] when the name is not a lower-case identifier, is already registered,
-    /// or the doc lacks its summary, halt paragraph or example.
+    /// the doc lacks its summary, halt paragraph or example, or a declared failure kind is not a
+    /// valid custom name.
     pub fn register_action<P, F>(
         &mut self,
         name: &'static str,
@@ -117,7 +121,8 @@ impl App {
     /// Registers a condition leaf: declares the kind `name` with parameters `P` and `doc` and
     /// binds `check`, which answers from the world snapshot alone (a pure function: called every
     /// tick the condition is checked, it must not keep state). `Ok(false)` fails the leaf with
-    /// `not satisfied`, `Err(reason)` fails it with the reason (e.g. an unknown object).
+    /// `not satisfied` (kind `condition_false`), `Err(failure)` fails it with that failure (e.g.
+    /// an unknown object, kind `other`).
     ///
     /// # Errors
     /// As for [`register_action`](Self::register_action).
@@ -129,7 +134,7 @@ impl App {
     ) -> Result<&mut Self, Error>
     where
         P: Params,
-        F: Fn(&World, &P) -> Result<bool, String> + Send + Sync + 'static,
+        F: Fn(&World, &P) -> Result<bool, Failure> + Send + Sync + 'static,
     {
         let mut registry = Registry::clone(self.loader.registry());
         registry.declare_condition::<P>(name, doc)?;

@@ -11,6 +11,7 @@
 //! |---|---|---|---|
 //! | 0 | [`motion`] | UR5e kinematics, closed-form IK, trajectories, gripper calibration | no |
 //! | 0 | [`output`] | safe output files (every file the CLI writes) | no |
+//! | 0 | [`failure`] | typed failures: a stable kind, a message, the node, the cause | no |
 //! | 1 | [`yaml`] | located YAML: values with file:line:column, typed reads, diagnostics, units | no |
 //! | 2 | [`scene`] | scene files: named objects, placements, the goal | no |
 //! | 2 | [`error`] | the library's typed [`Error`] | no |
@@ -56,7 +57,7 @@
 //! use macrotree::episode::{EpisodeConfig, Goal};
 //! use macrotree::kinds::{ObjectRef, ObjectRole};
 //! use macrotree::world::World;
-//! use macrotree::{App, Params};
+//! use macrotree::{App, Failure, FailureKind, Params};
 //! use schemars::JsonSchema;
 //! use serde::{Deserialize, Serialize};
 //!
@@ -79,19 +80,30 @@
 //!     fn timeout(&self) -> Option<f64> {
 //!         Some(10.0) // simulated seconds
 //!     }
+//!     fn failure_kinds() -> &'static [&'static str] {
+//!         &["short_push"] // its own failure kind, besides the built-in ones
+//!     }
 //! }
 //!
 //! struct PushAction(Push);
 //!
 //! impl MacroAction for PushAction {
-//!     fn start(&mut self, cell: &mut Cell) -> Result<(), String> {
+//!     fn start(&mut self, cell: &mut Cell) -> Result<(), Failure> {
 //!         let block = object_index(&self.0.object, cell.world())?;
 //!         // … plan the motion from the world, start it with `cell.track(…)` …
 //!         # let _ = block;
 //!         Ok(())
 //!     }
 //!     fn update(&mut self, cell: &mut Cell) -> Progress {
-//!         if cell.arm_motion_finished() { Progress::Done } else { Progress::Running }
+//!         if !cell.arm_motion_finished() {
+//!             return Progress::Running;
+//!         }
+//!         # let pushed = 0.1;
+//!         if pushed < self.0.distance {
+//!             // Every failure is typed: a built-in kind or one the node kind declares.
+//!             return Progress::Failed(Failure::new(FailureKind::Custom("short_push"), "the block moved too little"));
+//!         }
+//!         Progress::Done
 //!     }
 //! }
 //!
@@ -112,7 +124,7 @@
 //!     }
 //! }
 //!
-//! fn near(w: &World, p: &Near) -> Result<bool, String> {
+//! fn near(w: &World, p: &Near) -> Result<bool, Failure> {
 //!     let c = w.objects[object_index(&p.object, w)?].pos;
 //!     Ok((c.x - p.point[0]).hypot(c.y - p.point[1]) <= 0.01)
 //! }
@@ -139,6 +151,7 @@
 #[cfg(feature = "sim")]
 pub use app::App;
 pub use error::Error;
+pub use failure::{Failure, FailureKind};
 pub use kinds::{Category, ParamError, Params, Registry};
 
 #[cfg(feature = "sim")]
@@ -154,6 +167,7 @@ pub mod episode;
 pub mod error;
 #[cfg(feature = "sim")]
 pub mod factory;
+pub mod failure;
 #[cfg(feature = "sim")]
 pub mod faults;
 pub mod kinds;

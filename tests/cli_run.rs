@@ -75,6 +75,7 @@ fn run_reports_task_failure_with_exit_1() {
     );
     let r = last_json_line(&out);
     assert_eq!(r["success"], false);
+    assert_eq!(r["failure_kind"], "time_limit");
     let reason = r["failure_reason"].as_str().unwrap_or_default();
     assert!(reason.contains("time limit"), "reason: {reason}");
 }
@@ -139,6 +140,7 @@ fn failure_reason_names_the_failed_condition_not_just_the_tree() {
     assert_eq!(r["tree_status"], "failure");
     let reason = r["failure_reason"].as_str().unwrap_or_default();
     assert_eq!(reason, "condition failed: cube_grasped: not satisfied");
+    assert_eq!(r["failure_kind"], "condition_false");
 }
 
 #[test]

@@ -168,6 +168,7 @@ fn a_tree_that_succeeds_without_doing_the_job_is_caught() {
     );
     assert_eq!(r.tree_status, "success");
     assert!(!r.success);
+    assert_eq!(r.failure_kind, Some(macrotree::FailureKind::GoalNotMet));
     let reason = r.failure_reason.unwrap();
     assert!(
         reason.contains("the scene's goal does not hold: not red in red_bin"),
@@ -194,6 +195,7 @@ fn a_carry_that_would_lower_the_fingers_onto_the_bowl_names_it() {
         &EpisodeConfig::default(),
         &mut NoObserver,
     );
+    assert_eq!(r.failure_kind, Some(macrotree::FailureKind::Blocked));
     let reason = r.failure_reason.unwrap_or_default();
     assert!(
         reason.contains("no clear way down") && reason.contains("would hit bowl"),

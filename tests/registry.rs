@@ -68,7 +68,7 @@ impl Params for Touching {
 struct Idle;
 
 impl MacroAction for Idle {
-    fn start(&mut self, _: &mut Cell) -> Result<(), String> {
+    fn start(&mut self, _: &mut Cell) -> Result<(), macrotree::Failure> {
         Ok(())
     }
     fn update(&mut self, _: &mut Cell) -> Progress {
@@ -227,7 +227,10 @@ impl LeafDriver for Recorder {
         LeafOutcome::Success
     }
     fn halt(&mut self, _: LeafId, _: &Leaf) {}
-    fn select_object(&mut self, _: &macrotree::world::query::Query) -> Result<Option<Selection>, String> {
+    fn select_object(
+        &mut self,
+        _: &macrotree::world::query::Query,
+    ) -> Result<Option<Selection>, macrotree::Failure> {
         Ok(Some(Selection {
             object: "cube".into(),
             destination: None,

@@ -299,6 +299,7 @@ fn bad_scenario_files_exit_2_with_located_errors_and_nothing_runs() {
     let cases = [
         ("typo.yaml", "typo.yaml:4:3", "min_success_rate"),
         ("range.yaml", "range.yaml:2:8", "`count` must be 1 to"),
+        ("kind.yaml", "kind.yaml:5:17", "did you mean `grasp_lost`"),
         (
             "nomatch.yaml",
             "matches no node",

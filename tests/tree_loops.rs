@@ -86,8 +86,9 @@ fn for_each_fails_when_objects_still_match_after_max_iterations() {
     d.selections.extend((0..5).map(|_| selection("red", "red_bin")));
     assert_eq!(run(&mut runner, &mut d), TreeStatus::Failure);
     assert_eq!(d.starts("grasp"), 3, "exactly max_iterations iterations ran");
-    let reason = runner.node_reasons()[0].clone().unwrap_or_default();
-    assert!(reason.contains("after 3 iteration(s)"), "{reason}");
+    let reason = runner.node_reasons()[0].clone().unwrap();
+    assert!(reason.message.contains("after 3 iteration(s)"), "{reason}");
+    assert_eq!(reason.kind, macrotree::FailureKind::MaxIterations);
 }
 
 #[test]
@@ -95,7 +96,10 @@ fn for_each_fails_when_its_child_fails_and_stops_selecting() {
     let (mut runner, mut d) = setup(TREE);
     d.selections
         .extend([selection("red", "red_bin"), selection("blue", "blue_bin")]);
-    d.set("carry", LeafOutcome::Failure("grasp lost".into()));
+    d.set(
+        "carry",
+        LeafOutcome::failure(macrotree::FailureKind::GraspLost, "grasp lost"),
+    );
     assert_eq!(run(&mut runner, &mut d), TreeStatus::Failure);
     assert_eq!(d.starts("grasp"), 1);
     assert_eq!(d.selections.len(), 1, "no selection after the failed iteration");
@@ -115,7 +119,12 @@ fn reading_a_variable_before_it_is_written_fails_the_leaf_with_the_reason() {
     );
     // Nothing matches: the select fails, so the fallback ticks the grasp with `{block}` unset.
     assert_eq!(run(&mut runner, &mut d), TreeStatus::Failure);
-    let reasons: Vec<String> = runner.node_reasons().iter().flatten().cloned().collect();
+    let reasons: Vec<String> = runner
+        .node_reasons()
+        .iter()
+        .flatten()
+        .map(|f| f.message.clone())
+        .collect();
     assert!(
         reasons
             .iter()

@@ -2,14 +2,21 @@
 
 use std::sync::Arc;
 
+use macrotree::FailureKind;
 use macrotree::plan::{Loader, Plan};
 use macrotree::runtime::scripted::{Call, ScriptedDriver};
 use macrotree::runtime::{LeafOutcome, NodeStatus, TreeRunner, TreeStatus};
 
 use LeafOutcome::{Running, Success};
 
+/// A scripted failure (of kind `grasp_failed`, so tests can see the kind carried up the tree).
 fn fail(why: &str) -> LeafOutcome {
-    LeafOutcome::Failure(why.to_string())
+    LeafOutcome::failure(FailureKind::GraspFailed, why)
+}
+
+/// The message of node `i`'s last failure or halt.
+fn reason_of(r: &TreeRunner, i: usize) -> Option<&str> {
+    r.node_reasons()[i].as_ref().map(|f| f.message.as_str())
 }
 
 fn plan(yaml: &str) -> Arc<Plan> {
@@ -74,7 +81,10 @@ fn sequence_remembers_progress_and_stops_at_first_failure() {
     assert_eq!(d.ticks("release"), 0);
     assert_eq!(r.status_of("main/sequence/grasp"), Some(NodeStatus::Failure));
     assert_eq!(r.status_of("main/sequence/release"), Some(NodeStatus::Idle));
-    assert_eq!(r.node_reasons()[0].as_deref(), Some("grasp: stalled"));
+    assert_eq!(reason_of(&r, 0), Some("grasp: stalled"));
+    let f = r.failure().unwrap();
+    assert_eq!(f.kind, FailureKind::GraspFailed);
+    assert_eq!(f.node.as_deref(), Some("main/sequence/grasp"));
 }
 
 #[test]
@@ -162,9 +172,13 @@ fn guard_keeps_child_state_while_condition_holds_and_halts_it_when_it_fails() {
     let guard = p.node_by_path("main/guard").unwrap();
     let reason = r.node_reasons()[guard].clone().unwrap();
     assert!(
-        reason.contains("condition failed") && reason.contains("slipped"),
+        reason.message.contains("condition failed") && reason.message.contains("slipped"),
         "{reason}"
     );
+    // The guard's failure wraps its condition's, and keeps its kind.
+    assert_eq!(reason.kind, FailureKind::GraspFailed);
+    assert_eq!(reason.node.as_deref(), Some("main/guard"));
+    assert_eq!(reason.cause.as_ref().unwrap().message, "cube_grasped: slipped");
 }
 
 #[test]
@@ -234,7 +248,9 @@ fn retry_exhausts_attempts_then_fails() {
     assert_eq!(d.starts("grasp"), 3);
     assert_eq!(r.attempt(0), 3);
     let reason = r.node_reasons()[0].clone().unwrap();
-    assert!(reason.starts_with("all 3 attempts failed"), "{reason}");
+    assert!(reason.message.starts_with("all 3 attempts failed"), "{reason}");
+    assert_eq!(reason.kind, FailureKind::GraspFailed);
+    assert_eq!(reason.root_cause().node.as_deref(), Some("main/retry/grasp"));
 }
 
 #[test]
@@ -325,7 +341,8 @@ fn timeout_fails_after_simulated_seconds_and_halts_child() {
     assert_eq!((status, ticks), (TreeStatus::Failure, 4));
     assert_eq!(d.halts("home"), 1);
     assert_eq!(r.status_of("main/timeout/home"), Some(NodeStatus::Halted));
-    assert_eq!(r.node_reasons()[0].as_deref(), Some("timeout 1 s expired"));
+    assert_eq!(reason_of(&r, 0), Some("timeout 1 s expired"));
+    assert_eq!(r.failure().unwrap().kind, FailureKind::Timeout);
 }
 
 #[test]
@@ -336,7 +353,8 @@ fn timeout_passes_child_result_through() {
     let mut r = TreeRunner::new(p.clone());
     assert_eq!(run(&mut r, &mut d, 10), (TreeStatus::Failure, 2));
     assert_eq!(d.halts("home"), 0);
-    assert_eq!(r.node_reasons()[0].as_deref(), Some("home: collision"));
+    assert_eq!(reason_of(&r, 0), Some("home: collision"));
+    assert_eq!(r.failure().unwrap().kind, FailureKind::GraspFailed);
 }
 
 #[test]

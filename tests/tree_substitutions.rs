@@ -110,7 +110,10 @@ fn fail_first_counts_activations_across_retries() {
 fn failure_and_success_never_reach_the_driver() {
     let plan = plan();
     let mut driver = ScriptedDriver::new(&plan);
-    driver.set_default(LeafOutcome::Failure("real leaf ran".into()));
+    driver.set_default(LeafOutcome::failure(
+        macrotree::FailureKind::Other,
+        "real leaf ran",
+    ));
     let mut runner = TreeRunner::with_substitutions(
         plan.clone(),
         subs(
@@ -126,8 +129,9 @@ fn failure_and_success_never_reach_the_driver() {
     let (status, _) = run(&mut runner, &mut driver);
     assert_eq!(status, TreeStatus::Failure);
     let reason = runner.node_reasons()[0].clone().unwrap();
-    assert!(reason.contains("substituted"), "{reason}");
-    assert_eq!(macrotree::episode::failure_kind(&reason), "substituted");
+    assert!(reason.message.contains("substituted"), "{reason}");
+    assert_eq!(reason.kind, macrotree::FailureKind::Substituted);
+    assert_eq!(reason.root_cause().kind, macrotree::FailureKind::Substituted);
     assert_eq!(counts(&runner, "/retry").failures, 1);
     assert_eq!(counts(&runner, "grasp[again]").activations, 3);
     assert_eq!(

@@ -64,7 +64,7 @@ fn one_event_per_transition_with_fields() {
         [
             LeafOutcome::Success,
             LeafOutcome::Success,
-            LeafOutcome::Failure("slipped".into()),
+            LeafOutcome::failure(macrotree::FailureKind::GraspLost, "slipped"),
         ],
     );
     d.eventually("cube_grasped", LeafOutcome::Success);

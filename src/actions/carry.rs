@@ -6,6 +6,7 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
 use super::targets::{resolve, segment_distance, target_object};
+use crate::failure::{Failure, FailureKind};
 use crate::kinds::Carry as CarrySpec;
 use crate::motion::{CartesianMove, JointMove, MotionLimits, Trajectory};
 use crate::scene::ObjectKind;
@@ -106,7 +107,7 @@ impl Carry {
 
     /// Where the block's centre ends up when placed at the goal as it is now, metres: on a
     /// container's floor, on top of a block, or at a point, `place_height` above it.
-    fn place(&self, w: &World) -> Result<Vector3<f64>, String> {
+    fn place(&self, w: &World) -> Result<Vector3<f64>, Failure> {
         let goal = resolve(&self.spec.to, w)?;
         let dest = self.destination(w);
         let base = match dest {
@@ -190,7 +191,7 @@ impl Carry {
 
     /// Checks that the fingers can come down to `place` (block centre): no object other than the
     /// goal stands within the fingers' reach of it higher than the block's bottom will be.
-    fn check_descent(&self, w: &World, place: &Vector3<f64>) -> Result<(), String> {
+    fn check_descent(&self, w: &World, place: &Vector3<f64>) -> Result<(), Failure> {
         let dest = self.destination(w);
         let bottom = place.z - self.half;
         let reach = self.finger_reach();
@@ -200,13 +201,16 @@ impl Carry {
             }
             let gap = w.from_footprint(j, place).norm();
             if gap < reach && w.top(j) > bottom {
-                return Err(format!(
-                    "no clear way down to ({:.3}, {:.3}): the fingers would hit {} ({:.0} mm away, its top at {:.3} m)",
-                    place.x,
-                    place.y,
-                    w.name(j),
-                    gap * 1e3,
-                    w.top(j)
+                return Err(Failure::new(
+                    FailureKind::Blocked,
+                    format!(
+                        "no clear way down to ({:.3}, {:.3}): the fingers would hit {} ({:.0} mm away, its top at {:.3} m)",
+                        place.x,
+                        place.y,
+                        w.name(j),
+                        gap * 1e3,
+                        w.top(j)
+                    ),
                 ));
             }
         }
@@ -214,7 +218,7 @@ impl Carry {
     }
 
     /// Moves the block centre to `end` in a straight line: the phase `phase` starts.
-    fn start_phase(&mut self, cell: &mut Cell, phase: Phase, end: Vector3<f64>) -> Result<(), String> {
+    fn start_phase(&mut self, cell: &mut Cell, phase: Phase, end: Vector3<f64>) -> Result<(), Failure> {
         let pose = Isometry3::from_parts(Translation3::from(end + self.pinch_from_block), self.rotation);
         let limits = MotionLimits {
             tool_speed: self.spec.speed,
@@ -230,16 +234,24 @@ impl Carry {
             // crosses a wrist singularity or a branch flip, a joint move to the same pose does.
             Err(line) if phase == Phase::Transfer => {
                 let goal = crate::motion::ik(&pose, &from).map_err(|e| {
-                    format!(
-                        "unreachable carry path ({}): {line}; and by a joint move: {e}",
-                        phase.name()
+                    Failure::new(
+                        FailureKind::Unreachable,
+                        format!(
+                            "unreachable carry path ({}): {line}; and by a joint move: {e}",
+                            phase.name()
+                        ),
                     )
                 })?;
                 tracing::debug!(target: "macrotree::actions", "carry: straight transfer impossible ({line}); joint move instead");
                 self.goal_q = goal;
                 cell.track(Box::new(JointMove::new(from, goal, &limits)));
             }
-            Err(e) => return Err(format!("unreachable carry path ({}): {e}", phase.name())),
+            Err(e) => {
+                return Err(Failure::new(
+                    FailureKind::Unreachable,
+                    format!("unreachable carry path ({}): {e}", phase.name()),
+                ));
+            }
         }
         self.phase = phase;
         self.phase_end = end;
@@ -247,7 +259,7 @@ impl Carry {
     }
 
     /// The current phase's motion has ended: start the next one (or re-plan the transfer).
-    fn next_phase(&mut self, cell: &mut Cell) -> Result<(), String> {
+    fn next_phase(&mut self, cell: &mut Cell) -> Result<(), Failure> {
         let w = cell.world();
         let place = self.place(w)?;
         let from = w.objects[self.held].pos.xy();
@@ -258,8 +270,9 @@ impl Carry {
             Phase::Transfer if (above.xy() - self.phase_end.xy()).norm() > GOAL_MOVED => {
                 self.replans += 1;
                 if self.replans > MAX_REPLANS {
-                    return Err(format!(
-                        "the goal kept moving: re-planned the transfer {MAX_REPLANS} times"
+                    return Err(Failure::new(
+                        FailureKind::GoalMoved,
+                        format!("the goal kept moving: re-planned the transfer {MAX_REPLANS} times"),
                     ));
                 }
                 tracing::debug!(target: "macrotree::actions", replans = self.replans, "carry: goal moved, re-planning the transfer");
@@ -275,10 +288,13 @@ impl Carry {
 }
 
 impl MacroAction for Carry {
-    fn start(&mut self, cell: &mut Cell) -> Result<(), String> {
+    fn start(&mut self, cell: &mut Cell) -> Result<(), Failure> {
         let w = cell.world();
         let Some(held) = w.held_block(Tolerances::GRASP_OFF_AXIS) else {
-            return Err("carry needs a block in the gripper, but none is grasped".into());
+            return Err(Failure::new(
+                FailureKind::NotHeld,
+                "carry needs a block in the gripper, but none is grasped",
+            ));
         };
         self.held = held;
         self.half = w.half(held);
@@ -310,13 +326,16 @@ impl MacroAction for Carry {
             self.lost += 1;
             if self.lost >= LOST_TICKS {
                 let c = w.objects[self.held].pos;
-                return Progress::Failed(format!(
-                    "grasp lost during {}: {} at ({:.3}, {:.3}, {:.3}) m",
-                    self.phase.name(),
-                    w.name(self.held),
-                    c.x,
-                    c.y,
-                    c.z
+                return Progress::Failed(Failure::new(
+                    FailureKind::GraspLost,
+                    format!(
+                        "grasp lost during {}: {} at ({:.3}, {:.3}, {:.3}) m",
+                        self.phase.name(),
+                        w.name(self.held),
+                        c.x,
+                        c.y,
+                        c.z
+                    ),
                 ));
             }
         }

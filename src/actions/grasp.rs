@@ -3,6 +3,7 @@
 use super::cell::Cell;
 use super::macro_action::{MacroAction, Progress};
 use super::targets::object_index;
+use crate::failure::{Failure, FailureKind};
 use crate::kinds::Grasp as GraspSpec;
 use crate::motion::gripper::{CLOSED_CTRL, ctrl_for_width};
 use crate::world::conditions::Tolerances;
@@ -33,7 +34,7 @@ impl Grasp {
 }
 
 impl MacroAction for Grasp {
-    fn start(&mut self, cell: &mut Cell) -> Result<(), String> {
+    fn start(&mut self, cell: &mut Cell) -> Result<(), Failure> {
         // The arm holds still — unless a sibling action (in a `parallel`) is moving it.
         if cell.arm_motion_finished() {
             cell.hold();
@@ -90,14 +91,17 @@ impl MacroAction for Grasp {
                 .filter(|&i| !w.released(i))
                 .map(|i| w.name(i))
                 .collect();
-            Progress::Failed(format!(
-                "grasp failed: fingers stopped at {:.1} mm without holding {what} (pads touch: {})",
-                w.gripper_width * 1e3,
-                if touched.is_empty() {
-                    "nothing".to_string()
-                } else {
-                    touched.join(", ")
-                }
+            Progress::Failed(Failure::new(
+                FailureKind::GraspFailed,
+                format!(
+                    "grasp failed: fingers stopped at {:.1} mm without holding {what} (pads touch: {})",
+                    w.gripper_width * 1e3,
+                    if touched.is_empty() {
+                        "nothing".to_string()
+                    } else {
+                        touched.join(", ")
+                    }
+                ),
             ))
         }
     }

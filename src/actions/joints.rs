@@ -26,7 +26,7 @@ impl MoveJoints {
 }
 
 impl MacroAction for MoveJoints {
-    fn start(&mut self, cell: &mut Cell) -> Result<(), String> {
+    fn start(&mut self, cell: &mut Cell) -> Result<(), crate::failure::Failure> {
         let from = cell.arm_setpoint();
         cell.track(Box::new(JointMove::new(
             from,

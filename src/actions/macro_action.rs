@@ -1,6 +1,7 @@
 //! The contract every macro-action controller follows.
 
 use super::cell::Cell;
+use crate::failure::{Failure, FailureKind};
 
 /// How a running macro action is doing after a tick.
 #[derive(Debug, Clone, PartialEq)]
@@ -9,14 +10,14 @@ pub enum Progress {
     Running,
     /// Finished successfully.
     Done,
-    /// Finished unsuccessfully, with a reason a person can act on.
-    Failed(String),
+    /// Finished unsuccessfully: a failure of a stable kind, with a message a person can act on.
+    Failed(Failure),
 }
 
 /// A macro action: planned on its first tick, updated every tick after, halted when preempted.
 pub trait MacroAction: Send {
     /// Plans the action from the current world (first tick). An error fails the leaf at once.
-    fn start(&mut self, cell: &mut Cell) -> Result<(), String>;
+    fn start(&mut self, cell: &mut Cell) -> Result<(), Failure>;
     /// Checks progress after the last control period.
     fn update(&mut self, cell: &mut Cell) -> Progress;
     /// The action was preempted: by default the arm holds where it is commanded to be now and the
@@ -112,9 +113,12 @@ impl Arrival {
         }
         let since = *self.resting_since.get_or_insert(w.time);
         if w.time - since >= self.blocked_after {
-            Progress::Failed(format!(
-                "blocked: the arm stopped {:.1} mm short of its goal (contact?)",
-                error * 1e3
+            Progress::Failed(Failure::new(
+                FailureKind::Blocked,
+                format!(
+                    "blocked: the arm stopped {:.1} mm short of its goal (contact?)",
+                    error * 1e3
+                ),
             ))
         } else {
             Progress::Running

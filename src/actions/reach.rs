@@ -5,9 +5,15 @@ use nalgebra::{Isometry3, Translation3, Vector3};
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
 use super::targets::{resolve, segment_distance, target_block, target_object, tool_yaw};
+use crate::failure::{Failure, FailureKind};
 use crate::kinds::{PathKind, Reach as ReachSpec, Yaw};
 use crate::motion::{CartesianMove, JointMove, MotionLimits, Trajectory, down_pose, fk, ik_down};
 use crate::world::World;
+
+/// A failure of kind `unreachable` (IK or path planning found no way).
+fn unreachable(message: String) -> Failure {
+    Failure::new(FailureKind::Unreachable, message)
+}
 
 /// How far from an object's footprint the open fingers reach around the pinch, metres.
 const FINGER_REACH: f64 = 0.05;
@@ -67,7 +73,7 @@ fn detour_height(w: &World, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
 }
 
 impl MacroAction for Reach {
-    fn start(&mut self, cell: &mut Cell) -> Result<(), String> {
+    fn start(&mut self, cell: &mut Cell) -> Result<(), Failure> {
         let w = cell.world();
         let offset = Vector3::from(self.spec.offset);
         let position = resolve(&self.spec.target, w)? + offset;
@@ -81,7 +87,8 @@ impl MacroAction for Reach {
             (Yaw::Angle(a), _) => (*a, false),
         };
         let from = cell.arm_setpoint();
-        let goal_q = ik_down(&position, yaw, quarter, &from).map_err(|e| format!("unreachable: {e}"))?;
+        let goal_q =
+            ik_down(&position, yaw, quarter, &from).map_err(|e| unreachable(format!("unreachable: {e}")))?;
         let limits = MotionLimits {
             tool_speed: self.spec.speed,
             ..MotionLimits::default()
@@ -102,14 +109,14 @@ impl MacroAction for Reach {
                             here.rotation,
                         );
                         let rise = CartesianMove::new(from, up, &limits)
-                            .map_err(|e| format!("unreachable detour (up): {e}"))?;
+                            .map_err(|e| unreachable(format!("unreachable detour (up): {e}")))?;
                         let over_at = Vector3::new(position.x, position.y, z);
                         let over_q = ik_down(&over_at, yaw, quarter, &rise.end())
-                            .map_err(|e| format!("unreachable detour (over): {e}"))?;
+                            .map_err(|e| unreachable(format!("unreachable detour (over): {e}")))?;
                         let over = JointMove::new(rise.end(), over_q, &limits);
                         let down_pose = down_pose(&position, yaw_of_solution(&over_q));
                         let down = CartesianMove::new(over_q, down_pose, &limits)
-                            .map_err(|e| format!("unreachable detour (down): {e}"))?;
+                            .map_err(|e| unreachable(format!("unreachable detour (down): {e}")))?;
                         self.goal_q = down.end();
                         cell.track(Box::new(rise));
                         self.pending = vec![Box::new(down), Box::new(over)];
@@ -119,8 +126,8 @@ impl MacroAction for Reach {
             }
             PathKind::Cartesian => {
                 let pose = down_pose(&position, yaw_of_solution(&goal_q));
-                let mv =
-                    CartesianMove::new(from, pose, &limits).map_err(|e| format!("unreachable path: {e}"))?;
+                let mv = CartesianMove::new(from, pose, &limits)
+                    .map_err(|e| unreachable(format!("unreachable path: {e}")))?;
                 cell.track(Box::new(mv));
             }
         }

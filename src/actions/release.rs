@@ -4,6 +4,7 @@ use nalgebra::Vector3;
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
+use crate::failure::{Failure, FailureKind};
 use crate::kinds::Release as ReleaseSpec;
 use crate::motion::gripper::{OPEN_CTRL, ctrl_for_width, width_for_ctrl};
 use crate::motion::{CartesianMove, MotionLimits, Trajectory};
@@ -45,7 +46,7 @@ impl Release {
 }
 
 impl MacroAction for Release {
-    fn start(&mut self, cell: &mut Cell) -> Result<(), String> {
+    fn start(&mut self, cell: &mut Cell) -> Result<(), Failure> {
         // The arm holds still — unless a sibling action (in a `parallel`) is moving it.
         if cell.arm_motion_finished() {
             cell.hold();
@@ -115,7 +116,10 @@ impl MacroAction for Release {
                     self.retreating = true;
                 }
                 Err(e) => {
-                    return Progress::Failed(format!("cannot retreat {:.3} m up: {e}", self.spec.retreat));
+                    return Progress::Failed(Failure::new(
+                        FailureKind::Unreachable,
+                        format!("cannot retreat {:.3} m up: {e}", self.spec.retreat),
+                    ));
                 }
             }
         }

@@ -3,6 +3,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+use crate::failure::Failure;
 use crate::kinds::ObjectRef;
 use crate::scene::ObjectKind;
 use crate::world::World;
@@ -10,7 +11,7 @@ use crate::world::World;
 /// Where a target is now, metres: a block's centre, the centre of a container floor's top
 /// surface (the legacy `bowl`: the bowl target), the centre of an obstacle's top, or a fixed
 /// point. Fails for a name the scene does not have (or a variable the runtime did not resolve).
-pub fn resolve(target: &crate::kinds::Target, w: &World) -> Result<Vector3<f64>, String> {
+pub fn resolve(target: &crate::kinds::Target, w: &World) -> Result<Vector3<f64>, Failure> {
     use crate::kinds::Target;
     match target {
         Target::Cube => Ok(w.cube_pos),
@@ -33,13 +34,14 @@ pub fn object_point(w: &World, i: usize) -> Vector3<f64> {
     }
 }
 
-/// The index of the object `o` names.
-pub fn object_index(o: &ObjectRef, w: &World) -> Result<usize, String> {
+/// The index of the object `o` names; a failure of kind `other` for a name the scene does not
+/// have or a variable the runtime did not resolve.
+pub fn object_index(o: &ObjectRef, w: &World) -> Result<usize, Failure> {
     match o {
         ObjectRef::Name(n) => w
             .index_of(n.as_str())
-            .ok_or_else(|| format!("scene `{}` has no object `{n}`", w.scene.name)),
-        ObjectRef::Var(v) => Err(format!("the variable `{{{v}}}` was not resolved")),
+            .ok_or_else(|| Failure::other(format!("scene `{}` has no object `{n}`", w.scene.name))),
+        ObjectRef::Var(v) => Err(Failure::other(format!("the variable `{{{v}}}` was not resolved"))),
     }
 }
 

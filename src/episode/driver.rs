@@ -5,6 +5,7 @@ use std::collections::HashMap;
 
 use crate::actions::{Cell, ChecksRecorder, MacroAction, Progress};
 use crate::factory::Factory;
+use crate::failure::{Failure, FailureKind};
 use crate::kinds::{Leaf, LeafCall};
 use crate::plan::LeafId;
 use crate::runtime::{LeafDriver, LeafOutcome, Selection};
@@ -40,8 +41,8 @@ pub struct MacroDriver<'a> {
     pub checks: ChecksRecorder,
     /// Leaf counters.
     pub counters: LeafCounters,
-    /// The reason of the last action that failed.
-    pub last_failure: Option<String>,
+    /// The last action failure.
+    pub last_failure: Option<Failure>,
     /// Contacts that should not happen, by name, in the order first seen.
     pub collisions: Vec<Collision>,
 }
@@ -152,22 +153,24 @@ impl LeafDriver for MacroDriver<'_> {
             Leaf::Condition(c) => {
                 return match self.factory.check(c, self.cell.world()) {
                     Some(Ok(true)) => LeafOutcome::Success,
-                    Some(Ok(false)) => LeafOutcome::Failure("not satisfied".into()),
+                    Some(Ok(false)) => LeafOutcome::failure(FailureKind::ConditionFalse, "not satisfied"),
                     Some(Err(e)) => LeafOutcome::Failure(e),
-                    None => LeafOutcome::Failure(format!("`{}` is not a condition", c.kind())),
+                    None => {
+                        LeafOutcome::Failure(Failure::other(format!("`{}` is not a condition", c.kind())))
+                    }
                 };
             }
             Leaf::Action(a) => a,
             Leaf::Wait(_) | Leaf::Select(_) => {
-                return LeafOutcome::Failure(format!(
+                return LeafOutcome::Failure(Failure::other(format!(
                     "`{}` is handled by the runtime, not the driver",
                     leaf.kind()
-                ));
+                )));
             }
         };
         if first || !self.active.contains_key(&id) {
             let Some(mut controller) = self.start_action(action) else {
-                return LeafOutcome::Failure(format!("`{}` is not an action", action.kind()));
+                return LeafOutcome::Failure(Failure::other(format!("`{}` is not an action", action.kind())));
             };
             self.cell.notify_action_start(action.kind());
             if let Err(reason) = controller.start(self.cell) {
@@ -191,12 +194,15 @@ impl LeafDriver for MacroDriver<'_> {
         if progress == Progress::Running && now >= active.deadline {
             let waiting = active.action.waiting_for(self.cell);
             active.action.halt(self.cell);
-            progress = Progress::Failed(format!("timeout after {:.2} s: {waiting}", active.timeout));
+            progress = Progress::Failed(Failure::new(
+                FailureKind::Timeout,
+                format!("timeout after {:.2} s: {waiting}", active.timeout),
+            ));
         }
         self.finish(id, leaf, progress)
     }
 
-    fn select_object(&mut self, query: &Query) -> Result<Option<Selection>, String> {
+    fn select_object(&mut self, query: &Query) -> Result<Option<Selection>, Failure> {
         let w = self.cell.world();
         Ok(query::select(w, query).map(|i| Selection {
             object: w.name(i).to_string(),

@@ -13,6 +13,7 @@ pub use report::{EpisodeReport, NodeReport, ObjectReport};
 
 use crate::actions::Cell;
 use crate::factory::Factory;
+use crate::failure::{Failure, FailureKind};
 use crate::plan::Plan;
 use crate::runtime::{TreeRunner, TreeStatus};
 use crate::scene::Placement;
@@ -105,40 +106,6 @@ impl Default for EpisodeConfig {
     }
 }
 
-/// A stable name for the kind of a failure reason, for grouping failures across a sweep:
-/// `time_limit`, `unstable`, `goal_not_met`, `grasp_lost`, `grasp_failed`, `unreachable`,
-/// `blocked` (no clear way), `timeout` (a leaf's own limit), `halted`, `condition_false`,
-/// `layout`, `panicked`, `substituted` (a scripted failure of a test double), `substitution`
-/// (substitutions that do not fit the tree), or `other`.
-pub fn failure_kind(reason: &str) -> &'static str {
-    const KINDS: &[(&str, &str)] = &[
-        ("substituted:", "substituted"),
-        ("substitution `", "substitution"),
-        ("time limit", "time_limit"),
-        ("MuJoCo reported an unstable", "unstable"),
-        ("goal does not hold", "goal_not_met"),
-        ("not at rest in the bowl", "goal_not_met"),
-        ("grasp lost", "grasp_lost"),
-        ("grasp failed", "grasp_failed"),
-        ("unreachable", "unreachable"),
-        ("no clear way", "blocked"),
-        ("blocked:", "blocked"),
-        ("timeout", "timeout"),
-        ("expired", "timeout"),
-        ("preempted", "halted"),
-        ("not satisfied", "condition_false"),
-        ("layout:", "layout"),
-        ("panicked", "panicked"),
-    ];
-    // The innermost reason ("all 3 attempts failed; last: …") decides.
-    let inner = reason.rsplit("last: ").next().unwrap_or(reason);
-    KINDS
-        .iter()
-        .find(|(needle, _)| inner.contains(needle))
-        .or_else(|| KINDS.iter().find(|(needle, _)| reason.contains(needle)))
-        .map_or("other", |(_, kind)| kind)
-}
-
 /// Called after every control period (viewer, recorder, progress).
 pub trait EpisodeObserver {
     /// The tree was ticked and the physics advanced by one control period.
@@ -184,7 +151,10 @@ pub fn run_in_cell(
     let dt = cell.control_period();
     let (subs, bad_subs) = match crate::runtime::substitute::resolve(&plan, &config.substitutions) {
         Ok(subs) => (subs, None),
-        Err(e) => (Default::default(), Some(e.to_string())),
+        Err(e) => (
+            Default::default(),
+            Some(Failure::new(FailureKind::Substitution, e.to_string())),
+        ),
     };
     let mut runner = TreeRunner::with_substitutions(plan, subs);
     let mut driver = MacroDriver::new(cell, factory);
@@ -207,7 +177,7 @@ pub fn run_in_cell(
         // MuJoCo resets an unstable simulation and carries on: the episode is no longer physics.
         if let Some(why) = driver.cell().sim().instability() {
             tracing::error!(target: "macrotree::episode", "{why}");
-            unstable = Some(why);
+            unstable = Some(Failure::new(FailureKind::Unstable, why));
             break;
         }
     }
@@ -219,7 +189,7 @@ pub fn run_in_cell(
     let collisions = std::mem::take(&mut driver.collisions);
     // The root's reason tells the whole story ("all 3 attempts failed; last: …"); an action's
     // own reason is the fallback.
-    let root_reason = runner.node_reasons().first().cloned().flatten();
+    let root_reason = runner.failure().cloned();
     let last_failure = unstable
         .clone()
         .or(bad_subs)

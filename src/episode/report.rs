@@ -5,6 +5,7 @@ use serde::Serialize;
 use super::{Collision, LeafCounters};
 use super::{EpisodeConfig, Goal};
 use crate::actions::Checks;
+use crate::failure::{Failure, FailureKind};
 use crate::runtime::TreeStatus;
 use crate::scene::ObjectKind;
 use crate::world::World;
@@ -53,8 +54,13 @@ pub struct EpisodeReport {
     /// the failure started, not the composite or decorator that passed it up (that is the root).
     pub failed_node: Option<String>,
     /// A stable name for the kind of failure (`grasp_lost`, `timeout`, `substituted`, …; see
-    /// [`super::failure_kind`]), for grouping; `None` on success.
-    pub failure_kind: Option<&'static str>,
+    /// [`FailureKind`]), for grouping; `None` on success. Serialized as its name.
+    pub failure_kind: Option<FailureKind>,
+    /// The failure itself, when the episode failed: its kind, message (`failure_reason`), the
+    /// node it happened at and its chain of causes (not written to the JSON, which has
+    /// `failure_reason`, `failure_kind` and `failed_node`).
+    #[serde(skip)]
+    pub failure: Option<Failure>,
     /// How often every node ran, in plan order (preorder).
     pub nodes: Vec<NodeReport>,
 }
@@ -126,7 +132,7 @@ impl EpisodeReport {
         counters: LeafCounters,
         physics_steps: u64,
         wall_time_s: f64,
-        tree_failure: Option<String>,
+        tree_failure: Option<Failure>,
     ) -> Self {
         let tree_status = match status {
             TreeStatus::Success => "success",
@@ -140,33 +146,42 @@ impl EpisodeReport {
             Goal::Tree => true,
         };
         let success = status == TreeStatus::Success && goal_ok;
-        let failure_reason = if success {
+        let failure = if success {
             None
         } else if timed_out {
-            Some(format!(
-                "time limit: the tree was still running after {:.1} s of simulated time",
-                config.max_sim_time
+            Some(Failure::new(
+                FailureKind::TimeLimit,
+                format!(
+                    "time limit: the tree was still running after {:.1} s of simulated time",
+                    config.max_sim_time
+                ),
             ))
         } else if status == TreeStatus::Success && config.goal == Goal::Bowl {
-            Some("the tree succeeded but the cube is not at rest in the bowl".into())
+            Some(Failure::new(
+                FailureKind::GoalNotMet,
+                "the tree succeeded but the cube is not at rest in the bowl",
+            ))
         } else if status == TreeStatus::Success {
             let missed: Vec<&str> = goal
                 .iter()
                 .filter(|g| !g.holds)
                 .map(|g| g.predicate.as_str())
                 .collect();
-            Some(format!(
-                "the tree succeeded but the scene's goal does not hold: not {}",
-                missed.join(", not ")
+            Some(Failure::new(
+                FailureKind::GoalNotMet,
+                format!(
+                    "the tree succeeded but the scene's goal does not hold: not {}",
+                    missed.join(", not ")
+                ),
             ))
         } else {
-            Some(tree_failure.unwrap_or_else(|| "the tree failed".into()))
+            Some(tree_failure.unwrap_or_else(|| Failure::other("the tree failed")))
         };
         let l = &config.layout;
         Self {
             success,
             tree_status,
-            failure_reason,
+            failure_reason: failure.as_ref().map(|f| f.message.clone()),
             sim_time_s: world.time,
             wall_time_s,
             physics_steps,
@@ -185,7 +200,8 @@ impl EpisodeReport {
             goal,
             collisions: Vec::new(),
             failed_node: None,
-            failure_kind: None,
+            failure_kind: failure.as_ref().map(|f| f.kind),
+            failure,
             nodes: Vec::new(),
         }
     }
@@ -197,7 +213,7 @@ impl EpisodeReport {
         start: &World,
         end: &World,
         collisions: Vec<Collision>,
-        unstable: Option<String>,
+        unstable: Option<Failure>,
     ) {
         self.objects = (0..end.objects.len())
             .map(|i| ObjectReport {
@@ -210,8 +226,14 @@ impl EpisodeReport {
         self.collisions = collisions;
         if let Some(why) = unstable {
             self.success = false;
-            self.failure_reason = Some(why);
+            self.set_failure(why);
         }
-        self.failure_kind = self.failure_reason.as_deref().map(super::failure_kind);
+    }
+
+    /// Marks the episode failed by `failure`: its reason and kind.
+    pub fn set_failure(&mut self, failure: Failure) {
+        self.failure_reason = Some(failure.message.clone());
+        self.failure_kind = Some(failure.kind);
+        self.failure = Some(failure);
     }
 }

@@ -9,7 +9,7 @@ use crate::kinds::{
 use crate::world::conditions::{self as cond, Tolerances};
 use crate::world::{World, goal};
 
-fn obj(w: &World, o: &ObjectRef) -> Result<usize, String> {
+fn obj(w: &World, o: &ObjectRef) -> Result<usize, crate::failure::Failure> {
     object_index(o, w)
 }
 

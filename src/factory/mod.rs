@@ -14,12 +14,13 @@ use std::collections::BTreeMap;
 use std::fmt;
 use std::sync::{Arc, OnceLock};
 
-use crate::actions::MacroAction;
+use crate::actions::{Cell, MacroAction, Progress};
+use crate::failure::{Failure, FailureKind};
 use crate::kinds::{Category, LeafCall, Params, Registry};
 use crate::world::World;
 
 type StartFn = dyn Fn(&LeafCall) -> Option<Box<dyn MacroAction>> + Send + Sync;
-type CheckFn = dyn Fn(&World, &LeafCall) -> Option<Result<bool, String>> + Send + Sync;
+type CheckFn = dyn Fn(&World, &LeafCall) -> Option<Result<bool, Failure>> + Send + Sync;
 
 /// The bindings of action and condition kinds to how they run, by kind name.
 #[derive(Clone, Default)]
@@ -55,7 +56,9 @@ impl Factory {
     }
 
     /// Binds the action kind `name` (declared with parameters `P`) to `start`, which makes a new
-    /// controller from the parameters each time the leaf starts.
+    /// controller from the parameters each time the leaf starts. Its failures may be of the
+    /// built-in kinds or of the custom kinds `P` declares ([`Params::failure_kinds`]); one of
+    /// another custom kind is reported as `other`.
     ///
     /// # Errors
     /// When `name` is already bound.
@@ -67,25 +70,37 @@ impl Factory {
         if self.actions.contains_key(name) || self.conditions.contains_key(name) {
             return Err(BindError(format!("node kind `{name}` is already bound")));
         }
-        let f = move |call: &LeafCall| call.params::<P>().map(&start);
+        let f = move |call: &LeafCall| {
+            call.params::<P>().map(|p| {
+                Box::new(Declared {
+                    inner: start(p),
+                    kinds: P::failure_kinds(),
+                    node_kind: name,
+                }) as Box<dyn MacroAction>
+            })
+        };
         self.actions.insert(name, Arc::new(f));
         Ok(self)
     }
 
     /// Binds the condition kind `name` (declared with parameters `P`) to `check`, a pure
-    /// function of the world snapshot.
+    /// function of the world snapshot. Its failures' kinds are checked as for
+    /// [`bind_action`](Self::bind_action).
     ///
     /// # Errors
     /// When `name` is already bound.
     pub fn bind_condition<P, F>(&mut self, name: &'static str, check: F) -> Result<&mut Self, BindError>
     where
         P: Params,
-        F: Fn(&World, &P) -> Result<bool, String> + Send + Sync + 'static,
+        F: Fn(&World, &P) -> Result<bool, Failure> + Send + Sync + 'static,
     {
         if self.actions.contains_key(name) || self.conditions.contains_key(name) {
             return Err(BindError(format!("node kind `{name}` is already bound")));
         }
-        let f = move |w: &World, call: &LeafCall| call.params::<P>().map(|p| check(w, p));
+        let f = move |w: &World, call: &LeafCall| {
+            call.params::<P>()
+                .map(|p| check(w, p).map_err(|e| declared(e, P::failure_kinds(), name)))
+        };
         self.conditions.insert(name, Arc::new(f));
         Ok(self)
     }
@@ -98,7 +113,7 @@ impl Factory {
 
     /// The answer of the condition leaf `call` in `world`; `None` when its kind has no check
     /// here.
-    pub fn check(&self, call: &LeafCall, world: &World) -> Option<Result<bool, String>> {
+    pub fn check(&self, call: &LeafCall, world: &World) -> Option<Result<bool, Failure>> {
         self.conditions.get(call.kind()).and_then(|f| f(world, call))
     }
 
@@ -114,6 +129,50 @@ impl Factory {
             })
             .map(|t| t.name())
             .collect()
+    }
+}
+
+/// `failure` as its node kind `node_kind` may report it: a custom kind it did not declare in
+/// `kinds` becomes `other` (and is logged), with the message saying so.
+fn declared(failure: Failure, kinds: &[&str], node_kind: &str) -> Failure {
+    match failure.kind {
+        FailureKind::Custom(k) if !kinds.contains(&k) => {
+            tracing::error!(target: "macrotree::actions", "`{node_kind}` failed with the failure kind `{k}`, which it does not declare (Params::failure_kinds); reported as `other`");
+            let message = format!("{} (undeclared failure kind `{k}`)", failure.message);
+            Failure {
+                kind: FailureKind::Other,
+                message,
+                ..failure
+            }
+        }
+        _ => failure,
+    }
+}
+
+/// A controller whose failures are checked against the custom kinds its node kind declares.
+struct Declared {
+    inner: Box<dyn MacroAction>,
+    kinds: &'static [&'static str],
+    node_kind: &'static str,
+}
+
+impl MacroAction for Declared {
+    fn start(&mut self, cell: &mut Cell) -> Result<(), Failure> {
+        self.inner
+            .start(cell)
+            .map_err(|e| declared(e, self.kinds, self.node_kind))
+    }
+    fn update(&mut self, cell: &mut Cell) -> Progress {
+        match self.inner.update(cell) {
+            Progress::Failed(e) => Progress::Failed(declared(e, self.kinds, self.node_kind)),
+            p => p,
+        }
+    }
+    fn halt(&mut self, cell: &mut Cell) {
+        self.inner.halt(cell);
+    }
+    fn waiting_for(&self, cell: &Cell) -> String {
+        self.inner.waiting_for(cell)
     }
 }
 

@@ -67,6 +67,14 @@ pub trait Params:
     fn validate_fields(&self) -> Result<(), ParamError> {
         self.validate().map_err(ParamError::new)
     }
+
+    /// The failure kinds of its own this node kind may fail with, besides the built-in ones:
+    /// stable `snake_case` names its controller (or check) uses as
+    /// [`FailureKind::Custom`](crate::failure::FailureKind::Custom). Checked when the kind is
+    /// declared; a failure of an undeclared custom kind is reported as `other`. Default: none.
+    fn failure_kinds() -> &'static [&'static str] {
+        &[]
+    }
 }
 
 /// Type-erased [`Params`].

@@ -228,6 +228,7 @@ impl Registry {
         name: &'static str,
         doc: &'static str,
     ) -> Result<&mut Self, Error> {
+        check_failure_kinds::<P>(name)?;
         self.add(
             name,
             Category::Action,
@@ -251,6 +252,7 @@ impl Registry {
         name: &'static str,
         doc: &'static str,
     ) -> Result<&mut Self, Error> {
+        check_failure_kinds::<P>(name)?;
         self.add(
             name,
             Category::Condition,
@@ -313,4 +315,26 @@ impl Registry {
         }));
         Ok(self)
     }
+}
+
+/// Checks the failure kinds `P` declares for the node kind `name`
+/// ([`Params::failure_kinds`]): each a valid custom name, none twice.
+fn check_failure_kinds<P: Params>(name: &str) -> Result<(), Error> {
+    let kinds = P::failure_kinds();
+    for (i, k) in kinds.iter().enumerate() {
+        let why = crate::failure::FailureKind::check_custom_name(k)
+            .err()
+            .or_else(|| {
+                kinds[..i]
+                    .contains(k)
+                    .then(|| format!("failure kind `{k}` is declared twice"))
+            });
+        if let Some(message) = why {
+            return Err(Error::Registry {
+                kind: name.to_string(),
+                message,
+            });
+        }
+    }
+    Ok(())
 }

@@ -39,6 +39,7 @@ use std::fmt;
 
 use serde::Serialize;
 
+use crate::failure::{Failure, FailureKind};
 use crate::kinds::Leaf;
 use crate::plan::LeafId;
 
@@ -78,8 +79,16 @@ pub enum LeafOutcome {
     Running,
     /// Done; the rest of the tick's `dt` goes to the next node.
     Success,
-    /// Could not do it, with a short human-readable reason ("IK failed", "cube slipped").
-    Failure(String),
+    /// Could not do it: a failure of a stable kind with a short human-readable message ("IK
+    /// failed", "cube slipped"). The runner adds the leaf's kind to the message and its path.
+    Failure(Failure),
+}
+
+impl LeafOutcome {
+    /// A failure of `kind` with `message`.
+    pub fn failure(kind: FailureKind, message: impl Into<String>) -> Self {
+        LeafOutcome::Failure(Failure::new(kind, message))
+    }
 }
 
 /// What executes action and condition leaves; the MuJoCo-backed one lives elsewhere, a scripted
@@ -97,11 +106,11 @@ pub trait LeafDriver {
     fn halt(&mut self, id: LeafId, leaf: &Leaf);
     /// Answers a `select` query against the world: `Ok(None)` when no object matches. Drivers
     /// that know no world cannot select (the default answer is an error).
-    fn select_object(&mut self, query: &crate::world::query::Query) -> Result<Option<Selection>, String> {
-        Err(format!(
+    fn select_object(&mut self, query: &crate::world::query::Query) -> Result<Option<Selection>, Failure> {
+        Err(Failure::other(format!(
             "this driver cannot select objects (query: {})",
             query.describe()
-        ))
+        )))
     }
 }
 

@@ -8,6 +8,7 @@ use tracing::Level;
 use super::blackboard::Blackboard;
 use super::substitute::{Resolved, Scripted};
 use super::{LeafDriver, LeafOutcome, NodeCounts, NodeStatus, Transition, TreeStatus};
+use crate::failure::{Failure, FailureKind};
 use crate::kinds::{Leaf, Select};
 use crate::plan::{Internal, LeafId, Plan};
 
@@ -50,7 +51,7 @@ struct LeafRt {
 
 struct RunState {
     statuses: Vec<NodeStatus>,
-    reasons: Vec<Option<String>>,
+    reasons: Vec<Option<Failure>>,
     /// How each node last finished before it was reset to Idle (a retry starting its next
     /// attempt in the same tick), so a leaf halted by that attempt's end names the real cause.
     ended_as: Vec<Option<NodeStatus>>,
@@ -75,7 +76,7 @@ struct RunState {
     vars: Blackboard,
     /// Per node: activations, successes, failures, halts (same indices as `plan.nodes`).
     counts: Vec<NodeCounts>,
-    last_failure: Option<String>,
+    last_failure: Option<Failure>,
     /// The node of the last leaf that failed.
     last_failed_node: Option<usize>,
     /// Blackboard writes since the last drain (bounded like the transitions).
@@ -171,10 +172,11 @@ impl RunState {
 
     /// Set a node's status; log a transition if it changed. A node that starts running again
     /// after it finished (re-entered by a loop) is first reset to Idle, with its own event.
-    fn set(&mut self, plan: &Plan, node: usize, to: NodeStatus, reason: Option<String>) {
+    fn set(&mut self, plan: &Plan, node: usize, to: NodeStatus, reason: Option<Failure>) {
         let from = self.statuses[node];
+        let message = reason.as_ref().map(|f| f.message.clone());
         if to == NodeStatus::Failure || to == NodeStatus::Halted {
-            self.reasons[node] = reason.clone();
+            self.reasons[node] = reason;
         }
         if from == to {
             return;
@@ -182,7 +184,7 @@ impl RunState {
         if to == NodeStatus::Running && from != NodeStatus::Idle {
             self.reset_node(plan, node);
         }
-        self.record(plan, node, to, reason);
+        self.record(plan, node, to, message);
     }
 
     /// Back to Idle (a loop starts its child again), logged at debug level.
@@ -329,10 +331,13 @@ impl RunState {
                         rt.scripted_ticks += 1;
                         LeafOutcome::Running
                     }
-                    Some(Scripted::Failure | Scripted::FailFirst(_)) => LeafOutcome::Failure(format!(
-                        "substituted: scripted failure ({})",
-                        rt.scripted.map_or(String::new(), |s| s.to_string())
-                    )),
+                    Some(Scripted::Failure | Scripted::FailFirst(_)) => LeafOutcome::failure(
+                        FailureKind::Substituted,
+                        format!(
+                            "substituted: scripted failure ({})",
+                            rt.scripted.map_or(String::new(), |s| s.to_string())
+                        ),
+                    ),
                     _ => LeafOutcome::Success,
                 };
                 let running = matches!(outcome, LeafOutcome::Running);
@@ -355,7 +360,7 @@ impl RunState {
                 let out = if rt.reads_vars {
                     match self.vars.resolve(leaf) {
                         Ok(l) => span.in_scope(|| driver.tick(id, &l, first)),
-                        Err(unset) => LeafOutcome::Failure(unset),
+                        Err(unset) => LeafOutcome::Failure(Failure::other(unset)),
                     }
                 } else {
                     span.in_scope(|| driver.tick(id, leaf, first))
@@ -363,7 +368,10 @@ impl RunState {
                 let out = match (leaf, out) {
                     (Leaf::Condition(c), LeafOutcome::Running) => {
                         tracing::warn!(target: "macrotree::tree", path = %info.path, "condition `{}` answered Running; conditions must answer at once, treating it as Failure", c.kind());
-                        LeafOutcome::Failure(format!("condition `{}` answered Running", c.kind()))
+                        LeafOutcome::Failure(Failure::other(format!(
+                            "condition `{}` answered Running",
+                            c.kind()
+                        )))
                     }
                     (_, o) => o,
                 };
@@ -388,7 +396,7 @@ impl RunState {
                 rt.running = false;
                 rt.span = None;
                 self.counts[node].failures += 1;
-                let reason = format!("{}: {reason}", info.kind.kind());
+                let reason = reason.prefixed(&format!("{}: ", info.kind.kind())).at(&info.path);
                 self.last_failure = Some(reason.clone());
                 self.last_failed_node = Some(node);
                 self.set(plan, node, NodeStatus::Failure, Some(reason));
@@ -414,7 +422,13 @@ impl RunState {
             } else {
                 (
                     NodeStatus::Failure,
-                    Some(format!("inverted: `{}` succeeded", info.kind.kind())),
+                    Some(
+                        Failure::new(
+                            FailureKind::Inverted,
+                            format!("inverted: `{}` succeeded", info.kind.kind()),
+                        )
+                        .at(&plan.nodes[inv].path),
+                    ),
                 )
             };
             if !effective {
@@ -483,7 +497,7 @@ impl RunState {
                         kind = info.kind,
                         attempt = iteration,
                         reset,
-                        reason = self.last_failure.as_deref(),
+                        reason = self.last_failure.as_ref().map(|f| f.message.as_str()),
                         "{}: reset {} node(s) to idle; attempt {} of {} starts next tick",
                         display_name(info),
                         reset,
@@ -534,11 +548,17 @@ impl RunState {
                         (Status::Failure, dt)
                     }
                     Ok(Some(found)) if iteration > limit => {
-                        self.last_failure = Some(format!(
-                            "for_each: {} still matches ({}) after {limit} iteration(s) (max_iterations)",
-                            select.query().describe(),
-                            found.object
-                        ));
+                        self.last_failure = Some(
+                            Failure::new(
+                                FailureKind::MaxIterations,
+                                format!(
+                                    "for_each: {} still matches ({}) after {limit} iteration(s) (max_iterations)",
+                                    select.query().describe(),
+                                    found.object
+                                ),
+                            )
+                            .at(&info.path),
+                        );
                         (Status::Failure, dt)
                     }
                     Ok(Some(found)) => {
@@ -546,7 +566,7 @@ impl RunState {
                         (Status::Success, dt)
                     }
                     Err(reason) => {
-                        self.last_failure = Some(format!("for_each: {reason}"));
+                        self.last_failure = Some(reason.prefixed("for_each: ").at(&info.path));
                         (Status::Failure, dt)
                     }
                 }
@@ -561,7 +581,9 @@ impl RunState {
                 self.write_selection(plan, node, sel, found);
                 LeafOutcome::Success
             }
-            Ok(None) => LeafOutcome::Failure(format!("no {} matches", sel.query().describe())),
+            Ok(None) => {
+                LeafOutcome::Failure(Failure::other(format!("no {} matches", sel.query().describe())))
+            }
             Err(reason) => LeafOutcome::Failure(reason),
         }
     }
@@ -599,13 +621,20 @@ impl RunState {
         }
     }
 
-    /// Why node `node` failed, from its kind and its children's statuses.
-    fn failure_reason(&self, plan: &Plan, node: usize) -> String {
+    /// Why node `node` failed, from its kind and its children's statuses: the last failure
+    /// below it, wrapped (with it as the cause) by a retry or a guard, or the node's own (a
+    /// timeout that expired, an inverter whose child succeeded).
+    fn failure_reason(&self, plan: &Plan, node: usize) -> Failure {
         let info = &plan.nodes[node];
         let last = self
             .last_failure
             .clone()
-            .unwrap_or_else(|| "a child failed".into());
+            .unwrap_or_else(|| Failure::other("a child failed").at(&info.path));
+        let wrap = |message: String| {
+            Failure::new(last.kind, message)
+                .at(&info.path)
+                .caused_by(last.clone())
+        };
         match info.kind {
             "timeout" => {
                 let child_failed = info.children.first().is_some_and(|&c| {
@@ -614,11 +643,17 @@ impl RunState {
                 if child_failed {
                     last
                 } else {
-                    format!("{} expired", info.label)
+                    Failure::new(FailureKind::Timeout, format!("{} expired", info.label)).at(&info.path)
                 }
             }
-            "retry" => format!("all {} attempts failed; last: {last}", self.attempts[node].max(1)),
-            "inverter" | "force_failure" => format!("{}: child succeeded", info.kind),
+            "retry" => wrap(format!(
+                "all {} attempts failed; last: {last}",
+                self.attempts[node].max(1)
+            )),
+            "inverter" => Failure::new(FailureKind::Inverted, "inverter: child succeeded").at(&info.path),
+            "force_failure" => {
+                Failure::new(FailureKind::Forced, "force_failure: child succeeded").at(&info.path)
+            }
             "guard" | "reactive_sequence" => {
                 let cond_failed = info
                     .children
@@ -626,7 +661,7 @@ impl RunState {
                     .take(info.children.len().saturating_sub(1))
                     .any(|&c| self.touched[c] == self.tick && self.statuses[c] == NodeStatus::Failure);
                 if cond_failed {
-                    format!("condition failed: {last}")
+                    wrap(format!("condition failed: {last}"))
                 } else {
                     last
                 }
@@ -669,24 +704,29 @@ impl RunState {
                         .find(|&a| ended(a) != NodeStatus::Halted)
                         .or(stopped.last().copied())
                         .unwrap_or(i);
-                    let mut reason = format!(
-                        "preempted: `{}` {}",
-                        plan.nodes[by].path,
-                        match ended(by) {
-                            NodeStatus::Halted => "was halted",
-                            NodeStatus::Success => "succeeded",
-                            _ => "failed",
-                        }
+                    let mut reason = Failure::new(
+                        FailureKind::Halted,
+                        format!(
+                            "preempted: `{}` {}",
+                            plan.nodes[by].path,
+                            match ended(by) {
+                                NodeStatus::Halted => "was halted",
+                                NodeStatus::Success => "succeeded",
+                                _ => "failed",
+                            }
+                        ),
                     );
                     if ended(by) == NodeStatus::Failure
                         && let Some(why) = &self.reasons[by]
                     {
-                        reason.push_str(&format!(" ({why})"));
+                        reason.message.push_str(&format!(" ({why})"));
+                        reason = reason.caused_by(why.clone());
                     }
                     reason
                 }
-                _ => "preempted: no longer ticked by its parent".to_string(),
+                _ => Failure::new(FailureKind::Halted, "preempted: no longer ticked by its parent"),
             };
+            let reason = reason.at(&plan.nodes[i].path);
             if let Some(id) = plan.nodes[i].leaf {
                 self.halt_leaf(plan, driver, id);
             }
@@ -793,8 +833,14 @@ impl TreeRunner {
     }
 
     /// The last failure / halt reason of every node (same indices as `plan.nodes`).
-    pub fn node_reasons(&self) -> &[Option<String>] {
+    pub fn node_reasons(&self) -> &[Option<Failure>] {
         &self.st.reasons
+    }
+
+    /// Why the tree failed: the root's failure (its message names the failing leaf or condition,
+    /// e.g. "all 3 attempts failed; last: …"), once it has failed or was halted.
+    pub fn failure(&self) -> Option<&Failure> {
+        self.st.reasons.first().and_then(Option::as_ref)
     }
 
     /// Status of the node at `path` (`None` if there is no such node).
@@ -862,11 +908,12 @@ impl TreeRunner {
                     st.halt_leaf(plan, driver, id);
                 }
                 st.counts[i].halts += 1;
+                let path = &plan.nodes[i].path;
                 st.set(
                     plan,
                     i,
                     NodeStatus::Halted,
-                    Some("preempted: the tree was stopped".into()),
+                    Some(Failure::new(FailureKind::Halted, "preempted: the tree was stopped").at(path)),
                 );
             }
         }

@@ -7,12 +7,13 @@
 //!
 //! ```
 //! use macrotree::plan::Loader;
+//! use macrotree::FailureKind;
 //! use macrotree::runtime::{LeafOutcome, scripted::ScriptedDriver};
 //!
 //! let plan = Loader::default().compile_str("main: {sequence: {children: [{grasp: {}}, {cube_grasped: {}}]}}", "t.yaml").unwrap();
 //! let mut d = ScriptedDriver::new(&plan);
 //! d.script("grasp", [LeafOutcome::Running, LeafOutcome::Success]); // 2 ticks, then done
-//! d.set("cube_grasped", LeafOutcome::Failure("slipped".into()));   // every tick from now on
+//! d.set("cube_grasped", LeafOutcome::failure(FailureKind::GraspLost, "slipped")); // every tick from now on
 //! ```
 
 use std::collections::{HashMap, VecDeque};
@@ -207,7 +208,10 @@ impl LeafDriver for ScriptedDriver {
 
     /// Pops the next scripted answer of [`selections`](Self::selections) (none left: nothing
     /// matches).
-    fn select_object(&mut self, _query: &crate::world::query::Query) -> Result<Option<Selection>, String> {
+    fn select_object(
+        &mut self,
+        _query: &crate::world::query::Query,
+    ) -> Result<Option<Selection>, crate::failure::Failure> {
         Ok(self.selections.pop_front())
     }
 }

@@ -26,6 +26,7 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::episode::Goal;
+use crate::failure::FailureKind;
 use crate::faults::FaultKind;
 use crate::plan::Plan;
 use crate::runtime::substitute::{Substitution, glob_match};
@@ -381,6 +382,20 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>) -> Option<ScenarioFile>
             .help("add `outcome: failure`, or remove it"),
         );
     }
+    if let Some(kind) = &e.failure_kind
+        && FailureKind::builtin(kind).is_none()
+        && let Err(why) = FailureKind::check_custom_name(kind)
+    {
+        let names = FailureKind::BUILTIN.map(FailureKind::as_str);
+        issues.push(
+            Issue::new(at(&["expect", "failure_kind"]), why)
+                .label(format!(
+                    "a failure kind: {}, or one a custom node declares",
+                    names.join(", ")
+                ))
+                .maybe_help(did_you_mean(kind, names.iter().copied())),
+        );
+    }
     if let Some(t) = e.max_sim_time
         && !(t.is_finite() && t > 0.0 && t <= crate::episode::MAX_SIM_TIME_S)
     {
@@ -582,8 +597,8 @@ pub fn check(expect: &Expect, results: &[ScenarioResult], summary: &Summary) -> 
             if let Some(kind) = &expect.failure_kind {
                 let other: Vec<String> = results
                     .iter()
-                    .filter(|r| !r.success && r.failure_kind != Some(kind.as_str()))
-                    .map(|r| format!("#{} {}", r.index, r.failure_kind.unwrap_or("other")))
+                    .filter(|r| !r.success && r.failure_kind.map(FailureKind::as_str) != Some(kind.as_str()))
+                    .map(|r| format!("#{} {}", r.index, r.failure_kind.unwrap_or(FailureKind::Other)))
                     .collect();
                 out.push(Checked {
                     expectation: format!("every failure is of kind `{kind}`"),
@@ -705,7 +720,7 @@ pub fn offending_commands(expect: &Expect, results: &[ScenarioResult], config: &
                             || expect
                                 .failure_kind
                                 .as_deref()
-                                .is_some_and(|k| r.failure_kind != Some(k))
+                                .is_some_and(|k| r.failure_kind.map(FailureKind::as_str) != Some(k))
                             || expect
                                 .failed_node
                                 .as_deref()

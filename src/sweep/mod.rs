@@ -45,6 +45,7 @@ use crate::actions::{CONTROL_PERIOD, Cell, Checks};
 use crate::episode::Collision;
 use crate::episode::{EpisodeConfig, EpisodeReport, Goal, NoObserver, NodeReport, ObjectReport, run_in_cell};
 use crate::factory::Factory;
+use crate::failure::FailureKind;
 use crate::faults::FaultKind;
 use crate::plan::Plan;
 use crate::runtime::substitute::Substitution;
@@ -382,8 +383,8 @@ pub struct ScenarioResult {
     pub collisions: Vec<Collision>,
     /// The path of the node whose failure ended the episode, if one did.
     pub failed_node: Option<String>,
-    /// A stable name for the kind of failure (`timeout`, `grasp_lost`, …), for grouping.
-    pub failure_kind: Option<&'static str>,
+    /// The kind of failure (`timeout`, `grasp_lost`, …; serialized as its name), for grouping.
+    pub failure_kind: Option<FailureKind>,
     /// How often every node ran, in plan order.
     pub nodes: Vec<NodeReport>,
     /// Wall-clock time of the episode, seconds (not written to the JSONL).
@@ -410,7 +411,6 @@ impl ScenarioResult {
         layout: Option<ScenarioLayout>,
         r: EpisodeReport,
     ) -> Self {
-        let failure_kind = r.failure_reason.as_deref().map(crate::episode::failure_kind);
         Self {
             suite: config.suite.clone(),
             tree: config.tree.clone(),
@@ -438,7 +438,7 @@ impl ScenarioResult {
             objects: r.objects,
             goal: r.goal,
             collisions: r.collisions,
-            failure_kind,
+            failure_kind: r.failure_kind,
             failed_node: r.failed_node,
             nodes: r.nodes,
             wall_time_s: r.wall_time_s,
@@ -452,7 +452,7 @@ impl ScenarioResult {
         index: u64,
         seed: u64,
         layout: Option<ScenarioLayout>,
-        reason: String,
+        reason: crate::failure::Failure,
     ) -> Self {
         Self {
             suite: config.suite.clone(),
@@ -469,8 +469,8 @@ impl ScenarioResult {
             layout,
             success: false,
             tree_status: "failure",
-            failure_kind: Some(crate::episode::failure_kind(&reason)),
-            failure_reason: Some(reason),
+            failure_kind: Some(reason.kind),
+            failure_reason: Some(reason.message),
             sim_time_s: 0.0,
             grasp_attempts: 0,
             halts: 0,
@@ -648,7 +648,13 @@ pub fn run_scene_scenario_observed(
             let report = run_in_cell(cell, plan.clone(), factory, &episode, observer);
             ScenarioResult::of_scene(&scenario, config, report)
         }
-        Err(e) => ScenarioResult::not_run(config, index, 0, None, format!("layout: {e}")),
+        Err(e) => ScenarioResult::not_run(
+            config,
+            index,
+            0,
+            None,
+            crate::failure::Failure::new(FailureKind::Layout, format!("layout: {e}")),
+        ),
     }
 }
 
@@ -702,7 +708,10 @@ pub fn run_sweep_with<T: Send>(
                                 index,
                                 s.as_ref().map_or(0, |s| s.seed),
                                 s.and_then(|s| s.layout),
-                                format!("panicked: {}", panic_message(&*payload)),
+                                crate::failure::Failure::new(
+                                    FailureKind::Panicked,
+                                    format!("panicked: {}", panic_message(&*payload)),
+                                ),
                             );
                             (r, None)
                         }

@@ -254,6 +254,15 @@ pub fn parse_line(line: &str) -> Result<ScenarioResult, String> {
         Value::Null => None,
         r => Some(r.as_str().ok_or("`failure_reason` is not text")?.to_string()),
     };
+    let failure_kind = match field("failure_kind")? {
+        Value::Null => None,
+        k => {
+            let name = k.as_str().ok_or("`failure_kind` is not text")?;
+            let kind =
+                crate::failure::FailureKind::parse(name).map_err(|e| format!("`failure_kind`: {e}"))?;
+            Some(kind)
+        }
+    };
     let status = field("tree_status")?.as_str().unwrap_or_default();
     let fault = match field("fault")? {
         Value::Null => None,
@@ -318,7 +327,7 @@ pub fn parse_line(line: &str) -> Result<ScenarioResult, String> {
             .into_iter()
             .find(|s| *s == status)
             .ok_or("unknown `tree_status`")?,
-        failure_kind: failure_reason.as_deref().map(crate::episode::failure_kind),
+        failure_kind,
         failure_reason,
         sim_time_s: float(field("sim_time_s")?, "sim_time_s")?,
         grasp_attempts: u32_of("grasp_attempts")?,

@@ -28,8 +28,8 @@ pub struct Failure {
     pub bowl: Option<[f64; 2]>,
     /// The node whose failure ended the episode.
     pub node: Option<String>,
-    /// The kind of failure (`timeout`, `grasp_lost`, …).
-    pub kind: Option<&'static str>,
+    /// The kind of failure (`timeout`, `grasp_lost`, …; serialized as its name).
+    pub kind: Option<crate::failure::FailureKind>,
     /// Contacts that should not happen, by name (`the fingers hit bin wall`).
     pub collisions: Vec<String>,
     /// Why it failed.
@@ -220,7 +220,7 @@ impl Summary {
         for f in &failures {
             let key = (
                 f.node.clone().unwrap_or_else(|| "-".into()),
-                f.kind.unwrap_or("other").to_string(),
+                f.kind.unwrap_or(crate::failure::FailureKind::Other).to_string(),
             );
             groups.entry(key).or_default().push(f.index);
         }
