@@ -93,7 +93,8 @@ fn bench_replay_ends_in_the_episodes_exact_final_state() {
             .expect("valid"),
     );
     let config = macrotree::episode::EpisodeConfig::default();
-    let mut cell = macrotree::actions::Cell::new(&scene, &config.layout, config.control_period);
+    let mut cell =
+        macrotree::actions::Cell::new(&scene, &macrotree::sim::Layout::default(), config.control_period);
     let r = macrotree::episode::run_in_cell(
         &mut cell,
         plan,

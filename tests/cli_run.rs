@@ -217,3 +217,139 @@ fn bench_prints_the_ratio_and_simulated_time() {
     // The replay runs exactly the episode's physics steps.
     assert!(r["physics_steps"].as_u64().unwrap() > 1000);
 }
+
+/// Issue 18: a scene without a bowl has no `bowl_target` (it was the sentinel
+/// `[100, 100, 0]`), and `run` prints no cube or bowl line for what the scene does not have.
+#[test]
+fn a_scene_without_a_bowl_reports_no_bowl_target_and_prints_no_bowl_line() {
+    let run = |scene: &str| {
+        let out = macrotree(&[
+            "run",
+            "tests/fixtures/cli/gripper_open.yaml",
+            "--scene",
+            scene,
+            "--json",
+        ]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "stderr: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        // The human summary: stdout without the JSON line.
+        let human: Vec<String> = String::from_utf8_lossy(&out.stdout)
+            .lines()
+            .filter(|l| !l.starts_with('{'))
+            .map(str::to_string)
+            .collect();
+        (last_json_line(&out), human.join("\n"))
+    };
+    // One block, no container: the cube is reported, no bowl anywhere.
+    let (r, text) = run("tests/fixtures/cli/cube_no_bowl.yaml");
+    assert!(r.get("bowl_target").is_none(), "{r}");
+    assert!(!r.to_string().contains("100.0"), "the sentinel is back: {r}");
+    assert_eq!(r["cube_final"].as_array().map(Vec::len), Some(3), "{r}");
+    assert_eq!(r["layout"]["cube"][0], 0.45, "{r}");
+    assert!(r["layout"].get("bowl").is_none(), "{r}");
+    assert!(text.contains("cube final ("), "{text}");
+    assert!(
+        !text.contains("bowl"),
+        "a bowl line for a scene without one:\n{text}"
+    );
+    // Two blocks, no container: neither a cube nor a bowl.
+    let (r, human) = run("tests/fixtures/cli/two_blocks.yaml");
+    assert!(
+        r.get("bowl_target").is_none() && r.get("cube_final").is_none(),
+        "{r}"
+    );
+    assert_eq!(r["layout"], serde_json::json!({}), "{r}");
+    assert!(
+        !human.contains("cube") && !human.contains("bowl"),
+        "cube/bowl lines for a scene without them:\n{human}"
+    );
+    assert!(human.contains("block a: final"), "{human}");
+}
+
+/// The report's `layout` is where the cube and the bowl really started, for any scene and any
+/// way of placing them (it used to repeat the built-in default for other scenes).
+#[test]
+fn the_reports_layout_is_where_the_cube_and_bowl_started() {
+    let out = macrotree(&[
+        "run",
+        "tests/fixtures/cli/gripper_open.yaml",
+        "--cube",
+        "0.5,-0.2,30",
+        "--bowl",
+        "0.4,0.1",
+        "--goal",
+        "tree",
+        "--json",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r = last_json_line(&out);
+    let cube: Vec<f64> = r["layout"]["cube"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert_eq!(&cube[..2], &[0.5, -0.2]);
+    assert!((cube[2] - 30.0).abs() < 1e-9, "{r}");
+    assert_eq!(r["layout"]["bowl"], serde_json::json!([0.4, 0.1]));
+    // A scene with its own poses: the cube's pose from the file.
+    let out = macrotree(&[
+        "run",
+        "tests/fixtures/cli/gripper_open.yaml",
+        "--scene",
+        "tests/fixtures/cli/cube_no_bowl.yaml",
+        "--cube",
+        "0.4,-0.25",
+        "--json",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r = last_json_line(&out);
+    assert_eq!(r["layout"]["cube"], serde_json::json!([0.4, -0.25, 0.0]), "{r}");
+}
+
+/// `--goal bowl` on a scene without a cube and a bowl could never succeed: it is refused with
+/// exit 2 before anything is simulated, by `run` and by `sweep`.
+#[test]
+fn goal_bowl_is_refused_for_a_scene_without_a_cube_and_a_bowl() {
+    for args in [
+        &["run", "tests/fixtures/cli/gripper_open.yaml"][..],
+        &[
+            "sweep",
+            "tests/fixtures/cli/gripper_open.yaml",
+            "--scenarios",
+            "1",
+        ][..],
+    ] {
+        let mut args = args.to_vec();
+        args.extend([
+            "--scene",
+            "tests/fixtures/cli/cube_no_bowl.yaml",
+            "--goal",
+            "bowl",
+        ]);
+        let out = macrotree(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains("--goal bowl")
+                && stderr.contains("1 blocks and 0 containers")
+                && stderr.contains("help:"),
+            "{args:?}: {stderr}"
+        );
+        assert!(out.stdout.is_empty(), "{args:?}: nothing simulated");
+    }
+}

@@ -31,7 +31,7 @@ fn run_all(layouts: &[Layout]) -> Vec<(EpisodeReport, oracle::Verdict)> {
         .iter()
         .map(|layout| {
             let config = EpisodeConfig {
-                layout: *layout,
+                placement: Some(scene.placement_from_layout(layout)),
                 ..EpisodeConfig::default()
             };
             let r = run_in_cell(
@@ -137,15 +137,15 @@ fn same_tree_layout_and_seed_give_a_bit_identical_episode() {
     let scene = Scene::load().expect("scene");
     let plan = flagship();
     let config = EpisodeConfig {
-        layout: Layout::new(0.38, 0.12, 27.0, 0.55, -0.15),
+        placement: Some(scene.placement_from_layout(&Layout::new(0.38, 0.12, 27.0, 0.55, -0.15))),
         seed: 7,
         ..EpisodeConfig::default()
     };
-    let mut a = macrotree::actions::Cell::new(&scene, &config.layout, config.control_period);
-    let mut b = macrotree::actions::Cell::new(&scene, &config.layout, config.control_period);
+    let mut a = macrotree::actions::Cell::new(&scene, &Layout::default(), config.control_period);
+    let mut b = macrotree::actions::Cell::new(&scene, &Layout::default(), config.control_period);
     // Run `b` once on another layout first: a reused cell must not remember anything.
     let other = EpisodeConfig {
-        layout: Layout::default(),
+        placement: None,
         ..config.clone()
     };
     run_in_cell(

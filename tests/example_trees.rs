@@ -42,7 +42,7 @@ struct Squeeze {
 /// Distance of the cube centre from the middle of the pads along the finger axis, metres.
 fn off_pad_middle(w: &macrotree::world::World) -> f64 {
     let axis = (w.right_pad_pos - w.left_pad_pos).normalize();
-    (w.cube_pos - (w.left_pad_pos + w.right_pad_pos) / 2.0)
+    (w.objects[w.cube().expect("a cube")].pos - (w.left_pad_pos + w.right_pad_pos) / 2.0)
         .dot(&axis)
         .abs()
 }
@@ -81,7 +81,8 @@ impl EpisodeObserver for Trace {
             self.transitions.push(t);
         }
         if self.squeeze.running {
-            self.squeeze.touched |= w.left_pad_contact || w.right_pad_contact;
+            let cube = &w.objects[w.cube().expect("a cube")];
+            self.squeeze.touched |= cube.left_pad_contact || cube.right_pad_contact;
             self.squeeze.max_off = self.squeeze.max_off.max(off_pad_middle(w));
         }
     }
@@ -99,7 +100,7 @@ struct Outcome {
 fn run(plan: &Arc<Plan>, layout: Layout, fault: Option<(FaultKind, u64)>) -> Outcome {
     let mut cell = Cell::new(scene(), &layout, CONTROL_PERIOD);
     let config = EpisodeConfig {
-        layout,
+        placement: Some(scene().placement_from_layout(&layout)),
         fault: fault.map(|(k, _)| k),
         seed: fault.map_or(0, |(_, s)| s),
         ..EpisodeConfig::default()
@@ -112,7 +113,7 @@ fn run(plan: &Arc<Plan>, layout: Layout, fault: Option<(FaultKind, u64)>) -> Out
         &config,
         &mut trace,
     );
-    let cube_yaw = cell.world().cube_yaw();
+    let cube_yaw = cell.world().yaw(cell.world().cube().expect("a cube"));
     oracle::assert_no_warning(cell.sim(), &format!("{layout:?} {fault:?}"));
     let verdict = oracle::settle_and_judge(cell.sim_mut(), "cube", "bowl");
     eprintln!(
@@ -121,9 +122,9 @@ fn run(plan: &Arc<Plan>, layout: Layout, fault: Option<(FaultKind, u64)>) -> Out
         report.checks.in_bowl,
         report.sim_time_s,
         report.grasp_attempts,
-        report.cube_final[0],
-        report.cube_final[1],
-        report.cube_final[2],
+        report.cube_final.unwrap()[0],
+        report.cube_final.unwrap()[1],
+        report.cube_final.unwrap()[2],
         cube_yaw.to_degrees(),
         report
             .failure_reason
@@ -152,7 +153,7 @@ fn place_on_table_sets_the_cube_down_square_on_the_spot() {
         let o = run(&plan, layout, fault);
         let r = &o.report;
         assert_eq!(r.tree_status, "success", "{layout:?}: {:?}", r.failure_reason);
-        let [x, y, z] = r.cube_final;
+        let [x, y, z] = r.cube_final.expect("the scene has a cube");
         let off = (x - 0.32).hypot(y + 0.30);
         eprintln!("  {:.1} mm from the spot", off * 1e3);
         assert!(off <= 0.005, "{layout:?}: cube {:.1} mm from the spot", off * 1e3);

@@ -43,7 +43,7 @@ fn scene() -> &'static Scene {
 
 /// Runs `yaml` for one episode on the built-in scene with `observers` on the physics.
 fn episode(yaml: &str, config: &EpisodeConfig, observers: Vec<Box<dyn StepObserver>>) -> EpisodeReport {
-    let mut cell = Cell::new(scene(), &config.layout, CONTROL_PERIOD);
+    let mut cell = Cell::new(scene(), &Layout::default(), CONTROL_PERIOD);
     cell.observers.extend(observers);
     run_in_cell(
         &mut cell,
@@ -313,7 +313,8 @@ impl StepObserver for CirclingBowl {
         self.carrying |= kind == "carry";
     }
     fn before_step(&mut self, sim: &mut Sim) {
-        let Some(mocap) = sim.scene().ids.bowl.map(|b| b.mocap) else {
+        let scene = sim.scene();
+        let Some(mocap) = scene.spec.legacy_bowl().and_then(|b| scene.objects[b].mocap) else {
             return;
         };
         if !self.carrying {

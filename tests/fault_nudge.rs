@@ -48,9 +48,10 @@ struct Moved {
 impl EpisodeObserver for Moved {
     fn on_tick(&mut self, cell: &Cell, _runner: &mut TreeRunner) {
         let w = cell.world();
-        let start = *self.start.get_or_insert(w.cube_pos);
-        if cell.gripper_command() > 0.0 && w.cube_pos.z < 0.03 {
-            self.max = self.max.max((w.cube_pos - start).xy().norm());
+        let cube = w.objects[w.cube().expect("a cube")].pos;
+        let start = *self.start.get_or_insert(cube);
+        if cell.gripper_command() > 0.0 && cube.z < 0.03 {
+            self.max = self.max.max((cube - start).xy().norm());
         }
     }
 }
@@ -67,7 +68,7 @@ fn a_nudge_really_moves_the_cube_as_the_gripper_closes() {
         let (nudge, log) = injector_with_log(FaultKind::Nudge, seed);
         cell.observers.push(nudge);
         let config = EpisodeConfig {
-            layout,
+            placement: Some(scene().placement_from_layout(&layout)),
             seed,
             ..EpisodeConfig::default()
         };
@@ -112,7 +113,7 @@ fn every_fault_fires_exactly_once_in_an_episode() {
         let (fault, log) = injector_with_log(kind, 7);
         cell.observers.push(fault);
         let config = EpisodeConfig {
-            layout,
+            placement: Some(scene().placement_from_layout(&layout)),
             seed: 7,
             ..EpisodeConfig::default()
         };

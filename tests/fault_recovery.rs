@@ -7,6 +7,7 @@ use macrotree::actions::{CONTROL_PERIOD, Cell};
 use macrotree::episode::{EpisodeConfig, EpisodeObserver, run_in_cell};
 use macrotree::faults::{FaultKind, injector_with_log};
 use macrotree::runtime::TreeRunner;
+use macrotree::sim::Layout;
 use macrotree::sweep::{SweepConfig, run_sweep, sample_scenario};
 use nalgebra::Vector3;
 
@@ -27,7 +28,9 @@ struct Track {
 impl EpisodeObserver for Track {
     fn on_tick(&mut self, cell: &Cell, _runner: &mut TreeRunner) {
         let w = cell.world();
-        self.samples.push((w.time, w.cube_pos, w.bowl_pos));
+        let (cube, bowl) = (w.cube().expect("a cube"), w.bowl().expect("a bowl"));
+        self.samples
+            .push((w.time, w.objects[cube].pos, w.objects[bowl].pos));
     }
 }
 
@@ -65,11 +68,11 @@ impl Track {
 fn episode(kind: FaultKind, index: u64) -> Episode {
     let scenario = sample_scenario(2024, index);
     let config = EpisodeConfig {
-        layout: scenario.layout.to_layout(),
+        placement: Some(scene().placement_from_layout(&scenario.layout.to_layout())),
         seed: scenario.seed,
         ..EpisodeConfig::default()
     };
-    let mut cell = Cell::new(scene(), &config.layout, CONTROL_PERIOD);
+    let mut cell = Cell::new(scene(), &Layout::default(), CONTROL_PERIOD);
     let (fault, log) = injector_with_log(kind, config.seed);
     cell.observers.push(fault);
     let mut track = Track::default();

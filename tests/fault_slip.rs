@@ -8,8 +8,10 @@ use macrotree::faults::{FaultKind, injector_with_log};
 use macrotree::runtime::{NodeStatus, Transition, TreeRunner};
 use macrotree::sim::Layout;
 use macrotree::sweep::{SweepConfig, run_sweep, sample_scenario};
-use macrotree::world::CUBE_HALF;
 use nalgebra::Vector3;
+
+/// Half the edge of the 44 mm cube of the built-in scene, metres.
+const CUBE_HALF: f64 = 0.022;
 
 #[path = "support/flagship.rs"]
 mod flagship;
@@ -30,7 +32,7 @@ impl EpisodeObserver for Trace {
     fn on_tick(&mut self, cell: &Cell, runner: &mut TreeRunner) {
         self.transitions.extend(runner.drain_transitions());
         let w = cell.world();
-        self.cube.push((w.time, w.cube_pos));
+        self.cube.push((w.time, w.objects[w.cube().expect("a cube")].pos));
     }
 }
 
@@ -42,11 +44,11 @@ fn leaf(t: &Transition) -> &str {
 fn a_slip_drops_the_cube_and_the_tree_picks_it_up_where_it_fell() {
     let scenario = sample_scenario(1, 0);
     let config = EpisodeConfig {
-        layout: scenario.layout.to_layout(),
+        placement: Some(scene().placement_from_layout(&scenario.layout.to_layout())),
         seed: scenario.seed,
         ..EpisodeConfig::default()
     };
-    let mut cell = Cell::new(scene(), &config.layout, CONTROL_PERIOD);
+    let mut cell = Cell::new(scene(), &Layout::default(), CONTROL_PERIOD);
     let (slip, log) = injector_with_log(FaultKind::Slip, config.seed);
     cell.observers.push(slip);
     let mut trace = Trace::default();
@@ -179,7 +181,7 @@ fn a_slip_is_deterministic_and_fires_once() {
         let (slip, log) = injector_with_log(FaultKind::Slip, seed);
         cell.observers.push(slip);
         let config = EpisodeConfig {
-            layout,
+            placement: Some(scene().placement_from_layout(&layout)),
             seed,
             ..EpisodeConfig::default()
         };

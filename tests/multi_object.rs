@@ -226,3 +226,30 @@ fn tempdir(name: &str) -> std::path::PathBuf {
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }
+
+/// Issue 18: which sampler a sweep uses is the scene file's `sampler:` setting, not whether the
+/// scene equals the built-in one: a renamed copy of `cube_bowl.yaml` keeps the tutorial's
+/// sampler (and its `--cube … --bowl …` layouts), the same cell without the line samples every
+/// object from its own `random:`.
+#[test]
+fn the_tutorial_sampler_follows_the_scene_setting_not_the_scene_name() {
+    use macrotree::scene::SceneSpec;
+    let text = std::fs::read_to_string(Path::new(ROOT).join("scenes/cube_bowl.yaml")).unwrap();
+    let sweep = SweepConfig {
+        seed: 11,
+        ..SweepConfig::default()
+    };
+    let copy = Scene::load_spec(&SceneSpec::from_str(&text, "my_cell.yaml").unwrap()).unwrap();
+    let s = sweep.scene_scenario(&copy, 3).unwrap();
+    let expected = macrotree::sweep::sample_scenario(11, 3);
+    assert_eq!(s.layout, Some(expected.layout));
+    assert_eq!(s.seed, expected.seed);
+    let cube = copy.spec.legacy_cube().unwrap();
+    assert_eq!(s.placement.poses[cube].x, expected.layout.cube[0]);
+    let plain = text.replace("\nsampler: tutorial\n", "\n");
+    let plain = Scene::load_spec(&SceneSpec::from_str(&plain, "cube_bowl.yaml").unwrap()).unwrap();
+    let s = sweep.scene_scenario(&plain, 3).unwrap();
+    assert_eq!(s.layout, None, "no tutorial layout without the setting");
+    let (seed, placement) = macrotree::scene::sample_placement(&plain.spec, 11, 3).unwrap();
+    assert_eq!((s.seed, s.placement), (seed, placement));
+}

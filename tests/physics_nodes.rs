@@ -99,7 +99,7 @@ fn run(yaml: &str) -> (EpisodeReport, Trace, Cell) {
     let layout = Layout::default();
     let mut cell = Cell::new(scene(), &layout, CONTROL_PERIOD);
     let config = EpisodeConfig {
-        layout,
+        placement: Some(scene().placement_from_layout(&layout)),
         ..EpisodeConfig::default()
     };
     let mut trace = Trace::default();

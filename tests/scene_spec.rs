@@ -236,3 +236,35 @@ fn a_scene_override_rechecks_the_tree() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// Issue 18: the reference tutorial's sampler is a setting of the scene file (`sampler:
+/// tutorial`), not a comparison with the built-in scene; it needs the scene's one randomized cube
+/// and bowl, and a wrong value is located.
+#[test]
+fn the_tutorial_sampler_is_a_scene_setting_that_needs_a_cube_and_a_bowl() {
+    let builtin = SceneSpec::builtin();
+    assert_eq!(builtin.sampler, macrotree::scene::Sampler::Tutorial);
+    let shipped = std::fs::read_to_string(Path::new(ROOT).join("scenes/cube_bowl.yaml")).unwrap();
+    assert!(shipped.contains("\nsampler: tutorial\n"));
+    // Without the line, the same cell samples its objects one by one.
+    let plain =
+        SceneSpec::from_str(&shipped.replace("\nsampler: tutorial\n", "\n"), "cube_bowl.yaml").unwrap();
+    assert_eq!(plain.sampler, macrotree::scene::Sampler::Objects);
+    // A copy under another name keeps the setting.
+    let copy = SceneSpec::from_str(&shipped, "my_cell.yaml").unwrap();
+    assert_eq!(copy.sampler, macrotree::scene::Sampler::Tutorial);
+    let d = scene_errors(
+        "sampler: tutorial\nobjects:\n  a: {block: {size: 0.04}, random: {x: [0.3, 0.6], y: [-0.3, -0.1]}}\n  b: {block: {size: 0.04}, random: {x: [0.3, 0.6], y: [0.1, 0.3]}}\n",
+    );
+    let text = d[0].to_string();
+    assert!(
+        text.contains("sampler: tutorial") && text.contains("cell.yaml:1:10"),
+        "{text}"
+    );
+    let d = scene_errors("sampler: tutorail\nobjects:\n  a: {block: {size: 0.04}, pose: [0.45, 0.1]}\n");
+    let text = d[0].to_string();
+    assert!(
+        text.contains("unknown sampler `tutorail`") && text.contains("did you mean `tutorial`?"),
+        "{text}"
+    );
+}

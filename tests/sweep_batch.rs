@@ -126,7 +126,7 @@ fn parse_run_command(cmd: &str) -> macrotree::episode::EpisodeConfig {
     match cli.command {
         Command::Run(args) => args
             .episode
-            .config()
+            .config_on(scene())
             .unwrap_or_else(|_| panic!("{cmd}: bad input")),
         other => panic!("{cmd} parsed to {other:?}"),
     }
@@ -157,7 +157,7 @@ fn the_printed_command_reproduces_the_scenario_bit_for_bit() {
         let cmd = swept.reproduce(TREE, &config);
         let parsed = parse_run_command(&cmd);
         // Bit-exact: the same layout (floats compared with ==), seed, limits.
-        assert_eq!(parsed, config.episode_config(&scenario), "{cmd}");
+        assert_eq!(parsed, config.episode_config(scene(), &scenario), "{cmd}");
         // And the same episode, run the way `macrotree run` runs it (a fresh cell).
         let report = run_episode(
             scene(),
@@ -198,8 +198,14 @@ fn reproduction_commands_spell_the_fault_the_goal_and_the_time_limit() {
         panic!("not a run command: {cmd}");
     };
     assert_eq!(args.episode.fault, Some(FaultKind::LateBowl));
-    let parsed = args.episode.config().unwrap_or_else(|_| panic!("bad input"));
-    assert_eq!(parsed.layout, config.episode_config(&scenario).layout);
+    let parsed = args
+        .episode
+        .config_on(scene())
+        .unwrap_or_else(|_| panic!("bad input"));
+    assert_eq!(
+        parsed.placement,
+        config.episode_config(scene(), &scenario).placement
+    );
     assert_eq!(parsed.seed, scenario.seed);
     assert_eq!(parsed.max_sim_time, 12.5);
     assert_eq!(parsed.goal, Goal::Tree);

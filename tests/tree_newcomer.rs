@@ -205,10 +205,10 @@ fn cube_at_checks_the_yaw_of_a_placement() {
                 .unwrap_or_else(|d| panic!("{}", show(&d))),
         );
         let config = EpisodeConfig {
-            layout: Layout {
+            placement: Some(scene.placement_from_layout(&Layout {
                 cube_yaw: cube_yaw_deg.to_radians(),
                 ..Layout::default()
-            },
+            })),
             goal: Goal::Tree,
             ..EpisodeConfig::default()
         };

@@ -82,7 +82,7 @@ impl Carry {
         Self {
             spec,
             held: 0,
-            half: crate::world::CUBE_HALF,
+            half: 0.0,
             pinch_from_block: Vector3::zeros(),
             rotation: UnitQuaternion::identity(),
             phase: Phase::Lift,

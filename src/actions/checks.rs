@@ -1,11 +1,14 @@
 //! The checks the reference tutorial asserts on every pick-and-place
-//! (../shared/notes/torchrl_anchor.md §5.1), measured the same way on our episodes.
+//! (../shared/notes/torchrl_anchor.md §5.1), measured the same way on our episodes, on the
+//! scene's cube and bowl ([`World::cube`], [`World::bowl`]). A scene without a cube measures
+//! nothing (no grasp distance, no motion or lift, not in the bowl); without a bowl, nothing is in
+//! it.
 
 use nalgebra::Vector3;
 use serde::Serialize;
 
-use crate::world::conditions::{Tolerances, cube_in_bowl, home_error};
-use crate::world::{CUBE_HALF, World};
+use crate::world::conditions::{Tolerances, home_error};
+use crate::world::{World, goal};
 
 /// The tutorial's checks for one episode. Distances in metres, joint error in radians.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -19,7 +22,8 @@ pub struct Checks {
     pub cube_lift_while_closed: f64,
     /// Joint-space distance of the arm from home at the end (Euclidean norm).
     pub home_error: f64,
-    /// The cube rests inside the bowl at the end.
+    /// The cube rests inside the bowl at the end (the `in` condition on the scene's cube and
+    /// bowl; false in a scene without them).
     pub in_bowl: bool,
 }
 
@@ -46,11 +50,12 @@ pub struct ChecksRecorder {
 
 impl ChecksRecorder {
     /// A grasp just finished: measure the pad–cube distance and take the cube's position as the
-    /// reference for the closed-gripper motion checks.
+    /// reference for the closed-gripper motion checks (nothing without a cube).
     pub fn after_grasp(&mut self, w: &World) {
-        let d = pad_cube_distance(w);
+        let Some(cube) = w.cube() else { return };
+        let d = pad_block_distance(w, cube);
         self.grasp_distance = Some(self.grasp_distance.map_or(d, |g| g.min(d)));
-        self.grasp_ref = Some(w.cube_pos);
+        self.grasp_ref = Some(w.objects[cube].pos);
     }
 
     /// The gripper opens: stop tracking cube motion.
@@ -60,9 +65,10 @@ impl ChecksRecorder {
 
     /// Called after every control period with whether the gripper is commanded closed.
     pub fn on_tick(&mut self, w: &World, gripper_closed: bool) {
-        if let (Some(r), true) = (self.grasp_ref, gripper_closed) {
-            self.motion = self.motion.max((w.cube_pos - r).norm());
-            self.lift = self.lift.max(w.cube_pos.z - r.z);
+        if let (Some(r), true, Some(cube)) = (self.grasp_ref, gripper_closed, w.cube()) {
+            let p = w.objects[cube].pos;
+            self.motion = self.motion.max((p - r).norm());
+            self.lift = self.lift.max(p.z - r.z);
         }
     }
 
@@ -73,18 +79,22 @@ impl ChecksRecorder {
             cube_motion_while_closed: self.motion,
             cube_lift_while_closed: self.lift,
             home_error: home_error(w),
-            in_bowl: cube_in_bowl(w, Tolerances::REST_SPEED),
+            in_bowl: match (w.cube(), w.bowl()) {
+                (Some(c), Some(b)) => goal::rests_in(w, c, b, Tolerances::REST_SPEED),
+                _ => false,
+            },
         }
     }
 }
 
-/// Distance from the nearer pad centre to the cube's surface (0 when inside), metres. Unlike the
-/// reference, the cube's rotation is taken into account.
-pub fn pad_cube_distance(w: &World) -> f64 {
-    let to_cube = |p: &Vector3<f64>| {
-        let local = w.cube_quat.inverse() * (p - w.cube_pos);
-        let excess = local.map(|c| (c.abs() - CUBE_HALF).max(0.0));
+/// Distance from the nearer pad centre to block `i`'s surface (0 when inside), metres. Unlike
+/// the reference, the block's rotation is taken into account.
+pub fn pad_block_distance(w: &World, i: usize) -> f64 {
+    let (o, half) = (&w.objects[i], w.half(i));
+    let to_block = |p: &Vector3<f64>| {
+        let local = o.quat.inverse() * (p - o.pos);
+        let excess = local.map(|c| (c.abs() - half).max(0.0));
         excess.norm()
     };
-    to_cube(&w.left_pad_pos).min(to_cube(&w.right_pad_pos))
+    to_block(&w.left_pad_pos).min(to_block(&w.right_pad_pos))
 }

@@ -18,7 +18,7 @@ mod targets;
 
 pub(crate) use carry::Carry as CarryAction;
 pub use cell::{CONTROL_PERIOD, Cell, StepObserver};
-pub use checks::{Checks, ChecksRecorder, pad_cube_distance};
+pub use checks::{Checks, ChecksRecorder, pad_block_distance};
 pub(crate) use grasp::Grasp as GraspAction;
 pub(crate) use joints::MoveJoints as MoveJointsAction;
 pub use macro_action::{Arrival, MacroAction, Progress};

@@ -14,8 +14,8 @@ use crate::world::World;
 pub fn resolve(target: &crate::kinds::Target, w: &World) -> Result<Vector3<f64>, Failure> {
     use crate::kinds::Target;
     match target {
-        Target::Cube => Ok(w.cube_pos),
-        Target::Bowl => Ok(w.bowl_target),
+        Target::Cube => Ok(w.objects[w.require_cube()?].pos),
+        Target::Bowl => Ok(object_point(w, w.require_bowl()?)),
         Target::Point(p) => Ok(Vector3::new(p[0], p[1], p[2])),
         Target::Object(o) => {
             let i = object_index(o, w)?;
@@ -49,7 +49,7 @@ pub fn object_index(o: &ObjectRef, w: &World) -> Result<usize, Failure> {
 pub fn target_block(target: &crate::kinds::Target, w: &World) -> Option<usize> {
     use crate::kinds::Target;
     match target {
-        Target::Cube => w.scene.legacy_cube(),
+        Target::Cube => w.cube(),
         Target::Object(o) => object_index(o, w)
             .ok()
             .filter(|&i| w.spec(i).kind() == ObjectKind::Block),
@@ -61,8 +61,8 @@ pub fn target_block(target: &crate::kinds::Target, w: &World) -> Option<usize> {
 pub fn target_object(target: &crate::kinds::Target, w: &World) -> Option<usize> {
     use crate::kinds::Target;
     match target {
-        Target::Cube => w.scene.legacy_cube(),
-        Target::Bowl => w.scene.legacy_bowl(),
+        Target::Cube => w.cube(),
+        Target::Bowl => w.bowl(),
         Target::Object(o) => object_index(o, w).ok(),
         Target::Point(_) => None,
     }

@@ -95,7 +95,7 @@ pub fn bench(app: &crate::App, args: BenchArgs) -> Result<(), CliError> {
     let placement = config
         .placement
         .clone()
-        .unwrap_or_else(|| scene.placement_from_layout(&config.layout));
+        .unwrap_or_else(|| scene.default_placement());
     let repeat = args.repeat.max(1);
     let mut episode_times = Vec::new();
     let mut replay_times = Vec::new();
@@ -103,7 +103,7 @@ pub fn bench(app: &crate::App, args: BenchArgs) -> Result<(), CliError> {
     let mut states = None;
     for _ in 0..repeat {
         let controls = Arc::new(Mutex::new(Vec::new()));
-        let mut cell = Cell::new(&scene, &config.layout, config.control_period);
+        let mut cell = Cell::new(&scene, &crate::sim::Layout::default(), config.control_period);
         // Not recorded: the first run warms caches; recording costs one copy per step, which is
         // charged to the episode (conservative).
         cell.observers.push(Box::new(Recorder(controls.clone())));

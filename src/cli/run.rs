@@ -108,7 +108,8 @@ pub struct EpisodeArgs {
 }
 
 impl EpisodeArgs {
-    /// The episode configuration these arguments describe.
+    /// The episode configuration these arguments describe, with the scene's default placement
+    /// (see [`config_on`](Self::config_on) for `--cube`, `--bowl` and `--scenario`).
     pub fn config(&self) -> Result<EpisodeConfig, CliError> {
         if !(self.max_sim_time.is_finite() && self.max_sim_time > 0.0) {
             return Err(CliError::Input(format!(
@@ -116,16 +117,7 @@ impl EpisodeArgs {
                 self.max_sim_time
             )));
         }
-        let mut layout = Layout::default();
-        if let Some(c) = self.cube {
-            layout.cube_xy = [c.x, c.y];
-            layout.cube_yaw = c.yaw_deg.to_radians();
-        }
-        if let Some(b) = self.bowl {
-            layout.bowl_xy = [b.x, b.y];
-        }
         Ok(EpisodeConfig {
-            layout,
             placement: None,
             seed: self.seed,
             max_sim_time: self.max_sim_time,
@@ -138,6 +130,20 @@ impl EpisodeArgs {
 }
 
 impl EpisodeArgs {
+    /// The legacy layout `--cube` and `--bowl` describe (the tutorial's default for what they
+    /// leave out).
+    pub fn layout(&self) -> Layout {
+        let mut layout = Layout::default();
+        if let Some(c) = self.cube {
+            layout.cube_xy = [c.x, c.y];
+            layout.cube_yaw = c.yaw_deg.to_radians();
+        }
+        if let Some(b) = self.bowl {
+            layout.bowl_xy = [b.x, b.y];
+        }
+        layout
+    }
+
     /// The episode configuration on `scene`: [`config`](Self::config) with every object placed —
     /// `--scenario K` draws the sweep's scenario K, `--cube`/`--bowl` move the scene's cube and
     /// bowl, otherwise the scene's poses (or, for a randomized scene without them, scenario 0 of
@@ -145,6 +151,7 @@ impl EpisodeArgs {
     /// other, blocks within reach) before anything is simulated.
     pub fn config_on(&self, scene: &Scene) -> Result<EpisodeConfig, CliError> {
         let mut config = self.config()?;
+        check_goal(config.goal, scene)?;
         let placement = if let Some(k) = self.scenario {
             let sweep = crate::sweep::SweepConfig {
                 seed: self.sweep_seed,
@@ -154,9 +161,6 @@ impl EpisodeArgs {
                 CliError::Input(format!("error: scenario {k} of seed {}: {e}", self.sweep_seed))
             })?;
             config.seed = s.seed;
-            if let Some(l) = s.layout {
-                config.layout = l.to_layout();
-            }
             s.placement
         } else {
             if (self.cube.is_some() && scene.spec.legacy_cube().is_none())
@@ -169,7 +173,7 @@ impl EpisodeArgs {
                     scene.spec.of_kind(crate::scene::ObjectKind::Container).count()
                 )));
             }
-            scene.placement_from_layout(&config.layout)
+            scene.placement_from_layout(&self.layout())
         };
         placement.check(&scene.spec).map_err(|e| {
             CliError::Input(format!(
@@ -179,13 +183,24 @@ impl EpisodeArgs {
                 crate::scene::reach_limits()[1]
             ))
         })?;
-        // The built-in scene's legacy layout stays the episode's description (bit-identical
-        // to earlier releases); any other placement is given whole.
-        if *scene.spec != *crate::spec::load::builtin_scene() {
-            config.placement = Some(placement);
-        }
+        config.placement = Some(placement);
         Ok(config)
     }
+}
+
+/// `--goal bowl` judges the scene's cube in its bowl: refused (bad input) for a scene without
+/// them, where it could never succeed.
+pub(super) fn check_goal(goal: Goal, scene: &Scene) -> Result<(), CliError> {
+    let spec = &scene.spec;
+    if goal == Goal::Bowl && (spec.legacy_cube().is_none() || spec.legacy_bowl().is_none()) {
+        return Err(CliError::Input(format!(
+            "error: --goal bowl checks that the scene's cube rests in its bowl, but scene `{}` has {} blocks and {} containers (the cube and the bowl are the ones called `cube` and `bowl`, else the only block and the only container)\n  help: use --goal scene (the scene's own goal) or --goal tree",
+            spec.name,
+            spec.of_kind(crate::scene::ObjectKind::Block).count(),
+            spec.of_kind(crate::scene::ObjectKind::Container).count()
+        )));
+    }
+    Ok(())
 }
 
 /// Runs `macrotree run`.
@@ -430,23 +445,29 @@ fn print_summary(r: &crate::episode::EpisodeReport, goal: Goal, json: bool) {
     for c in &r.collisions {
         say!(json, "  collision at {:.2} s: {}", c.time, c.what);
     }
-    say!(
-        json,
-        "  cube final ({:.3}, {:.3}, {:.3}) m, bowl target ({:.3}, {:.3}, {:.3}) m",
-        r.cube_final[0],
-        r.cube_final[1],
-        r.cube_final[2],
-        r.bowl_target[0],
-        r.bowl_target[1],
-        r.bowl_target[2]
-    );
-    say!(
-        json,
-        "  checks: grasp distance {} m, motion while closed {:.3} m, lift while closed {:.3} m, home error {:.4} rad, in bowl {}",
-        c.grasp_distance.map_or("-".into(), |d| format!("{d:.4}")),
-        c.cube_motion_while_closed,
-        c.cube_lift_while_closed,
-        c.home_error,
-        c.in_bowl
-    );
+    // The cube and bowl lines only for a scene that has them (see `World::cube`).
+    let xyz = |p: [f64; 3]| format!("({:.3}, {:.3}, {:.3}) m", p[0], p[1], p[2]);
+    match (r.cube_final, r.bowl_target) {
+        (Some(cube), Some(bowl)) => say!(json, "  cube final {}, bowl target {}", xyz(cube), xyz(bowl)),
+        (Some(cube), None) => say!(json, "  cube final {}", xyz(cube)),
+        (None, Some(bowl)) => say!(json, "  bowl target {}", xyz(bowl)),
+        (None, None) => {}
+    }
+    if r.cube_final.is_some() {
+        say!(
+            json,
+            "  checks: grasp distance {} m, motion while closed {:.3} m, lift while closed {:.3} m, home error {:.4} rad{}",
+            c.grasp_distance.map_or("-".into(), |d| format!("{d:.4}")),
+            c.cube_motion_while_closed,
+            c.cube_lift_while_closed,
+            c.home_error,
+            if r.bowl_target.is_some() {
+                format!(", in bowl {}", c.in_bowl)
+            } else {
+                String::new()
+            }
+        );
+    } else {
+        say!(json, "  checks: home error {:.4} rad", c.home_error);
+    }
 }

@@ -103,6 +103,7 @@ pub fn sweep(app: &crate::App, args: SweepArgs) -> Result<(), CliError> {
     let shard = super::resolve_shard(args.shard, args.shard_count)?;
     let (plan, scene) = load_task(app, &args.tree, args.scene.as_deref())?;
     super::check_substitutions(&plan, &args.substitute)?;
+    super::run::check_goal(args.goal, &scene)?;
     let plan = Arc::new(plan);
     let config = SweepConfig {
         scenarios: args.scenarios,

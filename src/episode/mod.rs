@@ -9,7 +9,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 pub use driver::{Collision, LeafCounters, MacroDriver};
-pub use report::{EpisodeReport, NodeReport, ObjectReport};
+pub use report::{EpisodeReport, LayoutJson, NodeReport, ObjectReport};
 
 use crate::actions::Cell;
 use crate::factory::Factory;
@@ -28,11 +28,9 @@ pub const DEFAULT_MAX_SIM_TIME_S: f64 = 60.0;
 /// How to run an episode.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EpisodeConfig {
-    /// Where the cube and the bowl start (the scene's other objects at their default poses),
-    /// unless [`placement`](Self::placement) is given.
-    pub layout: Layout,
-    /// Where every object of the scene starts (one pose per object, scene order); overrides
-    /// [`layout`](Self::layout).
+    /// Where every object of the scene starts (one pose per object, scene order); `None`: the
+    /// scene's default placement ([`Scene::default_placement`]). The legacy `--cube`/`--bowl`
+    /// layouts become placements through [`Scene::placement_from_layout`].
     pub placement: Option<Placement>,
     /// Seed for everything random in the episode (fault timing and magnitude). The same tree,
     /// layout and seed give a bit-identical result.
@@ -94,7 +92,6 @@ impl std::str::FromStr for Goal {
 impl Default for EpisodeConfig {
     fn default() -> Self {
         Self {
-            layout: Layout::default(),
             placement: None,
             seed: 0,
             max_sim_time: DEFAULT_MAX_SIM_TIME_S,
@@ -125,11 +122,11 @@ pub fn run_episode(
     config: &EpisodeConfig,
     observer: &mut dyn EpisodeObserver,
 ) -> EpisodeReport {
-    let mut cell = Cell::new(scene, &config.layout, config.control_period);
+    let mut cell = Cell::new(scene, &Layout::default(), config.control_period);
     run_in_cell(&mut cell, plan, factory, config, observer)
 }
 
-/// Runs one episode of `plan` in `cell`, which is reset to the configured layout first; each
+/// Runs one episode of `plan` in `cell`, which is reset to the configured placement first; each
 /// leaf runs as `factory` binds its kind.
 pub fn run_in_cell(
     cell: &mut Cell,
@@ -139,10 +136,11 @@ pub fn run_in_cell(
     observer: &mut dyn EpisodeObserver,
 ) -> EpisodeReport {
     let wall = Instant::now();
-    match &config.placement {
-        Some(p) => cell.reset_placement(p),
-        None => cell.reset(&config.layout),
-    }
+    let placement = match &config.placement {
+        Some(p) => p.clone(),
+        None => cell.sim().scene().default_placement(),
+    };
+    cell.reset_placement(&placement);
     let initial = cell.world().clone();
     let observers_before = cell.observers.len();
     if let Some(kind) = config.fault {
@@ -208,6 +206,7 @@ pub fn run_in_cell(
         wall.elapsed().as_secs_f64(),
         last_failure,
     );
+    report.layout = LayoutJson::of(&placement, &world.scene);
     report.add_scene(&initial, &world, collisions, unstable);
     report.nodes = NodeReport::of(&runner);
     if !report.success {

@@ -7,7 +7,7 @@ use super::{EpisodeConfig, Goal};
 use crate::actions::Checks;
 use crate::failure::{Failure, FailureKind};
 use crate::runtime::TreeStatus;
-use crate::scene::ObjectKind;
+use crate::scene::{ObjectKind, Placement, SceneSpec};
 use crate::world::World;
 use crate::world::goal::{GoalValue, evaluate};
 
@@ -32,13 +32,16 @@ pub struct EpisodeReport {
     pub grasp_attempts: u32,
     /// Leaves preempted while running.
     pub halts: u32,
-    /// Final cube centre [x, y, z].
-    pub cube_final: [f64; 3],
-    /// Bowl target [x, y, z].
-    pub bowl_target: [f64; 3],
-    /// The reference tutorial's checks.
+    /// Final centre [x, y, z] of the scene's cube ([`World::cube`]); absent without one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cube_final: Option<[f64; 3]>,
+    /// The bowl target [x, y, z] at the end (the centre of the top of the scene's bowl's floor,
+    /// [`World::bowl_target`]); absent without a bowl.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bowl_target: Option<[f64; 3]>,
+    /// The reference tutorial's checks (on the scene's cube and bowl).
     pub checks: Checks,
-    /// The layout: cube [x, y, yaw_deg] and bowl [x, y].
+    /// Where the scene's cube and bowl started.
     pub layout: LayoutJson,
     /// The seed.
     pub seed: u64,
@@ -111,13 +114,30 @@ fn pose(w: &World, i: usize) -> [f64; 4] {
     [p.x, p.y, p.z, w.yaw(i).to_degrees()]
 }
 
-/// A layout as JSON.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+/// Where the scene's cube and bowl ([`World::cube`], [`World::bowl`]) started, as JSON: the
+/// `--cube X,Y,YAW --bowl X,Y` of `macrotree run`. Each is absent when the scene has none.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct LayoutJson {
     /// Cube centre x, y (metres) and yaw (degrees).
-    pub cube: [f64; 3],
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cube: Option<[f64; 3]>,
     /// Bowl centre x, y (metres).
-    pub bowl: [f64; 2],
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bowl: Option<[f64; 2]>,
+}
+
+impl LayoutJson {
+    /// The cube's and the bowl's starting poses in `placement` (one pose per object of `scene`).
+    pub fn of(placement: &Placement, scene: &SceneSpec) -> Self {
+        let pose = |i: usize| placement.poses[i];
+        Self {
+            cube: scene.legacy_cube().map(|c| {
+                let p = pose(c);
+                [p.x, p.y, p.yaw.to_degrees()]
+            }),
+            bowl: scene.legacy_bowl().map(|b| [pose(b).x, pose(b).y]),
+        }
+    }
 }
 
 impl EpisodeReport {
@@ -177,7 +197,6 @@ impl EpisodeReport {
         } else {
             Some(tree_failure.unwrap_or_else(|| Failure::other("the tree failed")))
         };
-        let l = &config.layout;
         Self {
             success,
             tree_status,
@@ -187,13 +206,10 @@ impl EpisodeReport {
             physics_steps,
             grasp_attempts: counters.grasp_attempts,
             halts: counters.halts,
-            cube_final: world.cube_pos.into(),
-            bowl_target: world.bowl_target.into(),
+            cube_final: world.cube().map(|c| world.objects[c].pos.into()),
+            bowl_target: world.bowl_target().map(Into::into),
             checks,
-            layout: LayoutJson {
-                cube: [l.cube_xy[0], l.cube_xy[1], l.cube_yaw.to_degrees()],
-                bowl: l.bowl_xy,
-            },
+            layout: LayoutJson::default(),
             seed: config.seed,
             scene: world.scene.name.clone(),
             objects: Vec::new(),
@@ -207,7 +223,8 @@ impl EpisodeReport {
     }
 
     /// Adds every object's initial (`start`) and final (`end`) pose and the collisions seen; an
-    /// unstable simulation is a failure whatever the tree said.
+    /// unstable simulation is a failure whatever the tree said. (The caller sets
+    /// [`layout`](Self::layout) from the placement the episode started from.)
     pub fn add_scene(
         &mut self,
         start: &World,
@@ -235,5 +252,102 @@ impl EpisodeReport {
         self.failure_reason = Some(failure.message.clone());
         self.failure_kind = Some(failure.kind);
         self.failure = Some(failure);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{UnitQuaternion, Vector3};
+
+    use super::*;
+    use crate::actions::ChecksRecorder;
+    use crate::world::conditions::tests_support::{HALF, resting};
+
+    /// The reports of one episode that ended in `w` with the tree's success, judged by `goal`.
+    fn judged(w: &World, goal: Goal) -> EpisodeReport {
+        let config = EpisodeConfig {
+            goal,
+            ..EpisodeConfig::default()
+        };
+        let checks = ChecksRecorder::default().finish(w);
+        EpisodeReport::new(
+            TreeStatus::Success,
+            false,
+            &config,
+            w,
+            checks,
+            LeafCounters::default(),
+            0,
+            0.0,
+            None,
+        )
+    }
+
+    /// Regression (issue 18): `cube_in_bowl` (and `--goal bowl`, which the tutorial's `in_bowl`
+    /// check decides) measured the cube along world axes while the scene's `in` goal (`--goal
+    /// scene`) measures it in the container's frame, so for a turned bowl the two goals gave
+    /// opposite verdicts on the same episode.
+    #[test]
+    fn goal_bowl_and_goal_scene_agree_for_a_turned_container() {
+        let mut w = resting();
+        // The bowl turned 45°; the cube 0.05 m along both of the bowl's own axes from its centre
+        // (room: 0.075 − 0.022 = 0.053 m), i.e. 0.0707 m from it along world y.
+        w.objects[1].quat = UnitQuaternion::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_4);
+        let b = w.objects[1].pos;
+        let mut inside = w.clone();
+        inside.objects[0].pos = Vector3::new(b.x, b.y + 0.05 * std::f64::consts::SQRT_2, 0.01 + HALF);
+        // Past the wall along the bowl's axes (0.06 m), 0.0 m off along world x.
+        let mut outside = w.clone();
+        outside.objects[0].pos = Vector3::new(b.x, b.y + 0.06 * std::f64::consts::SQRT_2 + 0.02, 0.01 + HALF);
+        for (w, expected) in [(&inside, true), (&outside, false)] {
+            let bowl = judged(w, Goal::Bowl);
+            let scene = judged(w, Goal::Scene);
+            assert_eq!(
+                bowl.success, scene.success,
+                "--goal bowl and --goal scene disagree"
+            );
+            assert_eq!(bowl.success, expected);
+            assert_eq!(bowl.checks.in_bowl, expected);
+            assert_eq!(scene.goal[0].holds, expected, "{:?}", scene.goal);
+        }
+    }
+
+    #[test]
+    fn a_scene_without_a_bowl_reports_no_bowl_target_and_a_true_layout() {
+        let mut w = resting();
+        w.scene = std::sync::Arc::new(
+            SceneSpec::from_str(
+                "objects:\n  cube: {block: {size: 0.044}, pose: [0.45, -0.18, deg(30)]}\n  post: {obstacle: {size: [0.05, 0.05, 0.1]}, pose: [0.45, 0.1]}\n",
+                "no_bowl.yaml",
+            )
+            .unwrap(),
+        );
+        let mut r = judged(&w, Goal::Scene);
+        r.layout = LayoutJson::of(&Placement::fixed(&w.scene).unwrap(), &w.scene);
+        let json = serde_json::to_value(&r).unwrap();
+        assert!(json.get("bowl_target").is_none(), "{json}");
+        assert_eq!(json["cube_final"], serde_json::json!([0.45, -0.18, HALF]));
+        let cube = json["layout"]["cube"].as_array().unwrap();
+        assert_eq!(cube[0], 0.45);
+        assert!((cube[2].as_f64().unwrap() - 30.0).abs() < 1e-9, "{json}");
+        assert!(json["layout"].get("bowl").is_none(), "{json}");
+        assert_eq!(json["checks"]["in_bowl"], false);
+        // Two blocks: no cube either.
+        w.scene = std::sync::Arc::new(
+            SceneSpec::from_str(
+                "objects:\n  a: {block: {size: 0.044}, pose: [0.45, -0.18]}\n  b: {block: {size: 0.044}, pose: [0.45, 0.08]}\n",
+                "two.yaml",
+            )
+            .unwrap(),
+        );
+        let mut r = judged(&w, Goal::Scene);
+        r.layout = LayoutJson::of(&Placement::fixed(&w.scene).unwrap(), &w.scene);
+        let json = serde_json::to_value(&r).unwrap();
+        assert!(
+            json.get("cube_final").is_none() && json.get("bowl_target").is_none(),
+            "{json}"
+        );
+        assert_eq!(json["layout"], serde_json::json!({}));
+        assert_eq!(json["checks"]["grasp_distance"], serde_json::Value::Null);
     }
 }

@@ -1,6 +1,8 @@
 //! `bump`: while the arm makes its first approach (the first `reach`), the table is bumped and
-//! the cube slides 3–6 cm, in a seeded direction within 60° of straight away from the bowl. The
-//! approach was planned for where the cube was; the tree must look again before it grasps.
+//! the cube slides 3–6 cm, in a seeded direction within 60° of straight away from the bowl (in a
+//! scene without a bowl, away from the robot's base). The approach was planned for where the cube
+//! was; the tree must look again before it grasps. A scene without a cube (see
+//! [`World::cube`]) is not bumped.
 
 use rand_chacha::ChaCha8Rng;
 
@@ -20,10 +22,12 @@ const STEPS: u32 = 10;
 
 enum State {
     Idle,
-    /// The first reach started; the bump comes at `at` (simulated seconds), away from the bowl.
+    /// The first reach started; the bump comes at `at` (simulated seconds) and pushes `block`
+    /// (the cube) toward `away` (radians about world z, away from the bowl).
     Armed {
         at: Option<f64>,
         away: f64,
+        block: usize,
     },
     Pushing(Push),
     Done,
@@ -52,10 +56,19 @@ impl Bump {
 impl Fault for Bump {
     fn on_action_start(&mut self, kind: &str, world: &World) {
         if kind == "reach" && matches!(self.state, State::Idle) {
-            let away = world.cube_pos - world.bowl_pos;
+            let Some(block) = world.cube() else {
+                self.state = State::Done;
+                return;
+            };
+            let cube = world.objects[block].pos;
+            let from = world
+                .bowl()
+                .map_or(nalgebra::Vector3::zeros(), |b| world.objects[b].pos);
+            let away = cube - from;
             self.state = State::Armed {
                 at: None,
                 away: away.y.atan2(away.x),
+                block,
             };
         }
     }
@@ -63,13 +76,13 @@ impl Fault for Bump {
     fn before_step(&mut self, sim: &mut Sim) -> Option<String> {
         match &mut self.state {
             State::Idle | State::Done => None,
-            State::Armed { at, away } => {
+            State::Armed { at, away, block } => {
                 let at = *at.get_or_insert(sim.time() + self.delay);
                 if sim.time() < at {
                     return None;
                 }
                 let angle = *away + self.spread;
-                let block = sim.scene().ids.cube;
+                let block = *block;
                 let mut push = Push::slide(sim, block, angle, self.distance, STEPS);
                 push.apply(sim);
                 let c = block_pos(sim, block);

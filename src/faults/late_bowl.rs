@@ -59,7 +59,8 @@ impl Fault for LateBowl {
 
     fn before_step(&mut self, sim: &mut Sim) -> Option<String> {
         // A scene without a container has no bowl to move.
-        let mocap = sim.scene().ids.bowl.map(|b| b.mocap)?;
+        let scene = sim.scene();
+        let mocap = scene.spec.legacy_bowl().and_then(|b| scene.objects[b].mocap)?;
         match &mut self.state {
             State::Idle | State::Done => None,
             State::Armed { at } => {

@@ -10,7 +10,7 @@ use serde::Deserialize;
 use super::color::Color;
 use super::goal::{Goal, GoalAtom};
 use super::sample::{Placement, sample_placement};
-use super::types::{ObjectKind, ObjectSpec, Pose, RandomPlacement, SceneSpec, Shape};
+use super::types::{ObjectKind, ObjectSpec, Pose, RandomPlacement, Sampler, SceneSpec, Shape};
 use crate::yaml::de::from_value;
 use crate::yaml::diag::{Diagnostic, Issue, Loc, Sources};
 use crate::yaml::suggest::did_you_mean;
@@ -25,7 +25,7 @@ pub const BUILTIN_CUBE_BOWL: &str = include_str!("../../scenes/cube_bowl.yaml");
 pub const MAX_OBJECTS: usize = 16;
 
 /// Keys allowed at the top level of a scene file.
-const TOP_LEVEL_KEYS: &[&str] = &["description", "objects", "goal"];
+const TOP_LEVEL_KEYS: &[&str] = &["description", "objects", "goal", "sampler"];
 
 fn d_mass() -> f64 {
     0.05
@@ -187,6 +187,23 @@ pub struct SceneFileSchema {
     /// Predicates that must hold when the episode ends.
     #[serde(default)]
     pub goal: Vec<GoalRaw>,
+    /// How sweeps draw layouts: `objects` (default: each object from its `random:`) or
+    /// `tutorial` (the reference tutorial's cube-and-bowl sampler; needs one block and one
+    /// container).
+    #[serde(default)]
+    pub sampler: SamplerRaw,
+}
+
+/// `sampler:` values.
+#[derive(Deserialize, JsonSchema, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum SamplerRaw {
+    /// Every randomized object from its own `random:` region.
+    #[default]
+    Objects,
+    /// The reference tutorial's sampler: the cube and the bowl drawn together from its task
+    /// region (x 0.30…0.60 m, y −0.30…0.30 m, cube yaw −45°…45°, at least 0.16 m apart).
+    Tutorial,
 }
 
 impl SceneSpec {
@@ -282,6 +299,7 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
     let mut description = None;
     let mut objects_v = None;
     let mut goal_v = None;
+    let mut sampler_v = None;
     for (k, val) in entries {
         match k.as_str() {
             Some("description") => match val.as_str() {
@@ -296,11 +314,12 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
             },
             Some("objects") => objects_v = Some((k.loc, val)),
             Some("goal") => goal_v = Some(val),
+            Some("sampler") => sampler_v = Some(val),
             other => {
                 let other = other.unwrap_or("?");
                 issues.push(
                     Issue::new(k.loc, format!("unknown top-level key `{other}` in a scene file"))
-                        .label("expected `description`, `objects` or `goal`")
+                        .label("expected `description`, `objects`, `goal` or `sampler`")
                         .maybe_help(did_you_mean(other, TOP_LEVEL_KEYS.iter().copied())),
                 )
             }
@@ -320,12 +339,21 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
         description,
         objects,
         goal: Goal::default(),
+        sampler: Sampler::default(),
     };
     let goal = match goal_v {
         Some(g) => read_goal(g, &scene, issues),
         None => Goal::default(),
     };
-    let scene = SceneSpec { goal, ..scene };
+    let sampler = match sampler_v {
+        Some(v) => read_sampler(v, &scene, issues),
+        None => Sampler::default(),
+    };
+    let scene = SceneSpec {
+        goal,
+        sampler,
+        ..scene
+    };
     if issues.is_empty() {
         check_fixed_poses(&scene, objects_v, issues);
     }
@@ -339,6 +367,43 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
         );
     }
     Some(scene)
+}
+
+/// `sampler: objects | tutorial`; `tutorial` needs the scene's cube and bowl (one block and one
+/// container, or the ones called `cube` and `bowl`), both randomized.
+fn read_sampler(v: &Value, scene: &SceneSpec, issues: &mut Vec<Issue>) -> Sampler {
+    match v.as_str() {
+        Some("objects") => Sampler::Objects,
+        Some("tutorial") => {
+            let (cube, bowl) = (scene.legacy_cube(), scene.legacy_bowl());
+            if let (Some(c), Some(b)) = (cube, bowl)
+                && scene.objects[c].random.is_some()
+                && scene.objects[b].random.is_some()
+            {
+                return Sampler::Tutorial;
+            }
+            if !scene.objects.is_empty() {
+                issues.push(
+                    Issue::new(
+                        v.loc,
+                        "`sampler: tutorial` draws the scene's cube and bowl, but this scene has no single randomized block and container",
+                    )
+                    .label("expected one block and one container (or ones called `cube` and `bowl`), each with `random:`")
+                    .help("use `sampler: objects` (the default), which draws every object from its own `random:`"),
+                );
+            }
+            Sampler::Objects
+        }
+        other => {
+            let found = other.map_or_else(|| v.describe(), |s| format!("`{s}`"));
+            issues.push(
+                Issue::new(v.loc, format!("unknown sampler {found}"))
+                    .label("expected `objects` or `tutorial`")
+                    .maybe_help(other.and_then(|o| did_you_mean(o, ["objects", "tutorial"]))),
+            );
+            Sampler::Objects
+        }
+    }
 }
 
 fn read_objects(v: &Value, issues: &mut Vec<Issue>) -> Vec<ObjectSpec> {

@@ -168,6 +168,20 @@ impl ObjectSpec {
     }
 }
 
+/// How sweeps draw a scene's starting layouts (the scene file's `sampler:`).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Sampler {
+    /// Every randomized object from its own `random:` region ([`super::sample_placement`]).
+    #[default]
+    Objects,
+    /// The reference tutorial's sampler: the scene's cube ([`SceneSpec::legacy_cube`]) and bowl
+    /// ([`SceneSpec::legacy_bowl`]) drawn together from its task region (x 0.30…0.60 m,
+    /// y −0.30…0.30 m, cube yaw −45°…45°, centres at least 0.16 m apart); the other objects at
+    /// their default poses. Sweeps then print `run --cube X,Y,YAW --bowl X,Y` reproductions.
+    Tutorial,
+}
+
 /// A loaded, validated scene.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SceneSpec {
@@ -179,6 +193,8 @@ pub struct SceneSpec {
     pub objects: Vec<ObjectSpec>,
     /// The task's goal, evaluated when the episode ends.
     pub goal: Goal,
+    /// How sweeps draw the starting layouts.
+    pub sampler: Sampler,
 }
 
 impl SceneSpec {

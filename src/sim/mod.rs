@@ -10,5 +10,5 @@ pub mod simulator;
 
 pub use error::SimError;
 pub use layout::Layout;
-pub use scene::{ContainerIds, ModelOrigin, ObjectIds, Scene};
+pub use scene::{ModelOrigin, ObjectIds, Scene};
 pub use simulator::{HOME_Q, Sim, TIMESTEP};

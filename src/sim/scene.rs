@@ -15,11 +15,8 @@ use mujoco_rs::wrappers::mj_editing::{Attach, MjSpec};
 
 use super::error::SimError;
 use super::layout::Layout;
-use crate::scene::{
-    CONTAINER_FLOOR, CONTAINER_WALL, OBJECT_PREFIX, ObjectKind, Placement, Pose, SceneSpec, Shape,
-    sample_placement,
-};
-use crate::world::{BowlGeometry, Part, Piece};
+use crate::scene::{OBJECT_PREFIX, ObjectKind, Placement, Pose, SceneSpec, sample_placement};
+use crate::world::{Part, Piece};
 
 /// The cell XML (without the robot and the scene's objects), embedded at build time.
 pub const SCENE_XML: &str = include_str!("../../assets/scene.xml");
@@ -54,35 +51,14 @@ pub struct SceneIds {
     pub gripper_driver_qpos: usize,
     /// `qvel` (dof) address of the right driver joint.
     pub gripper_driver_dof: usize,
-    /// The block the legacy name `cube` stands for (the block called `cube`, else the scene's
-    /// first block): its index into [`Scene::objects`].
-    pub cube: usize,
     /// Geom ids of the two left pad boxes.
     pub left_pads: [usize; 2],
     /// Geom ids of the two right pad boxes.
     pub right_pads: [usize; 2],
     /// Site id of the 2F-85 pinch point (the tool point).
     pub pinch_site: usize,
-    /// The container the legacy name `bowl` stands for (the container called `bowl`, else the
-    /// scene's first container), if the scene has one.
-    pub bowl: Option<ContainerIds>,
     /// Geom id of the floor.
     pub floor_geom: usize,
-}
-
-/// Ids of a container in the compiled model.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ContainerIds {
-    /// Index into [`Scene::objects`].
-    pub index: usize,
-    /// The container's shape as the legacy `bowl` fields of a world describe it.
-    pub geometry: BowlGeometry,
-    /// Site id of the centre of the floor's top surface.
-    pub target_site: usize,
-    /// Mocap index of the body.
-    pub mocap: usize,
-    /// Body id.
-    pub body: usize,
 }
 
 /// Where one scene object lives in the compiled model.
@@ -190,7 +166,7 @@ impl Scene {
     /// The scene of `spec` around an already compiled `model` (of that scene).
     fn from_model(model: MjModel, spec: &SceneSpec) -> Result<Self, SimError> {
         let objects = lookup_objects(&model, spec)?;
-        let ids = SceneIds::lookup(&model, spec, &objects)?;
+        let ids = SceneIds::lookup(&model)?;
         let geom_parts = geom_parts(&model, spec, &objects);
         let gain = model.actuator_gainprm();
         let bias = model.actuator_biasprm();
@@ -434,7 +410,7 @@ fn geom_parts(m: &MjModel, spec: &SceneSpec, objects: &[ObjectIds]) -> Vec<Part>
 }
 
 impl SceneIds {
-    fn lookup(m: &MjModel, spec: &SceneSpec, objects: &[ObjectIds]) -> Result<Self, SimError> {
+    fn lookup(m: &MjModel) -> Result<Self, SimError> {
         let id = |kind: MjtObjBase, name: &str| {
             m.name_to_id(kind, name)
                 .ok_or_else(|| SimError::Scene(format!("the compiled scene has no {kind:?} named {name}")))
@@ -450,36 +426,6 @@ impl SceneIds {
             arm_dof[i] = jnt_dofadr[j] as usize;
             arm_act[i] = id(MjtObjBase::mjOBJ_ACTUATOR, &format!("ur5e/{name}"))?;
         }
-        let cube = spec
-            .legacy_cube()
-            .or_else(|| spec.of_kind(ObjectKind::Block).next())
-            .ok_or_else(|| SimError::Scene("the scene has no block".into()))?;
-        let bowl = spec
-            .legacy_bowl()
-            .or_else(|| spec.of_kind(ObjectKind::Container).next())
-            .map(|c| -> Result<ContainerIds, SimError> {
-                let name = format!("{OBJECT_PREFIX}{}/target", spec.objects[c].name);
-                let Shape::Container {
-                    inner_half,
-                    wall_height,
-                } = spec.objects[c].shape
-                else {
-                    unreachable!("a container has a container's shape")
-                };
-                Ok(ContainerIds {
-                    index: c,
-                    geometry: BowlGeometry {
-                        inner_half_width: inner_half[0],
-                        outer_half_width: inner_half[0] + CONTAINER_WALL,
-                        rim_height: wall_height,
-                        floor_height: CONTAINER_FLOOR,
-                    },
-                    target_site: id(MjtObjBase::mjOBJ_SITE, &name)?,
-                    mocap: objects[c].mocap.unwrap_or_default(),
-                    body: objects[c].body,
-                })
-            })
-            .transpose()?;
         Ok(Self {
             arm_qpos,
             arm_dof,
@@ -489,7 +435,6 @@ impl SceneIds {
                 as usize,
             gripper_driver_dof: jnt_dofadr[id(MjtObjBase::mjOBJ_JOINT, "gripper/right_driver_joint")?]
                 as usize,
-            cube,
             left_pads: [
                 id(MjtObjBase::mjOBJ_GEOM, "gripper/left_pad1")?,
                 id(MjtObjBase::mjOBJ_GEOM, "gripper/left_pad2")?,
@@ -499,7 +444,6 @@ impl SceneIds {
                 id(MjtObjBase::mjOBJ_GEOM, "gripper/right_pad2")?,
             ],
             pinch_site: id(MjtObjBase::mjOBJ_SITE, "gripper/pinch")?,
-            bowl,
             floor_geom: id(MjtObjBase::mjOBJ_GEOM, "floor")?,
         })
     }

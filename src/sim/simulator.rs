@@ -9,7 +9,7 @@ use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 use super::layout::Layout;
 use super::scene::Scene;
 use crate::scene::{Placement, Shape};
-use crate::world::{BowlGeometry, ObjectState, Part, World};
+use crate::world::{ObjectState, Part, World};
 
 pub use crate::motion::HOME_Q;
 
@@ -18,10 +18,6 @@ pub const PAD_HALF_THICKNESS: f64 = 0.004;
 
 /// Physics time step of the scene, seconds (set in assets/scene.xml).
 pub const TIMESTEP: f64 = 0.002;
-
-/// Where the legacy `bowl` fields of a [`World`] put the bowl when the scene has no container:
-/// far off the table, so nothing is ever in it or near it.
-const NO_BOWL: Vector3<f64> = Vector3::new(100.0, 100.0, 0.0);
 
 /// A running simulation of the task scene.
 pub struct Sim {
@@ -272,17 +268,12 @@ impl Sim {
                 touches.push((pa, pb));
             }
         }
-        let cube = objects[ids.cube].clone();
         let nsite = self.scene.model.ffi().nsite as usize;
         // SAFETY: site_xmat holds nsite * 9 doubles for the lifetime of `data`.
         let site_xmat = unsafe { std::slice::from_raw_parts(d.ffi().site_xmat, nsite * 9) };
         let m = &site_xmat[ids.pinch_site * 9..ids.pinch_site * 9 + 9];
         let pinch_rot = Matrix3::from_row_slice(m);
         let sx = d.site_xpos();
-        let (bowl_pos, bowl_target, bowl) = match ids.bowl {
-            Some(b) => (v3(d.mocap_pos()[b.mocap]), v3(sx[b.target_site]), b.geometry),
-            None => (NO_BOWL, NO_BOWL, BowlGeometry::NONE),
-        };
         World {
             time: d.ffi().time,
             arm_q,
@@ -292,17 +283,8 @@ impl Sim {
             gripper_speed: qvel[ids.gripper_driver_dof],
             pinch_pos: v3(sx[ids.pinch_site]),
             pinch_rot,
-            left_pad_contact: cube.left_pad_contact,
-            right_pad_contact: cube.right_pad_contact,
             left_pad_pos,
             right_pad_pos,
-            cube_pos: cube.pos,
-            cube_quat: cube.quat,
-            cube_linvel: cube.linvel,
-            cube_angvel: cube.angvel,
-            bowl_pos,
-            bowl_target,
-            bowl,
             home_q: HOME_Q,
             scene: scene.spec.clone(),
             objects,

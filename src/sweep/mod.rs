@@ -240,12 +240,13 @@ impl SweepConfig {
         ScenarioIndices::new(self.scenarios, self.shard)
     }
 
-    /// Scenario `index` of this sweep on `scene`. The built-in `cube_bowl` scene keeps the
-    /// documented task-region sampler ([`sample_scenario`]), so its sweeps and reproduction
-    /// commands (`--cube … --bowl …`) are those of earlier releases; every other scene draws its
-    /// own randomization ([`crate::scene::sample_placement`]).
+    /// Scenario `index` of this sweep on `scene`. A scene with `sampler: tutorial` (the built-in
+    /// `cube_bowl`) draws its cube and bowl with the documented task-region sampler
+    /// ([`sample_scenario`]), so its sweeps and reproduction commands (`--cube … --bowl …`) are
+    /// those of earlier releases; every other scene draws its own randomization
+    /// ([`crate::scene::sample_placement`]).
     pub fn scene_scenario(&self, scene: &Scene, index: u64) -> Result<SceneScenario, PlacementError> {
-        if *scene.spec == *crate::spec::load::builtin_scene() {
+        if scene.spec.sampler == crate::scene::Sampler::Tutorial {
             let s = sample_scenario(self.seed, index);
             return Ok(SceneScenario {
                 sweep_seed: s.sweep_seed,
@@ -267,32 +268,23 @@ impl SweepConfig {
 
     /// The episode configuration of a scenario of any scene (see [`Self::scene_scenario`]).
     pub fn scene_episode_config(&self, scenario: &SceneScenario) -> EpisodeConfig {
-        match &scenario.layout {
-            Some(l) => self.episode_config(&Scenario {
-                sweep_seed: scenario.sweep_seed,
-                index: scenario.index,
-                seed: scenario.seed,
-                layout: *l,
-            }),
-            None => EpisodeConfig {
-                placement: Some(scenario.placement.clone()),
-                seed: scenario.seed,
-                max_sim_time: self.max_sim_time,
-                control_period: CONTROL_PERIOD,
-                fault: self.fault,
-                goal: self.goal,
-                substitutions: self.substitutions.clone(),
-                ..EpisodeConfig::default()
-            },
+        EpisodeConfig {
+            placement: Some(scenario.placement.clone()),
+            seed: scenario.seed,
+            max_sim_time: self.max_sim_time,
+            control_period: CONTROL_PERIOD,
+            fault: self.fault,
+            goal: self.goal,
+            substitutions: self.substitutions.clone(),
         }
     }
 
-    /// The episode configuration of `scenario`: exactly what `macrotree run` builds from the
-    /// reproduction command [`ScenarioResult::reproduce`] prints.
-    pub fn episode_config(&self, scenario: &Scenario) -> EpisodeConfig {
+    /// The episode configuration of `scenario` of a `sampler: tutorial` scene (`scene`): exactly
+    /// what `macrotree run` builds from the reproduction command [`ScenarioResult::reproduce`]
+    /// prints.
+    pub fn episode_config(&self, scene: &Scene, scenario: &Scenario) -> EpisodeConfig {
         EpisodeConfig {
-            layout: scenario.layout.to_layout(),
-            placement: None,
+            placement: Some(scene.placement_from_layout(&scenario.layout.to_layout())),
             seed: scenario.seed,
             max_sim_time: self.max_sim_time,
             control_period: CONTROL_PERIOD,
@@ -314,7 +306,7 @@ pub struct SceneScenario {
     pub seed: u64,
     /// Every object's starting pose, scene order.
     pub placement: Placement,
-    /// The legacy cube/bowl layout, for the built-in scene.
+    /// The tutorial's cube/bowl layout, for a `sampler: tutorial` scene.
     pub layout: Option<ScenarioLayout>,
 }
 
@@ -348,8 +340,8 @@ pub struct ScenarioResult {
     pub seed: u64,
     /// The injected fault.
     pub fault: Option<FaultKind>,
-    /// The layout of the built-in scene, exactly as sampled (and as `run --cube X,Y,YAW --bowl
-    /// X,Y` takes it); other scenes list every object in `objects`.
+    /// The layout of a `sampler: tutorial` scene (the built-in one), exactly as sampled (and as
+    /// `run --cube X,Y,YAW --bowl X,Y` takes it); other scenes list every object in `objects`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub layout: Option<ScenarioLayout>,
     /// The episode met the sweep's goal (by default: the tree succeeded and the cube rests in
@@ -367,10 +359,12 @@ pub struct ScenarioResult {
     pub halts: u32,
     /// MuJoCo steps taken.
     pub physics_steps: u64,
-    /// Final cube centre [x, y, z], metres.
-    pub cube_final: [f64; 3],
-    /// Bowl target [x, y, z] at the end, metres.
-    pub bowl_target: [f64; 3],
+    /// Final centre [x, y, z] of the scene's cube, metres; absent without one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cube_final: Option<[f64; 3]>,
+    /// Bowl target [x, y, z] at the end, metres; absent without a bowl.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bowl_target: Option<[f64; 3]>,
     /// The reference tutorial's checks.
     pub checks: Checks,
     /// The scene's name.
@@ -393,8 +387,8 @@ pub struct ScenarioResult {
 }
 
 impl ScenarioResult {
-    /// The result of `scenario` (of the built-in scene) of the sweep `config` from its episode
-    /// report.
+    /// The result of `scenario` (of a `sampler: tutorial` scene) of the sweep `config` from its
+    /// episode report.
     pub fn new(scenario: &Scenario, config: &SweepConfig, r: EpisodeReport) -> Self {
         Self::of(config, scenario.index, scenario.seed, Some(scenario.layout), r)
     }
@@ -475,8 +469,8 @@ impl ScenarioResult {
             grasp_attempts: 0,
             halts: 0,
             physics_steps: 0,
-            cube_final: [f64::NAN; 3],
-            bowl_target: [f64::NAN; 3],
+            cube_final: None,
+            bowl_target: None,
             checks: Checks {
                 grasp_distance: None,
                 cube_motion_while_closed: 0.0,
@@ -559,7 +553,8 @@ pub(crate) fn shell_quote(s: &str) -> String {
     }
 }
 
-/// Runs scenario `scenario` (of the built-in scene) of `config` in `cell` (reset first).
+/// Runs scenario `scenario` (of a `sampler: tutorial` scene, such as the built-in one) of
+/// `config` in `cell` (reset first).
 pub fn run_scenario(
     cell: &mut Cell,
     plan: &Arc<Plan>,
@@ -567,7 +562,7 @@ pub fn run_scenario(
     config: &SweepConfig,
     scenario: &Scenario,
 ) -> ScenarioResult {
-    let episode = config.episode_config(scenario);
+    let episode = config.episode_config(cell.sim().scene(), scenario);
     let report = run_in_cell(cell, plan.clone(), factory, &episode, &mut NoObserver);
     ScenarioResult::new(scenario, config, report)
 }

@@ -333,8 +333,14 @@ pub fn parse_line(line: &str) -> Result<ScenarioResult, String> {
         grasp_attempts: u32_of("grasp_attempts")?,
         halts: u32_of("halts")?,
         physics_steps: u64_of("physics_steps")?,
-        cube_final: floats(v.get("cube_final"), "cube_final")?,
-        bowl_target: floats(v.get("bowl_target"), "bowl_target")?,
+        cube_final: v
+            .get("cube_final")
+            .map(|x| floats(Some(x), "cube_final"))
+            .transpose()?,
+        bowl_target: v
+            .get("bowl_target")
+            .map(|x| floats(Some(x), "bowl_target"))
+            .transpose()?,
         checks: Checks {
             grasp_distance: match checks.get("grasp_distance") {
                 Some(Value::Null) => None,

@@ -9,7 +9,7 @@ use super::World;
 pub struct Tolerances;
 
 impl Tolerances {
-    /// Cube speed below which it counts as at rest, m/s.
+    /// Block speed below which it counts as at rest, m/s.
     pub const REST_SPEED: f64 = 0.05;
     /// Cube bottom height above the table that counts as lifted, metres.
     pub const LIFT_HEIGHT: f64 = 0.03;
@@ -25,57 +25,35 @@ impl Tolerances {
     pub const AT_POINT: f64 = 0.01;
 }
 
-/// Both pads touch the cube and its centre lies between them: projected onto the pad-to-pad
-/// segment it falls inside the segment, and it is at most `off_axis` metres from that line.
-pub fn cube_grasped(w: &World, off_axis: f64) -> bool {
-    if !(w.left_pad_contact && w.right_pad_contact) {
-        return false;
-    }
-    let axis = w.right_pad_pos - w.left_pad_pos;
-    let len2 = axis.norm_squared();
-    if len2 < 1e-12 {
-        return false;
-    }
-    let rel = w.cube_pos - w.left_pad_pos;
-    let t = rel.dot(&axis) / len2;
-    let off = (rel - axis * t).norm();
-    (0.0..=1.0).contains(&t) && off <= off_axis
+/// Both pads touch block `i` and its centre lies between them, at most `off_axis` metres from
+/// the line through the pad centres (the `grasped` condition).
+pub fn grasped(w: &World, i: usize, off_axis: f64) -> bool {
+    w.holds(i, off_axis)
 }
 
-/// The cube's lowest point is at least `min_height` metres above the table.
-pub fn cube_lifted(w: &World, min_height: f64) -> bool {
-    w.cube_bottom() >= min_height
+/// Block `i`'s lowest point is at least `min_height` metres above the table (the `lifted`
+/// condition).
+pub fn lifted(w: &World, i: usize, min_height: f64) -> bool {
+    w.bottom(i) >= min_height
 }
 
-/// The cube is at rest (speed below `rest_speed`, m/s) inside the bowl, released: its centre
-/// at most (inner half-width − the cube's half-size) from the bowl's centre along each axis — so
-/// the whole cube fits between the walls — and below the rim, and no pad touching it (a cube
-/// squeezed onto the rim by a closed gripper is not in the bowl).
-pub fn cube_in_bowl(w: &World, rest_speed: f64) -> bool {
-    let d = w.cube_pos - w.bowl_pos;
-    let half = w
-        .scene
-        .legacy_cube()
-        .map_or(super::CUBE_HALF, |c| w.spec(c).shape.footprint_half()[0]);
-    let room = w.bowl.inner_half_width - half;
-    let inside = d.x.abs() <= room && d.y.abs() <= room;
-    let below_rim = w.cube_pos.z < w.bowl.rim_height;
-    let released = !(w.left_pad_contact || w.right_pad_contact);
-    inside && below_rim && released && w.cube_linvel.norm() < rest_speed
-}
-
-/// The cube rests on the table (bottom within `max_height` metres of z = 0, at rest), outside the bowl.
-pub fn cube_on_table(w: &World, max_height: f64, rest_speed: f64) -> bool {
-    let d = w.cube_pos - w.bowl_pos;
-    let over_bowl = d.x.abs() < w.bowl.inner_half_width + 0.01 && d.y.abs() < w.bowl.inner_half_width + 0.01;
-    w.cube_bottom() <= max_height && !over_bowl && w.cube_linvel.norm() < rest_speed
-}
-
-/// The cube rests on the table (as [`cube_on_table`] with `max_height`) with its centre within
-/// `tolerance` metres of `point` = (x, y), measured in the table plane.
-pub fn cube_at(w: &World, point: [f64; 2], tolerance: f64, max_height: f64, rest_speed: f64) -> bool {
-    let (dx, dy) = (w.cube_pos.x - point[0], w.cube_pos.y - point[1]);
-    cube_on_table(w, max_height, rest_speed) && dx.hypot(dy) <= tolerance
+/// Block `i` rests on the table ([`on_table`] with [`Tolerances::ON_TABLE_HEIGHT`]) with its centre
+/// within `tolerance` metres of `point` = (x, y) in the table plane and, when `yaw` is given, its
+/// side faces within `yaw_tolerance` radians of `yaw` modulo a quarter turn (the `at` condition).
+pub fn at(
+    w: &World,
+    i: usize,
+    point: [f64; 2],
+    tolerance: f64,
+    yaw: Option<f64>,
+    yaw_tolerance: f64,
+    rest_speed: f64,
+) -> bool {
+    let pos = w.objects[i].pos;
+    let near = (pos.x - point[0]).hypot(pos.y - point[1]) <= tolerance;
+    let turned =
+        yaw.is_none_or(|target| super::snapshot::fold_quarter_turn(w.yaw(i) - target).abs() <= yaw_tolerance);
+    on_table(w, i, Tolerances::ON_TABLE_HEIGHT, rest_speed) && near && turned
 }
 
 /// Block `i` rests on the table: its bottom within `max_height` metres of the table top, not over
@@ -117,7 +95,7 @@ pub(crate) mod tests_support {
     use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
     use crate::scene::SceneSpec;
-    use crate::world::{BowlGeometry, CUBE_HALF, ObjectState, World};
+    use crate::world::{ObjectState, World};
 
     /// A still object at `pos`.
     pub fn still(pos: Vector3<f64>) -> ObjectState {
@@ -131,6 +109,9 @@ pub(crate) mod tests_support {
         }
     }
 
+    /// Half the edge of the cube of the `cube_bowl` scene, metres.
+    pub const HALF: f64 = 0.022;
+
     /// A cube resting on the table at (0.45, −0.18), open gripper far above it, bowl at (0.45, 0.08)
     /// (the built-in `cube_bowl` scene: `objects[0]` is the cube, `objects[1]` the bowl).
     pub fn resting() -> World {
@@ -143,21 +124,12 @@ pub(crate) mod tests_support {
             gripper_speed: 0.0,
             pinch_pos: Vector3::new(0.45, -0.18, 0.3),
             pinch_rot: Matrix3::identity(),
-            left_pad_contact: false,
-            right_pad_contact: false,
             left_pad_pos: Vector3::new(0.40, -0.18, 0.3),
             right_pad_pos: Vector3::new(0.50, -0.18, 0.3),
-            cube_pos: Vector3::new(0.45, -0.18, CUBE_HALF),
-            cube_quat: UnitQuaternion::identity(),
-            cube_linvel: Vector3::zeros(),
-            cube_angvel: Vector3::zeros(),
-            bowl_pos: Vector3::new(0.45, 0.08, 0.0),
-            bowl_target: Vector3::new(0.45, 0.08, 0.01),
-            bowl: BowlGeometry::TRAY,
             home_q: [0.0; 6],
             scene: Arc::new(SceneSpec::builtin()),
             objects: vec![
-                still(Vector3::new(0.45, -0.18, CUBE_HALF)),
+                still(Vector3::new(0.45, -0.18, HALF)),
                 still(Vector3::new(0.45, 0.08, 0.0)),
             ],
             touches: Vec::new(),
@@ -167,13 +139,10 @@ pub(crate) mod tests_support {
     /// The same cube held between the pads 10 cm above the table.
     pub fn held() -> World {
         let mut w = resting();
-        w.cube_pos = Vector3::new(0.45, -0.18, 0.10 + CUBE_HALF);
-        w.left_pad_pos = Vector3::new(0.45 - CUBE_HALF - 0.004, -0.18, 0.125);
-        w.right_pad_pos = Vector3::new(0.45 + CUBE_HALF + 0.004, -0.18, 0.125);
-        w.left_pad_contact = true;
-        w.right_pad_contact = true;
-        w.gripper_width = 2.0 * CUBE_HALF;
-        w.objects[0].pos = w.cube_pos;
+        w.objects[0].pos = Vector3::new(0.45, -0.18, 0.10 + HALF);
+        w.left_pad_pos = Vector3::new(0.45 - HALF - 0.004, -0.18, 0.125);
+        w.right_pad_pos = Vector3::new(0.45 + HALF + 0.004, -0.18, 0.125);
+        w.gripper_width = 2.0 * HALF;
         w.objects[0].left_pad_contact = true;
         w.objects[0].right_pad_contact = true;
         w
@@ -184,99 +153,105 @@ pub(crate) mod tests_support {
 mod tests {
     use nalgebra::{UnitQuaternion, Vector3};
 
-    use super::tests_support::{held, resting};
+    use super::tests_support::{HALF, held, resting};
     use super::*;
-    use crate::world::CUBE_HALF;
+    use crate::world::goal::rests_in;
 
     #[test]
-    fn grasped_needs_both_pads_and_the_cube_between_them() {
-        assert!(cube_grasped(&held(), Tolerances::GRASP_OFF_AXIS));
+    fn grasped_needs_both_pads_and_the_block_between_them() {
+        assert!(grasped(&held(), 0, Tolerances::GRASP_OFF_AXIS));
         let mut one_pad = held();
-        one_pad.right_pad_contact = false;
-        assert!(!cube_grasped(&one_pad, Tolerances::GRASP_OFF_AXIS));
-        // Both pads touch, but the cube centre is outside the segment between them (pinched on an edge).
+        one_pad.objects[0].right_pad_contact = false;
+        assert!(!grasped(&one_pad, 0, Tolerances::GRASP_OFF_AXIS));
+        // Both pads touch, but the centre is outside the segment between them (pinched on an edge).
         let mut beside = held();
-        beside.cube_pos.x += 0.05;
-        assert!(!cube_grasped(&beside, Tolerances::GRASP_OFF_AXIS));
+        beside.objects[0].pos.x += 0.05;
+        assert!(!grasped(&beside, 0, Tolerances::GRASP_OFF_AXIS));
         // Between the pads along the axis, but 4 cm below their line.
         let mut low = held();
-        low.cube_pos.z -= 0.04;
-        assert!(!cube_grasped(&low, Tolerances::GRASP_OFF_AXIS));
-        assert!(!cube_grasped(&resting(), Tolerances::GRASP_OFF_AXIS));
+        low.objects[0].pos.z -= 0.04;
+        assert!(!grasped(&low, 0, Tolerances::GRASP_OFF_AXIS));
+        assert!(!grasped(&resting(), 0, Tolerances::GRASP_OFF_AXIS));
     }
 
     #[test]
-    fn lifted_uses_the_lowest_point_even_when_the_cube_is_tilted() {
-        assert!(!cube_lifted(&resting(), 0.03));
-        assert!(cube_lifted(&held(), 0.03));
-        assert!(!cube_lifted(&held(), 0.11));
+    fn lifted_uses_the_lowest_point_even_when_the_block_is_tilted() {
+        assert!(!lifted(&resting(), 0, 0.03));
+        assert!(lifted(&held(), 0, 0.03));
+        assert!(!lifted(&held(), 0, 0.11));
         // Tilted 45° about x: the lowest edge is √2·half below the centre.
         let mut tilted = resting();
-        tilted.cube_pos.z = 0.03 + CUBE_HALF * std::f64::consts::SQRT_2;
-        tilted.cube_quat = UnitQuaternion::from_euler_angles(std::f64::consts::FRAC_PI_4, 0.0, 0.0);
-        assert!((tilted.cube_bottom() - 0.03).abs() < 1e-12);
-        assert!(cube_lifted(&tilted, 0.029) && !cube_lifted(&tilted, 0.031));
+        tilted.objects[0].pos.z = 0.03 + HALF * std::f64::consts::SQRT_2;
+        tilted.objects[0].quat = UnitQuaternion::from_euler_angles(std::f64::consts::FRAC_PI_4, 0.0, 0.0);
+        assert!((tilted.bottom(0) - 0.03).abs() < 1e-12);
+        assert!(lifted(&tilted, 0, 0.029) && !lifted(&tilted, 0, 0.031));
     }
 
     #[test]
-    fn in_bowl_means_inside_the_walls_below_the_rim_and_at_rest() {
+    fn in_means_inside_the_walls_below_the_rim_released_and_at_rest() {
         let mut w = resting();
-        w.cube_pos = Vector3::new(0.47, 0.06, 0.01 + CUBE_HALF);
-        assert!(cube_in_bowl(&w, Tolerances::REST_SPEED));
-        assert!(!cube_on_table(&w, 0.01, Tolerances::REST_SPEED));
+        w.objects[0].pos = Vector3::new(0.47, 0.06, 0.01 + HALF);
+        let v = Tolerances::REST_SPEED;
+        assert!(rests_in(&w, 0, 1, v));
+        assert!(!on_table(&w, 0, 0.01, v));
         let mut moving = w.clone();
-        moving.cube_linvel = Vector3::new(0.0, 0.0, -0.3);
-        assert!(!cube_in_bowl(&moving, Tolerances::REST_SPEED));
+        moving.objects[0].linvel = Vector3::new(0.0, 0.0, -0.3);
+        assert!(!rests_in(&moving, 0, 1, v));
         let mut above = w.clone();
-        above.cube_pos.z = 0.2;
-        assert!(!cube_in_bowl(&above, Tolerances::REST_SPEED));
+        above.objects[0].pos.z = 0.2;
+        assert!(!rests_in(&above, 0, 1, v));
         let mut squeezed = w.clone();
-        squeezed.left_pad_contact = true;
-        squeezed.right_pad_contact = true;
-        assert!(
-            !cube_in_bowl(&squeezed, Tolerances::REST_SPEED),
-            "a held cube is not in the bowl"
-        );
+        squeezed.objects[0].left_pad_contact = true;
+        squeezed.objects[0].right_pad_contact = true;
+        assert!(!rests_in(&squeezed, 0, 1, v), "a held cube is not in the bowl");
         let mut on_rim = w.clone();
-        on_rim.cube_pos.x = 0.45 + 0.08;
-        assert!(!cube_in_bowl(&on_rim, Tolerances::REST_SPEED));
+        on_rim.objects[0].pos.x = 0.45 + 0.08;
+        assert!(!rests_in(&on_rim, 0, 1, v));
         // The whole cube must fit between the walls: its centre at most 0.075 − 0.022 m from the
         // bowl's centre (issue 13, item 15: the centre alone within 0.075 m was accepted).
+        let bowl_x = w.objects[1].pos.x;
         let mut flush = w.clone();
-        flush.cube_pos.x = w.bowl_pos.x + 0.075 - CUBE_HALF - 1e-9;
-        assert!(cube_in_bowl(&flush, Tolerances::REST_SPEED));
+        flush.objects[0].pos.x = bowl_x + 0.075 - HALF - 1e-9;
+        assert!(rests_in(&flush, 0, 1, v));
         let mut in_wall = w.clone();
-        in_wall.cube_pos.x = w.bowl_pos.x + 0.075 - CUBE_HALF + 0.001;
-        assert!(!cube_in_bowl(&in_wall, Tolerances::REST_SPEED));
-        in_wall.cube_pos.x = w.bowl_pos.x + 0.074;
-        assert!(!cube_in_bowl(&in_wall, Tolerances::REST_SPEED));
-        assert!(!cube_in_bowl(&resting(), Tolerances::REST_SPEED));
+        in_wall.objects[0].pos.x = bowl_x + 0.075 - HALF + 0.001;
+        assert!(!rests_in(&in_wall, 0, 1, v));
+        in_wall.objects[0].pos.x = bowl_x + 0.074;
+        assert!(!rests_in(&in_wall, 0, 1, v));
+        assert!(!rests_in(&resting(), 0, 1, v));
     }
 
     #[test]
-    fn on_table_is_resting_outside_the_bowl() {
-        assert!(cube_on_table(&resting(), 0.005, Tolerances::REST_SPEED));
-        assert!(!cube_on_table(&held(), 0.005, Tolerances::REST_SPEED));
+    fn on_table_is_resting_outside_every_container() {
+        assert!(on_table(&resting(), 0, 0.005, Tolerances::REST_SPEED));
+        assert!(!on_table(&held(), 0, 0.005, Tolerances::REST_SPEED));
         let mut sliding = resting();
-        sliding.cube_linvel = Vector3::new(0.2, 0.0, 0.0);
-        assert!(!cube_on_table(&sliding, 0.005, Tolerances::REST_SPEED));
+        sliding.objects[0].linvel = Vector3::new(0.2, 0.0, 0.0);
+        assert!(!on_table(&sliding, 0, 0.005, Tolerances::REST_SPEED));
     }
 
     #[test]
-    fn cube_at_is_resting_within_tolerance_of_the_point() {
+    fn at_is_resting_within_tolerance_of_the_point() {
         let w = resting();
-        let (x, y) = (w.cube_pos.x, w.cube_pos.y);
-        let h = Tolerances::ON_TABLE_HEIGHT;
+        let p = w.objects[0].pos;
         let v = Tolerances::REST_SPEED;
         assert!(
-            cube_at(&w, [x + 0.006, y - 0.0079], 0.01, h, v),
+            at(&w, 0, [p.x + 0.006, p.y - 0.0079], 0.01, None, 0.05, v),
             "9.9 mm away, 10 mm allowed"
         );
-        assert!(!cube_at(&w, [x + 0.006, y - 0.009], 0.01, h, v), "10.8 mm away");
         assert!(
-            !cube_at(&held(), [x, y], 0.01, h, v),
+            !at(&w, 0, [p.x + 0.006, p.y - 0.009], 0.01, None, 0.05, v),
+            "10.8 mm away"
+        );
+        assert!(
+            !at(&held(), 0, [p.x, p.y], 0.01, None, 0.05, v),
             "a lifted cube is not placed"
         );
+        let turned = 20f64.to_radians();
+        let mut w = resting();
+        w.objects[0].quat = UnitQuaternion::from_euler_angles(0.0, 0.0, turned);
+        assert!(at(&w, 0, [p.x, p.y], 0.01, Some(turned + 0.01), 0.02, v));
+        assert!(!at(&w, 0, [p.x, p.y], 0.01, Some(turned + 0.03), 0.02, v));
     }
 
     #[test]
@@ -289,14 +264,5 @@ mod tests {
         assert!(at_home(&w, 0.04));
         w.arm_q = [0.03, 0.03, 0.0, 0.0, 0.0, 0.0];
         assert!(!at_home(&w, 0.04), "the norm, not the largest joint, is compared");
-    }
-
-    #[test]
-    fn distance_from_the_bowl_footprint() {
-        let w = resting();
-        let inside = w.from_bowl(&Vector3::new(0.45, 0.08, 0.0));
-        assert_eq!(inside.norm(), 0.0);
-        let d = w.from_bowl(&Vector3::new(0.45, -0.18, 0.0));
-        assert!((d.y - (-0.26 + 0.085)).abs() < 1e-12 && d.x == 0.0);
     }
 }

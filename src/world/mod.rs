@@ -54,9 +54,10 @@
 
 pub mod conditions;
 pub mod goal;
+mod legacy;
 pub mod objects;
 pub mod query;
 pub mod snapshot;
 
 pub use objects::{ObjectState, Part, Piece, Touch};
-pub use snapshot::{BowlGeometry, CUBE_HALF, World};
+pub use snapshot::World;

@@ -7,46 +7,10 @@ use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use super::objects::{ObjectState, Touch};
 use crate::scene::SceneSpec;
 
-/// Half of the cube's edge (the cube is 44 mm), metres.
-pub const CUBE_HALF: f64 = 0.022;
-
-/// The bowl's shape, in its own frame (origin at the centre of its footprint on the table).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BowlGeometry {
-    /// Half-width of the free space inside the walls, metres.
-    pub inner_half_width: f64,
-    /// Half-width of the footprint, walls included, metres.
-    pub outer_half_width: f64,
-    /// Height of the rim above the table, metres.
-    pub rim_height: f64,
-    /// Height of the bowl's floor (top surface) above the table, metres.
-    pub floor_height: f64,
-}
-
-impl BowlGeometry {
-    /// No bowl (a scene without a container): nothing fits in it.
-    pub const NONE: Self = Self {
-        inner_half_width: 0.0,
-        outer_half_width: 0.0,
-        rim_height: 0.0,
-        floor_height: 0.0,
-    };
-
-    /// The tray of the `cube_bowl` scene.
-    pub const TRAY: Self = Self {
-        inner_half_width: 0.075,
-        outer_half_width: 0.085,
-        rim_height: 0.06,
-        floor_height: 0.01,
-    };
-}
-
 /// A snapshot of the simulated cell, refreshed after every control step.
 ///
-/// Every object of the scene is in [`objects`](Self::objects) (same order as the scene); the
-/// `cube_*` and `bowl_*` fields repeat the state of the objects the legacy names `cube` and `bowl`
-/// stand for ([`SceneSpec::legacy_cube`], [`SceneSpec::legacy_bowl`]), which the `cube_*`
-/// conditions and the reference tutorial's checks read.
+/// Every object of the scene is in [`objects`](Self::objects) (same order as the scene). The
+/// legacy names `cube` and `bowl` are resolved on demand ([`World::cube`], [`World::bowl`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct World {
     /// Simulated time, seconds.
@@ -66,28 +30,10 @@ pub struct World {
     /// Pinch frame orientation (its z axis points out of the fingers), world frame (a rotation
     /// matrix whose columns are the frame's axes).
     pub pinch_rot: Matrix3<f64>,
-    /// The left pads touch the cube.
-    pub left_pad_contact: bool,
-    /// The right pads touch the cube.
-    pub right_pad_contact: bool,
     /// Centre of the left pads, world frame, metres.
     pub left_pad_pos: Vector3<f64>,
     /// Centre of the right pads, world frame, metres.
     pub right_pad_pos: Vector3<f64>,
-    /// Cube centre, world frame, metres.
-    pub cube_pos: Vector3<f64>,
-    /// Cube orientation, world frame (unit quaternion).
-    pub cube_quat: UnitQuaternion<f64>,
-    /// Cube linear velocity, m/s.
-    pub cube_linvel: Vector3<f64>,
-    /// Cube angular velocity, rad/s.
-    pub cube_angvel: Vector3<f64>,
-    /// Centre of the bowl's footprint on the table, metres.
-    pub bowl_pos: Vector3<f64>,
-    /// The bowl target (centre of its floor's top surface), metres.
-    pub bowl_target: Vector3<f64>,
-    /// The bowl's shape.
-    pub bowl: BowlGeometry,
     /// The arm's home joint angles, radians.
     pub home_q: [f64; 6],
     /// The scene: object names, shapes, colours and the goal.
@@ -97,34 +43,6 @@ pub struct World {
     /// The contacts between distinct parts of the cell right now (robot–object, object–object),
     /// table contacts excluded.
     pub touches: Vec<Touch>,
-}
-
-impl World {
-    /// Yaw of the cube's side faces about world z, folded into [-45°, 45°) (a cube looks the
-    /// same every 90°), radians. Taken from whichever cube axis lies most horizontal, so it is
-    /// right for a cube resting on any of its faces, not only the one it started on.
-    pub fn cube_yaw(&self) -> f64 {
-        let r = self.cube_quat.to_rotation_matrix();
-        let axis = (0..3)
-            .map(|i| r.matrix().column(i).into_owned())
-            .min_by(|a, b| a.z.abs().total_cmp(&b.z.abs()))
-            .expect("three axes");
-        fold_quarter_turn(axis.y.atan2(axis.x))
-    }
-
-    /// Horizontal vector from the nearest point of the bowl's footprint to `p` (zero inside it), metres.
-    pub fn from_bowl(&self, p: &Vector3<f64>) -> nalgebra::Vector2<f64> {
-        let h = self.bowl.outer_half_width;
-        let d = nalgebra::Vector2::new(p.x - self.bowl_pos.x, p.y - self.bowl_pos.y);
-        d - d.map(|c| c.clamp(-h, h))
-    }
-
-    /// Lowest point of the cube above the table, metres (exact for any orientation).
-    pub fn cube_bottom(&self) -> f64 {
-        let r = self.cube_quat.to_rotation_matrix();
-        let extent: f64 = (0..3).map(|i| r[(2, i)].abs() * CUBE_HALF).sum();
-        self.cube_pos.z - extent
-    }
 }
 
 /// Rotation about world z of a quaternion (the yaw of its x axis), radians in (-π, π].
@@ -144,7 +62,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn cube_yaw_is_read_from_the_side_faces_whatever_face_it_rests_on() {
+    fn a_blocks_yaw_is_read_from_the_side_faces_whatever_face_it_rests_on() {
         let mut w = crate::world::conditions::tests_support::resting();
         for yaw_deg in [-40.0f64, -10.0, 0.0, 20.6, 44.0] {
             let yaw = yaw_deg.to_radians();
@@ -154,8 +72,8 @@ mod tests {
                 UnitQuaternion::from_euler_angles(std::f64::consts::FRAC_PI_2, 0.0, 0.0),
                 UnitQuaternion::from_euler_angles(0.0, std::f64::consts::FRAC_PI_2, 0.0),
             ] {
-                w.cube_quat = UnitQuaternion::from_euler_angles(0.0, 0.0, yaw) * tip;
-                let got = w.cube_yaw();
+                w.objects[0].quat = UnitQuaternion::from_euler_angles(0.0, 0.0, yaw) * tip;
+                let got = w.yaw(0);
                 assert!(
                     (fold_quarter_turn(got - yaw)).abs() < 1e-9,
                     "yaw {yaw_deg}°, tip {tip:?}: got {}°",
