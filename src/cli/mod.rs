@@ -11,6 +11,7 @@ mod graph;
 mod limits;
 mod logging;
 mod nodes;
+mod output_set;
 mod outputs;
 mod report;
 mod run;

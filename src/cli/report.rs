@@ -57,6 +57,8 @@ pub fn report(args: ReportArgs) -> Result<(), CliError> {
     let mut files = Vec::new();
     for m in &merged {
         let path = PathBuf::from(m.config.suite.as_deref().unwrap_or_default());
+        crate::spec::confine::check_path_from_results(&path)
+            .map_err(|e| CliError::Input(format!("error: {e}")))?;
         let file = load_scenario_file(&path)
             .map_err(|d| super::invalid(d, format!("{} (named by the results)", path.display())))?;
         let mut same = file.sweep.clone();

@@ -30,8 +30,8 @@ pub struct SweepArgs {
     /// Sweep seed: scenario k of seed S is the same layout and episode seed everywhere.
     #[arg(long, default_value_t = 0, value_name = "S")]
     pub seed: u64,
-    /// Worker threads (default: one per core).
-    #[arg(long, short = 'j', value_name = "J", value_parser = clap::value_parser!(u64).range(1..))]
+    /// Worker threads, 1…1024 (default: one per core).
+    #[arg(long, short = 'j', value_name = "J", value_parser = super::limits::jobs)]
     pub jobs: Option<u64>,
     /// Inject this fault through physics in every scenario (see docs/faults.md).
     #[arg(long, value_parser = super::limits::fault())]
@@ -130,19 +130,30 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
             shard.map_or(1, |s| s.count),
         )));
     }
-    let (mut out, resumed) = match &args.out {
-        Some(path) => {
-            let (file, resumed) =
-                super::sweep_out::open(path, args.resume, &args.tree, &config, &scene, &plan)?;
-            (Some(file), resumed)
-        }
-        None => (None, Default::default()),
+    // Every option is checked before any output is touched.
+    let mut inputs = super::outputs::tree_inputs(&args.tree);
+    inputs.extend(args.scene.clone());
+    if let (Some(out), Some(dir)) = (&args.out, &args.dataset) {
+        super::output_set::refuse_output_inside("--out", out, "--dataset", dir)?;
+    }
+    let prepared = match &args.out {
+        Some(path) => Some(super::sweep_out::prepare(
+            path,
+            args.resume,
+            &inputs,
+            &config,
+            &scene,
+            &plan,
+        )?),
+        None => None,
     };
-    let done = resumed.results.len() as u64;
     let mut dataset = match &args.dataset {
         Some(dir) => Some(super::dataset::start(&args, dir, &scene, &plan, &config)?),
         None => None,
     };
+    let mut out = prepared.as_ref().map(|p| p.start()).transpose()?;
+    let resumed = prepared.map(|p| p.resumed).unwrap_or_default();
+    let done = resumed.results.len() as u64;
     let bar = if std::io::stderr().is_terminal() {
         ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
     } else {

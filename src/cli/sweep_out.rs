@@ -5,25 +5,39 @@ use std::path::Path;
 use std::sync::Arc;
 
 use super::CliError;
-use super::outputs::{output_error, tree_inputs};
+use super::outputs::output_error;
 use crate::output::{LineFile, OutputFile};
 use crate::plan::Plan;
 use crate::sim::Scene;
 use crate::sweep::SweepConfig;
 use crate::sweep::resume::{Resumed, read_existing, spot_check};
 
-/// Opens the output of a sweep of `tree` at `path`: with `resume`, keeps the complete results
-/// already there (checked to belong to this sweep) and returns them; otherwise starts the file
-/// empty (saying so when it replaces an existing file).
-pub(super) fn open(
+/// The checked output of a sweep, not yet touched: [`Prepared::start`] installs it.
+pub(super) struct Prepared {
+    out: OutputFile,
+    /// The results kept from the interrupted run (`--resume`).
+    pub resumed: Resumed,
+}
+
+impl Prepared {
+    /// Installs the file (holding the kept results) and opens it for the new lines.
+    pub(super) fn start(&self) -> Result<LineFile, CliError> {
+        self.out.stream(&self.resumed.kept).map_err(output_error)
+    }
+}
+
+/// Checks the output of a sweep of `tree` at `path`, which must be none of `inputs` (the files
+/// the sweep reads): with `resume`, reads the complete results already there (checked to belong
+/// to this sweep); otherwise the file will start empty (saying so when it replaces an existing
+/// file). Nothing is written until [`Prepared::start`].
+pub(super) fn prepare(
     path: &Path,
     resume: bool,
-    tree: &Path,
+    inputs: &[std::path::PathBuf],
     config: &SweepConfig,
     scene: &Scene,
     plan: &Arc<Plan>,
-) -> Result<(LineFile, Resumed), CliError> {
-    let inputs = tree_inputs(tree);
+) -> Result<Prepared, CliError> {
     let inputs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
     let out = OutputFile::check(path, &inputs).map_err(output_error)?;
     let resumed = if resume && out.is_stream() {
@@ -63,6 +77,5 @@ pub(super) fn open(
         }
         Resumed::default()
     };
-    let file = out.stream(&resumed.kept).map_err(output_error)?;
-    Ok((file, resumed))
+    Ok(Prepared { out, resumed })
 }

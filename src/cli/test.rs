@@ -110,6 +110,10 @@ pub fn test(args: TestArgs) -> Result<(), CliError> {
         inputs.extend(s.scene.clone());
         tasks.push((Arc::new(plan), scene));
     }
+    super::output_set::refuse_same_outputs(&[
+        ("--junit", args.junit.as_deref()),
+        ("--out", args.out.as_deref()),
+    ])?;
     let junit_out = args
         .junit
         .as_deref()

@@ -273,12 +273,27 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
         issues.push(
             Issue::new(
                 v.loc,
-                format!("a scene file must be a mapping, found {}", v.describe()),
+                format!(
+                    "a scene file must be a mapping, found {}",
+                    crate::spec::confine::kind_of(v)
+                ),
             )
             .label("expected `objects:` (and optionally `description:` and `goal:`)"),
         );
         return None;
     };
+    // Not a scene file at all (a `.env`, a credentials file): one issue, quoting one line.
+    if !entries
+        .iter()
+        .any(|(k, _)| k.as_str().is_some_and(|k| TOP_LEVEL_KEYS.contains(&k)))
+    {
+        issues.push(
+            Issue::new(v.loc, "this is not a scene file: it has none of `objects:`, `description:`, `goal:`")
+                .label("expected `objects:` (and optionally `description:` and `goal:`)")
+                .help("name a scene file (see docs/scenes.md)"),
+        );
+        return None;
+    }
     let mut description = None;
     let mut objects_v = None;
     let mut goal_v = None;

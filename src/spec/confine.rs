@@ -90,6 +90,56 @@ impl IncludeScope {
     }
 }
 
+/// Checks a tree's `scene:` (written `rel`, at `path` once joined to the tree's folder `base`)
+/// against the include rule: by spelling, then (when it exists) resolved.
+pub(crate) fn check_scene_path(
+    scope: &IncludeScope,
+    base: Option<&Path>,
+    path: &Path,
+    rel: &str,
+    loc: Loc,
+) -> Result<(), Issue> {
+    let written = Path::new(rel);
+    let checked = scope.check_spelling(base, written, loc).and_then(|()| match path.canonicalize() {
+        Ok(canon) => scope.check_resolved(&canon, written, loc),
+        Err(_) => Ok(()), // missing: the scene loader says so
+    });
+    checked.map_err(|issue| {
+        Issue::new(loc, format!("the scene `{rel}` is outside the tree's folder"))
+            .label(issue.label.unwrap_or_default().replace("includes may", "a tree may"))
+            .help(
+                "move the scene file into the tree's folder (or a subfolder), give it with \
+                 `--scene FILE`, or pass --allow-include-outside to read it anyway",
+            )
+    })
+}
+
+/// Checks `written`, a path read back from a results file (a scenario file's path), against
+/// the include rule with the current folder as the root: it must be relative and resolve inside
+/// the current folder, unless [`set_includes_anywhere`] allowed any path. `Err` says why.
+pub fn check_path_from_results(written: &Path) -> Result<(), String> {
+    if includes_anywhere() {
+        return Ok(());
+    }
+    let cwd = std::env::current_dir()
+        .and_then(|d| d.canonicalize())
+        .map_err(|e| format!("the current folder cannot be resolved: {e}"))?;
+    let inside = !written.is_absolute()
+        && lexical(&cwd.join(written)).starts_with(&cwd)
+        && written.canonicalize().map_or(true, |c| c.starts_with(&cwd));
+    if inside {
+        Ok(())
+    } else {
+        Err(format!(
+            "the results name `{}`, which is outside the current folder {}; run `report` from \
+             the folder the results were written in, or pass --allow-include-outside to read it \
+             anyway",
+            written.display(),
+            cwd.display()
+        ))
+    }
+}
+
 /// `path` with `.` and `..` resolved by spelling alone (no file system access).
 fn lexical(path: &Path) -> PathBuf {
     let mut out = PathBuf::new();
@@ -131,7 +181,7 @@ pub(crate) fn parse_top_level(v: &Value, issues: &mut Vec<Issue>) -> (Option<Tre
 }
 
 /// What `v` is, without its content.
-fn kind_of(v: &Value) -> &'static str {
+pub(crate) fn kind_of(v: &Value) -> &'static str {
     match v.kind {
         ValueKind::Null => "nothing (an empty document)",
         ValueKind::Bool(_) => "a boolean",

@@ -11,7 +11,7 @@
 
 pub mod catalog;
 pub mod check;
-mod confine;
+pub(crate) mod confine;
 pub mod de;
 pub mod diag;
 pub mod expand;

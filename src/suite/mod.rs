@@ -251,13 +251,28 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>) -> Option<ScenarioFile>
         issues.push(
             Issue::new(
                 v.loc,
-                format!("a scenario file must be a mapping, found {}", v.describe()),
+                format!(
+                    "a scenario file must be a mapping, found {}",
+                    crate::spec::confine::kind_of(v)
+                ),
             )
             .label("expected `tree:`, `count:` and `expect:`")
             .help("see docs/testing_trees.md"),
         );
         return None;
     };
+    // Not a scenario file at all: one issue, quoting one line.
+    if !entries
+        .iter()
+        .any(|(k, _)| k.as_str().is_some_and(|k| KEYS.contains(&k)))
+    {
+        issues.push(
+            Issue::new(v.loc, "this is not a scenario file: it has none of its keys (`tree:`, `count:`, `expect:`, …)")
+                .label("expected `tree:`, `count:` and `expect:`")
+                .help("see docs/testing_trees.md"),
+        );
+        return None;
+    }
     for (k, _) in entries {
         let key = k.as_str().unwrap_or("?");
         if !KEYS.contains(&key) {
