@@ -96,6 +96,25 @@ impl Default for EpisodeConfig {
     }
 }
 
+/// Every name [`failure_kind`] gives (what `expect.failure_kind` of a scenario file may name).
+pub const FAILURE_KINDS: [&str; 15] = [
+    "time_limit",
+    "unstable",
+    "goal_not_met",
+    "grasp_lost",
+    "grasp_failed",
+    "unreachable",
+    "blocked",
+    "timeout",
+    "halted",
+    "condition_false",
+    "layout",
+    "panicked",
+    "substituted",
+    "substitution",
+    "other",
+];
+
 /// A stable name for the kind of a failure reason, for grouping failures across a sweep:
 /// `time_limit`, `unstable`, `goal_not_met`, `grasp_lost`, `grasp_failed`, `unreachable`,
 /// `blocked` (no clear way), `timeout` (a leaf's own limit), `halted`, `condition_false`,

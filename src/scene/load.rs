@@ -336,6 +336,9 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
         objects,
         goal: Goal::default(),
     };
+    if issues.is_empty() {
+        super::feasible::check_has_block(&scene, objects_key, issues);
+    }
     let goal = match goal_v {
         Some(g) => read_goal(g, &scene, issues),
         None => Goal::default(),
@@ -811,6 +814,7 @@ fn read_goal(v: &Value, scene: &SceneSpec, issues: &mut Vec<Issue>) -> Goal {
             );
         }
     }
+    super::feasible::check_goal_feasible(scene, &atoms, issues);
     Goal {
         atoms: atoms.into_iter().map(|(a, _)| a).collect(),
     }

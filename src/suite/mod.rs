@@ -386,6 +386,21 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>) -> Option<ScenarioFile>
             .help("add `outcome: failure`, or remove it"),
         );
     }
+    if let Some(kind) = &e.failure_kind
+        && !crate::episode::FAILURE_KINDS.contains(&kind.as_str())
+    {
+        issues.push(
+            Issue::new(
+                at(&["expect", "failure_kind"]),
+                format!("unknown failure kind `{kind}`"),
+            )
+            .label(format!(
+                "expected one of {}",
+                crate::episode::FAILURE_KINDS.join(", ")
+            ))
+            .maybe_help(did_you_mean(kind, crate::episode::FAILURE_KINDS.iter().copied())),
+        );
+    }
     if let Some(t) = e.max_sim_time
         && !(t.is_finite() && t > 0.0 && t <= 3600.0)
     {
