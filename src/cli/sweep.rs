@@ -13,7 +13,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use super::{CliError, load_task};
 use crate::episode::Goal;
 use crate::faults::FaultKind;
-use crate::sweep::{Summary, SweepConfig, run_sweep_with};
+use crate::sweep::{SweepConfig, run_sweep_streaming};
 
 /// Arguments of `sweep`.
 #[derive(Debug, Args)]
@@ -136,6 +136,8 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
     if let (Some(out), Some(dir)) = (&args.out, &args.dataset) {
         super::output_set::refuse_output_inside("--out", out, "--dataset", dir)?;
     }
+    let tree = args.tree.display().to_string();
+    let mut tally = crate::sweep::tally::Tally::new(&tree, &config);
     let prepared = match &args.out {
         Some(path) => Some(super::sweep_out::prepare(
             path,
@@ -144,6 +146,7 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
             &config,
             &scene,
             &plan,
+            &mut tally,
         )?),
         None => None,
     };
@@ -153,7 +156,7 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
     };
     let mut out = prepared.as_ref().map(|p| p.start()).transpose()?;
     let resumed = prepared.map(|p| p.resumed).unwrap_or_default();
-    let done = resumed.results.len() as u64;
+    let done = resumed.count;
     let bar = if std::io::stderr().is_terminal() {
         ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
     } else {
@@ -185,7 +188,9 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
             None,
         ),
     };
-    let run = run_sweep_with(&scene, &config, done, episode, |r, recording| {
+    let run = run_sweep_streaming(&scene, &config, done, episode, |r, recording| {
+        let r = &r;
+        tally.add(r);
         if let Some(w) = out.as_mut()
             && let Err(e) = w.write_line(&r.to_jsonl())
         {
@@ -225,10 +230,8 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
     if let Some(d) = dataset {
         d.finish()?;
     }
-    let mut results = resumed.results;
-    results.extend(run.results);
-    let tree = args.tree.display().to_string();
-    let summary = Summary::new(&tree, &config, &results, run.wall_time_s, run.jobs)
+    let summary = tally
+        .finish(run.wall_time_s, run.jobs)
         .with_physics(run.physics_time_s, super::process_elapsed_s());
     print!("{}", summary.to_text());
     if args.json {

@@ -22,6 +22,7 @@ pub mod layout;
 pub mod report;
 pub mod resume;
 mod summary;
+pub mod tally;
 
 use std::collections::BTreeMap;
 use std::ops::ControlFlow;
@@ -655,6 +656,27 @@ pub fn run_sweep_with<T: Send>(
     episode: impl Fn(&mut Cell, u64) -> (ScenarioResult, T) + Sync,
     mut on_result: impl FnMut(&ScenarioResult, Option<T>) -> ControlFlow<()>,
 ) -> Result<SweepRun, rayon::ThreadPoolBuildError> {
+    // Memory grows with the results, not with the size of the sweep.
+    let mut results = Vec::with_capacity(config.indices().skip_first(skip).len().min(4096));
+    let mut run = run_sweep_streaming(scene, config, skip, episode, |r, payload| {
+        let flow = on_result(&r, payload);
+        results.push(r);
+        flow
+    })?;
+    run.results = results;
+    Ok(run)
+}
+
+/// [`run_sweep_with`] that keeps no result: each is handed to `on_result` (in scenario order)
+/// and dropped, so memory does not grow with the number of scenarios. The returned
+/// [`SweepRun`] has no `results`.
+pub fn run_sweep_streaming<T: Send>(
+    scene: &Scene,
+    config: &SweepConfig,
+    skip: u64,
+    episode: impl Fn(&mut Cell, u64) -> (ScenarioResult, T) + Sync,
+    mut on_result: impl FnMut(ScenarioResult, Option<T>) -> ControlFlow<()>,
+) -> Result<SweepRun, rayon::ThreadPoolBuildError> {
     let wall = Instant::now();
     let episode = &episode;
     let pool = rayon::ThreadPoolBuilder::new()
@@ -663,8 +685,7 @@ pub fn run_sweep_with<T: Send>(
         .build()?;
     let jobs = pool.current_num_threads();
     let indices = config.indices().skip_first(skip);
-    // Memory grows with the results, not with the size of the sweep.
-    let mut results = Vec::with_capacity(indices.len().min(4096));
+    let mut next = 0usize;
     let (tx, rx) = mpsc::channel::<(usize, ScenarioResult, Option<T>)>();
     let stop = AtomicBool::new(false);
     let physics_ns = AtomicU64::new(0);
@@ -710,10 +731,9 @@ pub fn run_sweep_with<T: Send>(
                 continue; // draining the scenarios that were running
             }
             pending.insert(pos, (result, payload));
-            while let Some((result, payload)) = pending.remove(&results.len()) {
-                let flow = on_result(&result, payload);
-                results.push(result);
-                if flow.is_break() {
+            while let Some((result, payload)) = pending.remove(&next) {
+                next += 1;
+                if on_result(result, payload).is_break() {
                     stop.store(true, Ordering::Relaxed);
                     break;
                 }
@@ -721,7 +741,7 @@ pub fn run_sweep_with<T: Send>(
         }
     });
     Ok(SweepRun {
-        results,
+        results: Vec::new(),
         wall_time_s: wall.elapsed().as_secs_f64(),
         jobs,
         physics_time_s: physics_ns.load(Ordering::Relaxed) as f64 * 1e-9,
