@@ -34,3 +34,17 @@ pub(super) fn tree_inputs(tree: &Path) -> Vec<PathBuf> {
 pub(super) fn output_error(e: OutputError) -> CliError {
     CliError::Input(format!("error: {e}"))
 }
+
+/// The digest of the files a sweep reads (see [`crate::sweep::digest`]).
+pub(super) fn inputs_digest(inputs: &[PathBuf]) -> String {
+    let files: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
+    crate::sweep::digest::files_digest(&files)
+}
+
+/// The files a scenario file's sweep reads: its tree (with includes and `scene:`) and its
+/// `scene:` override.
+pub(super) fn suite_inputs(file: &crate::suite::ScenarioFile) -> Vec<PathBuf> {
+    let mut inputs = tree_inputs(&file.tree);
+    inputs.extend(file.scene.clone());
+    inputs
+}

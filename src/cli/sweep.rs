@@ -104,6 +104,9 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
     let (plan, scene) = load_task(&args.tree, args.scene.as_deref())?;
     super::check_substitutions(&plan, &args.substitute)?;
     let plan = Arc::new(plan);
+    // Every file the sweep reads: never an output, and digested into every result line.
+    let mut inputs = super::outputs::tree_inputs(&args.tree);
+    inputs.extend(args.scene.clone());
     let config = SweepConfig {
         scenarios: args.scenarios,
         seed: args.seed,
@@ -116,6 +119,7 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
         tree: args.tree.display().to_string(),
         substitutions: args.substitute.clone(),
         suite: None,
+        tree_digest: Some(super::outputs::inputs_digest(&inputs)),
         program: super::program_name(),
     };
     let total = config.indices().len() as u64;
@@ -131,8 +135,6 @@ pub fn sweep(args: SweepArgs) -> Result<(), CliError> {
         )));
     }
     // Every option is checked before any output is touched.
-    let mut inputs = super::outputs::tree_inputs(&args.tree);
-    inputs.extend(args.scene.clone());
     if let (Some(out), Some(dir)) = (&args.out, &args.dataset) {
         super::output_set::refuse_output_inside("--out", out, "--dataset", dir)?;
     }

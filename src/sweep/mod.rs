@@ -17,6 +17,7 @@
 //! println!("{} of {} succeeded", run.results.iter().filter(|r| r.success).count(), run.results.len());
 //! ```
 
+pub mod digest;
 mod indices;
 pub mod layout;
 pub mod report;
@@ -207,6 +208,9 @@ pub struct SweepConfig {
     pub substitutions: Vec<Substitution>,
     /// The scenario file of `macrotree test` this sweep belongs to, if any.
     pub suite: Option<String>,
+    /// The digest of the tree file, its includes and the scene file ([`digest::files_digest`]),
+    /// written to every result line: `--resume` refuses lines of other contents.
+    pub tree_digest: Option<String>,
     /// How reproduction commands name the program (`macrotree` when it is on `PATH`, else the
     /// path of the binary that ran, e.g. `target/release/macrotree`), shell-quoted.
     pub program: String,
@@ -226,6 +230,7 @@ impl Default for SweepConfig {
             tree: String::new(),
             substitutions: Vec::new(),
             suite: None,
+            tree_digest: None,
             program: "macrotree".to_string(),
         }
     }
@@ -384,6 +389,10 @@ pub struct ScenarioResult {
     pub failure_kind: Option<&'static str>,
     /// How often every node ran, in plan order.
     pub nodes: Vec<NodeReport>,
+    /// The digest of the tree, its includes and the scene the sweep ran
+    /// ([`SweepConfig::tree_digest`]); a line that has it also ends with its checksum (`crc32`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tree_digest: Option<String>,
     /// Wall-clock time of the episode, seconds (not written to the JSONL).
     #[serde(skip)]
     pub wall_time_s: f64,
@@ -439,6 +448,7 @@ impl ScenarioResult {
             failure_kind,
             failed_node: r.failed_node,
             nodes: r.nodes,
+            tree_digest: config.tree_digest.clone(),
             wall_time_s: r.wall_time_s,
         }
     }
@@ -488,13 +498,19 @@ impl ScenarioResult {
             collisions: Vec::new(),
             failed_node: None,
             nodes: Vec::new(),
+            tree_digest: config.tree_digest.clone(),
             wall_time_s: 0.0,
         }
     }
 
     /// The result as one JSON line (without the newline).
     pub fn to_jsonl(&self) -> String {
-        serde_json::to_string(self).expect("a scenario result serializes")
+        let json = serde_json::to_string(self).expect("a scenario result serializes");
+        if self.tree_digest.is_some() {
+            digest::with_checksum(&json)
+        } else {
+            json
+        }
     }
 
     /// The `macrotree run …` command that reproduces this scenario bit for bit (the program

@@ -189,6 +189,19 @@ fn check_result(
             r.index
         ));
     }
+    if r.tree_digest != config.tree_digest {
+        return Err(match &r.tree_digest {
+            None => "it was written by an earlier version of macrotree, whose lines carry no \
+                     digest of the tree (run without --resume to start over)"
+                .into(),
+            Some(d) => format!(
+                "the tree, a file it includes or the scene changed since it was written (digest \
+                 {}…, now {}…)",
+                &d[..d.len().min(12)],
+                config.tree_digest.as_deref().map_or("none", |c| &c[..c.len().min(12)])
+            ),
+        });
+    }
     if r.tree != config.tree {
         return Err(format!("tree {:?}, not {:?}", r.tree, config.tree));
     }
@@ -263,7 +276,16 @@ fn check_result(
 
 /// Reads one JSONL line back into the result it was written from.
 pub fn parse_line(line: &str) -> Result<ScenarioResult, String> {
-    let v: Value = serde_json::from_str(line).map_err(|e| format!("not JSON: {e}"))?;
+    let unchecked = super::digest::strip_checksum(line)?;
+    let v: Value = serde_json::from_str(unchecked.as_deref().unwrap_or(line))
+        .map_err(|e| format!("not JSON: {e}"))?;
+    let tree_digest = match v.get("tree_digest") {
+        None => None,
+        Some(d) => Some(d.as_str().ok_or("`tree_digest` is not text")?.to_string()),
+    };
+    if tree_digest.is_some() != unchecked.is_some() {
+        return Err("a line with a `tree_digest` ends with its `crc32`, and only such a line".into());
+    }
     let field = |k: &str| v.get(k).ok_or_else(|| format!("no `{k}`"));
     let u64_of = |k: &str| field(k)?.as_u64().ok_or_else(|| format!("`{k}` is not a count"));
     let u32_of = |k: &str| u32::try_from(u64_of(k)?).map_err(|_| format!("`{k}` is too large"));
@@ -369,6 +391,7 @@ pub fn parse_line(line: &str) -> Result<ScenarioResult, String> {
         failed_node: serde_json::from_value(parsed("failed_node")?)
             .map_err(|e| format!("`failed_node`: {e}"))?,
         nodes: serde_json::from_value(parsed("nodes")?).map_err(|e| format!("`nodes`: {e}"))?,
+        tree_digest,
         wall_time_s: 0.0,
     })
 }
