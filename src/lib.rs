@@ -128,6 +128,7 @@ pub mod actions;
 pub mod app;
 #[cfg(feature = "cli")]
 pub mod cli;
+pub mod cleanup;
 pub mod dataset;
 pub mod episode;
 pub mod error;

@@ -213,8 +213,13 @@ impl OutputFile {
             held: None,
         };
         // The folder accepts a new file: try one (and remove it).
-        let (probe, _) = out.create_temp()?;
+        let (probe, _, _registered) = out.create_temp()?;
         let _ = std::fs::remove_file(probe);
+        // Temporary files of this output left by a process that is gone.
+        let mut prefix = OsString::from(".");
+        prefix.push(&out.name);
+        prefix.push(".");
+        crate::cleanup::reclaim(&out.dir, &prefix, ".tmp", false);
         Ok(out)
     }
 
@@ -263,7 +268,7 @@ impl OutputFile {
         if let Some(mut file) = self.open_stream()? {
             return file.write_all(bytes).map_err(self.io("write error"));
         }
-        let (tmp, file) = self.create_temp()?;
+        let (tmp, file, _registered) = self.create_temp()?;
         let result = self.fill_and_install(&tmp, file, bytes);
         if result.is_err() {
             let _ = std::fs::remove_file(&tmp);
@@ -278,7 +283,7 @@ impl OutputFile {
         if self.stream_fd.is_some() {
             return self.stream(&[]);
         }
-        let (tmp, mut file) = self.create_temp()?;
+        let (tmp, mut file, _registered) = self.create_temp()?;
         let copied = (|| -> Result<(), OutputError> {
             use std::io::{Read, Seek};
             let mut src = src;
@@ -348,7 +353,7 @@ impl OutputFile {
                 ident: None,
             });
         }
-        let (tmp, file) = self.create_temp()?;
+        let (tmp, file, _registered) = self.create_temp()?;
         match self.install_stream(&tmp, file, prefix) {
             Ok(file) => self.line_file(file, prefix.len() as u64),
             Err(e) => {
@@ -367,11 +372,13 @@ impl OutputFile {
                 what: "an output stream (this output needs a file it can seek in)",
             });
         }
-        let (tmp, _) = self.create_temp()?;
+        let (tmp, file, registered) = self.create_temp()?;
         Ok(PendingFile {
             out: self,
             tmp,
             installed: false,
+            _lock: file,
+            _registered: registered,
         })
     }
 
@@ -395,8 +402,17 @@ impl OutputFile {
             .map_err(self.io("cannot open it"))
     }
 
-    /// A new, empty file next to the path, created exclusively under an unpredictable name.
-    fn create_temp(&self) -> Result<(PathBuf, File), OutputError> {
+    /// A new, empty file next to the path, created exclusively under an unpredictable name,
+    /// locked (its owner is alive while the lock is held) and registered for removal on a
+    /// signal ([`crate::cleanup`]).
+    fn create_temp(&self) -> Result<(PathBuf, File, crate::cleanup::Registered), OutputError> {
+        let (tmp, file) = self.create_temp_unregistered()?;
+        let _ = file.try_lock();
+        let registered = crate::cleanup::register(&tmp, false);
+        Ok((tmp, file, registered))
+    }
+
+    fn create_temp_unregistered(&self) -> Result<(PathBuf, File), OutputError> {
         let mut last = None;
         for _ in 0..16 {
             let mut name = OsString::from(".");
@@ -448,6 +464,9 @@ pub struct PendingFile<'a> {
     out: &'a OutputFile,
     tmp: PathBuf,
     installed: bool,
+    /// The temporary file, open and locked while it is pending.
+    _lock: File,
+    _registered: crate::cleanup::Registered,
 }
 
 impl PendingFile<'_> {

@@ -16,6 +16,7 @@ mod outputs;
 mod report;
 mod run;
 mod schema;
+mod signals;
 mod sweep;
 mod sweep_out;
 mod test;
@@ -131,6 +132,7 @@ pub fn main() -> ExitCode {
     );
     logging::init(cli.verbose, cli.log_format, quiet);
     crate::spec::set_includes_anywhere(cli.allow_include_outside);
+    signals::install();
     let result = match cli.command {
         Command::Run(args) => run::run(args),
         Command::Validate(args) => validate::validate(args),
