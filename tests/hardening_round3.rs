@@ -129,9 +129,18 @@ fn a_tree_scene_outside_its_folder_is_refused_without_reading_it() {
             assert!(!all.contains(secret), "leaked {secret}: {all}");
         }
     }
-    // `run` refuses it the same way.
+    // `run` refuses it the same way, and a YAML file outside the tree's folder and the current
+    // folder too.
     let out = macrotree(&["run", s(&tree)]);
     assert_refused(&out, "outside the tree's folder");
+    std::fs::write(dir.join("secrets.yaml"), format!("token: line1-token\n{SECRET}")).unwrap();
+    std::fs::write(&tree, format!("scene: ../secrets.yaml\n{text}")).unwrap();
+    let out = macrotree(&["validate", s(&tree)]);
+    assert_refused(&out, "outside the tree's folder");
+    assert!(!stderr(&out).contains("line1-token"), "{}", stderr(&out));
+    // The shipped trees name scenes of the repository's `scenes/` (run from the repository).
+    let out = macrotree(&["validate", "trees/sort_by_color.yaml", "trees/stack_three.yaml"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -104,14 +104,31 @@ pub(crate) fn check_scene_path(
         Ok(canon) => scope.check_resolved(&canon, written, loc),
         Err(_) => Ok(()), // missing: the scene loader says so
     });
-    checked.map_err(|issue| {
-        Issue::new(loc, format!("the scene `{rel}` is outside the tree's folder"))
-            .label(issue.label.unwrap_or_default().replace("includes may", "a tree may"))
+    // The other place scenes live: a YAML file in the project the command runs in (the
+    // repository's `scenes/` next to its `trees/`).
+    let yaml = written
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"));
+    let in_project = || {
+        let Ok(cwd) = std::env::current_dir().and_then(|d| d.canonicalize()) else {
+            return false;
+        };
+        let spelled = std::path::absolute(path).map(|p| lexical(&p)).unwrap_or_default();
+        spelled.starts_with(&cwd) && path.canonicalize().map_or(true, |c| c.starts_with(&cwd))
+    };
+    match checked {
+        Ok(()) => Ok(()),
+        Err(_) if yaml && in_project() => Ok(()),
+        Err(issue) => Err(Issue::new(loc, format!("the scene `{rel}` is outside the tree's folder"))
+            .label(format!(
+                "{}, or YAML files under the current folder",
+                issue.label.unwrap_or_default().replace("includes may", "a tree may")
+            ))
             .help(
                 "move the scene file into the tree's folder (or a subfolder), give it with \
                  `--scene FILE`, or pass --allow-include-outside to read it anyway",
-            )
-    })
+            )),
+    }
 }
 
 /// Checks `written`, a path read back from a results file (a scenario file's path), against
