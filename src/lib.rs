@@ -126,9 +126,9 @@ pub use registry::{Category, Params, Registry};
 
 pub mod actions;
 pub mod app;
+pub mod cleanup;
 #[cfg(feature = "cli")]
 pub mod cli;
-pub mod cleanup;
 pub mod dataset;
 pub mod episode;
 pub mod error;

@@ -287,7 +287,8 @@ impl OutputFile {
         let copied = (|| -> Result<(), OutputError> {
             use std::io::{Read, Seek};
             let mut src = src;
-            src.seek(io::SeekFrom::Start(0)).map_err(self.io("cannot read it"))?;
+            src.seek(io::SeekFrom::Start(0))
+                .map_err(self.io("cannot read it"))?;
             let n = io::copy(&mut src.take(len), &mut file).map_err(self.io("cannot copy it"))?;
             if n != len {
                 return Err(self.io("cannot copy it")(io::Error::other(

@@ -61,7 +61,10 @@ fn spawn(args: &[&str]) -> Child {
 fn wait_for(what: &str, mut cond: impl FnMut() -> bool) {
     let start = Instant::now();
     while !cond() {
-        assert!(start.elapsed() < Duration::from_secs(120), "waited too long for {what}");
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "waited too long for {what}"
+        );
         std::thread::sleep(Duration::from_millis(20));
     }
 }
@@ -158,7 +161,11 @@ fn a_scene_that_is_not_a_scene_file_gives_one_diagnostic_quoting_at_most_one_lin
     // Read as a tree, it shows only its first line too.
     let out = macrotree(&["validate", s(&dir.join("creds.env"))]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(!stderr(&out).contains("line2") && !stderr(&out).contains("line3"), "{}", stderr(&out));
+    assert!(
+        !stderr(&out).contains("line2") && !stderr(&out).contains("line3"),
+        "{}",
+        stderr(&out)
+    );
     for args in [
         vec!["validate", s(&tree)],
         vec!["validate", s(&tree), "--format", "github"],
@@ -171,7 +178,11 @@ fn a_scene_that_is_not_a_scene_file_gives_one_diagnostic_quoting_at_most_one_lin
         for secret in ["line2-very-secret", "line3-hunter2"] {
             assert!(!all.contains(secret), "{args:?} leaked {secret}: {all}");
         }
-        assert_eq!(all.matches("not a scene file").count(), 1, "one diagnostic: {all}");
+        assert_eq!(
+            all.matches("not a scene file").count(),
+            1,
+            "one diagnostic: {all}"
+        );
     }
     // A file that is not even YAML: one diagnostic, at most one of its lines.
     let env = dir.join("dot.env");
@@ -227,7 +238,16 @@ fn sweep_out_naming_the_scene_file_is_refused() {
     std::fs::copy(repo().join("scenes/cube_bowl.yaml"), &scene).unwrap();
     let before = std::fs::read(&scene).unwrap();
     let out = macrotree(&[
-        "sweep", TREE, "--scenarios", "2", "--scene", s(&scene), "--out", s(&scene), "--substitute", FREE,
+        "sweep",
+        TREE,
+        "--scenarios",
+        "2",
+        "--scene",
+        s(&scene),
+        "--out",
+        s(&scene),
+        "--substitute",
+        FREE,
     ]);
     assert_refused(&out, "it is an input of this command");
     assert_eq!(std::fs::read(&scene).unwrap(), before);
@@ -262,12 +282,25 @@ fn a_sweep_refused_for_a_bad_option_leaves_the_existing_out_untouched() {
         (vec!["--dataset", s(&ds), "--cameras", "nosuch"], "--cameras"),
     ];
     for (extra, needle) in cases {
-        let mut args = vec!["sweep", TREE, "--scenarios", "2", "--substitute", FREE, "--out", s(&results)];
+        let mut args = vec![
+            "sweep",
+            TREE,
+            "--scenarios",
+            "2",
+            "--substitute",
+            FREE,
+            "--out",
+            s(&results),
+        ];
         args.extend(extra);
         let out = macrotree(&args);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
         assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
-        assert_eq!(std::fs::read_to_string(&results).unwrap(), "earlier results\n", "{args:?}");
+        assert_eq!(
+            std::fs::read_to_string(&results).unwrap(),
+            "earlier results\n",
+            "{args:?}"
+        );
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -316,11 +349,33 @@ fn two_outputs_of_one_command_naming_one_file_are_refused() {
     std::os::unix::fs::symlink(&x, &link).unwrap();
     let same_spelled_twice = s(&dir.join("sub/../x")).to_string();
     std::fs::create_dir(dir.join("sub")).unwrap();
-    for (a, b) in [("--record", "--frames"), ("--video", "--frames"), ("--record", "--video")] {
-        let out = macrotree(&["run", TREE, "--substitute", FREE, a, s(&x), b, &same_spelled_twice]);
+    for (a, b) in [
+        ("--record", "--frames"),
+        ("--video", "--frames"),
+        ("--record", "--video"),
+    ] {
+        let out = macrotree(&[
+            "run",
+            TREE,
+            "--substitute",
+            FREE,
+            a,
+            s(&x),
+            b,
+            &same_spelled_twice,
+        ]);
         assert_refused(&out, "name the same file");
     }
-    let out = macrotree(&["run", TREE, "--substitute", FREE, "--record", "-", "--frames", "/dev/stdout"]);
+    let out = macrotree(&[
+        "run",
+        TREE,
+        "--substitute",
+        FREE,
+        "--record",
+        "-",
+        "--frames",
+        "/dev/stdout",
+    ]);
     assert_refused(&out, "name the same file");
     let out = macrotree(&[
         "test",
@@ -342,13 +397,39 @@ fn two_outputs_of_one_command_naming_one_file_are_refused() {
 fn a_second_writer_of_one_sweep_out_is_refused() {
     let dir = scratch("h3-second-writer");
     let results = dir.join("r.jsonl");
-    let long = ["sweep", TREE, "--scenarios", "400", "--jobs", "1", "--out", s(&results)];
+    let long = [
+        "sweep",
+        TREE,
+        "--scenarios",
+        "400",
+        "--jobs",
+        "1",
+        "--out",
+        s(&results),
+    ];
     let mut first = spawn(&long);
     wait_for("the first result line", || lines_of(&results) >= 1);
-    let second = macrotree(&["sweep", TREE, "--scenarios", "400", "--jobs", "1", "--out", s(&results)]);
+    let second = macrotree(&[
+        "sweep",
+        TREE,
+        "--scenarios",
+        "400",
+        "--jobs",
+        "1",
+        "--out",
+        s(&results),
+    ]);
     assert_refused(&second, "being written by another process");
     let resumed = macrotree(&[
-        "sweep", TREE, "--scenarios", "400", "--jobs", "1", "--out", s(&results), "--resume",
+        "sweep",
+        TREE,
+        "--scenarios",
+        "400",
+        "--jobs",
+        "1",
+        "--out",
+        s(&results),
+        "--resume",
     ]);
     assert_refused(&resumed, "being written by another process");
     // Another process replaces the file under the first: it does not report success.
@@ -365,7 +446,14 @@ fn a_sweep_whose_out_was_replaced_while_it_ran_exits_2() {
     let dir = scratch("h3-replaced");
     let results = dir.join("r.jsonl");
     let first = spawn(&[
-        "sweep", TREE, "--scenarios", "40", "--jobs", "1", "--out", s(&results),
+        "sweep",
+        TREE,
+        "--scenarios",
+        "40",
+        "--jobs",
+        "1",
+        "--out",
+        s(&results),
     ]);
     wait_for("the first result line", || lines_of(&results) >= 1);
     std::fs::write(dir.join("other"), "x\n").unwrap();
@@ -401,7 +489,11 @@ fn resume_after_the_tree_was_edited_is_refused() {
     let tree = tree_copy(&dir);
     let results = dir.join("r.jsonl");
     let out = small_sweep(&tree, &results, false);
-    assert!(out.status.code() == Some(0) || out.status.code() == Some(1), "{}", stderr(&out));
+    assert!(
+        out.status.code() == Some(0) || out.status.code() == Some(1),
+        "{}",
+        stderr(&out)
+    );
     let text = std::fs::read_to_string(&results).unwrap();
     let first_two: String = text.lines().take(2).map(|l| format!("{l}\n")).collect();
     std::fs::write(&results, &first_two).unwrap();
@@ -411,7 +503,9 @@ fn resume_after_the_tree_was_edited_is_refused() {
     assert_eq!(std::fs::read_to_string(&results).unwrap(), text);
     // … and is refused once the tree changed (attempts: 3 → 2).
     std::fs::write(&results, &first_two).unwrap();
-    let edited = std::fs::read_to_string(&tree).unwrap().replace("attempts: 3", "attempts: 2");
+    let edited = std::fs::read_to_string(&tree)
+        .unwrap()
+        .replace("attempts: 3", "attempts: 2");
     std::fs::write(&tree, edited).unwrap();
     let out = small_sweep(&tree, &results, true);
     assert_refused(&out, "the tree, a file it includes or the scene changed");
@@ -491,7 +585,17 @@ fn a_video_path_like_an_ffmpeg_option_or_a_url_is_written_as_a_file() {
     for path in ["-d/v.mp4", "http://127.0.0.1:9/v.mp4"] {
         let out = macrotree_in(
             &dir,
-            &["run", s(&tree), "--substitute", FREE, "--goal", "tree", "--size", "64x48", &format!("--video={path}")],
+            &[
+                "run",
+                s(&tree),
+                "--substitute",
+                FREE,
+                "--goal",
+                "tree",
+                "--size",
+                "64x48",
+                &format!("--video={path}"),
+            ],
         );
         assert_eq!(out.status.code(), Some(0), "{path}: {}", stderr(&out));
         let written = dir.join(path.replace("//", "/"));
@@ -546,12 +650,23 @@ fn a_sweep_tally_stays_bounded_however_many_scenarios_it_sums() {
     assert_eq!(summary.scenarios, 200_000);
     assert_eq!(summary.failures.len(), MAX_FAILURES_KEPT);
     assert_eq!(summary.failures_not_listed, failures - MAX_FAILURES_KEPT as u64);
-    assert!(summary.failure_groups.iter().all(|g| g.indices.len() <= MAX_GROUP_INDICES));
-    assert_eq!(summary.failure_groups.iter().map(|g| g.count).sum::<u64>(), failures);
+    assert!(
+        summary
+            .failure_groups
+            .iter()
+            .all(|g| g.indices.len() <= MAX_GROUP_INDICES)
+    );
+    assert_eq!(
+        summary.failure_groups.iter().map(|g| g.count).sum::<u64>(),
+        failures
+    );
     // Exact nearest-rank order statistics.
     let mut times: Vec<f64> = (0..200_000u64).map(|i| (i % 500) as f64 * 0.004).collect();
     times.sort_by(f64::total_cmp);
-    assert_eq!(summary.median_sim_time_s, macrotree::sweep::percentile(&times, 0.5));
+    assert_eq!(
+        summary.median_sim_time_s,
+        macrotree::sweep::percentile(&times, 0.5)
+    );
     assert_eq!(summary.p95_sim_time_s, macrotree::sweep::percentile(&times, 0.95));
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -568,7 +683,10 @@ fn peak_rss_kib(args: &[&str]) -> u64 {
         .output()
         .expect("/usr/bin/time (GNU time) runs: it measures the peak memory");
     let err = stderr(&out);
-    assert!(out.status.code() == Some(0) || out.status.code() == Some(1), "{err}");
+    assert!(
+        out.status.code() == Some(0) || out.status.code() == Some(1),
+        "{err}"
+    );
     err.lines()
         .find_map(|l| l.strip_prefix("PEAK "))
         .and_then(|n| n.trim().parse().ok())
@@ -580,7 +698,16 @@ fn sweep_memory_does_not_grow_with_the_scenario_count() {
     let dir = scratch("h3-rss");
     let out = dir.join("r.jsonl");
     let run = |n: &str, resume: bool| {
-        let mut args = vec!["sweep", TREE, "--scenarios", n, "--substitute", FAILING, "--out", s(&out)];
+        let mut args = vec![
+            "sweep",
+            TREE,
+            "--scenarios",
+            n,
+            "--substitute",
+            FAILING,
+            "--out",
+            s(&out),
+        ];
         if resume {
             args.push("--resume");
         }
@@ -608,7 +735,15 @@ fn sweep_summaries_list_at_most_20_failures_and_say_how_many_more() {
     let dir = scratch("h3-failure-cap");
     let out_file = dir.join("r.jsonl");
     let out = macrotree(&[
-        "sweep", TREE, "--scenarios", "60", "--substitute", FAILING, "--out", s(&out_file), "--json",
+        "sweep",
+        TREE,
+        "--scenarios",
+        "60",
+        "--substitute",
+        FAILING,
+        "--out",
+        s(&out_file),
+        "--json",
     ]);
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
     let text = stdout(&out);
@@ -670,7 +805,10 @@ fn the_model_cache_evicts_the_least_recently_used_and_removes_stale_temporaries(
         assert!(!p.exists(), "{} (least recently used) is evicted", p.display());
     }
     assert!(paths[0].exists() && keep.exists());
-    assert!(!stale.exists(), "a temporary file of a writer that is gone is removed");
+    assert!(
+        !stale.exists(),
+        "a temporary file of a writer that is gone is removed"
+    );
     assert!(live.exists(), "a temporary file being written is kept");
     drop(held);
     let _ = std::fs::remove_dir_all(&dir);
@@ -689,8 +827,18 @@ fn sigint_and_sigterm_remove_temporaries_and_staging_and_leave_out_resumable() {
         std::fs::write(dir.join(".r.jsonl.00000000deadbeef.tmp"), "stale").unwrap();
         std::fs::create_dir(dir.join(".ds.00000000deadbeef.partial")).unwrap();
         let mut child = spawn(&[
-            "sweep", TREE, "--scenarios", "400", "--jobs", "1", "--out", s(&results), "--dataset",
-            s(&ds), "--cameras", "none",
+            "sweep",
+            TREE,
+            "--scenarios",
+            "400",
+            "--jobs",
+            "1",
+            "--out",
+            s(&results),
+            "--dataset",
+            s(&ds),
+            "--cameras",
+            "none",
         ]);
         wait_for("two result lines", || lines_of(&results) >= 2);
         let staged = hidden_entries(&dir);
@@ -702,19 +850,35 @@ fn sigint_and_sigterm_remove_temporaries_and_staging_and_leave_out_resumable() {
         std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut err).unwrap();
         assert_eq!(status.code(), Some(code), "{err}");
         assert!(err.contains("stopped by SIG"), "{err}");
-        assert_eq!(hidden_entries(&dir), Vec::<String>::new(), "no temporary file or staging left");
+        assert_eq!(
+            hidden_entries(&dir),
+            Vec::<String>::new(),
+            "no temporary file or staging left"
+        );
         assert!(!ds.exists(), "no half dataset");
         // The results resume.
         let kept = lines_of(&results);
         assert!(kept >= 2);
         let resumed = spawn(&[
-            "sweep", TREE, "--scenarios", "400", "--jobs", "1", "--out", s(&results), "--resume",
+            "sweep",
+            TREE,
+            "--scenarios",
+            "400",
+            "--jobs",
+            "1",
+            "--out",
+            s(&results),
+            "--resume",
         ]);
         wait_for("a resumed line", || lines_of(&results) > kept);
         kill(&resumed, "-TERM");
         let out = resumed.wait_with_output().unwrap();
         assert_eq!(out.status.code(), Some(143), "{}", stderr(&out));
-        assert!(stderr(&out).contains(&format!("resuming {}: {kept} of 400", results.display())), "{}", stderr(&out));
+        assert!(
+            stderr(&out).contains(&format!("resuming {}: {kept} of 400", results.display())),
+            "{}",
+            stderr(&out)
+        );
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
@@ -738,7 +902,11 @@ fn a_scene_without_a_block_is_refused_by_validate_and_run_alike_located() {
     );
     let validate = macrotree(&["validate", s(&scene)]);
     assert_refused(&validate, "has no block");
-    assert!(stderr(&validate).contains("empty.yaml:2:"), "{}", stderr(&validate));
+    assert!(
+        stderr(&validate).contains("empty.yaml:2:"),
+        "{}",
+        stderr(&validate)
+    );
     let run = macrotree(&["run", "trees/place_on_table.yaml", "--scene", s(&scene)]);
     assert_refused(&run, "has no block");
     assert!(stderr(&run).contains("empty.yaml:2:"), "{}", stderr(&run));
@@ -772,7 +940,12 @@ fn goals_that_can_never_hold_are_refused_at_load_located() {
     assert_refused(&out, "does not fit inside container `bin`");
     assert!(stderr(&out).contains("wide.yaml:9:"), "{}", stderr(&out));
     // The shipped scenes all pass.
-    for scene in ["scenes/cube_bowl.yaml", "scenes/clear_table.yaml", "scenes/sort_three.yaml", "scenes/stack_three.yaml"] {
+    for scene in [
+        "scenes/cube_bowl.yaml",
+        "scenes/clear_table.yaml",
+        "scenes/sort_three.yaml",
+        "scenes/stack_three.yaml",
+    ] {
         let out = macrotree(&["validate", scene]);
         assert_eq!(out.status.code(), Some(0), "{scene}: {}", stderr(&out));
     }
@@ -793,9 +966,18 @@ fn a_misspelled_expect_failure_kind_is_refused_with_a_suggestion() {
     let out = macrotree(&["test", s(&suite)]);
     assert_refused(&out, "unknown failure kind `substitued`");
     assert!(stderr(&out).contains("s.yaml:7:"), "{}", stderr(&out));
-    assert!(stderr(&out).contains("substituted"), "did you mean: {}", stderr(&out));
+    assert!(
+        stderr(&out).contains("substituted"),
+        "did you mean: {}",
+        stderr(&out)
+    );
     // Every kind a failure reason can get is a valid name.
-    for reason in ["time limit of 60 s reached", "grasp failed: no contact", "substituted: failure", "???"] {
+    for reason in [
+        "time limit of 60 s reached",
+        "grasp failed: no contact",
+        "substituted: failure",
+        "???",
+    ] {
         let kind = macrotree::episode::failure_kind(reason);
         assert!(macrotree::episode::FAILURE_KINDS.contains(&kind), "{kind}");
     }

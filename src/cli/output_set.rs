@@ -122,7 +122,19 @@ mod tests {
         let b = absolute(&dir.join("./y.txt"));
         assert_eq!(a, b);
         assert!(refuse_same_outputs(&[("--a", Some(&dir.join("y.txt"))), ("--b", Some(&b))]).is_err());
-        assert!(refuse_same_outputs(&[("--a", Some(Path::new("-"))), ("--b", Some(Path::new("/dev/stdout")))]).is_err());
-        assert!(refuse_same_outputs(&[("--a", Some(&dir.join("y.txt"))), ("--b", Some(&dir.join("z.txt")))]).is_ok());
+        assert!(
+            refuse_same_outputs(&[
+                ("--a", Some(Path::new("-"))),
+                ("--b", Some(Path::new("/dev/stdout")))
+            ])
+            .is_err()
+        );
+        assert!(
+            refuse_same_outputs(&[
+                ("--a", Some(&dir.join("y.txt"))),
+                ("--b", Some(&dir.join("z.txt")))
+            ])
+            .is_ok()
+        );
     }
 }

@@ -65,7 +65,9 @@ pub fn report(args: ReportArgs) -> Result<(), CliError> {
         same.jobs = 0;
         same.shard = None;
         same.program = super::program_name();
-        same.tree_digest = Some(super::outputs::inputs_digest(&super::outputs::suite_inputs(&file)));
+        same.tree_digest = Some(super::outputs::inputs_digest(&super::outputs::suite_inputs(
+            &file,
+        )));
         if same != m.config {
             return Err(CliError::Input(format!(
                 "error: {} no longer describes the run in these results (tree, scene, count, seed, fault, goal, time limit or substitutions changed); run `macrotree test` again",

@@ -28,21 +28,19 @@ pub(super) fn install() {
             libc::sigaction(sig, &action, std::ptr::null_mut());
         }
     }
-    let _ = std::thread::Builder::new()
-        .name("signals".into())
-        .spawn(|| {
-            loop {
-                std::thread::sleep(Duration::from_millis(20));
-                let sig = SIGNALLED.load(Ordering::SeqCst);
-                if sig != 0 {
-                    crate::cleanup::remove_all();
-                    let name = if sig == libc::SIGINT { "SIGINT" } else { "SIGTERM" };
-                    eprintln!(
-                        "\nstopped by {name}: temporary files removed; a --out file keeps its \
+    let _ = std::thread::Builder::new().name("signals".into()).spawn(|| {
+        loop {
+            std::thread::sleep(Duration::from_millis(20));
+            let sig = SIGNALLED.load(Ordering::SeqCst);
+            if sig != 0 {
+                crate::cleanup::remove_all();
+                let name = if sig == libc::SIGINT { "SIGINT" } else { "SIGTERM" };
+                eprintln!(
+                    "\nstopped by {name}: temporary files removed; a --out file keeps its \
                          complete lines (add --resume to continue)"
-                    );
-                    std::process::exit(128 + sig);
-                }
+                );
+                std::process::exit(128 + sig);
             }
-        });
+        }
+    });
 }

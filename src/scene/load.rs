@@ -288,9 +288,12 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
         .any(|(k, _)| k.as_str().is_some_and(|k| TOP_LEVEL_KEYS.contains(&k)))
     {
         issues.push(
-            Issue::new(v.loc, "this is not a scene file: it has none of `objects:`, `description:`, `goal:`")
-                .label("expected `objects:` (and optionally `description:` and `goal:`)")
-                .help("name a scene file (see docs/scenes.md)"),
+            Issue::new(
+                v.loc,
+                "this is not a scene file: it has none of `objects:`, `description:`, `goal:`",
+            )
+            .label("expected `objects:` (and optionally `description:` and `goal:`)")
+            .help("name a scene file (see docs/scenes.md)"),
         );
         return None;
     }

@@ -100,10 +100,12 @@ pub(crate) fn check_scene_path(
     loc: Loc,
 ) -> Result<(), Issue> {
     let written = Path::new(rel);
-    let checked = scope.check_spelling(base, written, loc).and_then(|()| match path.canonicalize() {
-        Ok(canon) => scope.check_resolved(&canon, written, loc),
-        Err(_) => Ok(()), // missing: the scene loader says so
-    });
+    let checked = scope
+        .check_spelling(base, written, loc)
+        .and_then(|()| match path.canonicalize() {
+            Ok(canon) => scope.check_resolved(&canon, written, loc),
+            Err(_) => Ok(()), // missing: the scene loader says so
+        });
     // The other place scenes live: a YAML file in the project the command runs in (the
     // repository's `scenes/` next to its `trees/`).
     let yaml = written
@@ -119,15 +121,20 @@ pub(crate) fn check_scene_path(
     match checked {
         Ok(()) => Ok(()),
         Err(_) if yaml && in_project() => Ok(()),
-        Err(issue) => Err(Issue::new(loc, format!("the scene `{rel}` is outside the tree's folder"))
-            .label(format!(
-                "{}, or YAML files under the current folder",
-                issue.label.unwrap_or_default().replace("includes may", "a tree may")
-            ))
-            .help(
-                "move the scene file into the tree's folder (or a subfolder), give it with \
+        Err(issue) => Err(
+            Issue::new(loc, format!("the scene `{rel}` is outside the tree's folder"))
+                .label(format!(
+                    "{}, or YAML files under the current folder",
+                    issue
+                        .label
+                        .unwrap_or_default()
+                        .replace("includes may", "a tree may")
+                ))
+                .help(
+                    "move the scene file into the tree's folder (or a subfolder), give it with \
                  `--scene FILE`, or pass --allow-include-outside to read it anyway",
-            )),
+                ),
+        ),
     }
 }
 

@@ -267,9 +267,12 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>) -> Option<ScenarioFile>
         .any(|(k, _)| k.as_str().is_some_and(|k| KEYS.contains(&k)))
     {
         issues.push(
-            Issue::new(v.loc, "this is not a scenario file: it has none of its keys (`tree:`, `count:`, `expect:`, …)")
-                .label("expected `tree:`, `count:` and `expect:`")
-                .help("see docs/testing_trees.md"),
+            Issue::new(
+                v.loc,
+                "this is not a scenario file: it has none of its keys (`tree:`, `count:`, `expect:`, …)",
+            )
+            .label("expected `tree:`, `count:` and `expect:`")
+            .help("see docs/testing_trees.md"),
         );
         return None;
     }

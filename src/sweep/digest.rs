@@ -60,7 +60,10 @@ mod tests {
     #[test]
     fn checksums_round_trip_and_catch_edits() {
         let line = with_checksum(r#"{"a":1,"b":"x"}"#);
-        assert_eq!(strip_checksum(&line).unwrap().as_deref(), Some(r#"{"a":1,"b":"x"}"#));
+        assert_eq!(
+            strip_checksum(&line).unwrap().as_deref(),
+            Some(r#"{"a":1,"b":"x"}"#)
+        );
         let edited = line.replace("\"a\":1", "\"a\":2");
         assert!(strip_checksum(&edited).is_err());
         assert_eq!(strip_checksum(r#"{"a":1}"#).unwrap(), None);

@@ -197,8 +197,11 @@ fn check_result(
             Some(d) => format!(
                 "the tree, a file it includes or the scene changed since it was written (digest \
                  {}…, now {}…)",
-                &d[..d.len().min(12)],
-                config.tree_digest.as_deref().map_or("none", |c| &c[..c.len().min(12)])
+                d.chars().take(12).collect::<String>(),
+                config
+                    .tree_digest
+                    .as_deref()
+                    .map_or(String::from("none"), |c| c.chars().take(12).collect())
             ),
         });
     }
@@ -277,8 +280,8 @@ fn check_result(
 /// Reads one JSONL line back into the result it was written from.
 pub fn parse_line(line: &str) -> Result<ScenarioResult, String> {
     let unchecked = super::digest::strip_checksum(line)?;
-    let v: Value = serde_json::from_str(unchecked.as_deref().unwrap_or(line))
-        .map_err(|e| format!("not JSON: {e}"))?;
+    let v: Value =
+        serde_json::from_str(unchecked.as_deref().unwrap_or(line)).map_err(|e| format!("not JSON: {e}"))?;
     let tree_digest = match v.get("tree_digest") {
         None => None,
         Some(d) => Some(d.as_str().ok_or("`tree_digest` is not text")?.to_string()),

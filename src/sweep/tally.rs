@@ -210,12 +210,7 @@ impl Tally {
             failures: self.failures,
             failures_not_listed,
             failure_groups,
-            substitutions: self
-                .config
-                .substitutions
-                .iter()
-                .map(|s| s.to_string())
-                .collect(),
+            substitutions: self.config.substitutions.iter().map(|s| s.to_string()).collect(),
             nodes: self.nodes,
             coverage,
             physics_time_s: None,
