@@ -339,9 +339,6 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
         objects,
         goal: Goal::default(),
     };
-    if issues.is_empty() {
-        super::feasible::check_has_block(&scene, objects_key, issues);
-    }
     let goal = match goal_v {
         Some(g) => read_goal(g, &scene, issues),
         None => Goal::default(),
@@ -358,6 +355,9 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
             Issue::new(objects_key, format!("the randomization cannot be met: {e}"))
                 .help("widen the `random:` regions or lower the clearances"),
         );
+    }
+    if issues.is_empty() || !scene.objects.is_empty() {
+        super::feasible::check_has_block(&scene, objects_key, issues);
     }
     Some(scene)
 }

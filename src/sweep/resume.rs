@@ -189,6 +189,9 @@ fn check_result(
             r.index
         ));
     }
+    if r.tree != config.tree {
+        return Err(format!("tree {:?}, not {:?}", r.tree, config.tree));
+    }
     if r.tree_digest != config.tree_digest {
         return Err(match &r.tree_digest {
             None => "it was written by an earlier version of macrotree, whose lines carry no \
@@ -204,9 +207,6 @@ fn check_result(
                     .map_or(String::from("none"), |c| c.chars().take(12).collect())
             ),
         });
-    }
-    if r.tree != config.tree {
-        return Err(format!("tree {:?}, not {:?}", r.tree, config.tree));
     }
     if r.sweep_goal != config.goal {
         return Err(format!(
