@@ -141,6 +141,7 @@ pub(crate) fn check_scene_path(
 /// Checks `written`, a path read back from a results file (a scenario file's path), against
 /// the include rule with the current folder as the root: it must be relative and resolve inside
 /// the current folder, unless [`set_includes_anywhere`] allowed any path. `Err` says why.
+#[cfg(feature = "cli")]
 pub fn check_path_from_results(written: &Path) -> Result<(), String> {
     if includes_anywhere() {
         return Ok(());
