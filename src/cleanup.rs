@@ -62,9 +62,14 @@ pub fn try_lock(file: &File) -> bool {
     file.try_lock().is_ok()
 }
 
+/// A leftover younger than this is never reclaimed: its owner may have created it and not yet
+/// taken its lock.
+pub const MIN_AGE: std::time::Duration = std::time::Duration::from_secs(10);
+
 /// Removes the leftovers in `dir` whose names start with `prefix` and end with `suffix`
 /// (temporary files, or staging folders when `dirs`) whose owner is gone: nobody holds their
-/// lock. Links and other kinds of entries are left alone. Returns how many were removed.
+/// lock, and they are at least [`MIN_AGE`] old. Links and other kinds of entries are left
+/// alone. Returns how many were removed.
 pub fn reclaim(dir: &Path, prefix: &OsStr, suffix: &str, dirs: bool) -> usize {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return 0;
@@ -81,6 +86,14 @@ pub fn reclaim(dir: &Path, prefix: &OsStr, suffix: &str, dirs: bool) -> usize {
             continue;
         };
         if meta.file_type().is_symlink() || meta.is_dir() != dirs || !(meta.is_dir() || meta.is_file()) {
+            continue;
+        }
+        let fresh = meta
+            .modified()
+            .ok()
+            .and_then(|t| t.elapsed().ok())
+            .is_none_or(|age| age < MIN_AGE);
+        if fresh {
             continue;
         }
         let Ok(f) = File::open(&path) else {

@@ -69,6 +69,13 @@ fn wait_for(what: &str, mut cond: impl FnMut() -> bool) {
     }
 }
 
+/// Sets the modification time of `p` (a file or a folder) `secs` seconds back.
+fn age(p: &Path, secs: u64) {
+    let f = std::fs::File::open(p).unwrap();
+    f.set_modified(std::time::SystemTime::now() - Duration::from_secs(secs))
+        .unwrap();
+}
+
 fn lines_of(path: &Path) -> usize {
     std::fs::read(path)
         .map(|b| b.iter().filter(|&&c| c == b'\n').count())
@@ -794,8 +801,13 @@ fn the_model_cache_evicts_the_least_recently_used_and_removes_stale_temporaries(
     f.set_modified(std::time::SystemTime::now()).unwrap();
     let stale = dir.join(".model-abc.mjb.0123456789abcdef.tmp");
     std::fs::write(&stale, "half a model").unwrap();
+    age(&stale, 60);
     let live = dir.join(".model-def.mjb.fedcba9876543210.tmp");
     std::fs::write(&live, "being written").unwrap();
+    age(&live, 60);
+    // One just created (its writer may not have locked it yet) is kept too.
+    let fresh = dir.join(".model-fed.mjb.0000000000000001.tmp");
+    std::fs::write(&fresh, "just created").unwrap();
     let held = std::fs::File::open(&live).unwrap();
     held.try_lock().unwrap();
     let keep = paths.last().unwrap().clone();
@@ -810,6 +822,10 @@ fn the_model_cache_evicts_the_least_recently_used_and_removes_stale_temporaries(
         "a temporary file of a writer that is gone is removed"
     );
     assert!(live.exists(), "a temporary file being written is kept");
+    assert!(
+        fresh.exists(),
+        "a temporary file younger than the minimum age is kept"
+    );
     drop(held);
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -823,9 +839,14 @@ fn sigint_and_sigterm_remove_temporaries_and_staging_and_leave_out_resumable() {
         let dir = scratch(&format!("h3-signal{sig}"));
         let results = dir.join("r.jsonl");
         let ds = dir.join("ds");
-        // Leftovers of an earlier run killed with -9 (nobody holds their locks).
-        std::fs::write(dir.join(".r.jsonl.00000000deadbeef.tmp"), "stale").unwrap();
-        std::fs::create_dir(dir.join(".ds.00000000deadbeef.partial")).unwrap();
+        // Leftovers of an earlier run killed with -9 (nobody holds their locks), a minute old.
+        let stale_file = dir.join(".r.jsonl.00000000deadbeef.tmp");
+        std::fs::write(&stale_file, "stale").unwrap();
+        let stale_dir = dir.join(".ds.00000000deadbeef.partial");
+        std::fs::create_dir(&stale_dir).unwrap();
+        for p in [&stale_file, &stale_dir] {
+            age(p, 60);
+        }
         let mut child = spawn(&[
             "sweep",
             TREE,
