@@ -678,6 +678,55 @@ fn a_sweep_tally_stays_bounded_however_many_scenarios_it_sums() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+#[test]
+fn a_slow_scenario_does_not_let_results_pile_up_behind_it() {
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+    let scene = macrotree::sim::Scene::load().unwrap();
+    let plan = std::sync::Arc::new(macrotree::plan::load_plan(&repo().join(TREE)).unwrap());
+    let config = macrotree::sweep::SweepConfig {
+        scenarios: 5000,
+        jobs: 2,
+        goal: macrotree::episode::Goal::Tree,
+        substitutions: vec![FREE.parse().unwrap()],
+        ..Default::default()
+    };
+    let first_done = AtomicBool::new(false);
+    let started_meanwhile = AtomicUsize::new(0);
+    let mut delivered = 0u64;
+    let run = macrotree::sweep::run_sweep_streaming(
+        &scene,
+        &config,
+        0,
+        |cell, index| {
+            if index == 0 {
+                // Scenario 0 is slow: it waits until the others would have run far ahead.
+                std::thread::sleep(Duration::from_millis(1500));
+                first_done.store(true, Ordering::SeqCst);
+            } else if !first_done.load(Ordering::SeqCst) {
+                started_meanwhile.fetch_add(1, Ordering::SeqCst);
+            }
+            (
+                macrotree::sweep::run_scene_scenario(cell, &plan, &config, index),
+                (),
+            )
+        },
+        |r, _| {
+            assert_eq!(r.index, delivered, "in scenario order");
+            delivered += 1;
+            std::ops::ControlFlow::Continue(())
+        },
+    )
+    .unwrap();
+    assert_eq!(delivered, 5000);
+    assert!(run.results.is_empty(), "a streaming sweep keeps no result");
+    let ahead = started_meanwhile.load(Ordering::SeqCst);
+    assert!(
+        ahead <= macrotree::sweep::REORDER_WINDOW,
+        "{ahead} scenarios started while scenario 0 ran"
+    );
+    assert!(ahead > 10, "the other worker did run ahead ({ahead})");
+}
+
 /// Peak resident memory of `macrotree ARGS…`, KiB, through `/usr/bin/time -f %M`.
 fn peak_rss_kib(args: &[&str]) -> u64 {
     let out = Command::new("/usr/bin/time")

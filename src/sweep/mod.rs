@@ -30,7 +30,7 @@ use std::ops::ControlFlow;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::str::FromStr;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::mpsc;
 use std::time::Instant;
 
@@ -595,6 +595,10 @@ pub fn run_scene_scenario(
     run_scene_scenario_observed(cell, plan, config, index, &mut NoObserver)
 }
 
+/// Most scenarios a sweep runs ahead of the first one not yet handed to its callback (at least
+/// four per worker): bounds the results held while a slow scenario holds up the ones after it.
+pub const REORDER_WINDOW: usize = 1024;
+
 /// The outcome of a sweep.
 #[derive(Debug, Clone)]
 pub struct SweepRun {
@@ -705,15 +709,28 @@ pub fn run_sweep_streaming<T: Send>(
     let (tx, rx) = mpsc::channel::<(usize, ScenarioResult, Option<T>)>();
     let stop = AtomicBool::new(false);
     let physics_ns = AtomicU64::new(0);
+    // Results handed to `on_result` so far: a worker does not start a scenario more than
+    // `window` places ahead, so results waiting for a slow earlier one stay bounded.
+    let delivered = AtomicUsize::new(0);
+    let window = REORDER_WINDOW.max(4 * jobs);
     std::thread::scope(|s| {
         let stop = &stop;
         let physics_ns = &physics_ns;
+        let delivered = &delivered;
         s.spawn(move || {
             let new_cell = || Cell::new(scene, &Layout::default(), CONTROL_PERIOD);
             pool.install(|| {
                 // par_bridge hands out scenarios in index order, so results arrive nearly in order.
                 let todo = indices.take_while(|_| !stop.load(Ordering::Relaxed)).enumerate();
                 todo.par_bridge().for_each_init(new_cell, |cell, (pos, index)| {
+                    // Every scenario before `pos` is done or running on another worker, so the
+                    // one the consumer waits for always progresses.
+                    while pos >= delivered.load(Ordering::Acquire) + window && !stop.load(Ordering::Relaxed) {
+                        std::thread::sleep(std::time::Duration::from_millis(1));
+                    }
+                    if stop.load(Ordering::Relaxed) {
+                        return; // the consumer stopped: its result would be dropped
+                    }
                     let before = cell.sim().physics_time();
                     let outcome = catch_unwind(AssertUnwindSafe(|| episode(cell, index)));
                     let spent = cell.sim().physics_time().saturating_sub(before);
@@ -749,6 +766,7 @@ pub fn run_sweep_streaming<T: Send>(
             pending.insert(pos, (result, payload));
             while let Some((result, payload)) = pending.remove(&next) {
                 next += 1;
+                delivered.store(next, Ordering::Release);
                 if on_result(result, payload).is_break() {
                     stop.store(true, Ordering::Relaxed);
                     break;
