@@ -158,6 +158,7 @@ pub use kinds::{Category, ParamError, Params, Registry};
 pub mod actions;
 #[cfg(feature = "sim")]
 pub mod app;
+pub mod cleanup;
 #[cfg(feature = "cli")]
 pub mod cli;
 #[cfg(feature = "sim")]

@@ -18,7 +18,11 @@
 //! unpredictable name, flushed to disk (`fsync`), then renamed over `PATH` (an existing regular
 //! file keeps its permission bits). Any error removes the temporary file and leaves `PATH` as it
 //! was. Streams ([`OutputFile::stream`]) install their file the same way before the first line,
-//! then append whole lines to it. Files another program writes (`run --video`: ffmpeg) are
+//! then append whole lines to it. A stream holds an advisory lock (`flock`) on its file for as
+//! long as it is written, and on the file it replaces from the moment that is checked
+//! ([`OutputFile::lock_existing`]): a second writer of the same output is refused
+//! ([`OutputError::Locked`]), and [`LineFile::finish`] checks that the path still names the file
+//! written ([`OutputError::Replaced`]). Files another program writes (`run --video`: ffmpeg) are
 //! written to such a temporary file ([`OutputFile::pending`]) and installed the same way.
 
 use std::collections::hash_map::RandomState;
@@ -59,6 +63,16 @@ pub enum OutputError {
         /// Its folder.
         dir: PathBuf,
     },
+    /// Another process holds the lock of the file at `PATH`: it is writing it.
+    Locked {
+        /// The output path.
+        path: PathBuf,
+    },
+    /// `PATH` no longer names the file written (another process replaced or removed it).
+    Replaced {
+        /// The output path.
+        path: PathBuf,
+    },
     /// An I/O operation failed.
     Io {
         /// The output path.
@@ -96,6 +110,18 @@ impl fmt::Display for OutputError {
                 path.display(),
                 dir.display()
             ),
+            Self::Locked { path } => write!(
+                f,
+                "{} is being written by another process (it holds the file's lock); wait for it \
+                 to finish, or choose another output path",
+                path.display()
+            ),
+            Self::Replaced { path } => write!(
+                f,
+                "{} was replaced or removed by another process while this command wrote it; the \
+                 results written are not at that path: run again with one writer per output",
+                path.display()
+            ),
             Self::Io { path, action, source } => {
                 write!(f, "cannot write {}: {action}: {source}", path.display())
             }
@@ -115,6 +141,8 @@ pub struct OutputFile {
     name: OsString,
     /// Permission bits of the regular file at `path`, when there is one.
     existing_mode: Option<u32>,
+    /// The file at `path`, open and locked ([`Self::lock_existing`]).
+    held: Option<std::sync::Arc<File>>,
 }
 
 impl OutputFile {
@@ -133,6 +161,7 @@ impl OutputFile {
                 dir: PathBuf::new(),
                 name: OsString::new(),
                 existing_mode: None,
+                held: None,
             });
         }
         let name = match path.file_name() {
@@ -181,16 +210,47 @@ impl OutputFile {
             dir,
             name,
             existing_mode,
+            held: None,
         };
         // The folder accepts a new file: try one (and remove it).
-        let (probe, _) = out.create_temp()?;
+        let (probe, _, _registered) = out.create_temp()?;
         let _ = std::fs::remove_file(probe);
+        // Temporary files of this output left by a process that is gone.
+        let mut prefix = OsString::from(".");
+        prefix.push(&out.name);
+        prefix.push(".");
+        crate::cleanup::reclaim(&out.dir, &prefix, ".tmp", false);
         Ok(out)
     }
 
     /// The output path.
     pub fn path(&self) -> &Path {
         &self.path
+    }
+
+    /// Opens the regular file now at the path (without following a link) and takes its
+    /// advisory lock, held until this value and its streams are dropped: refused with
+    /// [`OutputError::Locked`] when another process holds it. Returns the open file (to read
+    /// what it holds), `None` when nothing is at the path or it is an output stream.
+    pub fn lock_existing(&mut self) -> Result<Option<std::sync::Arc<File>>, OutputError> {
+        if self.stream_fd.is_some() {
+            return Ok(None);
+        }
+        let file = match OpenOptions::new()
+            .read(true)
+            .custom_flags(O_NOFOLLOW)
+            .open(&self.path)
+        {
+            Ok(f) => f,
+            Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => return Err(self.io("cannot open it")(e)),
+        };
+        let meta = file.metadata().map_err(self.io("cannot inspect it"))?;
+        refuse_non_regular(&self.path, &meta)?;
+        try_lock(&file, &self.path)?;
+        let file = std::sync::Arc::new(file);
+        self.held = Some(file.clone());
+        Ok(Some(file))
     }
 
     /// A regular file was at the path when it was checked (writing will replace it).
@@ -208,7 +268,7 @@ impl OutputFile {
         if let Some(mut file) = self.open_stream()? {
             return file.write_all(bytes).map_err(self.io("write error"));
         }
-        let (tmp, file) = self.create_temp()?;
+        let (tmp, file, _registered) = self.create_temp()?;
         let result = self.fill_and_install(&tmp, file, bytes);
         if result.is_err() {
             let _ = std::fs::remove_file(&tmp);
@@ -216,8 +276,72 @@ impl OutputFile {
         result.map(|_| ())
     }
 
+    /// Installs a file holding the first `len` bytes of `src` at the path (as
+    /// [`stream`](Self::stream) does, copying in bounded memory) and returns it open, and
+    /// locked, for appending whole lines.
+    pub fn stream_from(&self, src: &File, len: u64) -> Result<LineFile, OutputError> {
+        if self.stream_fd.is_some() {
+            return self.stream(&[]);
+        }
+        let (tmp, mut file, _registered) = self.create_temp()?;
+        let copied = (|| -> Result<(), OutputError> {
+            use std::io::{Read, Seek};
+            let mut src = src;
+            src.seek(io::SeekFrom::Start(0))
+                .map_err(self.io("cannot read it"))?;
+            let n = io::copy(&mut src.take(len), &mut file).map_err(self.io("cannot copy it"))?;
+            if n != len {
+                return Err(self.io("cannot copy it")(io::Error::other(
+                    "the file became shorter while it was read",
+                )));
+            }
+            Ok(())
+        })();
+        let installed = copied.and_then(|()| self.install_stream(&tmp, file, &[]));
+        match installed {
+            Ok(file) => self.line_file(file, len),
+            Err(e) => {
+                let _ = std::fs::remove_file(&tmp);
+                Err(e)
+            }
+        }
+    }
+
+    /// Locks the new file `file` (at `tmp`), fills it with `prefix` and installs it.
+    fn install_stream(&self, tmp: &Path, file: File, prefix: &[u8]) -> Result<File, OutputError> {
+        try_lock(&file, &self.path)?;
+        // A file another writer put at the path since the check is not replaced under it.
+        if let Ok(other) = OpenOptions::new()
+            .read(true)
+            .custom_flags(O_NOFOLLOW)
+            .open(&self.path)
+        {
+            let held = self.held.as_ref().and_then(|h| h.metadata().ok());
+            let same = match (other.metadata(), held) {
+                (Ok(a), Some(b)) => same_file(&a, &b),
+                _ => false,
+            };
+            if !same {
+                try_lock(&other, &self.path)?;
+            }
+        }
+        self.fill_and_install(tmp, file, prefix)
+    }
+
+    fn line_file(&self, file: File, len: u64) -> Result<LineFile, OutputError> {
+        let meta = file.metadata().map_err(self.io("cannot inspect it"))?;
+        Ok(LineFile {
+            file,
+            path: self.path.clone(),
+            len,
+            lines: 0,
+            regular: true,
+            ident: Some((meta.dev(), meta.ino())),
+        })
+    }
+
     /// Installs a file holding `prefix` at the path (as [`write_all`](Self::write_all) does) and
-    /// returns it open for appending whole lines.
+    /// returns it open, and locked, for appending whole lines.
     pub fn stream(&self, prefix: &[u8]) -> Result<LineFile, OutputError> {
         if let Some(mut file) = self.open_stream()? {
             file.write_all(prefix).map_err(self.io("write error"))?;
@@ -227,17 +351,12 @@ impl OutputFile {
                 len: prefix.len() as u64,
                 lines: 0,
                 regular: false,
+                ident: None,
             });
         }
-        let (tmp, file) = self.create_temp()?;
-        match self.fill_and_install(&tmp, file, prefix) {
-            Ok(file) => Ok(LineFile {
-                file,
-                path: self.path.clone(),
-                len: prefix.len() as u64,
-                lines: 0,
-                regular: true,
-            }),
+        let (tmp, file, _registered) = self.create_temp()?;
+        match self.install_stream(&tmp, file, prefix) {
+            Ok(file) => self.line_file(file, prefix.len() as u64),
             Err(e) => {
                 let _ = std::fs::remove_file(&tmp);
                 Err(e)
@@ -254,11 +373,13 @@ impl OutputFile {
                 what: "an output stream (this output needs a file it can seek in)",
             });
         }
-        let (tmp, _) = self.create_temp()?;
+        let (tmp, file, registered) = self.create_temp()?;
         Ok(PendingFile {
             out: self,
             tmp,
             installed: false,
+            _lock: file,
+            _registered: registered,
         })
     }
 
@@ -282,8 +403,17 @@ impl OutputFile {
             .map_err(self.io("cannot open it"))
     }
 
-    /// A new, empty file next to the path, created exclusively under an unpredictable name.
-    fn create_temp(&self) -> Result<(PathBuf, File), OutputError> {
+    /// A new, empty file next to the path, created exclusively under an unpredictable name,
+    /// locked (its owner is alive while the lock is held) and registered for removal on a
+    /// signal ([`crate::cleanup`]).
+    fn create_temp(&self) -> Result<(PathBuf, File, crate::cleanup::Registered), OutputError> {
+        let (tmp, file) = self.create_temp_unregistered()?;
+        let _ = file.try_lock();
+        let registered = crate::cleanup::register(&tmp, false);
+        Ok((tmp, file, registered))
+    }
+
+    fn create_temp_unregistered(&self) -> Result<(PathBuf, File), OutputError> {
         let mut last = None;
         for _ in 0..16 {
             let mut name = OsString::from(".");
@@ -335,6 +465,9 @@ pub struct PendingFile<'a> {
     out: &'a OutputFile,
     tmp: PathBuf,
     installed: bool,
+    /// The temporary file, open and locked while it is pending.
+    _lock: File,
+    _registered: crate::cleanup::Registered,
 }
 
 impl PendingFile<'_> {
@@ -385,6 +518,8 @@ pub struct LineFile {
     lines: u64,
     /// A regular file (not standard output or error): can be cut back and synced.
     regular: bool,
+    /// (device, inode) of the file, checked against the path by [`Self::finish`].
+    ident: Option<(u64, u64)>,
 }
 
 impl LineFile {
@@ -417,16 +552,30 @@ impl LineFile {
         self.lines
     }
 
-    /// Flushes the file to disk.
+    /// The path of the file.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Flushes the file to disk and checks that the path still names it
+    /// ([`OutputError::Replaced`] when another process replaced or removed it).
     pub fn finish(self) -> Result<(), OutputError> {
         if !self.regular {
             return Ok(());
         }
         self.file.sync_all().map_err(|source| OutputError::Io {
-            path: self.path,
+            path: self.path.clone(),
             action: "cannot flush it to disk",
             source,
-        })
+        })?;
+        let now = std::fs::symlink_metadata(&self.path)
+            .ok()
+            .filter(|m| m.file_type().is_file())
+            .map(|m| (m.dev(), m.ino()));
+        if self.ident.is_some() && now != self.ident {
+            return Err(OutputError::Replaced { path: self.path });
+        }
+        Ok(())
     }
 }
 
@@ -452,6 +601,24 @@ fn refuse_non_regular(path: &Path, meta: &std::fs::Metadata) -> Result<(), Outpu
         path: path.to_path_buf(),
         what,
     })
+}
+
+/// `open(2)`'s flag: fail on a symbolic link instead of following it.
+const O_NOFOLLOW: i32 = libc::O_NOFOLLOW;
+
+/// Takes `file`'s advisory lock (`flock`, exclusive, without waiting).
+fn try_lock(file: &File, path: &Path) -> Result<(), OutputError> {
+    match file.try_lock() {
+        Ok(()) => Ok(()),
+        Err(std::fs::TryLockError::WouldBlock) => Err(OutputError::Locked {
+            path: path.to_path_buf(),
+        }),
+        Err(std::fs::TryLockError::Error(source)) => Err(OutputError::Io {
+            path: path.to_path_buf(),
+            action: "cannot lock it",
+            source,
+        }),
+    }
 }
 
 fn same_file(a: &std::fs::Metadata, b: &std::fs::Metadata) -> bool {

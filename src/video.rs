@@ -76,6 +76,34 @@ pub fn parse_fps(s: &str) -> Result<u32, String> {
     }
 }
 
+/// Opens the file a clip is written to (see [`VideoEncoder::start`]).
+fn open_clip(path: &Path) -> Result<std::fs::File, VideoError> {
+    use std::os::unix::fs::{MetadataExt, OpenOptionsExt};
+    let open = |create_new: bool| {
+        let mut o = std::fs::OpenOptions::new();
+        o.read(true).write(true).custom_flags(libc::O_NOFOLLOW);
+        if create_new {
+            o.create_new(true).mode(0o644);
+        }
+        o.open(path)
+    };
+    let refused = |why: String| VideoError::Ffmpeg(format!("cannot write {}: {why}", path.display()));
+    let file = match open(true) {
+        Ok(f) => return Ok(f),
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+            open(false).map_err(|e| refused(format!("{e} (a link is never followed)")))?
+        }
+        Err(e) => return Err(refused(e.to_string())),
+    };
+    let meta = file.metadata().map_err(|e| refused(e.to_string()))?;
+    if !meta.is_file() || meta.nlink() != 1 || meta.len() != 0 {
+        return Err(refused(
+            "something is already there (only a new file is written)".into(),
+        ));
+    }
+    Ok(file)
+}
+
 /// An ffmpeg process encoding the frames it is given into an MP4 file.
 pub struct VideoEncoder {
     child: Child,
@@ -87,10 +115,15 @@ pub struct VideoEncoder {
 }
 
 impl VideoEncoder {
-    /// Starts encoding `size` RGB frames at `fps` frames per second into `path` (created or
-    /// replaced by ffmpeg; callers pass a fresh temporary path and install it themselves).
+    /// Starts encoding `size` RGB frames at `fps` frames per second into `path`: a new file,
+    /// created exclusively without following a link, or the empty regular file a caller created
+    /// so (an [`crate::output::PendingFile`]); anything else is refused. ffmpeg never sees the
+    /// path: the file is opened here and handed to it as its standard output
+    /// (`file:/dev/stdout`), so no folder name can become an ffmpeg option and no path that
+    /// looks like a URL makes it open a connection.
     pub fn start(path: &Path, size: FrameSize, fps: u32) -> Result<Self, VideoError> {
         let ffmpeg = find_ffmpeg()?;
+        let out = open_clip(path)?;
         let mut child = Command::new(&ffmpeg)
             .args(["-nostdin", "-hide_banner", "-loglevel", "error"])
             .args(["-f", "rawvideo", "-pix_fmt", "rgb24"])
@@ -108,10 +141,9 @@ impl VideoEncoder {
                 "-map_metadata",
                 "-1",
             ])
-            .args(["-movflags", "+faststart", "-f", "mp4", "-y"])
-            .arg(path)
+            .args(["-movflags", "+faststart", "-f", "mp4", "-y", "file:/dev/stdout"])
             .stdin(Stdio::piped())
-            .stdout(Stdio::null())
+            .stdout(Stdio::from(out))
             .stderr(Stdio::piped())
             .spawn()
             .map_err(|e| VideoError::Ffmpeg(format!("cannot start {}: {e}", ffmpeg.display())))?;

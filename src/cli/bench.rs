@@ -24,8 +24,8 @@ pub struct BenchArgs {
     pub tree: PathBuf,
     #[command(flatten)]
     pub episode: EpisodeArgs,
-    /// Repetitions; the median of each timing is reported.
-    #[arg(long, default_value_t = 5)]
+    /// Repetitions, 1…1000; the median of each timing is reported.
+    #[arg(long, default_value_t = 5, value_parser = super::limits::repeat)]
     pub repeat: usize,
     /// Print the result as one JSON object on stdout (the only thing on stdout; the text for people goes to stderr).
     #[arg(long)]

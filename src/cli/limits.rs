@@ -11,6 +11,11 @@ pub const MAX_SPEED: f64 = 1000.0;
 /// Most scenarios in one sweep (before sharding): about a week of one core at the flagship
 /// tree's ~1000 scenarios per minute. Split bigger studies by `--seed`.
 pub const MAX_SCENARIOS: u64 = 10_000_000;
+/// Most worker threads of `sweep --jobs` and `test --jobs` (each holds one simulation; more
+/// threads than this only cost start-up time and memory).
+pub const MAX_JOBS: u64 = 1024;
+/// Most repetitions of `bench --repeat` (each runs the whole episode twice).
+pub const MAX_REPEAT: usize = 1000;
 
 /// `--fault NAME`: one of the faults' names (the library's [`crate::faults::FaultKind`] has no
 /// command-line types).
@@ -66,6 +71,26 @@ pub fn scenarios(s: &str) -> Result<u64, String> {
     }
 }
 
+/// `--jobs J`: 1 ≤ J ≤ [`MAX_JOBS`].
+pub fn jobs(s: &str) -> Result<u64, String> {
+    match s.trim().parse::<u64>() {
+        Ok(n) if (1..=MAX_JOBS).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "must be a whole number of worker threads between 1 and {MAX_JOBS}, got {s}"
+        )),
+    }
+}
+
+/// `--repeat N`: 1 ≤ N ≤ [`MAX_REPEAT`].
+pub fn repeat(s: &str) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(n) if (1..=MAX_REPEAT).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "must be a whole number of repetitions between 1 and {MAX_REPEAT}, got {s}"
+        )),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -83,6 +108,18 @@ mod tests {
         assert_eq!(scenarios("10000000"), Ok(10_000_000));
         for bad in ["0", "10000001", "18446744073709551615", "-1", "1e3"] {
             assert!(scenarios(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn sweep_jobs_and_bench_repeat_are_bounded() {
+        assert_eq!(jobs("1024"), Ok(1024));
+        for bad in ["0", "1025", "100000", "-1", "x"] {
+            assert!(jobs(bad).is_err(), "{bad}");
+        }
+        assert_eq!(repeat("1000"), Ok(1000));
+        for bad in ["0", "1001", "1000000000000", "-3"] {
+            assert!(repeat(bad).is_err(), "{bad}");
         }
     }
 }

@@ -13,10 +13,12 @@ mod info;
 mod limits;
 mod logging;
 mod nodes;
+mod output_set;
 mod outputs;
 mod report;
 mod run;
 mod schema;
+mod signals;
 mod sweep;
 mod sweep_out;
 mod test;
@@ -144,6 +146,7 @@ pub fn main_with(app: crate::App) -> ExitCode {
     logging::init(cli.verbose, cli.log_format, quiet);
     let app = app.includes_anywhere(cli.allow_include_outside);
     let app = &app;
+    signals::install();
     let result = match cli.command {
         Command::Run(args) => run::run(app, args),
         Command::Validate(args) => validate::validate(app, args),
@@ -153,7 +156,7 @@ pub fn main_with(app: crate::App) -> ExitCode {
         Command::Graph(args) => graph::graph(app, args),
         Command::Nodes(args) => nodes::nodes(app, args),
         Command::Test(args) => test::test(app, args),
-        Command::Report(args) => report::report(args),
+        Command::Report(args) => report::report(app, args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

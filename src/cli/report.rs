@@ -28,7 +28,7 @@ pub struct ReportArgs {
 }
 
 /// Runs `macrotree report`.
-pub fn report(args: ReportArgs) -> Result<(), CliError> {
+pub fn report(app: &crate::App, args: ReportArgs) -> Result<(), CliError> {
     let mut merged = merge_results(&args.files).map_err(|e| CliError::Input(format!("error: {e}")))?;
     for m in &mut merged {
         m.config.program = super::program_name();
@@ -57,12 +57,17 @@ pub fn report(args: ReportArgs) -> Result<(), CliError> {
     let mut files = Vec::new();
     for m in &merged {
         let path = PathBuf::from(m.config.suite.as_deref().unwrap_or_default());
-        let file = load_scenario_file(&path)
+        crate::spec::confine::check_path_from_results(&path, app.loader().allows_includes_anywhere())
+            .map_err(|e| CliError::Input(format!("error: {e}")))?;
+        let file = load_scenario_file(&path, &app.registry().failure_kinds())
             .map_err(|d| super::invalid(d, format!("{} (named by the results)", path.display())))?;
         let mut same = file.sweep.clone();
         same.jobs = 0;
         same.shard = None;
         same.program = super::program_name();
+        same.tree_digest = Some(super::outputs::inputs_digest(
+            &super::outputs::suite_inputs_read_again(app, &file),
+        ));
         if same != m.config {
             return Err(CliError::Input(format!(
                 "error: {} no longer describes the run in these results (tree, scene, count, seed, fault, goal, time limit or substitutions changed); run `macrotree test` again",

@@ -212,6 +212,11 @@ pub fn run(app: &crate::App, args: RunArgs) -> Result<(), CliError> {
     super::check_substitutions(&plan, &config.substitutions)?;
     let mut inputs = super::outputs::tree_inputs(&args.tree, &plan);
     inputs.extend(args.episode.scene.clone());
+    super::output_set::refuse_same_outputs(&[
+        ("--record", args.record.as_deref()),
+        ("--video", args.video.as_deref()),
+        ("--frames", args.frames.as_deref()),
+    ])?;
     let record_out = (args.record.as_deref())
         .map(|p| super::outputs::check_output(p, &inputs))
         .transpose()?;

@@ -13,7 +13,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use super::{CliError, load_task};
 use crate::episode::Goal;
 use crate::faults::FaultKind;
-use crate::sweep::{Summary, SweepConfig, run_sweep_with};
+use crate::sweep::{SweepConfig, run_sweep_streaming};
 
 /// Arguments of `sweep`.
 #[derive(Debug, Args)]
@@ -30,8 +30,8 @@ pub struct SweepArgs {
     /// Sweep seed: scenario k of seed S is the same layout and episode seed everywhere.
     #[arg(long, default_value_t = 0, value_name = "S")]
     pub seed: u64,
-    /// Worker threads (default: one per core).
-    #[arg(long, short = 'j', value_name = "J", value_parser = clap::value_parser!(u64).range(1..))]
+    /// Worker threads, 1…1024 (default: one per core).
+    #[arg(long, short = 'j', value_name = "J", value_parser = super::limits::jobs)]
     pub jobs: Option<u64>,
     /// Inject this fault through physics in every scenario (see docs/faults.md).
     #[arg(long, value_parser = super::limits::fault())]
@@ -105,6 +105,9 @@ pub fn sweep(app: &crate::App, args: SweepArgs) -> Result<(), CliError> {
     super::check_substitutions(&plan, &args.substitute)?;
     super::run::check_goal(args.goal, &scene)?;
     let plan = Arc::new(plan);
+    // Every file the sweep reads: never an output, and digested into every result line.
+    let mut inputs = super::outputs::tree_inputs(&args.tree, &plan);
+    inputs.extend(args.scene.clone());
     let config = SweepConfig {
         scenarios: args.scenarios,
         seed: args.seed,
@@ -117,6 +120,7 @@ pub fn sweep(app: &crate::App, args: SweepArgs) -> Result<(), CliError> {
         tree: args.tree.display().to_string(),
         substitutions: args.substitute.clone(),
         suite: None,
+        tree_digest: Some(super::outputs::inputs_digest(&inputs)),
         program: super::program_name(),
     };
     let total = config.indices().len() as u64;
@@ -131,26 +135,34 @@ pub fn sweep(app: &crate::App, args: SweepArgs) -> Result<(), CliError> {
             shard.map_or(1, |s| s.count),
         )));
     }
-    let (mut out, resumed) = match &args.out {
-        Some(path) => {
-            let (file, resumed) = super::sweep_out::open(
-                path,
-                args.resume,
-                &args.tree,
-                &config,
-                &scene,
-                &plan,
-                app.factory(),
-            )?;
-            (Some(file), resumed)
-        }
-        None => (None, Default::default()),
+    // Every option is checked before any output is touched.
+    if let (Some(out), Some(dir)) = (&args.out, &args.dataset) {
+        super::output_set::refuse_output_inside("--out", out, "--dataset", dir)?;
+    }
+    let tree = args.tree.display().to_string();
+    let mut tally = crate::sweep::tally::Tally::new(&tree, &config);
+    let prepared = match &args.out {
+        Some(path) => Some(super::sweep_out::prepare(
+            path,
+            args.resume,
+            &inputs,
+            &config,
+            super::sweep_out::Task {
+                scene: &scene,
+                plan: &plan,
+                factory: app.factory(),
+            },
+            &mut tally,
+        )?),
+        None => None,
     };
-    let done = resumed.results.len() as u64;
     let mut dataset = match &args.dataset {
         Some(dir) => Some(super::dataset::start(&args, dir, &scene, &plan, &config)?),
         None => None,
     };
+    let mut out = prepared.as_ref().map(|p| p.start()).transpose()?;
+    let resumed = prepared.map(|p| p.resumed).unwrap_or_default();
+    let done = resumed.count;
     let bar = if std::io::stderr().is_terminal() {
         ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
     } else {
@@ -182,7 +194,9 @@ pub fn sweep(app: &crate::App, args: SweepArgs) -> Result<(), CliError> {
             None,
         ),
     };
-    let run = run_sweep_with(&scene, &config, done, episode, |r, recording| {
+    let run = run_sweep_streaming(&scene, &config, done, episode, |r, recording| {
+        let r = &r;
+        tally.add(r);
         if let Some(w) = out.as_mut()
             && let Err(e) = w.write_line(&r.to_jsonl())
         {
@@ -222,10 +236,8 @@ pub fn sweep(app: &crate::App, args: SweepArgs) -> Result<(), CliError> {
     if let Some(d) = dataset {
         d.finish()?;
     }
-    let mut results = resumed.results;
-    results.extend(run.results);
-    let tree = args.tree.display().to_string();
-    let summary = Summary::new(&tree, &config, &results, run.wall_time_s, run.jobs)
+    let summary = tally
+        .finish(run.wall_time_s, run.jobs)
         .with_physics(run.physics_time_s, super::process_elapsed_s());
     super::human::say_text!(args.json, summary.to_text());
     if args.json {

@@ -1,69 +1,109 @@
-//! The JSONL file of `sweep --out`, and `--resume`: checked before the sweep starts, installed
-//! safely (see [`crate::output`]), then written one whole line per scenario.
+//! The JSONL file of `sweep --out`, and `--resume`: checked and locked before the sweep starts,
+//! installed safely (see [`crate::output`]), then written one whole line per scenario.
 
+use std::fs::File;
 use std::path::Path;
 use std::sync::Arc;
 
 use super::CliError;
-use super::outputs::{output_error, tree_inputs};
+use super::outputs::output_error;
 use crate::output::{LineFile, OutputFile};
 use crate::plan::Plan;
 use crate::sim::Scene;
 use crate::sweep::SweepConfig;
 use crate::sweep::resume::{Resumed, read_existing, spot_check};
+use crate::sweep::tally::Tally;
 
-/// Opens the output of a sweep of `tree` at `path`: with `resume`, keeps the complete results
-/// already there (checked to belong to this sweep) and returns them; otherwise starts the file
-/// empty (saying so when it replaces an existing file).
-pub(super) fn open(
+/// The checked (and locked) output of a sweep, not yet touched: [`Prepared::start`] installs it.
+pub(super) struct Prepared {
+    out: OutputFile,
+    /// The existing file, open and locked (kept lines are copied from it).
+    held: Option<Arc<File>>,
+    /// The results kept from the interrupted run (`--resume`).
+    pub resumed: Resumed,
+}
+
+impl Prepared {
+    /// Installs the file (holding the kept results) and opens it for the new lines.
+    pub(super) fn start(&self) -> Result<LineFile, CliError> {
+        match &self.held {
+            Some(file) if self.resumed.kept_len > 0 => self
+                .out
+                .stream_from(file, self.resumed.kept_len)
+                .map_err(output_error),
+            _ => self.out.stream(&[]).map_err(output_error),
+        }
+    }
+}
+
+/// What the sweep runs, against which a resumed file's last line is checked by running it again.
+#[derive(Clone, Copy)]
+pub(super) struct Task<'a> {
+    /// The scene, compiled with the robot.
+    pub scene: &'a Scene,
+    /// The tree.
+    pub plan: &'a Arc<Plan>,
+    /// How its leaves run.
+    pub factory: &'a crate::factory::Factory,
+}
+
+/// Checks the output of a sweep at `path`, which must be none of `inputs` (the files the sweep
+/// reads), and takes its lock (a second writer is refused): with `resume`, reads the complete
+/// results already there (checked to belong to this sweep) into `tally`; otherwise the file will
+/// start empty (saying so when it replaces an existing file). Nothing is written until
+/// [`Prepared::start`].
+pub(super) fn prepare(
     path: &Path,
     resume: bool,
-    tree: &Path,
+    inputs: &[std::path::PathBuf],
     config: &SweepConfig,
-    scene: &Scene,
-    plan: &Arc<Plan>,
-    factory: &crate::factory::Factory,
-) -> Result<(LineFile, Resumed), CliError> {
-    let inputs = tree_inputs(tree, plan);
+    task: Task<'_>,
+    tally: &mut Tally,
+) -> Result<Prepared, CliError> {
+    let Task { scene, plan, factory } = task;
     let inputs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
-    let out = OutputFile::check(path, &inputs).map_err(output_error)?;
-    let resumed = if resume && out.is_stream() {
+    let mut out = OutputFile::check(path, &inputs).map_err(output_error)?;
+    if resume && out.is_stream() {
         return Err(CliError::Input(format!(
             "error: --resume needs the results of the interrupted run: give the file they were \
              written to as --out, not {}",
             path.display()
         )));
-    } else if resume {
-        let resumed =
-            read_existing(path, scene, config).map_err(|e| CliError::Input(format!("error: {e}")))?;
-        spot_check(scene, plan, factory, config, &resumed).map_err(|reason| {
-            CliError::Input(format!(
-                "error: cannot resume from {}: {reason}; resume with the same options, or run \
-                 without --resume to start over",
-                path.display()
-            ))
-        })?;
-        eprintln!(
-            "resuming {}: {} of {} scenario(s) already done{}",
-            path.display(),
-            resumed.results.len(),
-            config.indices().len(),
-            if resumed.dropped_bytes > 0 {
-                format!(
-                    " (dropped a truncated last line of {} bytes)",
-                    resumed.dropped_bytes
-                )
-            } else {
-                String::new()
-            }
-        );
-        resumed
-    } else {
-        if out.replaces_existing() {
-            eprintln!("overwriting existing {}", path.display());
+    }
+    let held = out.lock_existing().map_err(output_error)?;
+    let resumed = match (&held, resume) {
+        (Some(file), true) => {
+            let resumed = read_existing(file, path, scene, config, |r| tally.add(r))
+                .map_err(|e| CliError::Input(format!("error: {e}")))?;
+            spot_check(scene, plan, factory, config, resumed.last.as_ref()).map_err(|reason| {
+                CliError::Input(format!(
+                    "error: cannot resume from {}: {reason}; resume with the same options, or run \
+                     without --resume to start over",
+                    path.display()
+                ))
+            })?;
+            eprintln!(
+                "resuming {}: {} of {} scenario(s) already done{}",
+                path.display(),
+                resumed.count,
+                config.indices().len(),
+                if resumed.dropped_bytes > 0 {
+                    format!(
+                        " (dropped a truncated last line of {} bytes)",
+                        resumed.dropped_bytes
+                    )
+                } else {
+                    String::new()
+                }
+            );
+            resumed
         }
-        Resumed::default()
+        _ => {
+            if out.replaces_existing() && !resume {
+                eprintln!("overwriting existing {}", path.display());
+            }
+            Resumed::default()
+        }
     };
-    let file = out.stream(&resumed.kept).map_err(output_error)?;
-    Ok((file, resumed))
+    Ok(Prepared { out, held, resumed })
 }

@@ -13,7 +13,7 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
-use super::outputs::{check_output, output_error, tree_inputs};
+use super::outputs::{check_output, output_error};
 use super::{CliError, load_task};
 use crate::suite::junit::{Case, to_xml};
 use crate::suite::{ScenarioFile, SuiteOutcome, find_files, load_scenario_file, offending_commands};
@@ -84,7 +84,7 @@ pub fn test(app: &crate::App, args: TestArgs) -> Result<(), CliError> {
     let mut diags = Vec::new();
     let mut suites = Vec::new();
     for f in &files {
-        match load_scenario_file(f) {
+        match load_scenario_file(f, &app.registry().failure_kinds()) {
             Ok(s) => suites.push(s),
             Err(d) => diags.extend(d),
         }
@@ -106,10 +106,15 @@ pub fn test(app: &crate::App, args: TestArgs) -> Result<(), CliError> {
         s.sweep.shard = shard;
         s.sweep.jobs = args.jobs.map_or(0, |j| j as usize);
         s.sweep.program = super::program_name();
-        inputs.extend(tree_inputs(&s.tree, &plan));
-        inputs.extend(s.scene.clone());
+        let read = super::outputs::suite_inputs(s, &plan);
+        s.sweep.tree_digest = Some(super::outputs::inputs_digest(&read));
+        inputs.extend(read);
         tasks.push((Arc::new(plan), scene));
     }
+    super::output_set::refuse_same_outputs(&[
+        ("--junit", args.junit.as_deref()),
+        ("--out", args.out.as_deref()),
+    ])?;
     let junit_out = args
         .junit
         .as_deref()

@@ -172,6 +172,10 @@ pub struct DatasetWriter {
     frames: u64,
     histograms: Vec<[[u64; 256]; 3]>,
     finished: bool,
+    /// The staging folder, open and locked while this writer lives (a later run reclaims it
+    /// only when the lock is free), and registered for removal on a signal.
+    _stage_lock: Option<std::fs::File>,
+    _registered: crate::cleanup::Registered,
 }
 
 impl DatasetWriter {
@@ -180,8 +184,17 @@ impl DatasetWriter {
         check_dir(dir, opts.overwrite)?;
         let parent = parent_of(dir);
         let name = dir.file_name().expect("checked").to_string_lossy().into_owned();
+        // Staging folders of this dataset left by a process that is gone.
+        crate::cleanup::reclaim(
+            &parent,
+            std::ffi::OsStr::new(&format!(".{name}.")),
+            ".partial",
+            true,
+        );
         let stage = parent.join(format!(".{name}.{:016x}.partial", random_u64()));
         std::fs::create_dir(&stage).map_err(io_err(format!("cannot create {}", stage.display())))?;
+        let registered = crate::cleanup::register(&stage, true);
+        let stage_lock = std::fs::File::open(&stage).ok().filter(crate::cleanup::try_lock);
         std::fs::create_dir(stage.join(CLIPS))
             .map_err(io_err(format!("cannot create a folder in {}", stage.display())))?;
         let row_bytes = 8 * 5 + 4 * (14 + 7 * opts.objects.len() as u64) + 64;
@@ -198,6 +211,8 @@ impl DatasetWriter {
             frames: 0,
             histograms: vec![[[0; 256]; 3]; cams],
             finished: false,
+            _stage_lock: stage_lock,
+            _registered: registered,
         })
     }
 
@@ -264,6 +279,17 @@ impl DatasetWriter {
             let dest = self.stage.join(&rel);
             std::fs::create_dir_all(dest.parent().expect("has a folder"))
                 .map_err(io_err(format!("cannot create the folder of {rel}")))?;
+            // Only the file the encoder created goes in: never a link planted in its place.
+            let planted = std::fs::symlink_metadata(&clip.path)
+                .map(|m| !m.file_type().is_file() || std::os::unix::fs::MetadataExt::nlink(&m) != 1)
+                .unwrap_or(true);
+            if planted {
+                return Err(DatasetError(format!(
+                    "the clip {} is not the regular file the encoder wrote (a link or another \
+                     file was put in its place); the dataset was not written",
+                    clip.path.display()
+                )));
+            }
             std::fs::rename(&clip.path, &dest)
                 .map_err(io_err(format!("cannot move the video into {rel}")))?;
             for c in 0..3 {

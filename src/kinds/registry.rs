@@ -72,11 +72,13 @@ pub(crate) enum Imp {
         parse: ParseParams,
         schema: fn(&mut SchemaGenerator) -> String,
         objects: &'static [(&'static str, ObjectRole)],
+        failures: &'static [&'static str],
     },
     Condition {
         parse: ParseParams,
         schema: fn(&mut SchemaGenerator) -> String,
         objects: &'static [(&'static str, ObjectRole)],
+        failures: &'static [&'static str],
     },
     Wait,
     Select,
@@ -121,6 +123,15 @@ impl NodeType {
     pub fn object_params(&self) -> &'static [(&'static str, ObjectRole)] {
         match &self.imp {
             Imp::Action { objects, .. } | Imp::Condition { objects, .. } => objects,
+            _ => &[],
+        }
+    }
+
+    /// The failure kinds of its own the kind declares ([`Params::failure_kinds`]; none for
+    /// other kinds).
+    pub fn failure_kinds(&self) -> &'static [&'static str] {
+        match &self.imp {
+            Imp::Action { failures, .. } | Imp::Condition { failures, .. } => failures,
             _ => &[],
         }
     }
@@ -201,6 +212,18 @@ impl Registry {
         self.types.iter().map(|t| &**t)
     }
 
+    /// The failure kinds the node kinds declare besides the built-in ones, in registration
+    /// order (what a scenario file's `expect.failure_kind` may name besides the built-in kinds).
+    pub fn failure_kinds(&self) -> Vec<&'static str> {
+        let mut out: Vec<&'static str> = Vec::new();
+        for k in self.types.iter().flat_map(|t| t.failure_kinds()) {
+            if !out.contains(k) {
+                out.push(k);
+            }
+        }
+        out
+    }
+
     /// Every kind's name, in registration order.
     pub fn names(&self) -> impl Iterator<Item = &'static str> + '_ {
         self.types.iter().map(|t| t.name)
@@ -237,6 +260,7 @@ impl Registry {
                 parse: parse_params::<P>,
                 schema: schema_of::<P>,
                 objects: P::OBJECT_PARAMS,
+                failures: P::failure_kinds(),
             },
         )
     }
@@ -261,6 +285,7 @@ impl Registry {
                 parse: parse_params::<P>,
                 schema: schema_of::<P>,
                 objects: P::OBJECT_PARAMS,
+                failures: P::failure_kinds(),
             },
         )
     }

@@ -290,12 +290,30 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
         issues.push(
             Issue::new(
                 v.loc,
-                format!("a scene file must be a mapping, found {}", v.describe()),
+                format!(
+                    "a scene file must be a mapping, found {}",
+                    crate::yaml::value::kind_of(v)
+                ),
             )
             .label("expected `objects:` (and optionally `description:` and `goal:`)"),
         );
         return None;
     };
+    // Not a scene file at all (a `.env`, a credentials file): one issue, quoting one line.
+    if !entries
+        .iter()
+        .any(|(k, _)| k.as_str().is_some_and(|k| TOP_LEVEL_KEYS.contains(&k)))
+    {
+        issues.push(
+            Issue::new(
+                v.loc,
+                "this is not a scene file: it has none of `objects:`, `description:`, `goal:`",
+            )
+            .label("expected `objects:` (and optionally `description:` and `goal:`)")
+            .help("name a scene file (see docs/scenes.md)"),
+        );
+        return None;
+    }
     let mut description = None;
     let mut objects_v = None;
     let mut goal_v = None;
@@ -365,6 +383,9 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
             Issue::new(objects_key, format!("the randomization cannot be met: {e}"))
                 .help("widen the `random:` regions or lower the clearances"),
         );
+    }
+    if issues.is_empty() || !scene.objects.is_empty() {
+        super::feasible::check_has_block(&scene, objects_key, issues);
     }
     Some(scene)
 }
@@ -861,6 +882,7 @@ fn read_goal(v: &Value, scene: &SceneSpec, issues: &mut Vec<Issue>) -> Goal {
             );
         }
     }
+    super::feasible::check_goal_feasible(scene, &atoms, issues);
     Goal {
         atoms: atoms.into_iter().map(|(a, _)| a).collect(),
     }

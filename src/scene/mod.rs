@@ -17,6 +17,7 @@
 //! ```
 
 mod color;
+mod feasible;
 mod goal;
 mod load;
 mod sample;

@@ -15,6 +15,12 @@
 //! digest is remembered next to the models with each file's size, times, inode and device
 //! ([`model_key_stamped`]); a file whose metadata changed is read again.
 //!
+//! The cache is bounded: it keeps at most [`MAX_MODELS`] models (each scene variant is one, about
+//! 43 MB) and at most [`MAX_BYTES`] of them; writing a new one removes the least recently used
+//! beyond that (a model's modification time is set on each use). Temporary files left by a
+//! process that stopped while writing one (any way, `kill -9` included) are removed by the next
+//! write (see [`crate::cleanup`]).
+//!
 //! Where: `$MACROTREE_CACHE_DIR` when set (`off` turns the cache off), else
 //! `$XDG_CACHE_HOME/macrotree`, else `~/.cache/macrotree`.
 
@@ -36,6 +42,11 @@ const HEADER_LEN: usize = 16 + 20 + 8 + 4;
 /// The code that composes the model, hashed into the key so that a change to it is never served
 /// an old model.
 const COMPOSER_SOURCES: [&str; 2] = [include_str!("scene.rs"), include_str!("mjcf.rs")];
+
+/// Most models the cache keeps (least recently used out).
+pub const MAX_MODELS: usize = 16;
+/// Most bytes of models the cache keeps (least recently used out): 1 GiB.
+pub const MAX_BYTES: u64 = 1 << 30;
 
 /// The Menagerie folders whose files go into the model.
 pub const MENAGERIE_MODELS: [&str; 2] = ["universal_robots_ur5e", "robotiq_2f85"];
@@ -211,9 +222,51 @@ pub fn model_path(dir: &Path, key: &str) -> PathBuf {
 
 /// The model cached under `key` in `dir`, if a valid file is there.
 pub fn load(dir: &Path, key: &str) -> Option<MjModel> {
-    let bytes = std::fs::read(model_path(dir, key)).ok()?;
+    let path = model_path(dir, key);
+    let bytes = std::fs::read(&path).ok()?;
     let payload = check(&bytes, key)?;
-    MjModel::from_buffer(payload).ok()
+    let model = MjModel::from_buffer(payload).ok()?;
+    // Used now: the last to be evicted.
+    if let Ok(f) = std::fs::File::open(&path) {
+        let _ = f.set_modified(std::time::SystemTime::now());
+    }
+    Some(model)
+}
+
+/// Removes the least recently used models of `dir` beyond [`MAX_MODELS`] and [`MAX_BYTES`]
+/// (never `keep`), and temporary files whose writer is gone. Returns the models removed.
+pub fn evict(dir: &Path, keep: &Path) -> Vec<PathBuf> {
+    crate::cleanup::reclaim(dir, std::ffi::OsStr::new(".model-"), ".tmp", false);
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut models: Vec<(std::time::SystemTime, u64, PathBuf)> = entries
+        .flatten()
+        .take(100_000)
+        .filter_map(|e| {
+            let name = e.file_name();
+            let name = name.to_str()?;
+            if !(name.starts_with("model-") && name.ends_with(".mjb")) {
+                return None;
+            }
+            let meta = std::fs::symlink_metadata(e.path()).ok()?;
+            if !meta.is_file() {
+                return None;
+            }
+            Some((meta.modified().ok()?, meta.len(), e.path()))
+        })
+        .collect();
+    // Most recently used first; `keep` (just written) counts as the most recent.
+    models.sort_by(|a, b| (b.2 == keep).cmp(&(a.2 == keep)).then(b.0.cmp(&a.0)));
+    let mut removed = Vec::new();
+    let mut bytes = 0u64;
+    for (i, (_, len, path)) in models.into_iter().enumerate() {
+        bytes = bytes.saturating_add(len);
+        if path != keep && (i >= MAX_MODELS || bytes > MAX_BYTES) && std::fs::remove_file(&path).is_ok() {
+            removed.push(path);
+        }
+    }
+    removed
 }
 
 /// The MJB payload of a cache file's `bytes` when its header is intact, names `key` and the
@@ -254,6 +307,9 @@ pub fn store(dir: &Path, key: &str, model: &MjModel) -> Result<PathBuf, String> 
     let path = model_path(dir, key);
     let out = crate::output::OutputFile::check(&path, &[]).map_err(|e| e.to_string())?;
     out.write_all(&bytes).map_err(|e| e.to_string())?;
+    for old in evict(dir, &path) {
+        tracing::debug!(path = %old.display(), "model cache: evicted the least recently used model");
+    }
     Ok(path)
 }
 

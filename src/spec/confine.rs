@@ -76,6 +76,82 @@ impl IncludeScope {
     }
 }
 
+/// Checks a tree's `scene:` (written `rel`, at `path` once joined to the tree's folder `base`)
+/// against the include rule: by spelling, then (when it exists) resolved.
+pub(crate) fn check_scene_path(
+    scope: &IncludeScope,
+    base: Option<&Path>,
+    path: &Path,
+    rel: &str,
+    loc: Loc,
+) -> Result<(), Issue> {
+    let written = Path::new(rel);
+    let checked = scope
+        .check_spelling(base, written, loc)
+        .and_then(|()| match path.canonicalize() {
+            Ok(canon) => scope.check_resolved(&canon, written, loc),
+            Err(_) => Ok(()), // missing: the scene loader says so
+        });
+    // The other place scenes live: a YAML file in the project the command runs in (the
+    // repository's `scenes/` next to its `trees/`).
+    let yaml = written
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"));
+    let in_project = || {
+        let Ok(cwd) = std::env::current_dir().and_then(|d| d.canonicalize()) else {
+            return false;
+        };
+        let spelled = std::path::absolute(path).map(|p| lexical(&p)).unwrap_or_default();
+        spelled.starts_with(&cwd) && path.canonicalize().map_or(true, |c| c.starts_with(&cwd))
+    };
+    match checked {
+        Ok(()) => Ok(()),
+        Err(_) if yaml && in_project() => Ok(()),
+        Err(issue) => Err(
+            Issue::new(loc, format!("the scene `{rel}` is outside the tree's folder"))
+                .label(format!(
+                    "{}, or YAML files under the current folder",
+                    issue
+                        .label
+                        .unwrap_or_default()
+                        .replace("includes may", "a tree may")
+                ))
+                .help(
+                    "move the scene file into the tree's folder (or a subfolder), give it with \
+                 `--scene FILE`, or pass --allow-include-outside to read it anyway",
+                ),
+        ),
+    }
+}
+
+/// Checks `written`, a path read back from a results file (a scenario file's path), against
+/// the include rule with the current folder as the root: it must be relative and resolve inside
+/// the current folder, unless `anywhere` (the command line's `--allow-include-outside`) allows
+/// any path. `Err` says why.
+#[cfg(feature = "cli")]
+pub fn check_path_from_results(written: &Path, anywhere: bool) -> Result<(), String> {
+    if anywhere {
+        return Ok(());
+    }
+    let cwd = std::env::current_dir()
+        .and_then(|d| d.canonicalize())
+        .map_err(|e| format!("the current folder cannot be resolved: {e}"))?;
+    let inside = !written.is_absolute()
+        && lexical(&cwd.join(written)).starts_with(&cwd)
+        && written.canonicalize().map_or(true, |c| c.starts_with(&cwd));
+    if inside {
+        Ok(())
+    } else {
+        Err(format!(
+            "the results name `{}`, which is outside the current folder {}; run `report` from \
+             the folder the results were written in, or pass --allow-include-outside to read it \
+             anyway",
+            written.display(),
+            cwd.display()
+        ))
+    }
+}
+
 /// `path` with `.` and `..` resolved by spelling alone (no file system access).
 fn lexical(path: &Path) -> PathBuf {
     let mut out = PathBuf::new();
@@ -109,23 +185,14 @@ pub(crate) fn parse_top_level(v: &Value, issues: &mut Vec<Issue>) -> (Option<Tre
             && !matches!(v.kind, ValueKind::Map(_))
         {
             // The value's description could quote text beyond its first line.
-            issue.message = format!("a tree file must be a mapping, found {}", kind_of(v));
+            issue.message = format!(
+                "a tree file must be a mapping, found {}",
+                crate::yaml::value::kind_of(v)
+            );
         }
     }
     issues.append(&mut found);
     (file, is_tree)
-}
-
-/// What `v` is, without its content.
-fn kind_of(v: &Value) -> &'static str {
-    match v.kind {
-        ValueKind::Null => "nothing (an empty document)",
-        ValueKind::Bool(_) => "a boolean",
-        ValueKind::Int(_) | ValueKind::Float(_) => "a number",
-        ValueKind::Str(_) => "text",
-        ValueKind::Seq(_) => "a list",
-        ValueKind::Map(_) => "a mapping",
-    }
 }
 
 #[cfg(test)]

@@ -346,6 +346,11 @@ impl TreeReader {
             Some(b) if !Path::new(rel).is_absolute() => b.join(rel),
             _ => PathBuf::from(rel),
         };
+        // The include rule: a scene outside the tree's folder is refused before it is opened.
+        if let Err(issue) = super::confine::check_scene_path(&self.scope, base, &path, rel, *loc) {
+            self.issues.push(issue);
+            return None;
+        }
         match crate::scene::load_scene_file(&path) {
             Ok(s) => Some(Arc::new(s)),
             Err(diags) => {

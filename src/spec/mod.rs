@@ -10,7 +10,7 @@
 #![warn(missing_docs)]
 
 pub mod check;
-mod confine;
+pub(crate) mod confine;
 pub mod expand;
 pub mod file;
 pub mod load;

@@ -18,18 +18,20 @@
 //! println!("{} of {} succeeded", run.results.iter().filter(|r| r.success).count(), run.results.len());
 //! ```
 
+pub mod digest;
 mod indices;
 pub mod layout;
 pub mod report;
 pub mod resume;
 mod summary;
+pub mod tally;
 
 use std::collections::BTreeMap;
 use std::ops::ControlFlow;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::str::FromStr;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::mpsc;
 use std::time::Instant;
 
@@ -210,6 +212,9 @@ pub struct SweepConfig {
     pub substitutions: Vec<Substitution>,
     /// The scenario file of `macrotree test` this sweep belongs to, if any.
     pub suite: Option<String>,
+    /// The digest of the tree file, its includes and the scene file ([`digest::files_digest`]),
+    /// written to every result line: `--resume` refuses lines of other contents.
+    pub tree_digest: Option<String>,
     /// How reproduction commands name the program (`macrotree` when it is on `PATH`, else the
     /// path of the binary that ran, e.g. `target/release/macrotree`), shell-quoted.
     pub program: String,
@@ -229,6 +234,7 @@ impl Default for SweepConfig {
             tree: String::new(),
             substitutions: Vec::new(),
             suite: None,
+            tree_digest: None,
             program: "macrotree".to_string(),
         }
     }
@@ -381,6 +387,10 @@ pub struct ScenarioResult {
     pub failure_kind: Option<FailureKind>,
     /// How often every node ran, in plan order.
     pub nodes: Vec<NodeReport>,
+    /// The digest of the tree, its includes and the scene the sweep ran
+    /// ([`SweepConfig::tree_digest`]); a line that has it also ends with its checksum (`crc32`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tree_digest: Option<String>,
     /// Wall-clock time of the episode, seconds (not written to the JSONL).
     #[serde(skip)]
     pub wall_time_s: f64,
@@ -435,6 +445,7 @@ impl ScenarioResult {
             failure_kind: r.failure_kind,
             failed_node: r.failed_node,
             nodes: r.nodes,
+            tree_digest: config.tree_digest.clone(),
             wall_time_s: r.wall_time_s,
         }
     }
@@ -484,13 +495,19 @@ impl ScenarioResult {
             collisions: Vec::new(),
             failed_node: None,
             nodes: Vec::new(),
+            tree_digest: config.tree_digest.clone(),
             wall_time_s: 0.0,
         }
     }
 
     /// The result as one JSON line (without the newline).
     pub fn to_jsonl(&self) -> String {
-        serde_json::to_string(self).expect("a scenario result serializes")
+        let json = serde_json::to_string(self).expect("a scenario result serializes");
+        if self.tree_digest.is_some() {
+            digest::with_checksum(&json)
+        } else {
+            json
+        }
     }
 
     /// The `macrotree run …` command that reproduces this scenario bit for bit (the program
@@ -578,6 +595,10 @@ pub fn run_scene_scenario(
     run_scene_scenario_observed(cell, plan, factory, config, index, &mut NoObserver)
 }
 
+/// Most scenarios a sweep runs ahead of the first one not yet handed to its callback (at least
+/// four per worker): bounds the results held while a slow scenario holds up the ones after it.
+pub const REORDER_WINDOW: usize = 1024;
+
 /// The outcome of a sweep.
 #[derive(Debug, Clone)]
 pub struct SweepRun {
@@ -664,6 +685,27 @@ pub fn run_sweep_with<T: Send>(
     episode: impl Fn(&mut Cell, u64) -> (ScenarioResult, T) + Sync,
     mut on_result: impl FnMut(&ScenarioResult, Option<T>) -> ControlFlow<()>,
 ) -> Result<SweepRun, rayon::ThreadPoolBuildError> {
+    // Memory grows with the results, not with the size of the sweep.
+    let mut results = Vec::with_capacity(config.indices().skip_first(skip).len().min(4096));
+    let mut run = run_sweep_streaming(scene, config, skip, episode, |r, payload| {
+        let flow = on_result(&r, payload);
+        results.push(r);
+        flow
+    })?;
+    run.results = results;
+    Ok(run)
+}
+
+/// [`run_sweep_with`] that keeps no result: each is handed to `on_result` (in scenario order)
+/// and dropped, so memory does not grow with the number of scenarios. The returned
+/// [`SweepRun`] has no `results`.
+pub fn run_sweep_streaming<T: Send>(
+    scene: &Scene,
+    config: &SweepConfig,
+    skip: u64,
+    episode: impl Fn(&mut Cell, u64) -> (ScenarioResult, T) + Sync,
+    mut on_result: impl FnMut(ScenarioResult, Option<T>) -> ControlFlow<()>,
+) -> Result<SweepRun, rayon::ThreadPoolBuildError> {
     let wall = Instant::now();
     let episode = &episode;
     let pool = rayon::ThreadPoolBuilder::new()
@@ -672,20 +714,32 @@ pub fn run_sweep_with<T: Send>(
         .build()?;
     let jobs = pool.current_num_threads();
     let indices = config.indices().skip_first(skip);
-    // Memory grows with the results, not with the size of the sweep.
-    let mut results = Vec::with_capacity(indices.len().min(4096));
+    let mut next = 0usize;
     let (tx, rx) = mpsc::channel::<(usize, ScenarioResult, Option<T>)>();
     let stop = AtomicBool::new(false);
     let physics_ns = AtomicU64::new(0);
+    // Results handed to `on_result` so far: a worker does not start a scenario more than
+    // `window` places ahead, so results waiting for a slow earlier one stay bounded.
+    let delivered = AtomicUsize::new(0);
+    let window = REORDER_WINDOW.max(4 * jobs);
     std::thread::scope(|s| {
         let stop = &stop;
         let physics_ns = &physics_ns;
+        let delivered = &delivered;
         s.spawn(move || {
             let new_cell = || Cell::new(scene, &Layout::default(), CONTROL_PERIOD);
             pool.install(|| {
                 // par_bridge hands out scenarios in index order, so results arrive nearly in order.
                 let todo = indices.take_while(|_| !stop.load(Ordering::Relaxed)).enumerate();
                 todo.par_bridge().for_each_init(new_cell, |cell, (pos, index)| {
+                    // Every scenario before `pos` is done or running on another worker, so the
+                    // one the consumer waits for always progresses.
+                    while pos >= delivered.load(Ordering::Acquire) + window && !stop.load(Ordering::Relaxed) {
+                        std::thread::sleep(std::time::Duration::from_millis(1));
+                    }
+                    if stop.load(Ordering::Relaxed) {
+                        return; // the consumer stopped: its result would be dropped
+                    }
                     let before = cell.sim().physics_time();
                     let outcome = catch_unwind(AssertUnwindSafe(|| episode(cell, index)));
                     let spent = cell.sim().physics_time().saturating_sub(before);
@@ -722,10 +776,10 @@ pub fn run_sweep_with<T: Send>(
                 continue; // draining the scenarios that were running
             }
             pending.insert(pos, (result, payload));
-            while let Some((result, payload)) = pending.remove(&results.len()) {
-                let flow = on_result(&result, payload);
-                results.push(result);
-                if flow.is_break() {
+            while let Some((result, payload)) = pending.remove(&next) {
+                next += 1;
+                delivered.store(next, Ordering::Release);
+                if on_result(result, payload).is_break() {
                     stop.store(true, Ordering::Relaxed);
                     break;
                 }
@@ -733,7 +787,7 @@ pub fn run_sweep_with<T: Send>(
         }
     });
     Ok(SweepRun {
-        results,
+        results: Vec::new(),
         wall_time_s: wall.elapsed().as_secs_f64(),
         jobs,
         physics_time_s: physics_ns.load(Ordering::Relaxed) as f64 * 1e-9,

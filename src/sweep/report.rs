@@ -58,6 +58,7 @@ fn identity(r: &ScenarioResult) -> Vec<(&'static str, String)> {
         ("tree", r.tree.clone()),
         ("scene file", format!("{:?}", r.scene_file)),
         ("scene", r.scene.clone()),
+        ("tree digest", r.tree_digest.clone().unwrap_or_default()),
         ("scenario count", r.scenarios.to_string()),
         ("seed", r.sweep_seed.to_string()),
         ("fault", r.fault.map_or("none", FaultKind::name).to_string()),
@@ -186,6 +187,7 @@ fn merge_group(mut lines: Vec<(Origin, ScenarioResult)>) -> Result<Merged, Merge
         tree: first.tree.clone(),
         substitutions: first.substitutions.clone(),
         suite: first.suite.clone(),
+        tree_digest: first.tree_digest.clone(),
         ..SweepConfig::default()
     };
     Ok(Merged {

@@ -2,7 +2,8 @@
 //!
 //! A sweep writes its lines in scenario order, each whole, so an interrupted sweep leaves a
 //! prefix of the complete file, possibly followed by one truncated line. [`read_existing`] keeps
-//! the complete lines and drops the truncated tail; the sweep then runs only the scenarios after
+//! the complete lines (reading one at a time: memory does not grow with the file) and drops the
+//! truncated tail; the sweep then runs only the scenarios after
 //! them ([`super::run_sweep_from`]), so the final file is byte-identical to that of an
 //! uninterrupted run, and so is the summary (but for the wall time).
 //!
@@ -21,7 +22,7 @@
 //!   episodes are deterministic, so a different tree, goal or time limit shows up there.
 
 use std::fmt;
-use std::io::Read;
+use std::io::Read as _;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -34,16 +35,22 @@ use crate::faults::FaultKind;
 use crate::plan::Plan;
 use crate::sim::{Layout, Scene};
 
-/// The complete results found in an existing output file.
+/// The complete results found in an existing output file (read in bounded memory: each result
+/// is handed to the caller and dropped).
 #[derive(Debug, Clone, Default)]
 pub struct Resumed {
-    /// The bytes of the complete lines kept, as they are in the file.
-    pub kept: Vec<u8>,
-    /// Their results, in order (scenario positions `0..results.len()` of the sweep).
-    pub results: Vec<ScenarioResult>,
+    /// Bytes of the complete lines kept (a prefix of the file).
+    pub kept_len: u64,
+    /// Complete lines kept: scenario positions `0..count` of the sweep.
+    pub count: u64,
+    /// The last result kept (for [`spot_check`]).
+    pub last: Option<ScenarioResult>,
     /// Bytes of a truncated last line that were dropped (0 when the file ended with a newline).
-    pub dropped_bytes: usize,
+    pub dropped_bytes: u64,
 }
+
+/// Longest line read back, bytes (a result line is a few kilobytes).
+pub const MAX_LINE_BYTES: u64 = 16 << 20;
 
 /// Why an existing file cannot be resumed. `Display` says what and what to do.
 #[derive(Debug)]
@@ -83,64 +90,77 @@ impl fmt::Display for ResumeError {
 
 impl std::error::Error for ResumeError {}
 
-/// Reads the results of `config` already in `path` (see the [module docs](self)). A missing
-/// file has none.
-pub fn read_existing(path: &Path, scene: &Scene, config: &SweepConfig) -> Result<Resumed, ResumeError> {
+/// Reads the results of `config` already in `file` (open at `path`; see the
+/// [module docs](self)), handing each to `on_result` in order. An empty file has none.
+pub fn read_existing(
+    file: &std::fs::File,
+    path: &Path,
+    scene: &Scene,
+    config: &SweepConfig,
+    mut on_result: impl FnMut(&ScenarioResult),
+) -> Result<Resumed, ResumeError> {
+    use std::io::{BufRead, Seek};
     let read_error = |source| ResumeError::Read {
         path: path.to_path_buf(),
         source,
     };
-    let mut bytes = Vec::new();
-    match std::fs::File::open(path) {
-        Ok(mut f) => {
-            if !f.metadata().map_err(read_error)?.is_file() {
-                return Err(read_error(std::io::Error::other("not a regular file")));
-            }
-            f.read_to_end(&mut bytes).map_err(read_error)?;
-        }
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Resumed::default()),
-        Err(e) => return Err(read_error(e)),
+    if !file.metadata().map_err(read_error)?.is_file() {
+        return Err(read_error(std::io::Error::other("not a regular file")));
     }
-    let complete = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
-    let dropped_bytes = bytes.len() - complete;
-    bytes.truncate(complete);
+    let mut f = file;
+    f.seek(std::io::SeekFrom::Start(0)).map_err(read_error)?;
+    let mut reader = std::io::BufReader::new(f);
     let indices = config.indices();
-    let mut results = Vec::new();
-    let lines = bytes.strip_suffix(b"\n").map(|b| b.split(|&c| c == b'\n'));
-    for (n, line) in lines.into_iter().flatten().enumerate() {
+    let mut out = Resumed::default();
+    let mut line = Vec::new();
+    loop {
+        line.clear();
+        let n = (&mut reader)
+            .take(MAX_LINE_BYTES + 1)
+            .read_until(b'\n', &mut line)
+            .map_err(read_error)?;
+        if n == 0 {
+            break;
+        }
         let foreign = |reason: String| ResumeError::Foreign {
             path: path.to_path_buf(),
-            line: n as u64 + 1,
+            line: out.count + 1,
             reason,
         };
-        let line = std::str::from_utf8(line).map_err(|_| foreign("not UTF-8".into()))?;
-        let Some(index) = indices.get(n as u64) else {
+        if line.last() != Some(&b'\n') {
+            if n as u64 > MAX_LINE_BYTES {
+                return Err(foreign(format!("longer than {MAX_LINE_BYTES} bytes")));
+            }
+            out.dropped_bytes = n as u64; // a truncated last line
+            break;
+        }
+        let text = std::str::from_utf8(&line[..n - 1]).map_err(|_| foreign("not UTF-8".into()))?;
+        let Some(index) = indices.get(out.count) else {
             return Err(foreign(format!(
                 "this sweep has only {} scenario(s)",
                 indices.count_left()
             )));
         };
-        let result = parse_line(line).map_err(foreign)?;
-        check_result(&result, line, index, scene, config).map_err(foreign)?;
-        results.push(result);
+        let result = parse_line(text).map_err(foreign)?;
+        check_result(&result, text, index, scene, config).map_err(foreign)?;
+        on_result(&result);
+        out.count += 1;
+        out.kept_len += n as u64;
+        out.last = Some(result);
     }
-    Ok(Resumed {
-        kept: bytes,
-        results,
-        dropped_bytes,
-    })
+    Ok(out)
 }
 
-/// Runs the last kept scenario again with this tree and configuration and checks that it gives
-/// the same line: the check for what the lines do not carry (tree, goal, time limit).
+/// Runs the last kept scenario (`last`) again with this tree and configuration and checks that
+/// it gives the same line: the check for what the lines do not carry (goal, time limit).
 pub fn spot_check(
     scene: &Scene,
     plan: &Arc<Plan>,
     factory: &crate::factory::Factory,
     config: &SweepConfig,
-    resumed: &Resumed,
+    last: Option<&ScenarioResult>,
 ) -> Result<(), String> {
-    let Some(last) = resumed.results.last() else {
+    let Some(last) = last else {
         return Ok(());
     };
     let mut cell = Cell::new(scene, &Layout::default(), CONTROL_PERIOD);
@@ -172,6 +192,22 @@ fn check_result(
     }
     if r.tree != config.tree {
         return Err(format!("tree {:?}, not {:?}", r.tree, config.tree));
+    }
+    if r.tree_digest != config.tree_digest {
+        return Err(match &r.tree_digest {
+            None => "it was written by an earlier version of macrotree, whose lines carry no \
+                     digest of the tree (run without --resume to start over)"
+                .into(),
+            Some(d) => format!(
+                "the tree, a file it includes or the scene changed since it was written (digest \
+                 {}…, now {}…)",
+                d.chars().take(12).collect::<String>(),
+                config
+                    .tree_digest
+                    .as_deref()
+                    .map_or(String::from("none"), |c| c.chars().take(12).collect())
+            ),
+        });
     }
     if r.sweep_goal != config.goal {
         return Err(format!(
@@ -244,7 +280,16 @@ fn check_result(
 
 /// Reads one JSONL line back into the result it was written from.
 pub fn parse_line(line: &str) -> Result<ScenarioResult, String> {
-    let v: Value = serde_json::from_str(line).map_err(|e| format!("not JSON: {e}"))?;
+    let unchecked = super::digest::strip_checksum(line)?;
+    let v: Value =
+        serde_json::from_str(unchecked.as_deref().unwrap_or(line)).map_err(|e| format!("not JSON: {e}"))?;
+    let tree_digest = match v.get("tree_digest") {
+        None => None,
+        Some(d) => Some(d.as_str().ok_or("`tree_digest` is not text")?.to_string()),
+    };
+    if tree_digest.is_some() != unchecked.is_some() {
+        return Err("a line with a `tree_digest` ends with its `crc32`, and only such a line".into());
+    }
     let field = |k: &str| v.get(k).ok_or_else(|| format!("no `{k}`"));
     let u64_of = |k: &str| field(k)?.as_u64().ok_or_else(|| format!("`{k}` is not a count"));
     let u32_of = |k: &str| u32::try_from(u64_of(k)?).map_err(|_| format!("`{k}` is too large"));
@@ -365,6 +410,7 @@ pub fn parse_line(line: &str) -> Result<ScenarioResult, String> {
         failed_node: serde_json::from_value(parsed("failed_node")?)
             .map_err(|e| format!("`failed_node`: {e}"))?,
         nodes: serde_json::from_value(parsed("nodes")?).map_err(|e| format!("`nodes`: {e}"))?,
+        tree_digest,
         wall_time_s: 0.0,
     })
 }

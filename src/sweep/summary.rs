@@ -6,9 +6,16 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 
-use super::{ScenarioResult, Shard, SweepConfig};
+use super::{ScenarioResult, SweepConfig};
 use crate::episode::Goal;
 use crate::faults::FaultKind;
+
+/// Most failing scenarios the text summary shows (like `macrotree test`).
+pub const MAX_FAILURES_SHOWN: usize = 20;
+
+fn is_zero(n: &u64) -> bool {
+    *n == 0
+}
 
 /// z for a two-sided 95% interval.
 const Z95: f64 = 1.959_963_984_540_054;
@@ -87,8 +94,12 @@ pub struct Summary {
     /// physics (1 would be a sweep that does nothing but `mj_step`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub physics_share: Option<f64>,
-    /// Every failing scenario, by index.
+    /// The failing scenarios, by index: the first [`super::tally::MAX_FAILURES_KEPT`] (the
+    /// JSONL has every one).
     pub failures: Vec<Failure>,
+    /// Failing scenarios not listed in `failures` (absent when 0).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub failures_not_listed: u64,
     /// Failures grouped by (node path, failure kind), most frequent first.
     pub failure_groups: Vec<FailureGroup>,
     /// Substitutions applied in every scenario (`PATTERN=OUTCOME`).
@@ -131,45 +142,6 @@ pub struct Coverage {
     pub never_failed: Vec<String>,
 }
 
-/// Sums the node counts of `results` (nodes in the order of the first result that lists them).
-fn node_totals(results: &[ScenarioResult]) -> (Vec<NodeTotals>, Coverage) {
-    let mut totals: Vec<NodeTotals> = Vec::new();
-    let mut at: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
-    for r in results {
-        for n in &r.nodes {
-            let i = *at.entry(n.path.clone()).or_insert_with(|| {
-                totals.push(NodeTotals {
-                    path: n.path.clone(),
-                    scenarios_ran: 0,
-                    activations: 0,
-                    successes: 0,
-                    failures: 0,
-                    halts: 0,
-                });
-                totals.len() - 1
-            });
-            let t = &mut totals[i];
-            let c = &n.counts;
-            t.scenarios_ran += u64::from(c.activations > 0);
-            t.activations += u64::from(c.activations);
-            t.successes += u64::from(c.successes);
-            t.failures += u64::from(c.failures);
-            t.halts += u64::from(c.halts);
-        }
-    }
-    let paths = |f: &dyn Fn(&NodeTotals) -> bool| -> Vec<String> {
-        totals.iter().filter(|t| f(t)).map(|t| t.path.clone()).collect()
-    };
-    let coverage = Coverage {
-        nodes: totals.len() as u64,
-        ran: totals.iter().filter(|t| t.activations > 0).count() as u64,
-        never_ran: paths(&|t| t.activations == 0),
-        never_succeeded: paths(&|t| t.activations > 0 && t.successes == 0),
-        never_failed: paths(&|t| t.activations > 0 && t.failures == 0),
-    };
-    (totals, coverage)
-}
-
 /// Failures that share the node that failed and the kind of failure.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FailureGroup {
@@ -179,7 +151,8 @@ pub struct FailureGroup {
     pub kind: String,
     /// How many scenarios.
     pub count: u64,
-    /// The scenario indices, ascending.
+    /// The scenario indices, ascending: the first [`super::tally::MAX_GROUP_INDICES`] of
+    /// `count`.
     pub indices: Vec<u64>,
 }
 
@@ -192,78 +165,11 @@ impl Summary {
         wall_time_s: f64,
         jobs: usize,
     ) -> Self {
-        let n = results.len() as u64;
-        let successes = results.iter().filter(|r| r.success).count() as u64;
-        let mut attempts_histogram = BTreeMap::new();
+        let mut tally = super::tally::Tally::new(tree, config);
         for r in results {
-            *attempts_histogram.entry(r.grasp_attempts).or_insert(0) += 1;
+            tally.add(r);
         }
-        let mut times: Vec<f64> = results.iter().map(|r| r.sim_time_s).collect();
-        times.sort_by(f64::total_cmp);
-        let failures = results
-            .iter()
-            .filter(|r| !r.success)
-            .map(|r| Failure {
-                index: r.index,
-                seed: r.seed,
-                cube: r.layout.map(|l| l.cube),
-                bowl: r.layout.map(|l| l.bowl),
-                node: r.failed_node.clone(),
-                kind: r.failure_kind,
-                collisions: r.collisions.iter().map(|c| c.what.clone()).collect(),
-                reason: r.failure_reason.clone().unwrap_or_else(|| "failed".into()),
-                grasp_attempts: r.grasp_attempts,
-                reproduce: r.reproduce(tree, config),
-            })
-            .collect::<Vec<Failure>>();
-        let mut groups: BTreeMap<(String, String), Vec<u64>> = BTreeMap::new();
-        for f in &failures {
-            let key = (
-                f.node.clone().unwrap_or_else(|| "-".into()),
-                f.kind.unwrap_or(crate::failure::FailureKind::Other).to_string(),
-            );
-            groups.entry(key).or_default().push(f.index);
-        }
-        let mut failure_groups: Vec<FailureGroup> = groups
-            .into_iter()
-            .map(|((node, kind), indices)| FailureGroup {
-                node,
-                kind,
-                count: indices.len() as u64,
-                indices,
-            })
-            .collect();
-        failure_groups.sort_by_key(|g| std::cmp::Reverse(g.count));
-        let (nodes, coverage) = node_totals(results);
-        Self {
-            tree: tree.to_string(),
-            seed: config.seed,
-            fault: config.fault,
-            goal: config.goal,
-            shard: config.shard.as_ref().map(Shard::to_string),
-            jobs,
-            scenarios: n,
-            successes,
-            success_rate: if n == 0 { 0.0 } else { successes as f64 / n as f64 },
-            success_rate_ci95: wilson_interval(successes, n),
-            attempts_histogram,
-            median_sim_time_s: percentile(&times, 0.5),
-            p95_sim_time_s: percentile(&times, 0.95),
-            wall_time_s,
-            scenarios_per_minute: if wall_time_s > 0.0 {
-                n as f64 * 60.0 / wall_time_s
-            } else {
-                0.0
-            },
-            failures,
-            failure_groups,
-            substitutions: config.substitutions.iter().map(|s| s.to_string()).collect(),
-            nodes,
-            coverage,
-            physics_time_s: None,
-            process_wall_time_s: None,
-            physics_share: None,
-        }
+        tally.finish(wall_time_s, jobs)
     }
 
     /// Adds how much of the sweep was physics: `physics_time_s` (time inside `mj_step`, summed
@@ -367,13 +273,18 @@ impl Summary {
             }
         }
         if !self.failures.is_empty() {
-            let _ = writeln!(s, "  failures ({}):", self.failures.len());
-            for f in &self.failures {
+            let total = self.failures.len() as u64 + self.failures_not_listed;
+            let _ = writeln!(s, "  failures ({total}):");
+            for f in self.failures.iter().take(MAX_FAILURES_SHOWN) {
                 let _ = writeln!(s, "    #{}: {}", f.index, f.reason);
                 if !f.collisions.is_empty() {
                     let _ = writeln!(s, "      collisions: {}", f.collisions.join("; "));
                 }
                 let _ = writeln!(s, "      {}", f.reproduce);
+            }
+            let more = total.saturating_sub(MAX_FAILURES_SHOWN as u64);
+            if more > 0 {
+                let _ = writeln!(s, "    … and {more} more (see --out or --json)");
             }
         }
         s

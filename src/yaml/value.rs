@@ -611,6 +611,18 @@ pub fn decode_utf8(bytes: &[u8], file: FileId) -> Result<&str, Issue> {
     })
 }
 
+/// What `v` is, without its content.
+pub fn kind_of(v: &Value) -> &'static str {
+    match v.kind {
+        ValueKind::Null => "nothing (an empty document)",
+        ValueKind::Bool(_) => "a boolean",
+        ValueKind::Int(_) | ValueKind::Float(_) => "a number",
+        ValueKind::Str(_) => "text",
+        ValueKind::Seq(_) => "a list",
+        ValueKind::Map(_) => "a mapping",
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

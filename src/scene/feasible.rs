@@ -1,0 +1,88 @@
+//! Scenes whose task can never be done are refused at load, located: a scene without a block
+//! (nothing to pick), goals that stack blocks in a cycle (`a on b`, `b on a`), and a block
+//! wider than the inside of the container it must end in.
+
+use std::collections::BTreeMap;
+
+use super::goal::GoalAtom;
+use super::types::{SceneSpec, Shape};
+use crate::yaml::diag::{Issue, Loc};
+
+/// A scene without a block: the issue at `objects:` (`at`).
+pub(super) fn check_has_block(scene: &SceneSpec, at: Loc, issues: &mut Vec<Issue>) {
+    if scene.of_kind(super::ObjectKind::Block).next().is_none() {
+        issues.push(
+            Issue::new(at, format!("scene `{}` has no block", scene.name))
+                .label("expected at least one `NAME: {block: {...}, ...}` here")
+                .help("a tree picks and places blocks: add one (see docs/scenes.md)"),
+        );
+    }
+}
+
+/// Goals that can never hold together: an `on` cycle, or a block that does not fit inside its
+/// container.
+pub(super) fn check_goal_feasible(scene: &SceneSpec, atoms: &[(GoalAtom, Loc)], issues: &mut Vec<Issue>) {
+    // Each block has at most one goal (checked before), so following `on` from a block either
+    // ends or comes back: a cycle.
+    let on: BTreeMap<&str, (&str, Loc)> = atoms
+        .iter()
+        .filter_map(|(a, loc)| match a {
+            GoalAtom::On { object, support } if object != support => {
+                Some((object.as_str(), (support.as_str(), *loc)))
+            }
+            _ => None,
+        })
+        .collect();
+    let mut reported = std::collections::BTreeSet::new();
+    for (&start, &(_, loc)) in &on {
+        let mut path = vec![start];
+        let mut cur = start;
+        while let Some(&(next, _)) = on.get(cur) {
+            if next == start {
+                let mut members = path.clone();
+                members.sort_unstable();
+                if reported.insert(members) {
+                    path.push(start);
+                    issues.push(
+                        Issue::new(loc, format!("the `on` goals form a cycle: {}", path.join(" on ")))
+                            .label("a block cannot rest, through others, on itself")
+                            .help("make the bottom block of each stack rest on the table or in a container"),
+                    );
+                }
+                break;
+            }
+            if path.contains(&next) {
+                break; // a cycle that does not pass through `start`: reported from its own members
+            }
+            path.push(next);
+            cur = next;
+        }
+    }
+    for (a, loc) in atoms {
+        let GoalAtom::In { object, container } = a else {
+            continue;
+        };
+        let (Some(block), Some(bin)) = (scene.object(object.as_str()), scene.object(container.as_str()))
+        else {
+            continue;
+        };
+        if let (Shape::Block { half, .. }, Shape::Container { inner_half, .. }) = (&block.shape, &bin.shape) {
+            let inside = inner_half[0].min(inner_half[1]);
+            if *half >= inside {
+                issues.push(
+                    Issue::new(
+                        *loc,
+                        format!(
+                            "block `{object}` ({:.3} m wide) does not fit inside container `{container}` ({:.3} × {:.3} m inside)",
+                            2.0 * half,
+                            2.0 * inner_half[0],
+                            2.0 * inner_half[1]
+                        ),
+                    )
+                    .label("this goal can never hold")
+                    .help("make the block smaller or the container wider (see docs/scenes.md)"),
+                );
+            }
+        }
+    }
+}
