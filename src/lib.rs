@@ -10,7 +10,8 @@
 //! | layer | module | what it holds | MuJoCo? |
 //! |---|---|---|---|
 //! | 0 | [`motion`] | UR5e kinematics, closed-form IK, trajectories, gripper calibration | no |
-//! | 0 | [`output`] | safe output files (every file the CLI writes) | no |
+//! | 0 | [`cleanup`] | temporary files and staging folders removed on exit, on SIGINT/SIGTERM, or by a later run | no |
+//! | 1 | [`output`] | safe output files (every file the CLI writes) | no |
 //! | 0 | [`failure`] | typed failures: a stable kind, a message, the node, the cause | no |
 //! | 1 | [`yaml`] | located YAML: values with file:line:column, typed reads, diagnostics, units | no |
 //! | 2 | [`scene`] | scene files: named objects, placements, the goal | no |

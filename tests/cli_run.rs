@@ -236,8 +236,8 @@ fn a_scene_without_a_bowl_reports_no_bowl_target_and_prints_no_bowl_line() {
             "stderr: {}",
             String::from_utf8_lossy(&out.stderr)
         );
-        // The human summary: stdout without the JSON line.
-        let human: Vec<String> = String::from_utf8_lossy(&out.stdout)
+        // The human summary: with --json it goes to stderr (stdout holds only the JSON).
+        let human: Vec<String> = String::from_utf8_lossy(&out.stderr)
             .lines()
             .filter(|l| !l.starts_with('{'))
             .map(str::to_string)

@@ -35,7 +35,7 @@ const BUILD_RS: &str = r#"fn main() {
 /// tree on physics and prints the report, or (with arguments) is the command line.
 const MAIN_RS: &str = r#"use macrotree::episode::{EpisodeConfig, Goal};
 use macrotree::world::World;
-use macrotree::{App, Params};
+use macrotree::{App, Failure, Params};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -48,7 +48,7 @@ impl Params for Flat {}
 
 const FLAT_DOC: &str = "Every block rests flat (tilted less than 5°).\n\nHalt: nothing to halt (instantaneous).\n\n```yaml\nflat: {}\n```\n";
 
-fn flat(w: &World, _: &Flat) -> Result<bool, String> {
+fn flat(w: &World, _: &Flat) -> Result<bool, Failure> {
     Ok(w.objects.iter().zip(&w.scene.objects).all(|(o, spec)| {
         spec.kind() != macrotree::scene::ObjectKind::Block || {
             let r = o.quat.to_rotation_matrix();

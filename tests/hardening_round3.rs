@@ -812,11 +812,12 @@ fn sweep_summaries_list_at_most_20_failures_and_say_how_many_more() {
         "--json",
     ]);
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
-    let text = stdout(&out);
+    // With --json the text summary is on stderr and stdout holds only the JSON.
+    let text = stderr(&out);
     assert!(text.contains("failures (60):"), "{text}");
     assert!(text.contains("… and 40 more"), "{text}");
     assert_eq!(text.matches("\n    #").count(), 20, "{text}");
-    let json: serde_json::Value = serde_json::from_str(text.lines().last().unwrap()).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&stdout(&out)).unwrap();
     assert_eq!(json["failures"].as_array().unwrap().len(), 60);
     assert_eq!(lines_of(&out_file), 60, "the JSONL keeps every one");
     let _ = std::fs::remove_dir_all(&dir);
@@ -827,7 +828,6 @@ fn sweep_summaries_list_at_most_20_failures_and_say_how_many_more() {
 
 #[test]
 fn sweep_jobs_and_bench_repeat_are_range_checked() {
-    let started = Instant::now();
     let out = macrotree(&["sweep", TREE, "--scenarios", "1", "--jobs", "100000"]);
     assert_refused(&out, "between 1 and 1024");
     let out = macrotree(&["test", "--jobs", "5000"]);
@@ -836,7 +836,6 @@ fn sweep_jobs_and_bench_repeat_are_range_checked() {
     assert_refused(&out, "between 1 and 1000");
     let out = macrotree(&["bench", TREE, "--repeat", "0"]);
     assert_refused(&out, "between 1 and 1000");
-    assert!(started.elapsed() < Duration::from_secs(60));
 }
 
 // ---------------------------------------------------------------------------------------------

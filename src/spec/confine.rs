@@ -125,7 +125,7 @@ pub(crate) fn check_scene_path(
 }
 
 /// Checks `written`, a path read back from a results file (a scenario file's path), against
-/// the include rule with the current folder as the root: it must be relative and resolve inside
+/// the include rule with the current folder as the root: it must resolve inside
 /// the current folder, unless `anywhere` (the command line's `--allow-include-outside`) allows
 /// any path. `Err` says why.
 #[cfg(feature = "cli")]
@@ -136,8 +136,7 @@ pub fn check_path_from_results(written: &Path, anywhere: bool) -> Result<(), Str
     let cwd = std::env::current_dir()
         .and_then(|d| d.canonicalize())
         .map_err(|e| format!("the current folder cannot be resolved: {e}"))?;
-    let inside = !written.is_absolute()
-        && lexical(&cwd.join(written)).starts_with(&cwd)
+    let inside = lexical(&cwd.join(written)).starts_with(&cwd)
         && written.canonicalize().map_or(true, |c| c.starts_with(&cwd));
     if inside {
         Ok(())

@@ -34,7 +34,7 @@
 //! use macrotree::kinds::ObjectRef;
 //! use macrotree::world::{Part, World};
 //!
-//! fn upright(w: &World, object: &ObjectRef, max_tilt_rad: f64) -> Result<bool, String> {
+//! fn upright(w: &World, object: &ObjectRef, max_tilt_rad: f64) -> Result<bool, macrotree::Failure> {
 //!     let i = object_index(object, w)?; // "scene `cube_bowl` has no object `cbe`"
 //!     let o = &w.objects[i];
 //!     // The block's axis closest to world z, and its angle from it (it may rest on any face).
