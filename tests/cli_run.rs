@@ -236,12 +236,18 @@ fn a_scene_without_a_bowl_reports_no_bowl_target_and_prints_no_bowl_line() {
             "stderr: {}",
             String::from_utf8_lossy(&out.stderr)
         );
-        // The human summary: with --json it goes to stderr (stdout holds only the JSON).
+        // The human summary: with --json it goes to stderr (stdout holds only the JSON), after
+        // the episode's log lines (which name the scene), from its SUCCESS/FAILURE line on.
         let human: Vec<String> = String::from_utf8_lossy(&out.stderr)
             .lines()
-            .filter(|l| !l.starts_with('{'))
+            .skip_while(|l| !(l.starts_with("SUCCESS") || l.starts_with("FAILURE")))
             .map(str::to_string)
             .collect();
+        assert!(
+            !human.is_empty(),
+            "no summary: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         (last_json_line(&out), human.join("\n"))
     };
     // One block, no container: the cube is reported, no bowl anywhere.

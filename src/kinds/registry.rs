@@ -61,6 +61,25 @@ fn schema_of<P: JsonSchema>(g: &mut SchemaGenerator) -> String {
     P::schema_name().into_owned()
 }
 
+/// How a leaf kind's parameters are read, and what they declare.
+pub(crate) struct LeafImp {
+    parse: ParseParams,
+    schema: fn(&mut SchemaGenerator) -> String,
+    objects: &'static [(&'static str, ObjectRole)],
+    failures: &'static [&'static str],
+}
+
+impl LeafImp {
+    fn of<P: Params>() -> Self {
+        LeafImp {
+            parse: parse_params::<P>,
+            schema: schema_of::<P>,
+            objects: P::OBJECT_PARAMS,
+            failures: P::failure_kinds(),
+        }
+    }
+}
+
 /// How a kind is read.
 pub(crate) enum Imp {
     /// A composite or decorator: parsed by the tree reader; its parameters and schema are given.
@@ -68,18 +87,10 @@ pub(crate) enum Imp {
         params: fn() -> Vec<ParamDoc>,
         schema: fn(&SchemaCtx) -> serde_json::Value,
     },
-    Action {
-        parse: ParseParams,
-        schema: fn(&mut SchemaGenerator) -> String,
-        objects: &'static [(&'static str, ObjectRole)],
-        failures: &'static [&'static str],
-    },
-    Condition {
-        parse: ParseParams,
-        schema: fn(&mut SchemaGenerator) -> String,
-        objects: &'static [(&'static str, ObjectRole)],
-        failures: &'static [&'static str],
-    },
+    /// An action leaf.
+    Action(LeafImp),
+    /// A condition leaf.
+    Condition(LeafImp),
     Wait,
     Select,
 }
@@ -122,7 +133,7 @@ impl NodeType {
     /// ([`Params::OBJECT_PARAMS`] of the kind's parameter type; none for other kinds).
     pub fn object_params(&self) -> &'static [(&'static str, ObjectRole)] {
         match &self.imp {
-            Imp::Action { objects, .. } | Imp::Condition { objects, .. } => objects,
+            Imp::Action(l) | Imp::Condition(l) => l.objects,
             _ => &[],
         }
     }
@@ -131,7 +142,7 @@ impl NodeType {
     /// other kinds).
     pub fn failure_kinds(&self) -> &'static [&'static str] {
         match &self.imp {
-            Imp::Action { failures, .. } | Imp::Condition { failures, .. } => failures,
+            Imp::Action(l) | Imp::Condition(l) => l.failures,
             _ => &[],
         }
     }
@@ -151,8 +162,8 @@ impl NodeType {
         };
         Some(match &self.imp {
             Imp::Control { .. } => return None,
-            Imp::Action { parse, .. } => call(*parse).map(Leaf::Action),
-            Imp::Condition { parse, .. } => call(*parse).map(Leaf::Condition),
+            Imp::Action(l) => call(l.parse).map(Leaf::Action),
+            Imp::Condition(l) => call(l.parse).map(Leaf::Condition),
             Imp::Wait => crate::yaml::de::from_value::<Wait>(body).map(Leaf::Wait),
             Imp::Select => crate::yaml::de::from_value::<Select>(body).map(Leaf::Select),
         })
@@ -161,7 +172,7 @@ impl NodeType {
     /// The parameter type's schema definition name, after adding it to `g` (leaves only).
     pub(crate) fn leaf_schema(&self, g: &mut SchemaGenerator) -> Option<String> {
         match &self.imp {
-            Imp::Action { schema, .. } | Imp::Condition { schema, .. } => Some(schema(g)),
+            Imp::Action(l) | Imp::Condition(l) => Some((l.schema)(g)),
             Imp::Wait => Some(schema_of::<Wait>(g)),
             Imp::Select => Some(schema_of::<Select>(g)),
             Imp::Control { .. } => None,
@@ -252,17 +263,7 @@ impl Registry {
         doc: &'static str,
     ) -> Result<&mut Self, Error> {
         check_failure_kinds::<P>(name)?;
-        self.add(
-            name,
-            Category::Action,
-            doc,
-            Imp::Action {
-                parse: parse_params::<P>,
-                schema: schema_of::<P>,
-                objects: P::OBJECT_PARAMS,
-                failures: P::failure_kinds(),
-            },
-        )
+        self.add(name, Category::Action, doc, Imp::Action(LeafImp::of::<P>()))
     }
 
     /// Declares a condition leaf `name` whose parameters are `P` (an instantaneous check of the
@@ -277,17 +278,7 @@ impl Registry {
         doc: &'static str,
     ) -> Result<&mut Self, Error> {
         check_failure_kinds::<P>(name)?;
-        self.add(
-            name,
-            Category::Condition,
-            doc,
-            Imp::Condition {
-                parse: parse_params::<P>,
-                schema: schema_of::<P>,
-                objects: P::OBJECT_PARAMS,
-                failures: P::failure_kinds(),
-            },
-        )
+        self.add(name, Category::Condition, doc, Imp::Condition(LeafImp::of::<P>()))
     }
 
     pub(crate) fn add(
