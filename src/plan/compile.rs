@@ -4,7 +4,7 @@ use std::collections::HashMap;
 
 use bonsai_bt::Behavior;
 
-use super::{Check, Internal, LeafId, LeafInfo, NodeInfo, Plan};
+use super::{Check, Internal, LeafId, LeafInfo, NodeInfo, NodeTag, Plan};
 use crate::kinds::Leaf;
 use crate::kinds::leaves::fmt_num;
 use crate::spec::{Diagnostic, Issue, Node, NodeKind, Sources, Spec};
@@ -151,6 +151,7 @@ impl Compiler<'_> {
         self.nodes.push(NodeInfo {
             path: path.to_string(),
             kind: n.kind.kind_name(),
+            tag: NodeTag::of(&n.kind),
             category: n.kind.category(),
             name,
             parent,

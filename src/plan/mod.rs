@@ -98,6 +98,69 @@ pub struct LeafInfo {
     pub check: Option<Check>,
 }
 
+/// What a compiled node is, for the code that acts on it (the runner, the diagrams): a typed
+/// tag, where [`NodeInfo::kind`] is the YAML name shown to people.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum NodeTag {
+    /// `sequence`.
+    Sequence,
+    /// `fallback`.
+    Fallback,
+    /// `reactive_sequence`.
+    ReactiveSequence,
+    /// `reactive_fallback`.
+    ReactiveFallback,
+    /// `parallel`.
+    Parallel,
+    /// `race`.
+    Race,
+    /// `guard`.
+    Guard,
+    /// `retry`.
+    Retry,
+    /// `repeat`.
+    Repeat,
+    /// `for_each`.
+    ForEach,
+    /// `timeout`.
+    Timeout,
+    /// `inverter`.
+    Inverter,
+    /// `force_success`.
+    ForceSuccess,
+    /// `force_failure`.
+    ForceFailure,
+    /// A subtree call.
+    Subtree,
+    /// A leaf: an action, a condition, `wait` or `select`.
+    Leaf,
+}
+
+impl NodeTag {
+    /// The tag of a parsed node.
+    pub fn of(kind: &crate::spec::NodeKind) -> NodeTag {
+        use crate::spec::NodeKind as K;
+        match kind {
+            K::Sequence(_) => NodeTag::Sequence,
+            K::Fallback(_) => NodeTag::Fallback,
+            K::ReactiveSequence(_) => NodeTag::ReactiveSequence,
+            K::ReactiveFallback(_) => NodeTag::ReactiveFallback,
+            K::Parallel(_) => NodeTag::Parallel,
+            K::Race(_) => NodeTag::Race,
+            K::Guard { .. } => NodeTag::Guard,
+            K::Retry { .. } => NodeTag::Retry,
+            K::Repeat { .. } => NodeTag::Repeat,
+            K::ForEach { .. } => NodeTag::ForEach,
+            K::Timeout { .. } => NodeTag::Timeout,
+            K::Inverter(_) => NodeTag::Inverter,
+            K::ForceSuccess(_) => NodeTag::ForceSuccess,
+            K::ForceFailure(_) => NodeTag::ForceFailure,
+            K::Subtree { .. } => NodeTag::Subtree,
+            K::Leaf(_) => NodeTag::Leaf,
+        }
+    }
+}
+
 /// One node of the plan (composite, decorator, subtree call or leaf), in preorder.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct NodeInfo {
@@ -105,8 +168,11 @@ pub struct NodeInfo {
     /// `[name]` if the node has a `name:` (for subtree calls, the subtree's name), and `#k`
     /// (1-based) when siblings would otherwise share the segment.
     pub path: String,
-    /// The YAML node kind (`sequence`, `retry`, `reach`, …).
+    /// The YAML node kind (`sequence`, `retry`, `reach`, …), as shown to people.
     pub kind: &'static str,
+    /// What the node is, for the code that acts on it.
+    #[serde(skip)]
+    pub tag: NodeTag,
     /// What the node is (composite, decorator, action, condition, runtime leaf).
     pub category: crate::kinds::Category,
     /// The `name:` given in YAML (for a subtree call without a name: the subtree's name).

@@ -2,11 +2,11 @@
 
 use std::fmt::Write as _;
 
-use super::Plan;
+use super::{NodeTag, Plan};
 
 /// Visual family of a node: its category, with subtree calls on their own.
 fn family(n: &super::NodeInfo) -> &'static str {
-    if n.kind == "subtree" {
+    if n.tag == NodeTag::Subtree {
         "subtree"
     } else {
         n.category.as_str()
@@ -45,7 +45,7 @@ pub fn to_dot(plan: &Plan) -> String {
     }
     for (i, n) in plan.nodes.iter().enumerate() {
         for (k, c) in n.children.iter().enumerate() {
-            if n.kind == "guard" && k == 0 {
+            if n.tag == NodeTag::Guard && k == 0 {
                 let _ = writeln!(out, "  n{i} -> n{c} [label=\"while\", style=dashed];");
             } else {
                 let _ = writeln!(out, "  n{i} -> n{c};");
@@ -80,7 +80,7 @@ pub fn to_mermaid(plan: &Plan) -> String {
     }
     for (i, n) in plan.nodes.iter().enumerate() {
         for (k, c) in n.children.iter().enumerate() {
-            if n.kind == "guard" && k == 0 {
+            if n.tag == NodeTag::Guard && k == 0 {
                 let _ = writeln!(out, "  n{i} -. while .-> n{c}");
             } else {
                 let _ = writeln!(out, "  n{i} --> n{c}");

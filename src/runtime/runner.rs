@@ -10,7 +10,7 @@ use super::substitute::{Resolved, Scripted};
 use super::{LeafDriver, LeafOutcome, NodeCounts, NodeStatus, Transition, TreeStatus};
 use crate::failure::{Failure, FailureKind};
 use crate::kinds::{Leaf, Select};
-use crate::plan::{Internal, LeafId, Plan};
+use crate::plan::{Internal, LeafId, NodeTag, Plan};
 
 /// Pending transitions kept when nobody drains them; older ones are dropped (and counted).
 const MAX_PENDING_TRANSITIONS: usize = 100_000;
@@ -98,13 +98,13 @@ impl RunState {
                 let mut a = ancestors[p].clone();
                 a.push(p);
                 ancestors[i] = a;
-                enclosing_retry[i] = if plan.nodes[p].kind == "retry" {
+                enclosing_retry[i] = if plan.nodes[p].tag == NodeTag::Retry {
                     Some(p)
                 } else {
                     enclosing_retry[p]
                 };
             }
-            if plan.nodes[i].kind == "retry" {
+            if plan.nodes[i].tag == NodeTag::Retry {
                 enclosing_retry[i] = Some(i);
             }
         }
@@ -155,8 +155,12 @@ impl RunState {
         if info.leaf.is_some()
             || info.parent.is_none()
             || matches!(
-                info.kind,
-                "retry" | "guard" | "timeout" | "reactive_sequence" | "reactive_fallback"
+                info.tag,
+                NodeTag::Retry
+                    | NodeTag::Guard
+                    | NodeTag::Timeout
+                    | NodeTag::ReactiveSequence
+                    | NodeTag::ReactiveFallback
             )
         {
             Level::INFO
@@ -288,7 +292,10 @@ impl RunState {
             }
             self.touched[a] = tick;
             if self.statuses[a] != NodeStatus::Running {
-                if matches!(plan.nodes[a].kind, "retry" | "repeat" | "for_each") {
+                if matches!(
+                    plan.nodes[a].tag,
+                    NodeTag::Retry | NodeTag::Repeat | NodeTag::ForEach
+                ) {
                     self.attempts[a] = 1;
                 }
                 self.counts[a].activations += 1;
@@ -488,7 +495,7 @@ impl RunState {
                 let reset = self.reset_below(plan, node);
                 self.attempts[node] = iteration;
                 let info = &plan.nodes[node];
-                if info.kind == "retry" {
+                if info.tag == NodeTag::Retry {
                     tracing::info!(
                         target: "macrotree::tree",
                         tick = self.tick,
@@ -635,8 +642,8 @@ impl RunState {
                 .at(&info.path)
                 .caused_by(last.clone())
         };
-        match info.kind {
-            "timeout" => {
+        match info.tag {
+            NodeTag::Timeout => {
                 let child_failed = info.children.first().is_some_and(|&c| {
                     self.statuses[c] == NodeStatus::Failure && self.touched[c] == self.tick
                 });
@@ -646,15 +653,17 @@ impl RunState {
                     Failure::new(FailureKind::Timeout, format!("{} expired", info.label)).at(&info.path)
                 }
             }
-            "retry" => wrap(format!(
+            NodeTag::Retry => wrap(format!(
                 "all {} attempts failed; last: {last}",
                 self.attempts[node].max(1)
             )),
-            "inverter" => Failure::new(FailureKind::Inverted, "inverter: child succeeded").at(&info.path),
-            "force_failure" => {
+            NodeTag::Inverter => {
+                Failure::new(FailureKind::Inverted, "inverter: child succeeded").at(&info.path)
+            }
+            NodeTag::ForceFailure => {
                 Failure::new(FailureKind::Forced, "force_failure: child succeeded").at(&info.path)
             }
-            "guard" | "reactive_sequence" => {
+            NodeTag::Guard | NodeTag::ReactiveSequence => {
                 let cond_failed = info
                     .children
                     .iter()
