@@ -6,7 +6,7 @@ use macrotree::episode::{EpisodeConfig, EpisodeObserver, run_in_cell};
 use macrotree::faults::{FaultKind, injector_with_log};
 use macrotree::runtime::TreeRunner;
 use macrotree::sim::Layout;
-use macrotree::sweep::{SweepConfig, run_sweep};
+use macrotree::sweep::SweepConfig;
 
 #[path = "support/flagship.rs"]
 mod flagship;
@@ -14,7 +14,7 @@ mod flagship;
 mod logs;
 #[path = "support/oracle.rs"]
 mod oracle;
-use flagship::{plan, scene};
+use flagship::{plan, scene, sweep_flagship};
 
 #[test]
 fn ten_seeded_nudges_all_succeed() {
@@ -25,14 +25,7 @@ fn ten_seeded_nudges_all_succeed() {
         fault: Some(FaultKind::Nudge),
         ..SweepConfig::default()
     };
-    let run = run_sweep(
-        scene(),
-        &plan(),
-        &macrotree::factory::Factory::builtin(),
-        &config,
-        |_| {},
-    )
-    .expect("thread pool");
+    let run = sweep_flagship(&config);
     for r in &run.results {
         assert!(r.success, "#{} {:?}: {:?}", r.index, r.layout, r.failure_reason);
     }

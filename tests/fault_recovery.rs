@@ -8,7 +8,7 @@ use macrotree::episode::{EpisodeConfig, EpisodeObserver, run_in_cell};
 use macrotree::faults::{FaultKind, injector_with_log};
 use macrotree::runtime::TreeRunner;
 use macrotree::sim::Layout;
-use macrotree::sweep::{SweepConfig, run_sweep, sample_scenario};
+use macrotree::sweep::{SweepConfig, sample_scenario};
 use nalgebra::Vector3;
 
 #[path = "support/flagship.rs"]
@@ -17,7 +17,7 @@ mod flagship;
 mod logs;
 #[path = "support/oracle.rs"]
 mod oracle;
-use flagship::{plan, scene};
+use flagship::{plan, scene, sweep_flagship};
 
 /// The cube's and the bowl's positions after every tick.
 #[derive(Default)]
@@ -161,14 +161,7 @@ fn batch(kind: FaultKind) {
         fault: Some(kind),
         ..SweepConfig::default()
     };
-    let run = run_sweep(
-        scene(),
-        &plan(),
-        &macrotree::factory::Factory::builtin(),
-        &config,
-        |_| {},
-    )
-    .expect("thread pool");
+    let run = sweep_flagship(&config);
     assert_eq!(run.results.len(), 20);
     let ok = run.results.iter().filter(|r| r.success).count();
     eprintln!("{kind}: {ok}/20 recovered");

@@ -7,7 +7,7 @@ use macrotree::episode::{EpisodeConfig, EpisodeObserver, run_in_cell};
 use macrotree::faults::{FaultKind, injector_with_log};
 use macrotree::runtime::{NodeStatus, Transition, TreeRunner};
 use macrotree::sim::Layout;
-use macrotree::sweep::{SweepConfig, run_sweep, sample_scenario};
+use macrotree::sweep::{SweepConfig, sample_scenario};
 use nalgebra::Vector3;
 
 /// Half the edge of the 44 mm cube of the built-in scene, metres.
@@ -19,7 +19,7 @@ mod flagship;
 mod logs;
 #[path = "support/oracle.rs"]
 mod oracle;
-use flagship::{plan, scene};
+use flagship::{plan, scene, sweep_flagship};
 
 /// Records the transitions and the cube's position at every tick.
 #[derive(Default)]
@@ -147,14 +147,7 @@ fn ten_seeded_slips_all_recover_with_a_second_grasp() {
         fault: Some(FaultKind::Slip),
         ..SweepConfig::default()
     };
-    let run = run_sweep(
-        scene(),
-        &plan(),
-        &macrotree::factory::Factory::builtin(),
-        &config,
-        |_| {},
-    )
-    .expect("thread pool");
+    let run = sweep_flagship(&config);
     for r in &run.results {
         eprintln!(
             "#{}: success {} after {} grasp(s)",
