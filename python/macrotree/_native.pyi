@@ -1,0 +1,83 @@
+"""Type stubs of the native extension (``python/src/``)."""
+
+from typing import Any
+
+import numpy as np
+
+__version__: str
+
+class MacrotreeError(Exception):
+    """Invalid input: the message is located (``file:line:column``) and says what to do."""
+
+def gripper_command_for_width(width: float) -> float: ...
+
+class Env:
+    object_names: list[str]
+    cameras: list[str]
+    home: list[float]
+    task: str
+    task_description: str
+    control_period: float
+    def __init__(
+        self,
+        *,
+        scene: str | None,
+        tree: str | None,
+        control_period: float,
+        max_sim_time: float,
+        fault: str | None,
+        cameras: list[str],
+        image_size: tuple[int, int],
+        frame_rate: float | None,
+        render_camera: str | None,
+    ) -> None: ...
+    def reset(
+        self,
+        *,
+        seed: int,
+        layout: str | None = None,
+        scenario: int | None = None,
+        sweep_seed: int | None = None,
+        placement: dict[str, list[float]] | None = None,
+    ) -> dict[str, Any]: ...
+    def step_macro(self, action: dict[str, Any]) -> dict[str, Any]: ...
+    def step_ctrl(self, ctrl: np.ndarray) -> dict[str, Any]: ...
+    def step_leaf(self, text: str) -> dict[str, Any]: ...
+    def step_subtree(self, name: str) -> dict[str, Any]: ...
+    def observation(self) -> dict[str, Any]: ...
+    def render(self, camera: str | None, height: int, width: int) -> np.ndarray: ...
+    def take_frames(self) -> list[np.ndarray]: ...
+    def gripper_command_for_width(self, width: float) -> float: ...
+
+class VecEnv:
+    object_names: list[str]
+    def __init__(
+        self,
+        *,
+        num_envs: int,
+        threads: int | None,
+        scene: str | None,
+        tree: str | None,
+        control_period: float,
+        max_sim_time: float,
+        fault: str | None,
+        cameras: list[str],
+        image_size: tuple[int, int],
+    ) -> None: ...
+    def reset(
+        self,
+        *,
+        ids: list[int],
+        seeds: list[int],
+        layout: str | None = None,
+        scenario: int | None = None,
+        sweep_seed: int | None = None,
+        placement: dict[str, list[float]] | None = None,
+    ) -> list[dict[str, Any]]: ...
+    def step(self, ids: list[int], actions: list[Any]) -> list[dict[str, Any]]: ...
+    def send(self, ids: list[int], actions: list[Any]) -> None: ...
+    def recv(self, count: int) -> list[tuple[int, dict[str, Any]]]: ...
+    def render(self, camera: str | None, height: int, width: int) -> list[np.ndarray]: ...
+    def close(self) -> None: ...
+
+def write_mp4(path: str, frames: list[np.ndarray], fps: int) -> int: ...

@@ -1,0 +1,212 @@
+"""``MacroEnv``: a ``gymnasium.Env`` over the Rust ``macrotree`` environment.
+
+One ``step`` runs one macro action to completion on simulated time, closed loop inside the action
+(``action_mode="macro"``), or holds a 7-D joint + gripper target for one control period
+(``action_mode="ctrl"``). Any registered leaf runs through :meth:`MacroEnv.step_leaf`, a named
+subtree through :meth:`MacroEnv.step_subtree`. Everything heavy happens in Rust with the GIL
+released; this class converts arguments and results.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Mapping
+from typing import Any, Literal, SupportsFloat
+
+import gymnasium as gym
+import numpy as np
+
+from macrotree import _native
+from macrotree.spaces import (
+    ctrl_action_space,
+    macro_action_space,
+    macro_to_native,
+    observation_space,
+)
+
+ActionMode = Literal["macro", "ctrl"]
+Observation = dict[str, Any]
+StepReturn = tuple[Observation, SupportsFloat, bool, bool, dict[str, Any]]
+
+#: Reset options understood by :meth:`MacroEnv.reset` (anything else is refused).
+RESET_OPTIONS = ("layout", "scenario", "sweep_seed", "placement", "reset_mask")
+
+
+def _path(value: str | os.PathLike[str] | None) -> str | None:
+    return None if value is None else os.fspath(value)
+
+
+class MacroEnv(gym.Env[Observation, Any]):
+    """A UR5e + 2F-85 cell of a macrotree scene, stepped one macro action at a time.
+
+    Args:
+        scene: a scene file (``scenes/*.yaml``); ``None`` takes the tree's ``scene:``.
+        tree: a tree file, for :meth:`step_subtree` and a scene goal of the tree; optional.
+        action_mode: ``"macro"`` (a ``Dict`` mirroring TorchRL's ``RobotMacroAction``) or
+            ``"ctrl"`` (``Box(7)``: six joint targets in radians and the gripper command 0…255,
+            held for one control period).
+        render_mode: ``None``, ``"rgb_array"`` (``render()`` gives an H×W×3 ``uint8`` image of
+            ``render_camera`` now) or ``"rgb_array_list"`` (``render()`` gives the frames sampled
+            at ``render_fps`` of simulated time during the steps since the last call).
+        cameras: cameras whose images are added to observations under ``pixels``.
+        image_size: ``(height, width)`` of camera images and of ``render()``, pixels.
+        render_camera: the camera ``render()`` shows (default: the scene's first camera).
+        control_period: seconds of one ``ctrl`` step and of one macro ``steps`` unit (a whole
+            number of 2 ms physics steps; default 0.01 s, the reference's 5-step frame skip).
+        max_sim_time: simulated seconds after which an episode is truncated.
+        fault: a fault injected through physics (``slip``, ``nudge``, …), or ``None``.
+    """
+
+    metadata: dict[str, Any] = {"render_modes": ["rgb_array", "rgb_array_list"], "render_fps": 30}
+
+    def __init__(
+        self,
+        scene: str | os.PathLike[str] | None = None,
+        tree: str | os.PathLike[str] | None = None,
+        *,
+        action_mode: ActionMode = "macro",
+        render_mode: str | None = None,
+        cameras: tuple[str, ...] | list[str] = (),
+        image_size: tuple[int, int] = (240, 320),
+        render_camera: str | None = None,
+        control_period: float = 0.01,
+        max_sim_time: float = 120.0,
+        fault: str | None = None,
+    ) -> None:
+        if action_mode not in ("macro", "ctrl"):
+            raise ValueError(f"action_mode must be 'macro' or 'ctrl', got {action_mode!r}")
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(
+                f"render_mode must be None or one of {self.metadata['render_modes']}, "
+                f"got {render_mode!r}"
+            )
+        if scene is None and tree is None:
+            raise ValueError("MacroEnv needs a scene file, a tree file, or both")
+        self._native = _native.Env(
+            scene=_path(scene),
+            tree=_path(tree),
+            control_period=float(control_period),
+            max_sim_time=float(max_sim_time),
+            fault=fault,
+            cameras=list(cameras),
+            image_size=(int(image_size[0]), int(image_size[1])),
+            frame_rate=float(self.metadata["render_fps"]) if render_mode == "rgb_array_list" else None,
+            render_camera=render_camera,
+        )
+        self.action_mode: ActionMode = action_mode
+        self.render_mode = render_mode
+        self.cameras = list(cameras)
+        self.image_size = (int(image_size[0]), int(image_size[1]))
+        self.render_camera = render_camera
+        self.object_names: list[str] = list(self._native.object_names)
+        self.observation_space = observation_space(
+            len(self.object_names), self.cameras, self.image_size
+        )
+        self.action_space = macro_action_space() if action_mode == "macro" else ctrl_action_space()
+        # LeRobot's environment contract.
+        self.task = str(self._native.task)
+        self.task_description = str(self._native.task_description)
+        self._last_info: dict[str, Any] = {}
+
+    # --- Gymnasium API -------------------------------------------------------------------------
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[Observation, dict[str, Any]]:
+        """Starts an episode.
+
+        Without options the objects are placed by the scene's random sampler, seeded from
+        ``seed`` (through ``self.np_random``, so ``reset()`` after ``reset(seed=s)`` continues the
+        sequence deterministically). Options (at most one of them):
+
+        * ``{"layout": "default"}``: the scene's own placement (the reference's default layout);
+        * ``{"scenario": K, "sweep_seed": S}``: scenario K of sweep seed S, the placement
+          ``macrotree run --scenario K --sweep-seed S`` uses;
+        * ``{"placement": {"cube": [x, y, yaw], …}}``: explicit poses on the table (metres, radians) for
+          the objects named (the others as in the scene's default placement).
+        """
+        super().reset(seed=seed)
+        options = dict(options or {})
+        unknown = sorted(set(options) - set(RESET_OPTIONS))
+        if unknown:
+            raise ValueError(f"unknown reset option(s) {unknown}; expected {list(RESET_OPTIONS)}")
+        options.pop("reset_mask", None)
+        draw = int(self.np_random.integers(0, 2**63 - 1))
+        result = self._native.reset(
+            seed=draw,
+            layout=options.get("layout"),
+            scenario=options.get("scenario"),
+            sweep_seed=options.get("sweep_seed"),
+            placement=options.get("placement"),
+        )
+        self._last_info = dict(result["info"])
+        return result["obs"], dict(result["info"])
+
+    def step(self, action: Any) -> StepReturn:
+        """Runs one action: a macro to completion, or one control period of ``ctrl``."""
+        if self.action_mode == "macro":
+            result = self._native.step_macro(macro_to_native(action))
+        else:
+            ctrl = np.asarray(action, dtype=np.float64).reshape(-1)
+            if ctrl.shape != (7,):
+                raise ValueError(f"a ctrl action has 7 values, got shape {ctrl.shape}")
+            result = self._native.step_ctrl(ctrl)
+        return self._unpack(result)
+
+    def render(self) -> Any:
+        """``rgb_array``: an H×W×3 ``uint8`` image of ``render_camera`` now. ``rgb_array_list``:
+        the frames sampled during the steps since the last call (and the current one)."""
+        if self.render_mode is None:
+            gym.logger.warn("render() called with render_mode=None; pass render_mode='rgb_array'")
+            return None
+        if self.render_mode == "rgb_array_list":
+            return list(self._native.take_frames())
+        h, w = self.image_size
+        return self._native.render(self.render_camera, h, w)
+
+    def close(self) -> None:
+        """Releases nothing explicitly (the native cell is freed with the object); idempotent."""
+
+    # --- beyond Gymnasium ------------------------------------------------------------------------
+
+    def step_leaf(self, leaf: Mapping[str, Any] | str) -> StepReturn:
+        """Runs any registered leaf to completion, given as a mapping such as
+        ``{"reach": {"target": "cube", "offset": [0, 0, 0.12]}}`` (or its YAML/JSON text). A bad
+        mapping raises :class:`macrotree.MacrotreeError` with a located message."""
+        text = leaf if isinstance(leaf, str) else json.dumps(leaf)
+        return self._unpack(self._native.step_leaf(text))
+
+    def step_subtree(self, name: str = "main") -> StepReturn:
+        """Runs a named subtree of the tree (``"main"``: the whole tree) until it finishes."""
+        return self._unpack(self._native.step_subtree(name))
+
+    def observation(self) -> dict[str, Any]:
+        """The full typed observation of the cell now: joints and velocities, gripper width and
+        command, pinch pose, every object's pose, velocity and grasped flag by name, contacts."""
+        return dict(self._native.observation())
+
+    def object_pose(self, obs: Observation, name: str) -> np.ndarray:
+        """The pose ``[x, y, z, qw, qx, qy, qz]`` of object ``name`` in an observation."""
+        i = self.object_names.index(name)
+        return np.asarray(obs["environment_state"][7 * i : 7 * i + 7])
+
+    @property
+    def home(self) -> np.ndarray:
+        """The UR5e home joint angles, radians."""
+        return np.asarray(self._native.home, dtype=np.float64)
+
+    def gripper_command_for_width(self, width: float) -> float:
+        """The 2F-85 command (0…255) that closes the pads to ``width`` metres."""
+        return float(self._native.gripper_command_for_width(float(width)))
+
+    def _unpack(self, result: dict[str, Any]) -> StepReturn:
+        info = dict(result["info"])
+        self._last_info = info
+        return (
+            result["obs"],
+            float(result["reward"]),
+            bool(result["terminated"]),
+            bool(result["truncated"]),
+            info,
+        )

@@ -1,0 +1,143 @@
+"""The action and observation spaces, and the conversion of a Gymnasium action to a native one.
+
+The ``macro`` action mirrors TorchRL's ``RobotMacroAction`` as a ``Dict`` (TorchRL converts ``Dict``
+to a ``Composite``; it has no converter for ``OneOf``). The ``ctrl`` action is a ``Box(7)``: six arm
+joint targets and the gripper command, held for one control period.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+
+#: Largest ``steps`` or ``settle_steps`` of one macro (control periods; 6000 = 60 s at 10 ms).
+#: ``steps = 0`` runs the macro closed loop: until its motion is done and the arm has settled.
+MAX_MACRO_STEPS = 6000
+
+#: Reach of the workspace box for ``position``, metres (the UR5e reaches 0.85 m).
+POSITION_BOUND = 1.5
+
+#: Range of the gripper command (the 2F-85 actuator's ctrlrange: 0 open … 255 closed).
+GRIPPER_COMMAND_RANGE = (0.0, 255.0)
+
+#: Joint target bound, radians (the UR5e's ±2π; the elbow is limited to ±π by the robot).
+JOINT_BOUND = 2.0 * math.pi
+
+
+class MacroMode(enum.IntEnum):
+    """``mode`` of a macro action (the reference's ``RobotMacroActionMode`` ids)."""
+
+    WAIT = 0
+    REACH_JOINTS = 1
+    REACH_POSE = 2
+    OPEN_GRIPPER = 3
+    CLOSE_GRIPPER = 4
+    RESET = 5
+
+
+class Path(enum.IntEnum):
+    """``path`` of a ``REACH_POSE`` macro: joint-space interpolation or a straight Cartesian line."""
+
+    JOINT = 0
+    CARTESIAN = 1
+
+
+class Gripper(enum.IntEnum):
+    """``gripper`` of a macro action: the gripper during the motion (2 keeps it as it is)."""
+
+    OPEN = 0
+    CLOSED = 1
+    KEEP = 2
+
+
+def macro_action_space() -> spaces.Dict:
+    """The ``macro`` action space (one macro per ``env.step``)."""
+    f32 = np.float32
+    return spaces.Dict(
+        {
+            "mode": spaces.Discrete(len(MacroMode)),
+            "position": spaces.Box(-POSITION_BOUND, POSITION_BOUND, (3,), f32),
+            "quaternion": spaces.Box(-1.0, 1.0, (4,), f32),
+            "joints": spaces.Box(-JOINT_BOUND, JOINT_BOUND, (6,), f32),
+            "gripper": spaces.Discrete(len(Gripper)),
+            "gripper_command": spaces.Box(*GRIPPER_COMMAND_RANGE, (1,), f32),
+            "path": spaces.Discrete(len(Path)),
+            "steps": spaces.Box(0, MAX_MACRO_STEPS, (1,), np.int64),
+            "settle_steps": spaces.Box(0, MAX_MACRO_STEPS, (1,), np.int64),
+        }
+    )
+
+
+def ctrl_action_space() -> spaces.Box:
+    """The ``ctrl`` action space: six arm joint targets (radians) and the gripper command (0…255)."""
+    low = np.array([-JOINT_BOUND] * 6 + [GRIPPER_COMMAND_RANGE[0]], dtype=np.float32)
+    high = np.array([JOINT_BOUND] * 6 + [GRIPPER_COMMAND_RANGE[1]], dtype=np.float32)
+    return spaces.Box(low, high, dtype=np.float32)
+
+
+def observation_space(
+    objects: int, cameras: list[str], image_size: tuple[int, int]
+) -> spaces.Dict:
+    """Observations: ``agent_pos`` (the dataset's ``observation.state``: six joint angles and the
+    gripper closure, radians), ``environment_state`` (every object's x, y, z, qw, qx, qy, qz in scene
+    order: the dataset's ``observation.environment_state``), ``pinch`` (the gripper's pinch point and
+    orientation: x, y, z, qw, qx, qy, qz), and ``pixels`` (one H×W×3 ``uint8`` image per camera) when
+    cameras are asked for."""
+    f32 = np.float32
+    fields: dict[str, spaces.Space[Any]] = {
+        "agent_pos": spaces.Box(-np.inf, np.inf, (7,), f32),
+        "environment_state": spaces.Box(-np.inf, np.inf, (7 * objects,), f32),
+        "pinch": spaces.Box(-np.inf, np.inf, (7,), f32),
+    }
+    if cameras:
+        h, w = image_size
+        fields["pixels"] = spaces.Dict(
+            {c: spaces.Box(0, 255, (h, w, 3), np.uint8) for c in cameras}
+        )
+    return spaces.Dict(fields)
+
+
+def _vector(value: Any, n: int, name: str) -> list[float]:
+    array = np.asarray(value, dtype=np.float64).reshape(-1)
+    if array.shape != (n,):
+        raise ValueError(f"macro action `{name}` must have {n} values, got shape {array.shape}")
+    return [float(v) for v in array]
+
+
+def _scalar(value: Any, name: str) -> float:
+    array = np.asarray(value, dtype=np.float64).reshape(-1)
+    if array.shape != (1,):
+        raise ValueError(f"macro action `{name}` must be one value, got shape {array.shape}")
+    return float(array[0])
+
+
+def macro_to_native(action: Any) -> dict[str, Any]:
+    """A ``macro`` action (mapping) as the native extension takes it; raises ``ValueError`` on a
+    malformed one (missing key, wrong shape). Ranges are checked by the native side."""
+    if not isinstance(action, dict):
+        raise ValueError(f"a macro action is a dict of the action space's keys, got {type(action)}")
+    missing = [k for k in ("mode",) if k not in action]
+    if missing:
+        raise ValueError(f"macro action misses {missing}")
+    out: dict[str, Any] = {"mode": int(_scalar(action["mode"], "mode"))}
+    if "position" in action:
+        out["position"] = _vector(action["position"], 3, "position")
+    if "quaternion" in action:
+        out["quaternion"] = _vector(action["quaternion"], 4, "quaternion")
+    if "joints" in action:
+        out["joints"] = _vector(action["joints"], 6, "joints")
+    if "gripper" in action:
+        out["gripper"] = int(_scalar(action["gripper"], "gripper"))
+    if "gripper_command" in action:
+        out["gripper_command"] = _scalar(action["gripper_command"], "gripper_command")
+    if "path" in action:
+        out["path"] = int(_scalar(action["path"], "path"))
+    if "steps" in action:
+        out["steps"] = int(_scalar(action["steps"], "steps"))
+    if "settle_steps" in action:
+        out["settle_steps"] = int(_scalar(action["settle_steps"], "settle_steps"))
+    return out

@@ -1,0 +1,299 @@
+"""``VectorEnv``: N cells stepped on Rust threads with the GIL released.
+
+A ``gymnasium.vector.VectorEnv`` (registered as every id's ``vector_entry_point``) with the
+autoreset modes ``SAME_STEP`` and ``DISABLED`` (TorchRL refuses ``NEXT_STEP``), deterministic
+per-sub-environment seeds, and envpool-style :meth:`VectorEnv.send` / :meth:`VectorEnv.recv` that
+return whichever environments finish first: macros differ widely in duration, so a batch smaller
+than N keeps every core busy.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from gymnasium.vector import AutoresetMode
+from gymnasium.vector import VectorEnv as GymVectorEnv
+from gymnasium.utils import seeding
+from gymnasium.vector.utils import batch_space
+
+from macrotree import _native
+from macrotree.env import RESET_OPTIONS, ActionMode, MacroEnv, _path
+from macrotree.spaces import (
+    ctrl_action_space,
+    macro_action_space,
+    macro_to_native,
+    observation_space,
+)
+
+#: Most sub-environments one ``VectorEnv`` takes.
+MAX_ENVS = 1024
+
+
+def _stack(items: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for key, value in items[0].items():
+        if isinstance(value, dict):
+            out[key] = _stack([item[key] for item in items])
+        else:
+            out[key] = np.stack([np.asarray(item[key]) for item in items])
+    return out
+
+
+def _batch_infos(infos: Sequence[dict[str, Any] | None]) -> dict[str, Any]:
+    """Gymnasium's vector info layout: each key an array over sub-environments, with a boolean
+    mask ``_key`` saying which sub-environments gave it."""
+    n = len(infos)
+    out: dict[str, Any] = {}
+    for i, info in enumerate(infos):
+        if info is None:
+            continue
+        for key, value in info.items():
+            if key not in out:
+                if isinstance(value, (bool, np.bool_)):
+                    out[key] = np.zeros(n, dtype=bool)
+                elif isinstance(value, (int, np.integer)):
+                    out[key] = np.zeros(n, dtype=np.int64)
+                elif isinstance(value, (float, np.floating)):
+                    out[key] = np.zeros(n, dtype=np.float64)
+                else:
+                    out[key] = np.full(n, None, dtype=object)
+                out[f"_{key}"] = np.zeros(n, dtype=bool)
+            out[key][i] = value
+            out[f"_{key}"][i] = True
+    return out
+
+
+class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
+    """``num_envs`` macrotree cells, stepped in parallel in Rust.
+
+    Takes :class:`macrotree.MacroEnv`'s arguments, plus ``num_envs``, ``autoreset_mode``
+    (``SAME_STEP``, the default, or ``DISABLED``) and ``threads`` (worker threads; default: one per
+    core, at most ``num_envs``). Sub-environment *i* gives, bit for bit, what a single
+    ``MacroEnv`` gives with the same resets and actions.
+    """
+
+    metadata: dict[str, Any] = {
+        "render_modes": ["rgb_array"],
+        "render_fps": 30,
+        "autoreset_mode": AutoresetMode.SAME_STEP,
+    }
+
+    def __init__(
+        self,
+        scene: str | os.PathLike[str] | None = None,
+        tree: str | os.PathLike[str] | None = None,
+        *,
+        num_envs: int = 2,
+        action_mode: ActionMode = "macro",
+        autoreset_mode: AutoresetMode | str = AutoresetMode.SAME_STEP,
+        render_mode: str | None = None,
+        cameras: tuple[str, ...] | list[str] = (),
+        image_size: tuple[int, int] = (240, 320),
+        control_period: float = 0.01,
+        max_sim_time: float = 120.0,
+        fault: str | None = None,
+        threads: int | None = None,
+    ) -> None:
+        if not 1 <= int(num_envs) <= MAX_ENVS:
+            raise ValueError(f"num_envs must be 1…{MAX_ENVS}, got {num_envs}")
+        mode = AutoresetMode(autoreset_mode)
+        if mode not in (AutoresetMode.SAME_STEP, AutoresetMode.DISABLED):
+            raise ValueError(
+                f"autoreset_mode must be SAME_STEP or DISABLED (TorchRL refuses NEXT_STEP), got {mode}"
+            )
+        if action_mode not in ("macro", "ctrl"):
+            raise ValueError(f"action_mode must be 'macro' or 'ctrl', got {action_mode!r}")
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
+        if scene is None and tree is None:
+            raise ValueError("VectorEnv needs a scene file, a tree file, or both")
+        self.num_envs = int(num_envs)
+        self.autoreset_mode = mode
+        self.metadata = {**self.metadata, "autoreset_mode": mode}
+        self.action_mode: ActionMode = action_mode
+        self.render_mode = render_mode
+        self.image_size = (int(image_size[0]), int(image_size[1]))
+        self._native = _native.VecEnv(
+            num_envs=self.num_envs,
+            threads=threads,
+            scene=_path(scene),
+            tree=_path(tree),
+            control_period=float(control_period),
+            max_sim_time=float(max_sim_time),
+            fault=fault,
+            cameras=list(cameras),
+            image_size=self.image_size,
+        )
+        self.object_names: list[str] = list(self._native.object_names)
+        self.single_observation_space = observation_space(
+            len(self.object_names), list(cameras), self.image_size
+        )
+        self.single_action_space = (
+            macro_action_space() if action_mode == "macro" else ctrl_action_space()
+        )
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self._pending: set[int] = set()
+        self._rngs: list[np.random.Generator | None] = [None] * self.num_envs
+        self._last_obs: list[dict[str, Any] | None] = [None] * self.num_envs
+
+    def _draw(self, i: int, seed: int | None) -> int:
+        """Sub-environment *i*'s placement seed, drawn exactly as :meth:`MacroEnv.reset` draws it."""
+        rng = self._rngs[i]
+        if seed is not None or rng is None:
+            rng, _ = seeding.np_random(seed)
+            self._rngs[i] = rng
+        return int(rng.integers(0, 2**63 - 1))
+
+    # --- Gymnasium vector API --------------------------------------------------------------------
+
+    def reset(
+        self, *, seed: int | list[int | None] | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, Any], dict[str, Any]]:
+        """Resets every sub-environment, or those of ``options["reset_mask"]``. An int seed gives
+        sub-environment *i* the seed ``seed + i``; a list gives one seed each. Other options are
+        :meth:`MacroEnv.reset`'s, applied to every sub-environment reset."""
+        if isinstance(seed, int):
+            seeds: list[int | None] = [seed + i for i in range(self.num_envs)]
+        elif seed is None:
+            seeds = [None] * self.num_envs
+        else:
+            seeds = list(seed)
+            if len(seeds) != self.num_envs:
+                raise ValueError(f"{len(seeds)} seeds for {self.num_envs} environments")
+        super().reset(seed=seeds[0] if seed is not None else None)
+        options = dict(options or {})
+        unknown = sorted(set(options) - set(RESET_OPTIONS))
+        if unknown:
+            raise ValueError(f"unknown reset option(s) {unknown}; expected {list(RESET_OPTIONS)}")
+        mask = options.pop("reset_mask", None)
+        ids = (
+            list(range(self.num_envs))
+            if mask is None
+            else [int(i) for i in np.flatnonzero(np.asarray(mask, dtype=bool))]
+        )
+        draws = [self._draw(i, seeds[i]) for i in ids]
+        results = self._native.reset(ids=ids, seeds=draws, **options)
+        return self._gather(ids, results)
+
+    def step(
+        self, actions: Any
+    ) -> tuple[dict[str, Any], np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        """Steps every sub-environment with its action, in parallel. Under ``SAME_STEP`` a
+        sub-environment that ended is reset in the same step; its last observation and info are in
+        ``info["final_obs"]`` and ``info["final_info"]``."""
+        ids = list(range(self.num_envs))
+        results = self._native.step(ids, self._native_actions(actions, self.num_envs))
+        return self._finish(ids, results)
+
+    def send(self, actions: Any, env_ids: Sequence[int] | np.ndarray | None = None) -> None:
+        """Starts the actions of ``env_ids`` (default: all) on the worker threads and returns at
+        once; collect the results with :meth:`recv`."""
+        ids = list(range(self.num_envs)) if env_ids is None else [int(i) for i in env_ids]
+        busy = self._pending.intersection(ids)
+        if busy:
+            raise ValueError(f"environments {sorted(busy)} are still running; recv() them first")
+        self._native.send(ids, self._native_actions(actions, len(ids)))
+        self._pending.update(ids)
+
+    def recv(
+        self, batch_size: int | None = None
+    ) -> tuple[dict[str, Any], np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        """Waits until ``batch_size`` (default: all pending) sub-environments finished and returns
+        their results; ``info["env_id"]`` says which, in the order they finished."""
+        if not self._pending:
+            raise ValueError("recv() with nothing sent")
+        want = len(self._pending) if batch_size is None else int(batch_size)
+        if not 1 <= want <= len(self._pending):
+            raise ValueError(f"batch_size must be 1…{len(self._pending)}, got {batch_size}")
+        done = self._native.recv(want)
+        ids = [int(i) for i, _ in done]
+        self._pending.difference_update(ids)
+        obs, rew, term, trunc, info = self._finish(ids, [r for _, r in done])
+        info["env_id"] = np.asarray(ids, dtype=np.int64)
+        return obs, rew, term, trunc, info
+
+    def render(self) -> tuple[np.ndarray, ...] | None:
+        """One H×W×3 ``uint8`` image per sub-environment (``render_mode="rgb_array"``)."""
+        if self.render_mode is None:
+            return None
+        h, w = self.image_size
+        return tuple(self._native.render(None, h, w))
+
+    def close_extras(self, **kwargs: Any) -> None:
+        """Waits for the actions still running, then frees the cells."""
+        self._native.close()
+        self._pending.clear()
+
+    # --- helpers -----------------------------------------------------------------------------------
+
+    def _native_actions(self, actions: Any, n: int) -> list[Any]:
+        if self.action_mode == "ctrl":
+            array = np.asarray(actions, dtype=np.float64)
+            if array.shape != (n, 7):
+                raise ValueError(f"ctrl actions must have shape ({n}, 7), got {array.shape}")
+            return [row for row in array]
+        if isinstance(actions, dict):
+            return [
+                macro_to_native({k: np.asarray(v)[i] for k, v in actions.items()})
+                for i in range(n)
+            ]
+        items = list(actions)
+        if len(items) != n:
+            raise ValueError(f"{len(items)} macro actions for {n} environments")
+        return [macro_to_native(a) for a in items]
+
+    def _gather(
+        self, ids: list[int], results: list[dict[str, Any]]
+    ) -> tuple[dict[str, Any], dict[str, Any]]:
+        """The whole batch after a (maybe partial) reset: reset sub-environments give their new
+        observation and info, the others their last observation and no info."""
+        infos: list[dict[str, Any] | None] = [None] * self.num_envs
+        for i, r in zip(ids, results, strict=True):
+            self._last_obs[i] = r["obs"]
+            infos[i] = dict(r["info"])
+        missing = [i for i, o in enumerate(self._last_obs) if o is None]
+        if missing:
+            raise ValueError(f"environments {missing} were never reset; reset them all first")
+        return _stack(self._last_obs), _batch_infos(infos)  # type: ignore[arg-type]
+
+    def _finish(
+        self, ids: list[int], results: list[dict[str, Any]]
+    ) -> tuple[dict[str, Any], np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        rewards = np.array([float(r["reward"]) for r in results], dtype=np.float64)
+        terminated = np.array([bool(r["terminated"]) for r in results], dtype=bool)
+        truncated = np.array([bool(r["truncated"]) for r in results], dtype=bool)
+        observations = [r["obs"] for r in results]
+        infos: list[dict[str, Any] | None] = [dict(r["info"]) for r in results]
+        ended = [k for k in range(len(ids)) if terminated[k] or truncated[k]]
+        final_obs: list[Any] = [None] * len(ids)
+        final_info: list[Any] = [None] * len(ids)
+        if self.autoreset_mode == AutoresetMode.SAME_STEP and ended:
+            again = self._native.reset(
+                ids=[ids[k] for k in ended], seeds=[self._draw(ids[k], None) for k in ended]
+            )
+            for k, r in zip(ended, again):
+                final_obs[k] = observations[k]
+                final_info[k] = infos[k]
+                observations[k] = r["obs"]
+                infos[k] = dict(r["info"])
+        for i, o in zip(ids, observations, strict=True):
+            self._last_obs[i] = o
+        info = _batch_infos(infos)
+        if ended and self.autoreset_mode == AutoresetMode.SAME_STEP:
+            info["final_obs"] = np.array(final_obs, dtype=object)
+            info["final_info"] = np.array(final_info, dtype=object)
+            info["_final_obs"] = np.array([x is not None for x in final_obs], dtype=bool)
+            info["_final_info"] = info["_final_obs"].copy()
+        return _stack(observations), rewards, terminated, truncated, info
+
+
+def make_single(**kwargs: Any) -> MacroEnv:
+    """A single :class:`MacroEnv` with the same arguments (for comparisons)."""
+    kwargs.pop("num_envs", None)
+    kwargs.pop("autoreset_mode", None)
+    kwargs.pop("threads", None)
+    return MacroEnv(**kwargs)

@@ -1,0 +1,125 @@
+//! Results as Python values: observations as dicts of numpy arrays, step results as
+//! `{"obs", "reward", "terminated", "truncated", "info"}` with Python bools and floats.
+
+use macrotree::env::{Observation, StepResult};
+use numpy::{IntoPyArray, PyArray3};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+/// Camera images to add to an observation under `pixels`, by camera name (H×W×3 bytes).
+pub type Pixels = Vec<(String, u32, u32, Vec<u8>)>;
+
+/// The Gymnasium observation: `agent_pos`, `environment_state`, `pinch` (float32), and `pixels`.
+pub fn observation<'py>(
+    py: Python<'py>,
+    o: &Observation,
+    pixels: Pixels,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("agent_pos", o.state().to_vec().into_pyarray(py))?;
+    d.set_item("environment_state", o.environment_state().into_pyarray(py))?;
+    let pinch: Vec<f32> = o.pinch_pos.iter().chain(&o.pinch_quat).map(|&v| v as f32).collect();
+    d.set_item("pinch", pinch.into_pyarray(py))?;
+    if !pixels.is_empty() {
+        let images = PyDict::new(py);
+        for (name, w, h, rgb) in pixels {
+            let array = rgb.into_pyarray(py).reshape([h as usize, w as usize, 3])?;
+            let array: Bound<'py, PyArray3<u8>> = array;
+            images.set_item(name, array)?;
+        }
+        d.set_item("pixels", images)?;
+    }
+    Ok(d)
+}
+
+/// The full typed observation as nested dicts (`objects` keyed by name).
+pub fn full_observation<'py>(py: Python<'py>, o: &Observation) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("time", o.time)?;
+    d.set_item("joint_pos", o.joint_pos.to_vec())?;
+    d.set_item("joint_vel", o.joint_vel.to_vec())?;
+    d.set_item("joint_target", o.joint_target.to_vec())?;
+    d.set_item("gripper_joint", o.gripper_joint)?;
+    d.set_item("gripper_width", o.gripper_width)?;
+    d.set_item("gripper_command", o.gripper_command)?;
+    d.set_item("pinch_pos", o.pinch_pos.to_vec())?;
+    d.set_item("pinch_quat", o.pinch_quat.to_vec())?;
+    d.set_item("left_pad", o.left_pad_pos.to_vec())?;
+    d.set_item("right_pad", o.right_pad_pos.to_vec())?;
+    let objects = PyDict::new(py);
+    for ob in &o.objects {
+        let x = PyDict::new(py);
+        x.set_item("kind", ob.kind)?;
+        x.set_item("pos", ob.pos.to_vec())?;
+        x.set_item("quat", ob.quat.to_vec())?;
+        x.set_item("linvel", ob.linvel.to_vec())?;
+        x.set_item("angvel", ob.angvel.to_vec())?;
+        x.set_item("grasped", ob.grasped)?;
+        x.set_item("half_size", ob.half_size)?;
+        objects.set_item(&ob.name, x)?;
+    }
+    d.set_item("objects", objects)?;
+    let contacts = PyList::empty(py);
+    for c in &o.contacts {
+        contacts.append((c.a.as_str(), c.b.as_str()))?;
+    }
+    d.set_item("contacts", contacts)?;
+    Ok(d)
+}
+
+/// The info of a reset: success so far, the goal predicates, grasped flags.
+pub fn reset_info<'py>(py: Python<'py>, o: &Observation, goal: &[macrotree::world::goal::GoalValue]) -> PyResult<Bound<'py, PyDict>> {
+    let info = PyDict::new(py);
+    let success = !goal.is_empty() && goal.iter().all(|g| g.holds);
+    info.set_item("is_success", success)?;
+    info.set_item("goal", goal_dict(py, goal)?)?;
+    info.set_item("grasped", grasped(py, o)?)?;
+    info.set_item("episode_sim_time", o.time)?;
+    Ok(info)
+}
+
+fn goal_dict<'py>(py: Python<'py>, goal: &[macrotree::world::goal::GoalValue]) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for g in goal {
+        d.set_item(&g.predicate, g.holds)?;
+    }
+    Ok(d)
+}
+
+fn grasped<'py>(py: Python<'py>, o: &Observation) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for ob in &o.objects {
+        d.set_item(&ob.name, ob.grasped)?;
+    }
+    Ok(d)
+}
+
+/// A step's result as `{"obs", "reward", "terminated", "truncated", "info"}`.
+pub fn step_result<'py>(
+    py: Python<'py>,
+    r: &StepResult,
+    pixels: Pixels,
+) -> PyResult<Bound<'py, PyDict>> {
+    let out = PyDict::new(py);
+    out.set_item("obs", observation(py, &r.observation, pixels)?)?;
+    out.set_item("reward", r.reward)?;
+    out.set_item("terminated", r.terminated)?;
+    out.set_item("truncated", r.truncated)?;
+    let info = reset_info(py, &r.observation, &r.goal)?;
+    info.set_item("status", if r.success() { "success" } else { "failure" })?;
+    let f = r.failure.as_ref();
+    info.set_item("failure_kind", f.map(|f| f.kind.as_str()))?;
+    info.set_item("failure_message", f.map(|f| f.message.as_str()))?;
+    info.set_item("failure_node", f.and_then(|f| f.node.as_deref()))?;
+    info.set_item("sim_time", r.sim_time)?;
+    info.set_item("physics_steps", r.physics_steps)?;
+    info.set_item("goal_steps", r.goal_ticks)?;
+    let collisions: Vec<&str> = r.collisions.iter().map(|c| c.what.as_str()).collect();
+    info.set_item("collisions", collisions)?;
+    info.set_item("faults", r.faults_fired.clone())?;
+    if !r.rewards.is_empty() {
+        info.set_item("rewards", r.rewards.clone().into_pyarray(py))?;
+    }
+    out.set_item("info", info)?;
+    Ok(out)
+}

@@ -1,0 +1,183 @@
+//! `VecEnv`: `macrotree::env::VecEnv` for Python — N cells on Rust worker threads, the GIL
+//! released while they step.
+
+use macrotree::env::{Action, Reset};
+use numpy::{IntoPyArray, PyArray3, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use crate::convert;
+use crate::env::{pixels, reset_of};
+use crate::error::{to_py, value};
+use crate::macro_action;
+use crate::setup::{self, Settings};
+
+/// N environments stepped in parallel.
+#[pyclass(module = "macrotree._native")]
+pub struct VecEnv {
+    inner: macrotree::env::VecEnv,
+    names: Vec<String>,
+    cameras: Vec<String>,
+    image: (u32, u32),
+}
+
+/// An action from Python: a macro dict or a 7-value ctrl array.
+fn action_of(a: &Bound<'_, PyAny>) -> PyResult<Action> {
+    if let Ok(d) = a.cast::<PyDict>() {
+        return Ok(Action::Primitive(macro_action::primitive(d)?));
+    }
+    let ctrl: PyReadonlyArray1<'_, f64> = a
+        .extract()
+        .map_err(|_| value("an action is a macro dict or 7 float64 ctrl values"))?;
+    let u: [f64; 7] = ctrl
+        .as_slice()?
+        .try_into()
+        .map_err(|_| value("a ctrl action has 7 values"))?;
+    Ok(Action::Ctrl(u))
+}
+
+impl VecEnv {
+    fn result<'py>(&self, py: Python<'py>, i: usize, r: Result<macrotree::env::StepResult, macrotree::Error>) -> PyResult<Bound<'py, PyDict>> {
+        let r = r.map_err(to_py)?;
+        let px = if self.cameras.is_empty() {
+            Vec::new()
+        } else {
+            self.inner.with_env(i, |e| pixels(e, &self.cameras, self.image)).map_err(to_py)??
+        };
+        convert::step_result(py, &r, px)
+    }
+}
+
+#[pymethods]
+impl VecEnv {
+    #[new]
+    #[pyo3(signature = (*, num_envs, threads, scene, tree, control_period, max_sim_time, fault, cameras, image_size))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        num_envs: usize,
+        threads: Option<usize>,
+        scene: Option<String>,
+        tree: Option<String>,
+        control_period: f64,
+        max_sim_time: f64,
+        fault: Option<String>,
+        cameras: Vec<String>,
+        image_size: (u32, u32),
+    ) -> PyResult<Self> {
+        let settings = Settings {
+            scene: scene.as_deref(),
+            tree: tree.as_deref(),
+            control_period,
+            max_sim_time,
+            fault: fault.as_deref(),
+        };
+        let parts = py.detach(|| setup::build(&settings))?;
+        let names = parts.scene.spec.objects.iter().map(|o| o.name.clone()).collect();
+        let threads = threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |c| c.get()));
+        let inner = py
+            .detach(|| macrotree::env::VecEnv::with_threads(&parts.app, parts.scene, parts.tree, parts.config, num_envs, threads))
+            .map_err(to_py)?;
+        Ok(Self { inner, names, cameras, image: image_size })
+    }
+
+    #[getter]
+    fn object_names(&self) -> Vec<String> {
+        self.names.clone()
+    }
+
+    #[pyo3(signature = (*, ids, seeds, layout=None, scenario=None, sweep_seed=None, placement=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn reset<'py>(
+        &mut self,
+        py: Python<'py>,
+        ids: Vec<usize>,
+        seeds: Vec<u64>,
+        layout: Option<String>,
+        scenario: Option<u64>,
+        sweep_seed: Option<u64>,
+        placement: Option<Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyList>> {
+        if ids.len() != seeds.len() {
+            return Err(value(format!("{} ids but {} seeds", ids.len(), seeds.len())));
+        }
+        let default = self.inner.with_env(0, |e| e.scene().default_placement()).map_err(to_py)?;
+        let how = seeds
+            .iter()
+            .map(|&s| reset_of(&self.names, &default, s, layout.as_deref(), scenario, sweep_seed, placement.as_ref()))
+            .collect::<PyResult<Vec<Reset>>>()?;
+        let inner = &mut self.inner;
+        let obs = py.detach(|| inner.reset_each(&ids, &how)).map_err(to_py)?;
+        let out = PyList::empty(py);
+        for (&i, o) in ids.iter().zip(&obs) {
+            let goal = self.inner.with_env(i, |e| macrotree::world::goal::evaluate(e.cell().world())).map_err(to_py)?;
+            let px = if self.cameras.is_empty() { Vec::new() } else { self.inner.with_env(i, |e| pixels(e, &self.cameras, self.image)).map_err(to_py)?? };
+            let d = PyDict::new(py);
+            d.set_item("obs", convert::observation(py, o, px)?)?;
+            d.set_item("info", convert::reset_info(py, o, &goal)?)?;
+            out.append(d)?;
+        }
+        Ok(out)
+    }
+
+    /// Steps environments `ids` with `actions` in parallel; results in the order of `ids`.
+    fn step<'py>(&mut self, py: Python<'py>, ids: Vec<usize>, actions: Vec<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyList>> {
+        let actions = actions.iter().map(action_of).collect::<PyResult<Vec<_>>>()?;
+        let inner = &mut self.inner;
+        py.detach(|| inner.send(&ids, &actions)).map_err(to_py)?;
+        let inner = &mut self.inner;
+        let mut done = py.detach(|| inner.recv(ids.len())).map_err(to_py)?;
+        let order = |i: &usize| ids.iter().position(|j| j == i).unwrap_or(usize::MAX);
+        done.sort_by_key(|(i, _)| order(i));
+        let out = PyList::empty(py);
+        for (i, r) in done {
+            out.append(self.result(py, i, r)?)?;
+        }
+        Ok(out)
+    }
+
+    /// Starts `actions` on environments `ids` and returns at once.
+    fn send<'py>(&mut self, py: Python<'py>, ids: Vec<usize>, actions: Vec<Bound<'py, PyAny>>) -> PyResult<()> {
+        let actions = actions.iter().map(action_of).collect::<PyResult<Vec<_>>>()?;
+        let inner = &mut self.inner;
+        py.detach(|| inner.send(&ids, &actions)).map_err(to_py)
+    }
+
+    /// Waits for at least `count` environments to finish; `[(id, result)]` in finishing order.
+    fn recv<'py>(&mut self, py: Python<'py>, count: usize) -> PyResult<Bound<'py, PyList>> {
+        let inner = &mut self.inner;
+        let done = py.detach(|| inner.recv(count)).map_err(to_py)?;
+        let out = PyList::empty(py);
+        for (i, r) in done {
+            out.append((i, self.result(py, i, r)?))?;
+        }
+        Ok(out)
+    }
+
+    #[pyo3(signature = (camera, height, width))]
+    fn render<'py>(&self, py: Python<'py>, camera: Option<String>, height: u32, width: u32) -> PyResult<Vec<Bound<'py, PyArray3<u8>>>> {
+        (0..self.inner.num_envs())
+            .map(|i| {
+                let img = self
+                    .inner
+                    .with_env(i, |e| {
+                        let cam = camera.clone().or_else(|| e.scene().camera_names().into_iter().next()).unwrap_or_default();
+                        e.render(&cam, width, height)
+                    })
+                    .map_err(to_py)?
+                    .map_err(to_py)?;
+                img.pixels.into_pyarray(py).reshape([img.height as usize, img.width as usize, 3])
+            })
+            .collect()
+    }
+
+    /// Waits for running actions, then stops the worker threads.
+    fn close(&mut self, py: Python<'_>) -> PyResult<()> {
+        let inner = &mut self.inner;
+        let pending = inner.pending();
+        if pending > 0 {
+            py.detach(|| inner.recv(pending)).map_err(to_py)?;
+        }
+        Ok(())
+    }
+}
