@@ -43,11 +43,18 @@ pub enum Error {
         /// What is out of range, and the accepted range.
         message: String,
     },
+    /// An environment action or reset was refused before anything was simulated (a NaN, a
+    /// joint out of its limits, an unknown subtree, a step after the simulation became
+    /// unstable); the message says which value and the accepted range.
+    Action {
+        /// What is wrong, and what is accepted.
+        message: String,
+    },
 }
 
 impl Error {
     /// A stable, machine-readable name of the failure: `invalid_tree`, `invalid_scene`,
-    /// `simulator`, `registry` or `config`.
+    /// `simulator`, `registry`, `config` or `invalid_action`.
     pub fn kind(&self) -> &'static str {
         match self {
             Error::Tree { .. } => "invalid_tree",
@@ -55,6 +62,7 @@ impl Error {
             Error::Simulator { .. } => "simulator",
             Error::Registry { .. } => "registry",
             Error::Config { .. } => "config",
+            Error::Action { .. } => "invalid_action",
         }
     }
 
@@ -95,7 +103,7 @@ impl fmt::Display for Error {
             Error::Registry { kind, message } => {
                 write!(f, "error: cannot register node kind `{kind}`: {message}")
             }
-            Error::Config { message } => write!(f, "error: {message}"),
+            Error::Config { message } | Error::Action { message } => write!(f, "error: {message}"),
         }
     }
 }

@@ -31,6 +31,7 @@
 //! | 12 | `app` | the library entry point: register, load, run | yes |
 //! | 12 | `sweep` | parallel seeded sweeps, summaries, shards, resume | yes |
 //! | 12 | `viewer` | MeshCat in the browser, live and replay | yes |
+//! | 13 | `env` | a step-wise environment: reset, one macro action per step, observations; vector env | yes |
 //! | 13 | `dataset` | LeRobot v3.0 datasets | yes |
 //! | 13 | `suite` | scenario suites (`macrotree test`): files, expectations, JUnit | yes |
 //! | 14 | `cli` | the command line | yes |
@@ -164,6 +165,8 @@ pub mod cleanup;
 pub mod cli;
 #[cfg(feature = "sim")]
 pub mod dataset;
+#[cfg(feature = "sim")]
+pub mod env;
 #[cfg(feature = "sim")]
 pub mod episode;
 pub mod error;

@@ -9,23 +9,15 @@ use std::time::{Duration, Instant};
 use serde::Serialize;
 
 use crate::actions::Cell;
-use crate::episode::EpisodeObserver;
+use crate::episode::{EpisodeObserver, vectors};
 use crate::plan::Plan;
 use crate::render::{FrameSize, font, with_thread_renderer};
 use crate::runtime::TreeRunner;
 use crate::video::VideoEncoder;
 
 /// Names of the 7 values of `observation.state` (and `action`): the UR5e's joints, then the
-/// gripper.
-pub const STATE_NAMES: [&str; 7] = [
-    "shoulder_pan",
-    "shoulder_lift",
-    "elbow",
-    "wrist_1",
-    "wrist_2",
-    "wrist_3",
-    "gripper",
-];
+/// gripper. One definition with the environment's observation ([`crate::episode::vectors`]).
+pub use crate::episode::vectors::STATE_NAMES;
 
 /// One sampled frame of an episode.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -181,22 +173,17 @@ impl EpisodeRecorder {
     }
 
     fn sample(&self, cell: &Cell, runner: &TreeRunner, sim_time: f64) -> FrameRecord {
+        // The flat vectors are the environment's observation's: one definition for both.
         let world = cell.world();
         let sim = cell.sim();
-        let scene = sim.scene();
-        let mut state = [0f32; 7];
-        let mut action = [0f32; 7];
-        let setpoint = cell.arm_setpoint();
-        for i in 0..6 {
-            state[i] = world.arm_q[i] as f32;
-            action[i] = setpoint[i] as f32;
-        }
-        state[6] = sim.data().qpos()[scene.ids.gripper_driver_qpos] as f32;
-        action[6] = cell.gripper_command() as f32;
-        let mut environment = Vec::with_capacity(world.objects.len() * 7);
+        let gripper_joint = sim.data().qpos()[sim.scene().ids.gripper_driver_qpos];
+        let state = vectors::state_vector(&world.arm_q, gripper_joint);
+        let action = vectors::command_vector(&cell.arm_setpoint(), cell.gripper_command());
+        let mut environment = Vec::with_capacity(world.objects.len() * vectors::VALUES_PER_OBJECT);
         for o in &world.objects {
             let q = o.quat.quaternion();
-            environment.extend([o.pos.x, o.pos.y, o.pos.z, q.w, q.i, q.j, q.k].map(|v| v as f32));
+            let p = [o.pos.x, o.pos.y, o.pos.z];
+            environment.extend(vectors::pose_vector(&p, &[q.w, q.i, q.j, q.k]));
         }
         let (mut paths, mut kinds) = (Vec::new(), Vec::new());
         for id in runner.running_leaves() {

@@ -4,6 +4,8 @@
 
 mod driver;
 mod report;
+pub mod scenario;
+pub mod vectors;
 
 use std::sync::Arc;
 use std::time::Instant;

@@ -101,6 +101,26 @@ impl Loader {
         )?)
     }
 
+    /// Like [`compile_str`](Self::compile_str), with object names checked against and run on
+    /// `scene` when given (instead of the tree's own `scene:` or the built-in `cube_bowl`).
+    ///
+    /// # Errors
+    /// As for [`load`](Self::load).
+    pub fn compile_str_for(
+        &self,
+        text: &str,
+        file_name: &str,
+        scene: Option<Arc<SceneSpec>>,
+    ) -> Result<Plan, Vec<Diagnostic>> {
+        compile_spec(&load(
+            &self.options(scene),
+            Source::Text {
+                text,
+                name: file_name,
+            },
+        )?)
+    }
+
     /// Reads, validates and compiles a tree from raw bytes (a file's content), as
     /// [`load`](Self::load) treats what it read: invalid UTF-8 is a located error. The entry
     /// point of the loader's fuzz target (`fuzz/`).

@@ -42,6 +42,7 @@
 mod compile;
 mod loader;
 mod render;
+mod subplan;
 
 use serde::Serialize;
 

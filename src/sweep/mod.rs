@@ -20,7 +20,6 @@
 
 pub mod digest;
 mod indices;
-pub mod layout;
 pub mod report;
 pub mod resume;
 mod summary;
@@ -38,6 +37,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::Serialize;
 
+pub use crate::episode::scenario as layout;
 pub use indices::ScenarioIndices;
 pub use layout::{Region, Scenario, ScenarioLayout, sample_scenario, sample_scenario_in};
 pub use report::{MergeError, Merged, merge_results};
@@ -51,7 +51,7 @@ use crate::failure::FailureKind;
 use crate::faults::FaultKind;
 use crate::plan::Plan;
 use crate::runtime::substitute::Substitution;
-use crate::scene::{Placement, PlacementError, sample_placement};
+use crate::scene::{Placement, PlacementError};
 use crate::sim::{Layout, Scene};
 use crate::world::goal::GoalValue;
 
@@ -252,23 +252,13 @@ impl SweepConfig {
     /// those of earlier releases; every other scene draws its own randomization
     /// ([`crate::scene::sample_placement`]).
     pub fn scene_scenario(&self, scene: &Scene, index: u64) -> Result<SceneScenario, PlacementError> {
-        if scene.spec.sampler == crate::scene::Sampler::Tutorial {
-            let s = sample_scenario(self.seed, index);
-            return Ok(SceneScenario {
-                sweep_seed: s.sweep_seed,
-                index,
-                seed: s.seed,
-                placement: scene.placement_from_layout(&s.layout.to_layout()),
-                layout: Some(s.layout),
-            });
-        }
-        let (seed, placement) = sample_placement(&scene.spec, self.seed, index)?;
+        let draw = crate::episode::scenario::draw(scene, self.seed, index)?;
         Ok(SceneScenario {
             sweep_seed: self.seed,
             index,
-            seed,
-            placement,
-            layout: None,
+            seed: draw.seed,
+            placement: draw.placement,
+            layout: draw.layout,
         })
     }
 

@@ -1,4 +1,6 @@
 //! The seeded layout sampler: scenario `k` of sweep seed `S` is a pure function of `(S, k)`.
+//! [`draw`] is the one place a scene's scenario is drawn: `macrotree sweep`, `run --scenario K
+//! --sweep-seed S` and `env::Reset::Scenario` all call it.
 //!
 //! Each scenario draws from its own ChaCha8 stream: the generator is seeded with
 //! `ChaCha8Rng::seed_from_u64(S)` and switched to stream `k` (`set_stream(k)`), so a scenario
@@ -14,7 +16,8 @@ use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::{RngCore, SeedableRng};
 use serde::Serialize;
 
-use crate::sim::Layout;
+use crate::scene::{Placement, PlacementError, Sampler, sample_placement};
+use crate::sim::{Layout, Scene};
 
 /// The task region the sampler draws from. Metres and degrees.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -121,6 +124,42 @@ pub fn sample_scenario_in(region: &Region, sweep_seed: u64, index: u64) -> Scena
         "the region {region:?} cannot hold a cube and a bowl {} m apart",
         region.min_separation
     )
+}
+
+/// Scenario `index` of sweep seed `sweep_seed` on `scene`: its episode seed and every object's
+/// starting pose.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScenarioDraw {
+    /// The episode seed (fault timing and magnitude).
+    pub seed: u64,
+    /// Every object's starting pose, scene order.
+    pub placement: Placement,
+    /// The tutorial's cube/bowl layout, for a `sampler: tutorial` scene.
+    pub layout: Option<ScenarioLayout>,
+}
+
+/// Scenario `index` of sweep seed `sweep_seed` on `scene`. A scene with `sampler: tutorial`
+/// (the built-in `cube_bowl`) draws its cube and bowl with the documented task-region sampler
+/// ([`sample_scenario`]); every other scene draws its own randomization
+/// ([`crate::scene::sample_placement`]).
+///
+/// # Errors
+/// When the scene's randomization cannot place its objects.
+pub fn draw(scene: &Scene, sweep_seed: u64, index: u64) -> Result<ScenarioDraw, PlacementError> {
+    if scene.spec.sampler == Sampler::Tutorial {
+        let s = sample_scenario(sweep_seed, index);
+        return Ok(ScenarioDraw {
+            seed: s.seed,
+            placement: scene.placement_from_layout(&s.layout.to_layout()),
+            layout: Some(s.layout),
+        });
+    }
+    let (seed, placement) = sample_placement(&scene.spec, sweep_seed, index)?;
+    Ok(ScenarioDraw {
+        seed,
+        placement,
+        layout: None,
+    })
 }
 
 /// A uniform float in [0, 1) from the top 53 bits of a draw.

@@ -1,0 +1,313 @@
+//! [`VecEnv`]: N environments stepped on a small pool of worker threads — all at once
+//! ([`VecEnv::step`]), or envpool-style ([`VecEnv::send`] / [`VecEnv::recv`]), which returns
+//! whichever environments finish first: macro actions differ widely in duration.
+//!
+//! Each environment runs its actions in the order they were sent, one at a time, on whichever
+//! worker is free; its results depend only on its own resets and actions, so sub-environment
+//! `i` gives bit for bit what a single [`MacroEnv`] given the same resets and actions gives.
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::mpsc::{Receiver, Sender, channel};
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::thread::JoinHandle;
+
+use super::{Action, EnvConfig, MacroEnv, Observation, Reset, StepResult};
+use crate::error::Error;
+use crate::plan::Plan;
+use crate::sim::Scene;
+
+/// Most environments in one [`VecEnv`].
+pub const MAX_ENVS: usize = 4096;
+
+/// A step to run: the environment and its action.
+type Job = (usize, Action);
+/// A finished step: the environment's id and its result.
+pub type Finished = (usize, Result<StepResult, Error>);
+
+/// N environments of one scene (and tree and config) on worker threads (see the module docs).
+pub struct VecEnv {
+    envs: Vec<Arc<Mutex<MacroEnv>>>,
+    jobs: Option<Sender<Job>>,
+    done: Receiver<Finished>,
+    workers: Vec<JoinHandle<()>>,
+    busy: Vec<bool>,
+    pending: usize,
+}
+
+fn lock(env: &Mutex<MacroEnv>) -> MutexGuard<'_, MacroEnv> {
+    env.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+fn invalid(message: String) -> Error {
+    Error::Action { message }
+}
+
+impl VecEnv {
+    /// `n` environments (1 … [`MAX_ENVS`]) like [`MacroEnv::new`]'s, stepped on
+    /// min(`n`, cores) worker threads.
+    ///
+    /// # Errors
+    /// As [`MacroEnv::new`]; [`Error::Config`] for `n` out of range.
+    pub fn new(
+        app: &crate::App,
+        scene: Scene,
+        tree: Option<Arc<Plan>>,
+        config: EnvConfig,
+        n: usize,
+    ) -> Result<Self, Error> {
+        let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+        Self::with_threads(app, scene, tree, config, n, cores)
+    }
+
+    /// Like [`new`](Self::new), on min(`n`, `threads`) worker threads (at least one).
+    ///
+    /// # Errors
+    /// As [`new`](Self::new).
+    pub fn with_threads(
+        app: &crate::App,
+        scene: Scene,
+        tree: Option<Arc<Plan>>,
+        config: EnvConfig,
+        n: usize,
+        threads: usize,
+    ) -> Result<Self, Error> {
+        if !(1..=MAX_ENVS).contains(&n) {
+            return Err(Error::Config {
+                message: format!("a vector environment holds 1 … {MAX_ENVS} environments, not {n}"),
+            });
+        }
+        let mut envs = Vec::with_capacity(n);
+        for _ in 0..n {
+            let env = MacroEnv::new(app, scene.clone(), tree.clone(), config.clone())?;
+            envs.push(Arc::new(Mutex::new(env)));
+        }
+        let (jobs, queue) = channel::<Job>();
+        let (done_tx, done) = channel::<Finished>();
+        let queue = Arc::new(Mutex::new(queue));
+        let workers = (0..threads.clamp(1, n))
+            .map(|k| {
+                let queue = queue.clone();
+                let done_tx = done_tx.clone();
+                let envs = envs.clone();
+                std::thread::Builder::new()
+                    .name(format!("macrotree-env-{k}"))
+                    .spawn(move || worker(&queue, &envs, &done_tx))
+                    .map_err(|e| Error::Simulator {
+                        message: format!("cannot start a worker thread: {e}"),
+                    })
+            })
+            .collect::<Result<Vec<_>, Error>>()?;
+        Ok(Self {
+            envs,
+            jobs: Some(jobs),
+            done,
+            workers,
+            busy: vec![false; n],
+            pending: 0,
+        })
+    }
+
+    /// Number of environments.
+    pub fn num_envs(&self) -> usize {
+        self.envs.len()
+    }
+
+    /// Number of worker threads.
+    pub fn threads(&self) -> usize {
+        self.workers.len()
+    }
+
+    /// Steps sent and not yet received.
+    pub fn pending(&self) -> usize {
+        self.pending
+    }
+
+    fn idle(&self, i: usize) -> Result<(), Error> {
+        if i >= self.envs.len() {
+            return Err(invalid(format!(
+                "environment {i} does not exist; there are {} (0 … {})",
+                self.envs.len(),
+                self.envs.len() - 1
+            )));
+        }
+        if self.busy[i] {
+            return Err(invalid(format!(
+                "environment {i} is still running a step; receive it first (recv)"
+            )));
+        }
+        Ok(())
+    }
+
+    /// Resets every environment, `how[i]` for environment `i`, on the calling thread.
+    ///
+    /// # Errors
+    /// [`Error::Action`] when `how` does not hold one reset per environment, a step is still
+    /// running, or a reset is refused (the first such error).
+    pub fn reset(&mut self, how: &[Reset]) -> Result<Vec<Observation>, Error> {
+        if how.len() != self.envs.len() {
+            return Err(invalid(format!(
+                "reset got {} resets for {} environments",
+                how.len(),
+                self.envs.len()
+            )));
+        }
+        let ids: Vec<usize> = (0..how.len()).collect();
+        self.reset_each(&ids, how)
+    }
+
+    /// Resets environments `ids` (`how[k]` for `ids[k]`), leaving the others as they are.
+    ///
+    /// # Errors
+    /// As [`reset`](Self::reset), for unknown or repeated ids too.
+    pub fn reset_each(&mut self, ids: &[usize], how: &[Reset]) -> Result<Vec<Observation>, Error> {
+        self.check_ids(ids, how.len())?;
+        ids.iter()
+            .zip(how)
+            .map(|(&i, h)| lock(&self.envs[i]).reset(h))
+            .collect()
+    }
+
+    fn check_ids(&self, ids: &[usize], n: usize) -> Result<(), Error> {
+        if ids.len() != n {
+            return Err(invalid(format!(
+                "{} environment ids for {n} actions or resets",
+                ids.len()
+            )));
+        }
+        let mut seen = vec![false; self.envs.len()];
+        for &i in ids {
+            self.idle(i)?;
+            if std::mem::replace(&mut seen[i], true) {
+                return Err(invalid(format!("environment {i} is given twice")));
+            }
+        }
+        Ok(())
+    }
+
+    /// Steps every environment, `actions[i]` on environment `i`, in parallel; the results in
+    /// environment order.
+    ///
+    /// # Errors
+    /// [`Error::Action`] when `actions` does not hold one action per environment or steps sent
+    /// with [`send`](Self::send) are still pending. Each environment's own result may be an
+    /// error (invalid action) as [`MacroEnv::step`]'s.
+    pub fn step(&mut self, actions: &[Action]) -> Result<Vec<Result<StepResult, Error>>, Error> {
+        if self.pending > 0 {
+            return Err(invalid(format!(
+                "{} steps sent with send() are still pending; receive them first (recv)",
+                self.pending
+            )));
+        }
+        let ids: Vec<usize> = (0..self.envs.len()).collect();
+        self.send(&ids, actions)?;
+        let mut out: Vec<Option<Result<StepResult, Error>>> = (0..ids.len()).map(|_| None).collect();
+        for (i, r) in self.recv(ids.len())? {
+            out[i] = Some(r);
+        }
+        Ok(out
+            .into_iter()
+            .map(|r| r.unwrap_or_else(|| Err(invalid("a step result went missing".to_string()))))
+            .collect())
+    }
+
+    /// Starts `actions[k]` on environment `ids[k]` and returns at once; collect the results
+    /// with [`recv`](Self::recv).
+    ///
+    /// # Errors
+    /// [`Error::Action`] for unknown or repeated ids, lengths that differ, or an environment
+    /// still running a step.
+    pub fn send(&mut self, ids: &[usize], actions: &[Action]) -> Result<(), Error> {
+        self.check_ids(ids, actions.len())?;
+        let jobs = self.jobs.as_ref().expect("open until drop");
+        for (&i, a) in ids.iter().zip(actions) {
+            jobs.send((i, a.clone()))
+                .map_err(|_| invalid("the worker threads have stopped".to_string()))?;
+            self.busy[i] = true;
+            self.pending += 1;
+        }
+        Ok(())
+    }
+
+    /// Waits until at least `min_batch` of the sent steps have finished and returns every
+    /// finished one (environment id, result), in the order they finished.
+    ///
+    /// # Errors
+    /// [`Error::Action`] when `min_batch` is 0 or more than the steps pending.
+    pub fn recv(&mut self, min_batch: usize) -> Result<Vec<Finished>, Error> {
+        if min_batch == 0 || min_batch > self.pending {
+            return Err(invalid(format!(
+                "recv({min_batch}): expected 1 … {} (the steps pending)",
+                self.pending
+            )));
+        }
+        let mut out = Vec::with_capacity(min_batch);
+        while out.len() < min_batch {
+            let d = self
+                .done
+                .recv()
+                .map_err(|_| invalid("the worker threads have stopped".to_string()))?;
+            out.push(d);
+        }
+        while let Ok(d) = self.done.try_recv() {
+            out.push(d);
+        }
+        for (i, _) in &out {
+            self.busy[*i] = false;
+        }
+        self.pending -= out.len();
+        Ok(out)
+    }
+
+    /// The observation of environment `i` now.
+    ///
+    /// # Errors
+    /// [`Error::Action`] for an unknown environment or one still running a step.
+    pub fn observe(&self, i: usize) -> Result<Observation, Error> {
+        self.idle(i)?;
+        Ok(lock(&self.envs[i]).observe())
+    }
+
+    /// Runs `f` on environment `i` (on the calling thread: e.g. to render it).
+    ///
+    /// # Errors
+    /// [`Error::Action`] for an unknown environment or one still running a step.
+    pub fn with_env<T>(&self, i: usize, f: impl FnOnce(&mut MacroEnv) -> T) -> Result<T, Error> {
+        self.idle(i)?;
+        Ok(f(&mut lock(&self.envs[i])))
+    }
+}
+
+impl Drop for VecEnv {
+    fn drop(&mut self) {
+        self.jobs = None;
+        for w in self.workers.drain(..) {
+            let _ = w.join();
+        }
+    }
+}
+
+/// A worker: takes the next job, runs it on its environment, sends the result; stops when the
+/// job queue closes.
+fn worker(queue: &Mutex<Receiver<Job>>, envs: &[Arc<Mutex<MacroEnv>>], done: &Sender<Finished>) {
+    loop {
+        let job = queue.lock().unwrap_or_else(|e| e.into_inner()).recv();
+        let Ok((i, action)) = job else {
+            return;
+        };
+        let result =
+            catch_unwind(AssertUnwindSafe(|| lock(&envs[i]).step(&action))).unwrap_or_else(|panic| {
+                let what = panic
+                    .downcast_ref::<&str>()
+                    .map(|s| s.to_string())
+                    .or_else(|| panic.downcast_ref::<String>().cloned())
+                    .unwrap_or_default();
+                tracing::error!(target: "macrotree::env", env = i, "a step panicked: {what}");
+                Err(Error::Simulator {
+                    message: format!("environment {i}: the step panicked (a bug): {what}"),
+                })
+            });
+        if done.send((i, result)).is_err() {
+            return;
+        }
+    }
+}
