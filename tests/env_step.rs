@@ -46,6 +46,7 @@ fn episode(env: &mut MacroEnv) -> Vec<Vec<u64>> {
         }),
         Action::Primitive(Primitive::Wait {
             duration: Duration::Seconds(0.1),
+            gripper: None,
         }),
     ];
     for a in &actions {
@@ -222,10 +223,12 @@ fn invalid_input_is_an_error_that_says_where_and_nothing_is_simulated() {
         Action::Ctrl([0.0, 0.0, 9.0, 0.0, 0.0, 0.0, 0.0]),
         Action::Primitive(Primitive::Wait {
             duration: Duration::Seconds(-0.5),
+            gripper: None,
         }),
         Action::Primitive(Primitive::ReachJoints {
             joints: [0.0, f64::INFINITY, 0.0, 0.0, 0.0, 0.0],
             duration: Duration::Auto,
+            gripper: None,
         }),
         Action::Subtree("pick".into()),
     ];

@@ -34,6 +34,8 @@
 
 mod action;
 mod config;
+#[cfg(feature = "render")]
+mod film;
 mod leaf;
 mod observation;
 mod primitive;
@@ -83,6 +85,8 @@ pub struct MacroEnv {
     unstable: bool,
     placement: Placement,
     episode_seed: u64,
+    #[cfg(feature = "render")]
+    film: Option<film::Film>,
 }
 
 impl MacroEnv {
@@ -123,6 +127,8 @@ impl MacroEnv {
             leaves: leaf::LeafCache::default(),
             subtrees: subtree::Subtrees::default(),
             fault_log: None,
+            #[cfg(feature = "render")]
+            film: None,
             fault_reported: false,
             unstable: false,
             placement,
@@ -150,6 +156,11 @@ impl MacroEnv {
             self.fault_log = Some(log);
         }
         self.unstable = false;
+        #[cfg(feature = "render")]
+        if let Some(f) = &mut self.film {
+            f.take();
+            f.restart(self.cell.world().time);
+        }
         Ok(self.observe())
     }
 
@@ -200,13 +211,25 @@ impl MacroEnv {
         let t0 = self.cell.world().time;
         let s0 = self.cell.sim().steps();
         let mut driver = MacroDriver::new(&mut self.cell, &self.factory);
+        #[cfg(feature = "render")]
+        let film = &mut self.film;
+        let mut filmed = Ok(());
         let ran = step::run(
             &mut driver,
             stepper.as_mut(),
             self.config.max_sim_time,
             self.config.rewards_per_tick,
+            &mut |_cell: &Cell| {
+                #[cfg(feature = "render")]
+                if let Some(f) = film.as_mut()
+                    && filmed.is_ok()
+                {
+                    filmed = f.tick(_cell);
+                }
+            },
         );
         drop(driver);
+        filmed?;
         self.unstable = ran.unstable;
         let world = self.cell.world();
         let goal = crate::world::goal::evaluate(world);

@@ -59,6 +59,12 @@ pub enum Duration {
     /// arrived (within 2 mm, at rest) or the fingers have stopped; a failure (`blocked`,
     /// `timeout`) if it does not. Not for `Wait`.
     Auto,
+    /// [`Duration::Auto`], then the target held for `settle` more reference steps
+    /// ([`REFERENCE_STEP`] each; `settle` ≥ 1). Not for `Wait`.
+    AutoThen {
+        /// Reference steps the target is held after the arrival.
+        settle: u32,
+    },
 }
 
 /// One of the reference tutorial's macro primitives. Positions in metres (world frame),
@@ -69,6 +75,8 @@ pub enum Primitive {
     Wait {
         /// How long (not `Auto`).
         duration: Duration,
+        /// The gripper command held meanwhile (0 open … 255 closed; `None`: keep it).
+        gripper: Option<f64>,
     },
     /// Move the pinch point to `position` with orientation `quaternion`.
     ReachPose {
@@ -80,6 +88,8 @@ pub enum Primitive {
         path: PathKind,
         /// How long.
         duration: Duration,
+        /// The gripper command during the motion (0 open … 255 closed; `None`: keep it).
+        gripper: Option<f64>,
     },
     /// Move the arm to joint angles (radians, within [`crate::motion::JOINT_LIMITS`]).
     ReachJoints {
@@ -87,6 +97,8 @@ pub enum Primitive {
         joints: [f64; 6],
         /// How long.
         duration: Duration,
+        /// The gripper command during the motion (0 open … 255 closed; `None`: keep it).
+        gripper: Option<f64>,
     },
     /// Open the gripper fully (command 0); the arm holds.
     OpenGripper {
@@ -126,7 +138,7 @@ impl Primitive {
 
     fn duration(&self) -> Duration {
         match self {
-            Primitive::Wait { duration }
+            Primitive::Wait { duration, .. }
             | Primitive::ReachPose { duration, .. }
             | Primitive::ReachJoints { duration, .. }
             | Primitive::OpenGripper { duration }
@@ -157,10 +169,27 @@ impl Primitive {
                     (MAX_DURATION / REFERENCE_STEP) as u64
                 ));
             }
-            Duration::Auto if matches!(self, Primitive::Wait { .. }) => {
+            Duration::Auto | Duration::AutoThen { .. } if matches!(self, Primitive::Wait { .. }) => {
                 return bad("wait: needs a duration (Seconds or Steps), not Auto".to_string());
             }
+            Duration::AutoThen { settle }
+                if settle == 0 || f64::from(settle) * REFERENCE_STEP > MAX_DURATION =>
+            {
+                return bad(format!(
+                    "{name}: settle {settle}; expected at least 1 and at most {} reference steps of {REFERENCE_STEP} s",
+                    (MAX_DURATION / REFERENCE_STEP) as u64
+                ));
+            }
             _ => {}
+        }
+        if let Primitive::Wait { gripper: Some(g), .. }
+        | Primitive::ReachPose { gripper: Some(g), .. }
+        | Primitive::ReachJoints { gripper: Some(g), .. } = self
+            && !(g.is_finite() && (OPEN_CTRL..=CLOSED_CTRL).contains(g))
+        {
+            return bad(format!(
+                "{name}: gripper command {g}; expected {OPEN_CTRL} (open) … {CLOSED_CTRL} (closed)"
+            ));
         }
         match self {
             Primitive::ReachPose {
@@ -249,8 +278,9 @@ impl Trajectory for Retimed {
 enum Until {
     /// After this many control periods.
     Ticks(u64),
-    /// When the arm has arrived at `goal` (or is blocked), at most `limit` ticks.
-    Arrived { goal: [f64; 6], limit: u64 },
+    /// When the arm has arrived at `goal` (or is blocked), at most `limit` ticks; then
+    /// `settle` more ticks holding it.
+    Arrived { goal: [f64; 6], limit: u64, settle: u64 },
     /// When the fingers have stopped, at most `limit` ticks.
     GripperStopped { limit: u64 },
 }
@@ -305,9 +335,13 @@ impl PrimitiveRun {
                     cell.track(Box::new(Retimed { inner: mv, duration }));
                 }
             }
-            Duration::Auto => {
+            Duration::Auto | Duration::AutoThen { .. } => {
                 let limit = self.ticks_for(mv.duration() + AUTO_SLACK);
-                self.until = Until::Arrived { goal, limit };
+                let settle = match self.primitive.duration() {
+                    Duration::AutoThen { settle } => self.ticks_for(f64::from(settle) * REFERENCE_STEP),
+                    _ => 0,
+                };
+                self.until = Until::Arrived { goal, limit, settle };
                 cell.track(mv);
             }
         }
@@ -324,7 +358,7 @@ impl PrimitiveRun {
             Duration::Steps { steps, settle } => {
                 Until::Ticks(self.ticks_for(f64::from(steps + settle) * REFERENCE_STEP))
             }
-            Duration::Auto => Until::GripperStopped {
+            Duration::Auto | Duration::AutoThen { .. } => Until::GripperStopped {
                 limit: self.ticks_for(AUTO_GRIPPER_LIMIT),
             },
         };
@@ -340,14 +374,17 @@ impl MacroAction for PrimitiveRun {
         let from = cell.arm_setpoint();
         let limits = MotionLimits::default();
         match self.primitive.clone() {
-            Primitive::Wait { duration } => {
+            Primitive::Wait { duration, gripper } => {
                 if cell.arm_motion_finished() {
                     cell.hold();
+                }
+                if let Some(g) = gripper {
+                    cell.set_gripper(g);
                 }
                 let seconds = match duration {
                     Duration::Seconds(s) => s,
                     Duration::Steps { steps, settle } => f64::from(steps + settle) * REFERENCE_STEP,
-                    Duration::Auto => self.dt,
+                    Duration::Auto | Duration::AutoThen { .. } => self.dt,
                 };
                 self.until = Until::Ticks(self.ticks_for(seconds));
             }
@@ -355,8 +392,12 @@ impl MacroAction for PrimitiveRun {
                 position,
                 quaternion,
                 path,
+                gripper,
                 ..
             } => {
+                if let Some(g) = gripper {
+                    cell.set_gripper(g);
+                }
                 let rotation = match quaternion {
                     Some([w, x, y, z]) => UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z)),
                     None => fk(&from).rotation,
@@ -375,7 +416,10 @@ impl MacroAction for PrimitiveRun {
                 };
                 self.start_motion(cell, mv);
             }
-            Primitive::ReachJoints { joints, .. } => {
+            Primitive::ReachJoints { joints, gripper, .. } => {
+                if let Some(g) = gripper {
+                    cell.set_gripper(g);
+                }
                 self.start_motion(cell, Box::new(JointMove::new(from, joints, &limits)));
             }
             Primitive::OpenGripper { .. } => self.start_gripper(cell, OPEN_CTRL),
@@ -405,9 +449,13 @@ impl MacroAction for PrimitiveRun {
                     Progress::Running
                 }
             }
-            Until::Arrived { goal, limit } => {
-                let (goal, limit) = (*goal, *limit);
+            Until::Arrived { goal, limit, settle } => {
+                let (goal, limit, settle) = (*goal, *limit, *settle);
                 match self.arrival.progress(cell, &goal) {
+                    Progress::Done if settle > 0 => {
+                        self.until = Until::Ticks(self.ticks + settle);
+                        Progress::Running
+                    }
                     Progress::Running if self.ticks >= limit => {
                         let waiting = self.arrival.waiting_for(cell, &goal);
                         cell.hold();
@@ -458,16 +506,18 @@ mod tests {
     #[test]
     fn bad_numbers_are_refused_with_the_value_and_the_range() {
         let cases = [
-            (Primitive::Wait { duration: secs(-1.0) }, "duration -1"),
+            (Primitive::Wait { duration: secs(-1.0), gripper: None }, "duration -1"),
             (
                 Primitive::Wait {
                     duration: secs(f64::NAN),
+                    gripper: None,
                 },
                 "duration NaN",
             ),
             (
                 Primitive::Wait {
                     duration: Duration::Auto,
+                    gripper: None,
                 },
                 "not Auto",
             ),
@@ -483,6 +533,7 @@ mod tests {
                     quaternion: None,
                     path: PathKind::Joint,
                     duration: Duration::Auto,
+                    gripper: None,
                 },
                 "position[1] is inf",
             ),
@@ -492,6 +543,7 @@ mod tests {
                     quaternion: Some([0.0; 4]),
                     path: PathKind::Joint,
                     duration: Duration::Auto,
+                    gripper: None,
                 },
                 "norm 0",
             ),
@@ -501,6 +553,7 @@ mod tests {
                     quaternion: None,
                     path: PathKind::Joint,
                     duration: Duration::Auto,
+                    gripper: None,
                 },
                 "from the robot's base",
             ),
@@ -508,6 +561,7 @@ mod tests {
                 Primitive::ReachJoints {
                     joints: [0.0, 0.0, 4.0, 0.0, 0.0, 0.0],
                     duration: Duration::Auto,
+                    gripper: None,
                 },
                 "joints[2] (elbow) is 4",
             ),

@@ -25,7 +25,32 @@ impl super::MacroEnv {
     /// [`Error::Action`] for an unknown camera or a size out of range; [`Error::Simulator`]
     /// when no OpenGL (EGL) is available.
     pub fn render(&self, camera: &str, width: u32, height: u32) -> Result<Image, Error> {
-        let scene = self.scene();
+        render_cell(self.cell(), camera, width, height)
+    }
+
+    /// Films the steps from now on: frames of `camera` at `width × height`, `rate` per
+    /// simulated second (the first one at once), held until [`take_frames`](Self::take_frames).
+    ///
+    /// # Errors
+    /// As [`render`](Self::render), and [`Error::Action`] for a rate out of range.
+    pub fn film(&mut self, camera: &str, width: u32, height: u32, rate: f64) -> Result<(), Error> {
+        let first = self.render(camera, width, height)?;
+        let mut film = super::film::Film::new(camera.to_string(), width, height, rate)?;
+        film.restart(self.cell().world().time);
+        self.film = Some(film);
+        let _ = first;
+        Ok(())
+    }
+
+    /// The frames filmed since the last call (empty when not filming), oldest first.
+    pub fn take_frames(&mut self) -> Vec<Image> {
+        self.film.as_mut().map(|f| f.take().0).unwrap_or_default()
+    }
+}
+
+/// Renders `camera` of `cell` at `width × height` (see [`super::MacroEnv::render`]).
+pub(super) fn render_cell(cell: &crate::actions::Cell, camera: &str, width: u32, height: u32) -> Result<Image, Error> {
+        let scene = cell.sim().scene();
         let Some(id) = scene.camera_id(camera) else {
             return Err(Error::Action {
                 message: format!(
@@ -40,7 +65,7 @@ impl super::MacroEnv {
             ),
         })?;
         let model = scene.model.clone();
-        let data = self.cell().sim().data();
+        let data = cell.sim().data();
         let pixels = with_thread_renderer(&model, size, |r| {
             r.sync(data);
             r.render(id).map(<[u8]>::to_vec)
@@ -54,5 +79,4 @@ impl super::MacroEnv {
             height,
             pixels,
         })
-    }
 }

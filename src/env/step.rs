@@ -178,6 +178,7 @@ pub(super) fn run(
     stepper: &mut dyn Stepper,
     max_sim_time: f64,
     rewards_per_tick: bool,
+    on_tick: &mut dyn FnMut(&crate::actions::Cell),
 ) -> Ran {
     let dt = d.cell().control_period();
     let mut ran = Ran {
@@ -204,6 +205,7 @@ pub(super) fn run(
             break;
         }
         d.advance();
+        on_tick(d.cell());
         let holds = goal_holds(d.cell().world());
         ran.goal_ticks += u64::from(holds);
         if rewards_per_tick {
