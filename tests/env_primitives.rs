@@ -129,12 +129,8 @@ fn reach_joints_and_reset_go_where_they_are_told() {
             duration: Duration::Auto,
         },
     );
-    for i in 0..6 {
-        assert!(
-            (r.observation.joint_pos[i] - joints[i]).abs() < 0.01,
-            "{:?}",
-            r.observation.joint_pos
-        );
+    for (q, want) in r.observation.joint_pos.iter().zip(joints) {
+        assert!((q - want).abs() < 0.01, "{:?}", r.observation.joint_pos);
     }
     run(
         &mut env,
