@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use macrotree::App;
 use macrotree::env::{Action, EnvConfig, MacroEnv, Reset, Status};
-use macrotree::episode::{EpisodeConfig, EpisodeObserver, run_episode};
+use macrotree::episode::{EpisodeObserver, run_episode};
 
 #[path = "support/flagship.rs"]
 mod flagship;
@@ -102,7 +102,6 @@ fn the_whole_tree_as_one_step_is_run_episode_bit_for_bit() {
     );
     let at = states.0.iter().find(|(n, _)| *n == r.physics_steps).unwrap();
     assert_eq!(at.1, env.cell().sim().state_fingerprint());
-    let _ = EpisodeConfig::default();
 }
 
 #[test]
