@@ -281,3 +281,30 @@ fn render_gives_an_hwc_rgb_image_of_a_named_camera_and_leaves_the_physics_alone(
     assert!(env.render("wrist", 63, 48).is_err());
     assert!(env.render("wrist", 0, 0).is_err());
 }
+
+#[test]
+fn a_configured_fault_fires_on_the_leaves_it_watches_and_is_reported_once() {
+    let mut env = env(EnvConfig {
+        fault: Some(macrotree::faults::FaultKind::Bump),
+        ..EnvConfig::default()
+    });
+    let mut fired = Vec::new();
+    for text in [
+        "home: {}",
+        "reach: {target: cube, offset: [0, 0, 0.12]}",
+        "home: {}",
+    ] {
+        let r = env.step(&leaf(text)).unwrap();
+        fired.push(r.faults_fired);
+    }
+    assert!(fired[0].is_empty());
+    assert_eq!(fired[1].len(), 1, "{fired:?}");
+    assert!(fired[1][0].starts_with("bump: "), "{fired:?}");
+    assert!(fired[2].is_empty(), "reported once");
+    // A reset re-arms it.
+    env.reset(&Reset::Default).unwrap();
+    let r = env
+        .step(&leaf("reach: {target: cube, offset: [0, 0, 0.12]}"))
+        .unwrap();
+    assert_eq!(r.faults_fired.len(), 1);
+}
