@@ -3,13 +3,15 @@
 //!
 //! 1. `ctrl` mode: 5000 `Action::Ctrl` steps (one 4 ms control period = 2 physics steps each)
 //!    against the same joint targets written straight into `ctrl` and `mj_step` in a loop.
-//! 2. The flagship tree driven leaf by leaf (`Action::Leaf`, the leaves `run_episode` starts)
+//! 2. `VecEnv` of 2 environments on 2 threads, 2000 synchronous `ctrl` steps, against one
+//!    environment's steps per second.
+//! 3. The flagship tree driven leaf by leaf (`Action::Leaf`, the leaves `run_episode` starts)
 //!    against `run_episode` of the tree (the same physics, bit for bit).
 
 use std::time::Instant;
 
 use macrotree::App;
-use macrotree::env::{Action, EnvConfig, MacroEnv, Reset};
+use macrotree::env::{Action, EnvConfig, MacroEnv, Reset, VecEnv};
 use macrotree::episode::{EpisodeConfig, NoObserver, run_episode};
 use macrotree::sim::{HOME_Q, Scene, Sim};
 
@@ -64,6 +66,29 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         e / steps * 1e6,
         b / steps * 1e6,
         b / e
+    );
+
+    // The vector env: 2 environments on 2 threads.
+    let mut v = VecEnv::with_threads(&app, scene.clone(), None, EnvConfig::default(), 2, 2)?;
+    let mut vec_t = Vec::new();
+    for _ in 0..REPEAT {
+        v.reset(&[Reset::Default, Reset::Default])?;
+        let t = Instant::now();
+        for k in 0..2000 {
+            for r in v.step(&[Action::Ctrl(target(k)), Action::Ctrl(target(k + 1))])? {
+                r?;
+            }
+        }
+        vec_t.push(t.elapsed().as_secs_f64());
+    }
+    let vt = median(vec_t);
+    let single = CTRL_STEPS as f64 / e;
+    let vector = 4000.0 / vt;
+    println!(
+        "vector: 2 environments on 2 threads, {:.0} env steps/s vs {:.0} for one environment ({:.2}x)",
+        vector,
+        single,
+        vector / single
     );
 
     // The flagship, leaf by leaf.
