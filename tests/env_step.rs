@@ -260,3 +260,54 @@ fn the_time_limit_truncates_a_step_and_halts_its_action() {
     let r = env.step(&leaf("home: {}")).unwrap();
     assert!(r.truncated && r.physics_steps == 0);
 }
+
+#[test]
+fn render_gives_an_hwc_rgb_image_of_a_named_camera_and_leaves_the_physics_alone() {
+    let mut env = env(EnvConfig::default());
+    env.step(&leaf("reach: {target: cube, offset: [0, 0, 0.12]}"))
+        .unwrap();
+    let before = env.cell().sim().state_fingerprint();
+    let cameras = env.scene().camera_names();
+    assert!(cameras.iter().any(|c| c == "wrist"), "{cameras:?}");
+    for camera in &cameras {
+        let img = env.render(camera, 64, 48).unwrap();
+        assert_eq!((img.width, img.height, img.pixels.len()), (64, 48, 64 * 48 * 3));
+        let first = &img.pixels[..3];
+        assert!(
+            img.pixels.chunks(3).any(|p| p != first),
+            "{camera}: not a blank image"
+        );
+    }
+    assert_eq!(env.cell().sim().state_fingerprint(), before);
+    let e = env.render("nope", 64, 48).unwrap_err();
+    assert!(e.to_string().contains("wrist"), "{e}");
+    assert!(env.render("wrist", 63, 48).is_err());
+    assert!(env.render("wrist", 0, 0).is_err());
+}
+
+#[test]
+fn a_configured_fault_fires_on_the_leaves_it_watches_and_is_reported_once() {
+    let mut env = env(EnvConfig {
+        fault: Some(macrotree::faults::FaultKind::Bump),
+        ..EnvConfig::default()
+    });
+    let mut fired = Vec::new();
+    for text in [
+        "home: {}",
+        "reach: {target: cube, offset: [0, 0, 0.12]}",
+        "home: {}",
+    ] {
+        let r = env.step(&leaf(text)).unwrap();
+        fired.push(r.faults_fired);
+    }
+    assert!(fired[0].is_empty());
+    assert_eq!(fired[1].len(), 1, "{fired:?}");
+    assert!(fired[1][0].starts_with("bump: "), "{fired:?}");
+    assert!(fired[2].is_empty(), "reported once");
+    // A reset re-arms it.
+    env.reset(&Reset::Default).unwrap();
+    let r = env
+        .step(&leaf("reach: {target: cube, offset: [0, 0, 0.12]}"))
+        .unwrap();
+    assert_eq!(r.faults_fired.len(), 1);
+}

@@ -177,6 +177,21 @@ mod tests {
     }
 
     #[test]
+    fn non_finite_numbers_in_a_leaf_are_refused_by_the_loader() {
+        for text in [
+            "reach: {target: [.nan, 0.1, 0.1]}",
+            "reach: {target: cube, offset: [0, 0, .inf]}",
+            "wait: {seconds: -1}",
+            "wait: {seconds: .nan}",
+            "grasp: {width: -0.01}",
+        ] {
+            let e = compile(text).unwrap_err();
+            assert_eq!(e.kind(), "invalid_tree", "{text}");
+            assert_eq!(e.diagnostics()[0].line, 1, "{text}: {e}");
+        }
+    }
+
+    #[test]
     fn composites_and_empty_texts_are_refused() {
         let e = compile("sequence: {children: [{home: {}}]}").unwrap_err();
         assert!(e.to_string().contains("a step runs one leaf"), "{e}");

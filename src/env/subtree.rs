@@ -35,7 +35,8 @@ impl Subtrees {
 }
 
 /// The node of `tree` that `name` names: `main` or the root's path for the whole tree, a node
-/// path, or a node's `name:` (a subtree call is named after its subtree) when one node has it.
+/// path, or a node's `name:` (a subtree call is named after its subtree) when one node has it
+/// — or nested nodes only (a subtree call and its root of the same name): the outermost.
 ///
 /// # Errors
 /// [`Error::Action`] when no node or several nodes have that name, listing the names (with a
@@ -50,8 +51,10 @@ pub fn find(tree: &Plan, name: &str) -> Result<usize, Error> {
     let named: Vec<usize> = (0..tree.nodes.len())
         .filter(|&i| tree.nodes[i].name.as_deref() == Some(name))
         .collect();
+    // A subtree call and its root often share the name: one chain of nodes, the outermost runs.
+    let nested = named.windows(2).all(|w| is_below(tree, w[1], w[0]));
     match named.as_slice() {
-        [one] => Ok(*one),
+        [first, ..] if nested => Ok(*first),
         [] => {
             let mut names: Vec<&str> = tree.nodes.iter().filter_map(|n| n.name.as_deref()).collect();
             names.sort_unstable();
@@ -83,6 +86,18 @@ pub fn find(tree: &Plan, name: &str) -> Result<usize, Error> {
             ),
         }),
     }
+}
+
+/// Node `i` is below node `ancestor`.
+fn is_below(tree: &Plan, i: usize, ancestor: usize) -> bool {
+    let mut cur = tree.nodes[i].parent;
+    while let Some(p) = cur {
+        if p == ancestor {
+            return true;
+        }
+        cur = tree.nodes[p].parent;
+    }
+    false
 }
 
 #[cfg(test)]
