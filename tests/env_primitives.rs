@@ -44,6 +44,7 @@ fn reach_pose_ends_within_millimetres_keeping_or_taking_the_orientation() {
             quaternion: Some(start.pinch_quat),
             path: PathKind::Joint,
             duration: Duration::Auto,
+            gripper: None,
         },
     );
     let o = &r.observation;
@@ -65,6 +66,7 @@ fn reach_pose_ends_within_millimetres_keeping_or_taking_the_orientation() {
                 steps: 150,
                 settle: 50,
             },
+            gripper: None,
         },
     );
     assert!((r.sim_time - 2.0).abs() < 1e-9, "{}", r.sim_time);
@@ -90,6 +92,7 @@ fn reach_pose_ends_within_millimetres_keeping_or_taking_the_orientation() {
             quaternion: Some(w),
             path: PathKind::Joint,
             duration: Duration::Seconds(1.5),
+            gripper: None,
         },
     );
     assert!((r.sim_time - 1.5).abs() < 1e-9);
@@ -109,6 +112,7 @@ fn an_unreachable_pose_fails_typed_without_moving() {
             quaternion: None,
             path: PathKind::Joint,
             duration: Duration::Auto,
+            gripper: None,
         }))
         .unwrap();
     assert_eq!(r.status, Status::Failure);
@@ -127,6 +131,7 @@ fn reach_joints_and_reset_go_where_they_are_told() {
         Primitive::ReachJoints {
             joints,
             duration: Duration::Auto,
+            gripper: None,
         },
     );
     for (q, want) in r.observation.joint_pos.iter().zip(joints) {
@@ -200,6 +205,7 @@ fn close_on_the_cube_grasps_it_and_open_lets_it_go() {
             quaternion: None,
             path: PathKind::Cartesian,
             duration: Duration::Auto,
+            gripper: None,
         },
     );
     let cube = r.observation.object("cube").unwrap();
@@ -240,6 +246,7 @@ fn wait_holds_for_its_duration() {
         &mut env,
         Primitive::Wait {
             duration: Duration::Seconds(0.5),
+            gripper: None,
         },
     );
     assert_eq!(r.physics_steps, 250);
@@ -250,6 +257,7 @@ fn wait_holds_for_its_duration() {
                 steps: 20,
                 settle: 30,
             },
+            gripper: None,
         },
     );
     assert_eq!(r2.physics_steps, 250);

@@ -32,7 +32,9 @@ fn skip() -> bool {
 
 /// Runs `cmd`, panicking with its output when it fails.
 fn run(cmd: &mut Command, what: &str) -> String {
-    let out = cmd.output().unwrap_or_else(|e| panic!("{what}: cannot start: {e}"));
+    let out = cmd
+        .output()
+        .unwrap_or_else(|e| panic!("{what}: cannot start: {e}"));
     let text = format!(
         "{}{}",
         String::from_utf8_lossy(&out.stdout),
@@ -78,7 +80,10 @@ fn installed() -> &'static Venv {
             let _ = std::fs::remove_dir_all(&dir);
             std::fs::create_dir_all(&base).expect("target/python-test");
             let python = std::env::var("MACROTREE_PYTHON").unwrap_or_else(|_| "python3".into());
-            run(Command::new(&python).arg("-m").arg("venv").arg(&dir), "python3 -m venv");
+            run(
+                Command::new(&python).arg("-m").arg("venv").arg(&dir),
+                "python3 -m venv",
+            );
             let venv = Venv { dir: dir.clone() };
             run(
                 venv.command("python")
@@ -91,7 +96,14 @@ fn installed() -> &'static Venv {
         let venv = Venv { dir };
         run(
             venv.command("python")
-                .args(["-m", "pip", "install", "--quiet", "--no-deps", "--no-build-isolation"])
+                .args([
+                    "-m",
+                    "pip",
+                    "install",
+                    "--quiet",
+                    "--no-deps",
+                    "--no-build-isolation",
+                ])
                 .args(["--force-reinstall", "./python"])
                 .env("CARGO_TARGET_DIR", base.join("build")),
             "pip install ./python",
@@ -108,7 +120,10 @@ fn python_code_is_linted_formatted_and_typed() {
     let venv = installed();
     let dirs = ["python/macrotree", "python/tests", "examples/python"];
     run(venv.command("ruff").arg("check").args(dirs), "ruff check");
-    run(venv.command("ruff").args(["format", "--check"]).args(dirs), "ruff format --check");
+    run(
+        venv.command("ruff").args(["format", "--check"]).args(dirs),
+        "ruff format --check",
+    );
     run(
         venv.command("mypy")
             .args(["--config-file", "python/pyproject.toml"])
@@ -148,5 +163,8 @@ fn ported_tutorial_passes_the_references_checks() {
     );
     eprintln!("{out}");
     assert_eq!(out.matches("checks passed").count(), 5, "five rollouts:\n{out}");
-    assert!(std::fs::metadata(&video).is_ok_and(|m| m.len() > 1000), "no video at {video:?}");
+    assert!(
+        std::fs::metadata(&video).is_ok_and(|m| m.len() > 1000),
+        "no video at {video:?}"
+    );
 }

@@ -20,7 +20,8 @@ MUJOCO_LIB_ENV = "MACROTREE_MUJOCO_LIB"
 
 
 class SetupError(ImportError):
-    """A run-time piece (MuJoCo library, Menagerie models) is missing; the message says what to do."""
+    """A run-time piece (MuJoCo library, Menagerie models) is missing; the message says what to
+    do."""
 
 
 def _package_dir(name: str) -> Path | None:

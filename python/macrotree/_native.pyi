@@ -5,6 +5,8 @@ from typing import Any
 import numpy as np
 
 __version__: str
+JOINT_LIMITS: list[tuple[float, float]]
+HOME: list[float]
 
 class MacrotreeError(Exception):
     """Invalid input: the message is located (``file:line:column``) and says what to do."""

@@ -56,9 +56,13 @@ class MacroEnv(gym.Env[Observation, Any]):
             number of 2 ms physics steps; default 0.01 s, the reference's 5-step frame skip).
         max_sim_time: simulated seconds after which an episode is truncated.
         fault: a fault injected through physics (``slip``, ``nudge``, …), or ``None``.
+        render_fps: frames per simulated second of ``rgb_array_list`` (``metadata["render_fps"]``).
     """
 
-    metadata: dict[str, Any] = {"render_modes": ["rgb_array", "rgb_array_list"], "render_fps": 30}
+    metadata: dict[str, Any] = {  # noqa: RUF012  (Gymnasium declares it so)
+        "render_modes": ["rgb_array", "rgb_array_list"],
+        "render_fps": 30,
+    }
 
     def __init__(
         self,
@@ -73,6 +77,7 @@ class MacroEnv(gym.Env[Observation, Any]):
         control_period: float = 0.01,
         max_sim_time: float = 120.0,
         fault: str | None = None,
+        render_fps: int = 30,
     ) -> None:
         if action_mode not in ("macro", "ctrl"):
             raise ValueError(f"action_mode must be 'macro' or 'ctrl', got {action_mode!r}")
@@ -91,9 +96,10 @@ class MacroEnv(gym.Env[Observation, Any]):
             fault=fault,
             cameras=list(cameras),
             image_size=(int(image_size[0]), int(image_size[1])),
-            frame_rate=float(self.metadata["render_fps"]) if render_mode == "rgb_array_list" else None,
+            frame_rate=float(render_fps) if render_mode == "rgb_array_list" else None,
             render_camera=render_camera,
         )
+        self.metadata = {**self.metadata, "render_fps": int(render_fps)}
         self.action_mode: ActionMode = action_mode
         self.render_mode = render_mode
         self.cameras = list(cameras)
@@ -123,8 +129,8 @@ class MacroEnv(gym.Env[Observation, Any]):
         * ``{"layout": "default"}``: the scene's own placement (the reference's default layout);
         * ``{"scenario": K, "sweep_seed": S}``: scenario K of sweep seed S, the placement
           ``macrotree run --scenario K --sweep-seed S`` uses;
-        * ``{"placement": {"cube": [x, y, yaw], …}}``: explicit poses on the table (metres, radians) for
-          the objects named (the others as in the scene's default placement).
+        * ``{"placement": {"cube": [x, y, yaw], …}}``: explicit poses on the table (metres,
+          radians) for the objects named (the others as in the scene's default placement).
         """
         super().reset(seed=seed)
         options = dict(options or {})

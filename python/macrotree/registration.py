@@ -40,6 +40,4 @@ def register_envs() -> None:
             kwargs={"scene": str(data / scene), "tree": str(data / tree)},
         )
     if GENERIC_ID not in gym.registry:
-        gym.register(
-            id=GENERIC_ID, entry_point=ENTRY_POINT, vector_entry_point=VECTOR_ENTRY_POINT
-        )
+        gym.register(id=GENERIC_ID, entry_point=ENTRY_POINT, vector_entry_point=VECTOR_ENTRY_POINT)

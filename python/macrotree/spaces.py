@@ -8,24 +8,38 @@ joint targets and the gripper command, held for one control period.
 from __future__ import annotations
 
 import enum
-import math
 from typing import Any
 
 import numpy as np
 from gymnasium import spaces
 
+from macrotree._native import JOINT_LIMITS
+
 #: Largest ``steps`` or ``settle_steps`` of one macro (control periods; 6000 = 60 s at 10 ms).
 #: ``steps = 0`` runs the macro closed loop: until its motion is done and the arm has settled.
 MAX_MACRO_STEPS = 6000
 
-#: Reach of the workspace box for ``position``, metres (the UR5e reaches 0.85 m).
-POSITION_BOUND = 1.5
+#: Half-side of the workspace box for ``position``, metres: every point of the box is within
+#: the 1.5 m a pose target may be from the robot's base (the UR5e reaches about 0.85 m, so far
+#: corners are valid input that fails as unreachable, reported in ``info``).
+POSITION_BOUND = 0.85
 
 #: Range of the gripper command (the 2F-85 actuator's ctrlrange: 0 open … 255 closed).
 GRIPPER_COMMAND_RANGE = (0.0, 255.0)
 
-#: Joint target bound, radians (the UR5e's ±2π; the elbow is limited to ±π by the robot).
-JOINT_BOUND = 2.0 * math.pi
+
+def _inside_f32(lo: float, hi: float) -> tuple[np.float32, np.float32]:
+    """``[lo, hi]`` as float32 bounds that never round outside the float64 range."""
+    low, high = np.float32(lo), np.float32(hi)
+    if float(low) < lo:
+        low = np.nextafter(low, np.float32(np.inf))
+    if float(high) > hi:
+        high = np.nextafter(high, np.float32(-np.inf))
+    return low, high
+
+
+#: Each arm joint's target range, radians (the UR5e's: ±2π, the elbow ±π).
+JOINT_BOUNDS = [_inside_f32(lo, hi) for lo, hi in JOINT_LIMITS]
 
 
 class MacroMode(enum.IntEnum):
@@ -40,7 +54,8 @@ class MacroMode(enum.IntEnum):
 
 
 class Path(enum.IntEnum):
-    """``path`` of a ``REACH_POSE`` macro: joint-space interpolation or a straight Cartesian line."""
+    """``path`` of a ``REACH_POSE`` macro: joint-space interpolation or a straight Cartesian
+    line."""
 
     JOINT = 0
     CARTESIAN = 1
@@ -62,7 +77,12 @@ def macro_action_space() -> spaces.Dict:
             "mode": spaces.Discrete(len(MacroMode)),
             "position": spaces.Box(-POSITION_BOUND, POSITION_BOUND, (3,), f32),
             "quaternion": spaces.Box(-1.0, 1.0, (4,), f32),
-            "joints": spaces.Box(-JOINT_BOUND, JOINT_BOUND, (6,), f32),
+            "joints": spaces.Box(
+                np.array([lo for lo, _ in JOINT_BOUNDS]),
+                np.array([hi for _, hi in JOINT_BOUNDS]),
+                (6,),
+                f32,
+            ),
             "gripper": spaces.Discrete(len(Gripper)),
             "gripper_command": spaces.Box(*GRIPPER_COMMAND_RANGE, (1,), f32),
             "path": spaces.Discrete(len(Path)),
@@ -73,19 +93,19 @@ def macro_action_space() -> spaces.Dict:
 
 
 def ctrl_action_space() -> spaces.Box:
-    """The ``ctrl`` action space: six arm joint targets (radians) and the gripper command (0…255)."""
-    low = np.array([-JOINT_BOUND] * 6 + [GRIPPER_COMMAND_RANGE[0]], dtype=np.float32)
-    high = np.array([JOINT_BOUND] * 6 + [GRIPPER_COMMAND_RANGE[1]], dtype=np.float32)
+    """The ``ctrl`` action space: six arm joint targets (radians) and the gripper command
+    (0…255)."""
+    low = np.array([lo for lo, _ in JOINT_BOUNDS] + [GRIPPER_COMMAND_RANGE[0]], dtype=np.float32)
+    high = np.array([hi for _, hi in JOINT_BOUNDS] + [GRIPPER_COMMAND_RANGE[1]], dtype=np.float32)
     return spaces.Box(low, high, dtype=np.float32)
 
 
-def observation_space(
-    objects: int, cameras: list[str], image_size: tuple[int, int]
-) -> spaces.Dict:
+def observation_space(objects: int, cameras: list[str], image_size: tuple[int, int]) -> spaces.Dict:
     """Observations: ``agent_pos`` (the dataset's ``observation.state``: six joint angles and the
-    gripper closure, radians), ``environment_state`` (every object's x, y, z, qw, qx, qy, qz in scene
-    order: the dataset's ``observation.environment_state``), ``pinch`` (the gripper's pinch point and
-    orientation: x, y, z, qw, qx, qy, qz), and ``pixels`` (one H×W×3 ``uint8`` image per camera) when
+    gripper closure, radians), ``environment_state`` (every object's x, y, z, qw, qx, qy, qz in
+    scene order: the dataset's ``observation.environment_state``), ``pinch`` (the gripper's pinch
+    point and orientation: x, y, z, qw, qx, qy, qz), and ``pixels`` (one H×W×3 ``uint8`` image per
+    camera) when
     cameras are asked for."""
     f32 = np.float32
     fields: dict[str, spaces.Space[Any]] = {

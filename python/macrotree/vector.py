@@ -14,9 +14,9 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
+from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode
 from gymnasium.vector import VectorEnv as GymVectorEnv
-from gymnasium.utils import seeding
 from gymnasium.vector.utils import batch_space
 
 from macrotree import _native
@@ -75,7 +75,7 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
     ``MacroEnv`` gives with the same resets and actions.
     """
 
-    metadata: dict[str, Any] = {
+    metadata: dict[str, Any] = {  # noqa: RUF012  (Gymnasium declares it so)
         "render_modes": ["rgb_array"],
         "render_fps": 30,
         "autoreset_mode": AutoresetMode.SAME_STEP,
@@ -102,7 +102,8 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         mode = AutoresetMode(autoreset_mode)
         if mode not in (AutoresetMode.SAME_STEP, AutoresetMode.DISABLED):
             raise ValueError(
-                f"autoreset_mode must be SAME_STEP or DISABLED (TorchRL refuses NEXT_STEP), got {mode}"
+                "autoreset_mode must be SAME_STEP or DISABLED (TorchRL refuses NEXT_STEP), "
+                f"got {mode}"
             )
         if action_mode not in ("macro", "ctrl"):
             raise ValueError(f"action_mode must be 'macro' or 'ctrl', got {action_mode!r}")
@@ -141,7 +142,8 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         self._last_obs: list[dict[str, Any] | None] = [None] * self.num_envs
 
     def _draw(self, i: int, seed: int | None) -> int:
-        """Sub-environment *i*'s placement seed, drawn exactly as :meth:`MacroEnv.reset` draws it."""
+        """Sub-environment *i*'s placement seed, drawn exactly as :meth:`MacroEnv.reset` draws
+        it."""
         rng = self._rngs[i]
         if seed is not None or rng is None:
             rng, _ = seeding.np_random(seed)
@@ -228,7 +230,7 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         self._native.close()
         self._pending.clear()
 
-    # --- helpers -----------------------------------------------------------------------------------
+    # --- helpers ------------------------------------------------------------------------------
 
     def _native_actions(self, actions: Any, n: int) -> list[Any]:
         if self.action_mode == "ctrl":
@@ -238,8 +240,7 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
             return [row for row in array]
         if isinstance(actions, dict):
             return [
-                macro_to_native({k: np.asarray(v)[i] for k, v in actions.items()})
-                for i in range(n)
+                macro_to_native({k: np.asarray(v)[i] for k, v in actions.items()}) for i in range(n)
             ]
         items = list(actions)
         if len(items) != n:
@@ -275,7 +276,7 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
             again = self._native.reset(
                 ids=[ids[k] for k in ended], seeds=[self._draw(ids[k], None) for k in ended]
             )
-            for k, r in zip(ended, again):
+            for k, r in zip(ended, again, strict=True):
                 final_obs[k] = observations[k]
                 final_info[k] = infos[k]
                 observations[k] = r["obs"]

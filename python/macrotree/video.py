@@ -26,5 +26,7 @@ def write_mp4(path: str | os.PathLike[str], frames: Sequence[np.ndarray], fps: i
     arrays = [np.ascontiguousarray(f) for f in frames]
     for array in arrays:
         if array.shape != (h, w, 3) or array.dtype != np.uint8:
-            raise ValueError(f"every frame must be {h}×{w}×3 uint8, got {array.shape} {array.dtype}")
+            raise ValueError(
+                f"every frame must be {h}×{w}×3 uint8, got {array.shape} {array.dtype}"
+            )
     return int(_native.write_mp4(os.fspath(path), arrays, int(fps)))

@@ -2,7 +2,7 @@
 //! `{"obs", "reward", "terminated", "truncated", "info"}` with Python bools and floats.
 
 use macrotree::env::{Observation, StepResult};
-use numpy::{IntoPyArray, PyArray3};
+use numpy::{IntoPyArray, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
@@ -10,15 +10,16 @@ use pyo3::types::{PyDict, PyList};
 pub type Pixels = Vec<(String, u32, u32, Vec<u8>)>;
 
 /// The Gymnasium observation: `agent_pos`, `environment_state`, `pinch` (float32), and `pixels`.
-pub fn observation<'py>(
-    py: Python<'py>,
-    o: &Observation,
-    pixels: Pixels,
-) -> PyResult<Bound<'py, PyDict>> {
+pub fn observation<'py>(py: Python<'py>, o: &Observation, pixels: Pixels) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("agent_pos", o.state().to_vec().into_pyarray(py))?;
     d.set_item("environment_state", o.environment_state().into_pyarray(py))?;
-    let pinch: Vec<f32> = o.pinch_pos.iter().chain(&o.pinch_quat).map(|&v| v as f32).collect();
+    let pinch: Vec<f32> = o
+        .pinch_pos
+        .iter()
+        .chain(&o.pinch_quat)
+        .map(|&v| v as f32)
+        .collect();
     d.set_item("pinch", pinch.into_pyarray(py))?;
     if !pixels.is_empty() {
         let images = PyDict::new(py);
@@ -33,7 +34,11 @@ pub fn observation<'py>(
 }
 
 /// The full typed observation as nested dicts (`objects` keyed by name).
-pub fn full_observation<'py>(py: Python<'py>, o: &Observation) -> PyResult<Bound<'py, PyDict>> {
+pub fn full_observation<'py>(
+    py: Python<'py>,
+    o: &Observation,
+    sizes: &[[f64; 3]],
+) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("time", o.time)?;
     d.set_item("joint_pos", o.joint_pos.to_vec())?;
@@ -47,15 +52,15 @@ pub fn full_observation<'py>(py: Python<'py>, o: &Observation) -> PyResult<Bound
     d.set_item("left_pad", o.left_pad_pos.to_vec())?;
     d.set_item("right_pad", o.right_pad_pos.to_vec())?;
     let objects = PyDict::new(py);
-    for ob in &o.objects {
+    for (ob, size) in o.objects.iter().zip(sizes) {
         let x = PyDict::new(py);
+        x.set_item("half_extents", size.to_vec())?;
         x.set_item("kind", ob.kind)?;
         x.set_item("pos", ob.pos.to_vec())?;
         x.set_item("quat", ob.quat.to_vec())?;
         x.set_item("linvel", ob.linvel.to_vec())?;
         x.set_item("angvel", ob.angvel.to_vec())?;
         x.set_item("grasped", ob.grasped)?;
-        x.set_item("half_size", ob.half_size)?;
         objects.set_item(&ob.name, x)?;
     }
     d.set_item("objects", objects)?;
@@ -68,7 +73,11 @@ pub fn full_observation<'py>(py: Python<'py>, o: &Observation) -> PyResult<Bound
 }
 
 /// The info of a reset: success so far, the goal predicates, grasped flags.
-pub fn reset_info<'py>(py: Python<'py>, o: &Observation, goal: &[macrotree::world::goal::GoalValue]) -> PyResult<Bound<'py, PyDict>> {
+pub fn reset_info<'py>(
+    py: Python<'py>,
+    o: &Observation,
+    goal: &[macrotree::world::goal::GoalValue],
+) -> PyResult<Bound<'py, PyDict>> {
     let info = PyDict::new(py);
     let success = !goal.is_empty() && goal.iter().all(|g| g.holds);
     info.set_item("is_success", success)?;
@@ -78,7 +87,10 @@ pub fn reset_info<'py>(py: Python<'py>, o: &Observation, goal: &[macrotree::worl
     Ok(info)
 }
 
-fn goal_dict<'py>(py: Python<'py>, goal: &[macrotree::world::goal::GoalValue]) -> PyResult<Bound<'py, PyDict>> {
+fn goal_dict<'py>(
+    py: Python<'py>,
+    goal: &[macrotree::world::goal::GoalValue],
+) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     for g in goal {
         d.set_item(&g.predicate, g.holds)?;
@@ -99,7 +111,9 @@ pub fn step_result<'py>(
     py: Python<'py>,
     r: &StepResult,
     pixels: Pixels,
+    sizes: &[[f64; 3]],
 ) -> PyResult<Bound<'py, PyDict>> {
+    let _ = sizes;
     let out = PyDict::new(py);
     out.set_item("obs", observation(py, &r.observation, pixels)?)?;
     out.set_item("reward", r.reward)?;

@@ -2,7 +2,9 @@
 
 use macrotree::env::{Action, MacroEnv, Reset};
 use macrotree::scene::{Placement, Pose};
-use numpy::{IntoPyArray, PyArray3, PyReadonlyArray1};
+use std::sync::{Mutex, MutexGuard};
+
+use numpy::{IntoPyArray, PyArray3, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -14,7 +16,7 @@ use crate::setup::{self, Settings};
 /// One simulated cell, stepped one action at a time (the GIL is released while it steps).
 #[pyclass(module = "macrotree._native")]
 pub struct Env {
-    inner: MacroEnv,
+    inner: Mutex<MacroEnv>,
     cameras: Vec<String>,
     image: (u32, u32),
     task: String,
@@ -30,14 +32,22 @@ pub fn reset_of(
     sweep_seed: Option<u64>,
     placement: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Reset> {
-    let given = [layout.is_some(), scenario.is_some() || sweep_seed.is_some(), placement.is_some()];
+    let given = [
+        layout.is_some(),
+        scenario.is_some() || sweep_seed.is_some(),
+        placement.is_some(),
+    ];
     if given.iter().filter(|g| **g).count() > 1 {
-        return Err(value("give at most one of `layout`, `scenario` (with `sweep_seed`) and `placement`"));
+        return Err(value(
+            "give at most one of `layout`, `scenario` (with `sweep_seed`) and `placement`",
+        ));
     }
     if let Some(l) = layout {
         return match l {
             "default" => Ok(Reset::Default),
-            other => Err(value(format!("reset layout `{other}`: the only named layout is `default`"))),
+            other => Err(value(format!(
+                "reset layout `{other}`: the only named layout is `default`"
+            ))),
         };
     }
     if scenario.is_some() || sweep_seed.is_some() {
@@ -51,9 +61,14 @@ pub fn reset_of(
         for (k, v) in p.iter() {
             let name: String = k.extract()?;
             let i = env_objects.iter().position(|n| *n == name).ok_or_else(|| {
-                value(format!("reset placement names `{name}`, which is not an object of the scene ({})", env_objects.join(", ")))
+                value(format!(
+                    "reset placement names `{name}`, which is not an object of the scene ({})",
+                    env_objects.join(", ")
+                ))
             })?;
-            let xyz: Vec<f64> = v.extract().map_err(|e| value(format!("placement of `{name}`: {e}")))?;
+            let xyz: Vec<f64> = v
+                .extract()
+                .map_err(|e| value(format!("placement of `{name}`: {e}")))?;
             let [x, y, yaw]: [f64; 3] = xyz
                 .try_into()
                 .map_err(|_| value(format!("placement of `{name}` is [x, y, yaw] (metres, radians)")))?;
@@ -76,17 +91,46 @@ pub fn pixels(env: &MacroEnv, cameras: &[String], (h, w): (u32, u32)) -> PyResul
 }
 
 impl Env {
-    fn finish<'py>(&self, py: Python<'py>, r: Result<macrotree::env::StepResult, macrotree::Error>) -> PyResult<Bound<'py, PyDict>> {
-        let r = r.map_err(to_py)?;
-        let px = pixels(&self.inner, &self.cameras, self.image)?;
-        convert::step_result(py, &r, px)
+    fn env(&self) -> MutexGuard<'_, MacroEnv> {
+        self.inner.lock().unwrap_or_else(|e| e.into_inner())
     }
 
-    fn step(&mut self, py: Python<'_>, action: Action) -> PyResult<Py<PyDict>> {
-        let inner = &mut self.inner;
-        let r = py.detach(|| inner.step(&action));
-        Ok(self.finish(py, r)?.unbind())
+    fn step(&self, py: Python<'_>, action: Action) -> PyResult<Py<PyDict>> {
+        let mut env = self.env();
+        let e: &mut MacroEnv = &mut env;
+        let r = py.detach(|| e.step(&action)).map_err(to_py)?;
+        let px = pixels(&env, &self.cameras, self.image)?;
+        Ok(convert::step_result(py, &r, px, &sizes(&env))?.unbind())
     }
+}
+
+/// The scene's first camera (what `render()` shows by default).
+pub fn first_camera(env: &MacroEnv) -> PyResult<String> {
+    env.scene()
+        .camera_names()
+        .into_iter()
+        .next()
+        .ok_or_else(|| value("the scene has no camera"))
+}
+
+/// An image as an H×W×3 `uint8` numpy array (no copy).
+pub fn image(py: Python<'_>, img: macrotree::env::Image) -> PyResult<Bound<'_, PyArray3<u8>>> {
+    img.pixels
+        .into_pyarray(py)
+        .reshape([img.height as usize, img.width as usize, 3])
+}
+
+/// Each object's half extents (x, y, z), metres, scene order.
+pub fn sizes(env: &MacroEnv) -> Vec<[f64; 3]> {
+    env.scene()
+        .spec
+        .objects
+        .iter()
+        .map(|o| {
+            let [hx, hy] = o.shape.footprint_half();
+            [hx, hy, o.shape.height() / 2.0]
+        })
+        .collect()
 }
 
 #[pymethods]
@@ -106,7 +150,6 @@ impl Env {
         frame_rate: Option<f64>,
         render_camera: Option<String>,
     ) -> PyResult<Self> {
-        let _ = (frame_rate, render_camera);
         let settings = Settings {
             scene: scene.as_deref(),
             tree: tree.as_deref(),
@@ -116,22 +159,42 @@ impl Env {
         };
         let parts = py.detach(|| setup::build(&settings))?;
         let task = parts.scene.spec.name.clone();
-        let inner = py
+        let mut inner = py
             .detach(|| MacroEnv::new(&parts.app, parts.scene, parts.tree, parts.config))
             .map_err(to_py)?;
-        Ok(Self { inner, cameras, image: image_size, task })
+        if let Some(rate) = frame_rate {
+            let camera = match render_camera {
+                Some(c) => c,
+                None => first_camera(&inner)?,
+            };
+            inner
+                .film(&camera, image_size.1, image_size.0, rate)
+                .map_err(to_py)?;
+        }
+        Ok(Self {
+            inner: Mutex::new(inner),
+            cameras,
+            image: image_size,
+            task,
+        })
     }
 
     /// Object names, scene order.
     #[getter]
     fn object_names(&self) -> Vec<String> {
-        self.inner.scene().spec.objects.iter().map(|o| o.name.clone()).collect()
+        self.env()
+            .scene()
+            .spec
+            .objects
+            .iter()
+            .map(|o| o.name.clone())
+            .collect()
     }
 
     /// The scene's cameras.
     #[getter]
     fn cameras(&self) -> Vec<String> {
-        self.inner.scene().camera_names()
+        self.env().scene().camera_names()
     }
 
     /// The UR5e home joint angles, radians.
@@ -149,23 +212,25 @@ impl Env {
     /// A sentence about the task (LeRobot's `task_description`).
     #[getter]
     fn task_description(&self) -> String {
-        let goal = &self.inner.scene().spec.goal;
+        let env = self.env();
+        let goal = macrotree::world::goal::evaluate(env.cell().world());
         if goal.is_empty() {
             format!("scene {}: no goal", self.task)
         } else {
-            format!("scene {}: {}", self.task, goal.describe())
+            let parts: Vec<&str> = goal.iter().map(|g| g.predicate.as_str()).collect();
+            format!("scene {}: {}", self.task, parts.join(", "))
         }
     }
 
     /// Seconds of one control period.
     #[getter]
     fn control_period(&self) -> f64 {
-        self.inner.config().control_period
+        self.env().config().control_period
     }
 
     #[pyo3(signature = (*, seed, layout=None, scenario=None, sweep_seed=None, placement=None))]
     fn reset(
-        &mut self,
+        &self,
         py: Python<'_>,
         seed: u64,
         layout: Option<String>,
@@ -174,23 +239,32 @@ impl Env {
         placement: Option<Bound<'_, PyDict>>,
     ) -> PyResult<Py<PyDict>> {
         let names = self.object_names();
-        let how = reset_of(&names, &self.inner.scene().default_placement(), seed, layout.as_deref(), scenario, sweep_seed, placement.as_ref())?;
-        let inner = &mut self.inner;
-        let obs = py.detach(|| inner.reset(&how)).map_err(to_py)?;
-        let goal = macrotree::world::goal::evaluate(self.inner.cell().world());
-        let px = pixels(&self.inner, &self.cameras, self.image)?;
+        let mut env = self.env();
+        let how = reset_of(
+            &names,
+            &env.scene().default_placement(),
+            seed,
+            layout.as_deref(),
+            scenario,
+            sweep_seed,
+            placement.as_ref(),
+        )?;
+        let e: &mut MacroEnv = &mut env;
+        let obs = py.detach(|| e.reset(&how)).map_err(to_py)?;
+        let goal = macrotree::world::goal::evaluate(env.cell().world());
+        let px = pixels(&env, &self.cameras, self.image)?;
         let out = PyDict::new(py);
         out.set_item("obs", convert::observation(py, &obs, px)?)?;
         out.set_item("info", convert::reset_info(py, &obs, &goal)?)?;
         Ok(out.unbind())
     }
 
-    fn step_macro(&mut self, py: Python<'_>, action: Bound<'_, PyDict>) -> PyResult<Py<PyDict>> {
+    fn step_macro(&self, py: Python<'_>, action: Bound<'_, PyDict>) -> PyResult<Py<PyDict>> {
         let p = macro_action::primitive(&action)?;
         self.step(py, Action::Primitive(p))
     }
 
-    fn step_ctrl(&mut self, py: Python<'_>, ctrl: PyReadonlyArray1<'_, f64>) -> PyResult<Py<PyDict>> {
+    fn step_ctrl(&self, py: Python<'_>, ctrl: PyReadonlyArray1<'_, f64>) -> PyResult<Py<PyDict>> {
         let u: [f64; 7] = ctrl
             .as_slice()?
             .try_into()
@@ -198,30 +272,40 @@ impl Env {
         self.step(py, Action::Ctrl(u))
     }
 
-    fn step_leaf(&mut self, py: Python<'_>, text: String) -> PyResult<Py<PyDict>> {
+    fn step_leaf(&self, py: Python<'_>, text: String) -> PyResult<Py<PyDict>> {
         self.step(py, Action::Leaf(text))
     }
 
-    fn step_subtree(&mut self, py: Python<'_>, name: String) -> PyResult<Py<PyDict>> {
+    fn step_subtree(&self, py: Python<'_>, name: String) -> PyResult<Py<PyDict>> {
         self.step(py, Action::Subtree(name))
     }
 
     fn observation(&self, py: Python<'_>) -> PyResult<Py<PyDict>> {
-        Ok(convert::full_observation(py, &self.inner.observe())?.unbind())
+        let env = self.env();
+        Ok(convert::full_observation(py, &env.observe(), &sizes(&env))?.unbind())
     }
 
     #[pyo3(signature = (camera, height, width))]
-    fn render<'py>(&self, py: Python<'py>, camera: Option<String>, height: u32, width: u32) -> PyResult<Bound<'py, PyArray3<u8>>> {
+    fn render<'py>(
+        &self,
+        py: Python<'py>,
+        camera: Option<String>,
+        height: u32,
+        width: u32,
+    ) -> PyResult<Bound<'py, PyArray3<u8>>> {
+        let env = self.env();
         let camera = match camera {
             Some(c) => c,
-            None => self.inner.scene().camera_names().into_iter().next().ok_or_else(|| value("the scene has no camera"))?,
+            None => first_camera(&env)?,
         };
-        let img = self.inner.render(&camera, width, height).map_err(to_py)?;
-        img.pixels.into_pyarray(py).reshape([img.height as usize, img.width as usize, 3])
+        let img = env.render(&camera, width, height).map_err(to_py)?;
+        image(py, img)
     }
 
-    fn take_frames(&mut self) -> Vec<Py<PyAny>> {
-        Vec::new()
+    /// The frames filmed since the last call (`rgb_array_list`), each H×W×3 `uint8`.
+    fn take_frames<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyArray3<u8>>>> {
+        let frames = self.env().take_frames();
+        frames.into_iter().map(|img| image(py, img)).collect()
     }
 
     fn gripper_command_for_width(&self, width: f64) -> PyResult<f64> {

@@ -19,7 +19,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MacrotreeError", m.py().get_type::<error::MacrotreeError>())?;
     m.add(
         "JOINT_LIMITS",
-        macrotree::motion::JOINT_LIMITS.iter().map(|&(lo, hi)| (lo, hi)).collect::<Vec<_>>(),
+        macrotree::motion::JOINT_LIMITS
+            .iter()
+            .map(|&(lo, hi)| (lo, hi))
+            .collect::<Vec<_>>(),
     )?;
     m.add("HOME", macrotree::motion::HOME_Q.to_vec())?;
     m.add_function(wrap_pyfunction!(gripper_command_for_width, m)?)?;

@@ -24,21 +24,26 @@ const GRIPPER_KEEP: i64 = 2;
 fn field<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<Option<T>> {
     match d.get_item(key)? {
         None => Ok(None),
-        Some(v) => v
-            .extract::<T>()
-            .map(Some)
-            .map_err(|e| value(format!("macro action `{key}`: {e}"))),
+        Some(v) => v.extract::<T>().map(Some).map_err(|e| {
+            let e: PyErr = e.into();
+            value(format!("macro action `{key}`: {e}"))
+        }),
     }
 }
 
 fn array<const N: usize>(d: &Bound<'_, PyDict>, key: &str, mode: &str) -> PyResult<[f64; N]> {
-    let v: Vec<f64> = field(d, key)?
-        .ok_or_else(|| value(format!("a `{mode}` macro needs `{key}` ({N} values)")))?;
-    v.try_into()
-        .map_err(|v: Vec<f64>| value(format!("macro action `{key}` has {} values, expected {N}", v.len())))
+    let v: Vec<f64> =
+        field(d, key)?.ok_or_else(|| value(format!("a `{mode}` macro needs `{key}` ({N} values)")))?;
+    v.try_into().map_err(|v: Vec<f64>| {
+        value(format!(
+            "macro action `{key}` has {} values, expected {N}",
+            v.len()
+        ))
+    })
 }
 
-/// The duration of `steps` and `settle_steps`: 0 steps is closed loop (`Auto`).
+/// The duration of `steps` and `settle_steps` (reference steps of 10 ms): 0 steps is closed
+/// loop (`Auto`, then `settle_steps` held); a wait of 0 steps lasts one reference step.
 fn duration(d: &Bound<'_, PyDict>, wait: bool) -> PyResult<Duration> {
     let steps: i64 = field(d, "steps")?.unwrap_or(0);
     let settle: i64 = field(d, "settle_steps")?.unwrap_or(0);
@@ -46,12 +51,11 @@ fn duration(d: &Bound<'_, PyDict>, wait: bool) -> PyResult<Duration> {
         u32::try_from(n).map_err(|_| value(format!("macro action `{key}` is {n}; expected 0 … {}", u32::MAX)))
     };
     let (steps, settle) = (count(steps, "steps")?, count(settle, "settle_steps")?);
-    Ok(if steps == 0 && settle == 0 && !wait {
-        Duration::Auto
-    } else if steps == 0 && settle == 0 {
-        Duration::Steps { steps: 1, settle: 0 }
-    } else {
-        Duration::Steps { steps, settle }
+    Ok(match (steps, settle, wait) {
+        (0, 0, false) => Duration::Auto,
+        (0, settle, false) => Duration::AutoThen { settle },
+        (0, 0, true) => Duration::Steps { steps: 1, settle: 0 },
+        (steps, settle, _) => Duration::Steps { steps, settle },
     })
 }
 
@@ -64,7 +68,11 @@ fn gripper_during(d: &Bound<'_, PyDict>) -> PyResult<Option<f64>> {
         (None, GRIPPER_OPEN) => Some(macrotree::motion::OPEN_CTRL),
         (None, GRIPPER_CLOSED) => Some(macrotree::motion::CLOSED_CTRL),
         (None, GRIPPER_KEEP) => None,
-        (None, other) => return Err(value(format!("macro action `gripper` is {other}; expected 0 (open), 1 (closed) or 2 (keep)"))),
+        (None, other) => {
+            return Err(value(format!(
+                "macro action `gripper` is {other}; expected 0 (open), 1 (closed) or 2 (keep)"
+            )));
+        }
     })
 }
 
@@ -73,7 +81,10 @@ pub fn primitive(d: &Bound<'_, PyDict>) -> PyResult<Primitive> {
     let mode: i64 = field(d, "mode")?.ok_or_else(|| value("a macro action needs `mode` (0 … 5)"))?;
     let gripper = gripper_during(d)?;
     Ok(match mode {
-        WAIT => Primitive::Wait { duration: duration(d, true)?, gripper },
+        WAIT => Primitive::Wait {
+            duration: duration(d, true)?,
+            gripper,
+        },
         REACH_JOINTS => Primitive::ReachJoints {
             joints: array(d, "joints", "reach_joints")?,
             duration: duration(d, false)?,
@@ -83,7 +94,9 @@ pub fn primitive(d: &Bound<'_, PyDict>) -> PyResult<Primitive> {
             let quaternion = match field::<Vec<f64>>(d, "quaternion")? {
                 None => None,
                 Some(q) => {
-                    let q: [f64; 4] = q.try_into().map_err(|_| value("macro action `quaternion` needs 4 values (w, x, y, z)"))?;
+                    let q: [f64; 4] = q
+                        .try_into()
+                        .map_err(|_| value("macro action `quaternion` needs 4 values (w, x, y, z)"))?;
                     // The reference's convention: an all-zero quaternion means position only.
                     (q.iter().map(|v| v * v).sum::<f64>() > 1e-12).then_some(q)
                 }
@@ -91,7 +104,11 @@ pub fn primitive(d: &Bound<'_, PyDict>) -> PyResult<Primitive> {
             let path = match field::<i64>(d, "path")?.unwrap_or(0) {
                 0 => PathKind::Joint,
                 1 => PathKind::Cartesian,
-                other => return Err(value(format!("macro action `path` is {other}; expected 0 (joint) or 1 (cartesian)"))),
+                other => {
+                    return Err(value(format!(
+                        "macro action `path` is {other}; expected 0 (joint) or 1 (cartesian)"
+                    )));
+                }
             };
             Primitive::ReachPose {
                 position: array(d, "position", "reach_pose")?,
@@ -101,13 +118,21 @@ pub fn primitive(d: &Bound<'_, PyDict>) -> PyResult<Primitive> {
                 gripper,
             }
         }
-        OPEN_GRIPPER => Primitive::OpenGripper { duration: duration(d, false)? },
+        OPEN_GRIPPER => Primitive::OpenGripper {
+            duration: duration(d, false)?,
+        },
         CLOSE_GRIPPER => Primitive::CloseGripper {
             command: field::<f64>(d, "gripper_command")?.filter(|c| !c.is_nan()),
             width: None,
             duration: duration(d, false)?,
         },
-        RESET => Primitive::Reset { duration: duration(d, false)? },
-        other => return Err(value(format!("macro action `mode` is {other}; expected 0 (wait), 1 (reach_joints), 2 (reach_pose), 3 (open_gripper), 4 (close_gripper) or 5 (reset)"))),
+        RESET => Primitive::Reset {
+            duration: duration(d, false)?,
+        },
+        other => {
+            return Err(value(format!(
+                "macro action `mode` is {other}; expected 0 (wait), 1 (reach_joints), 2 (reach_pose), 3 (open_gripper), 4 (close_gripper) or 5 (reset)"
+            )));
+        }
     })
 }

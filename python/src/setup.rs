@@ -44,14 +44,20 @@ pub fn build(s: &Settings<'_>) -> PyResult<Parts> {
         }
         (Some(scene), None) => {
             let spec = macrotree::scene::load_scene_file(Path::new(scene)).map_err(|diagnostics| {
-                to_py(macrotree::Error::Scene { file: scene.to_string(), diagnostics })
+                to_py(macrotree::Error::Scene {
+                    file: scene.to_string(),
+                    diagnostics,
+                })
             })?;
             (Arc::new(spec), None)
         }
         (None, None) => return Err(value("an environment needs a scene file, a tree file, or both")),
     };
-    let scene = Scene::load_spec(&spec)
-        .map_err(|e| to_py(macrotree::Error::Simulator { message: e.to_string() }))?;
+    let scene = Scene::load_spec(&spec).map_err(|e| {
+        to_py(macrotree::Error::Simulator {
+            message: e.to_string(),
+        })
+    })?;
     let fault = match s.fault {
         None => None,
         Some(name) => Some(name.parse().map_err(|e: String| value(e))?),
@@ -63,5 +69,10 @@ pub fn build(s: &Settings<'_>) -> PyResult<Parts> {
         ..EnvConfig::default()
     };
     config.check().map_err(to_py)?;
-    Ok(Parts { app, scene, tree, config })
+    Ok(Parts {
+        app,
+        scene,
+        tree,
+        config,
+    })
 }

@@ -2,12 +2,14 @@
 //! released while they step.
 
 use macrotree::env::{Action, Reset};
-use numpy::{IntoPyArray, PyArray3, PyReadonlyArray1};
+use std::sync::Mutex;
+
+use numpy::{PyArray3, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::convert;
-use crate::env::{pixels, reset_of};
+use crate::env::{first_camera, image, pixels, reset_of, sizes};
 use crate::error::{to_py, value};
 use crate::macro_action;
 use crate::setup::{self, Settings};
@@ -15,7 +17,7 @@ use crate::setup::{self, Settings};
 /// N environments stepped in parallel.
 #[pyclass(module = "macrotree._native")]
 pub struct VecEnv {
-    inner: macrotree::env::VecEnv,
+    inner: Mutex<macrotree::env::VecEnv>,
     names: Vec<String>,
     cameras: Vec<String>,
     image: (u32, u32),
@@ -36,15 +38,32 @@ fn action_of(a: &Bound<'_, PyAny>) -> PyResult<Action> {
     Ok(Action::Ctrl(u))
 }
 
+type Guard<'a> = std::sync::MutexGuard<'a, macrotree::env::VecEnv>;
+
 impl VecEnv {
-    fn result<'py>(&self, py: Python<'py>, i: usize, r: Result<macrotree::env::StepResult, macrotree::Error>) -> PyResult<Bound<'py, PyDict>> {
+    fn vec(&self) -> Guard<'_> {
+        self.inner.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    fn result<'py>(
+        &self,
+        py: Python<'py>,
+        v: &Guard<'_>,
+        i: usize,
+        r: Result<macrotree::env::StepResult, macrotree::Error>,
+    ) -> PyResult<Bound<'py, PyDict>> {
         let r = r.map_err(to_py)?;
-        let px = if self.cameras.is_empty() {
-            Vec::new()
-        } else {
-            self.inner.with_env(i, |e| pixels(e, &self.cameras, self.image)).map_err(to_py)??
-        };
-        convert::step_result(py, &r, px)
+        let (px, sz) = v
+            .with_env(i, |e| {
+                let px = if self.cameras.is_empty() {
+                    Ok(Vec::new())
+                } else {
+                    pixels(e, &self.cameras, self.image)
+                };
+                (px, sizes(e))
+            })
+            .map_err(to_py)?;
+        convert::step_result(py, &r, px?, &sz)
     }
 }
 
@@ -76,9 +95,23 @@ impl VecEnv {
         let names = parts.scene.spec.objects.iter().map(|o| o.name.clone()).collect();
         let threads = threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |c| c.get()));
         let inner = py
-            .detach(|| macrotree::env::VecEnv::with_threads(&parts.app, parts.scene, parts.tree, parts.config, num_envs, threads))
+            .detach(|| {
+                macrotree::env::VecEnv::with_threads(
+                    &parts.app,
+                    parts.scene,
+                    parts.tree,
+                    parts.config,
+                    num_envs,
+                    threads,
+                )
+            })
             .map_err(to_py)?;
-        Ok(Self { inner, names, cameras, image: image_size })
+        Ok(Self {
+            inner: Mutex::new(inner),
+            names,
+            cameras,
+            image: image_size,
+        })
     }
 
     #[getter]
@@ -89,7 +122,7 @@ impl VecEnv {
     #[pyo3(signature = (*, ids, seeds, layout=None, scenario=None, sweep_seed=None, placement=None))]
     #[allow(clippy::too_many_arguments)]
     fn reset<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
         ids: Vec<usize>,
         seeds: Vec<u64>,
@@ -101,17 +134,35 @@ impl VecEnv {
         if ids.len() != seeds.len() {
             return Err(value(format!("{} ids but {} seeds", ids.len(), seeds.len())));
         }
-        let default = self.inner.with_env(0, |e| e.scene().default_placement()).map_err(to_py)?;
+        let mut v = self.vec();
+        let default = v.with_env(0, |e| e.scene().default_placement()).map_err(to_py)?;
         let how = seeds
             .iter()
-            .map(|&s| reset_of(&self.names, &default, s, layout.as_deref(), scenario, sweep_seed, placement.as_ref()))
+            .map(|&s| {
+                reset_of(
+                    &self.names,
+                    &default,
+                    s,
+                    layout.as_deref(),
+                    scenario,
+                    sweep_seed,
+                    placement.as_ref(),
+                )
+            })
             .collect::<PyResult<Vec<Reset>>>()?;
-        let inner = &mut self.inner;
-        let obs = py.detach(|| inner.reset_each(&ids, &how)).map_err(to_py)?;
+        let e: &mut macrotree::env::VecEnv = &mut v;
+        let obs = py.detach(|| e.reset_each(&ids, &how)).map_err(to_py)?;
         let out = PyList::empty(py);
         for (&i, o) in ids.iter().zip(&obs) {
-            let goal = self.inner.with_env(i, |e| macrotree::world::goal::evaluate(e.cell().world())).map_err(to_py)?;
-            let px = if self.cameras.is_empty() { Vec::new() } else { self.inner.with_env(i, |e| pixels(e, &self.cameras, self.image)).map_err(to_py)?? };
+            let goal = v
+                .with_env(i, |e| macrotree::world::goal::evaluate(e.cell().world()))
+                .map_err(to_py)?;
+            let px = if self.cameras.is_empty() {
+                Vec::new()
+            } else {
+                v.with_env(i, |e| pixels(e, &self.cameras, self.image))
+                    .map_err(to_py)??
+            };
             let d = PyDict::new(py);
             d.set_item("obs", convert::observation(py, o, px)?)?;
             d.set_item("info", convert::reset_info(py, o, &goal)?)?;
@@ -121,62 +172,82 @@ impl VecEnv {
     }
 
     /// Steps environments `ids` with `actions` in parallel; results in the order of `ids`.
-    fn step<'py>(&mut self, py: Python<'py>, ids: Vec<usize>, actions: Vec<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyList>> {
+    fn step<'py>(
+        &self,
+        py: Python<'py>,
+        ids: Vec<usize>,
+        actions: Vec<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyList>> {
         let actions = actions.iter().map(action_of).collect::<PyResult<Vec<_>>>()?;
-        let inner = &mut self.inner;
-        py.detach(|| inner.send(&ids, &actions)).map_err(to_py)?;
-        let inner = &mut self.inner;
-        let mut done = py.detach(|| inner.recv(ids.len())).map_err(to_py)?;
+        let mut v = self.vec();
+        let e: &mut macrotree::env::VecEnv = &mut v;
+        let mut done = py
+            .detach(|| {
+                e.send(&ids, &actions)?;
+                e.recv(ids.len())
+            })
+            .map_err(to_py)?;
         let order = |i: &usize| ids.iter().position(|j| j == i).unwrap_or(usize::MAX);
         done.sort_by_key(|(i, _)| order(i));
         let out = PyList::empty(py);
         for (i, r) in done {
-            out.append(self.result(py, i, r)?)?;
+            out.append(self.result(py, &v, i, r)?)?;
         }
         Ok(out)
     }
 
     /// Starts `actions` on environments `ids` and returns at once.
-    fn send<'py>(&mut self, py: Python<'py>, ids: Vec<usize>, actions: Vec<Bound<'py, PyAny>>) -> PyResult<()> {
+    fn send<'py>(&self, py: Python<'py>, ids: Vec<usize>, actions: Vec<Bound<'py, PyAny>>) -> PyResult<()> {
         let actions = actions.iter().map(action_of).collect::<PyResult<Vec<_>>>()?;
-        let inner = &mut self.inner;
-        py.detach(|| inner.send(&ids, &actions)).map_err(to_py)
+        let mut v = self.vec();
+        let e: &mut macrotree::env::VecEnv = &mut v;
+        py.detach(|| e.send(&ids, &actions)).map_err(to_py)
     }
 
     /// Waits for at least `count` environments to finish; `[(id, result)]` in finishing order.
-    fn recv<'py>(&mut self, py: Python<'py>, count: usize) -> PyResult<Bound<'py, PyList>> {
-        let inner = &mut self.inner;
-        let done = py.detach(|| inner.recv(count)).map_err(to_py)?;
+    fn recv<'py>(&self, py: Python<'py>, count: usize) -> PyResult<Bound<'py, PyList>> {
+        let mut v = self.vec();
+        let e: &mut macrotree::env::VecEnv = &mut v;
+        let done = py.detach(|| e.recv(count)).map_err(to_py)?;
         let out = PyList::empty(py);
         for (i, r) in done {
-            out.append((i, self.result(py, i, r)?))?;
+            out.append((i, self.result(py, &v, i, r)?))?;
         }
         Ok(out)
     }
 
     #[pyo3(signature = (camera, height, width))]
-    fn render<'py>(&self, py: Python<'py>, camera: Option<String>, height: u32, width: u32) -> PyResult<Vec<Bound<'py, PyArray3<u8>>>> {
-        (0..self.inner.num_envs())
+    fn render<'py>(
+        &self,
+        py: Python<'py>,
+        camera: Option<String>,
+        height: u32,
+        width: u32,
+    ) -> PyResult<Vec<Bound<'py, PyArray3<u8>>>> {
+        let v = self.vec();
+        (0..v.num_envs())
             .map(|i| {
-                let img = self
-                    .inner
+                let img = v
                     .with_env(i, |e| {
-                        let cam = camera.clone().or_else(|| e.scene().camera_names().into_iter().next()).unwrap_or_default();
-                        e.render(&cam, width, height)
+                        let cam = match &camera {
+                            Some(c) => c.clone(),
+                            None => first_camera(e)?,
+                        };
+                        e.render(&cam, width, height).map_err(to_py)
                     })
-                    .map_err(to_py)?
-                    .map_err(to_py)?;
-                img.pixels.into_pyarray(py).reshape([img.height as usize, img.width as usize, 3])
+                    .map_err(to_py)??;
+                image(py, img)
             })
             .collect()
     }
 
     /// Waits for running actions, then stops the worker threads.
-    fn close(&mut self, py: Python<'_>) -> PyResult<()> {
-        let inner = &mut self.inner;
-        let pending = inner.pending();
+    fn close(&self, py: Python<'_>) -> PyResult<()> {
+        let mut v = self.vec();
+        let pending = v.pending();
         if pending > 0 {
-            py.detach(|| inner.recv(pending)).map_err(to_py)?;
+            let e: &mut macrotree::env::VecEnv = &mut v;
+            py.detach(|| e.recv(pending)).map_err(to_py)?;
         }
         Ok(())
     }

@@ -6,24 +6,36 @@ use std::path::Path;
 use macrotree::output::OutputFile;
 use macrotree::render::FrameSize;
 use macrotree::video::VideoEncoder;
-use numpy::PyReadonlyArray3;
+use numpy::{PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
 use crate::error::value;
 
 /// Writes `frames` (H×W×3 uint8, one size) at `fps` to `path`; returns the number of frames.
 #[pyfunction]
-pub fn write_mp4(py: Python<'_>, path: String, frames: Vec<PyReadonlyArray3<'_, u8>>, fps: u32) -> PyResult<u64> {
+pub fn write_mp4(
+    py: Python<'_>,
+    path: String,
+    frames: Vec<PyReadonlyArray3<'_, u8>>,
+    fps: u32,
+) -> PyResult<u64> {
     let first = frames.first().ok_or_else(|| value("no frames to write"))?;
     let shape = first.shape().to_vec();
     let size: FrameSize = format!("{}x{}", shape[1], shape[0]).parse().map_err(value)?;
     if !(macrotree::video::MIN_FPS..=macrotree::video::MAX_FPS).contains(&fps) {
-        return Err(value(format!("fps is {fps}; expected {} … {}", macrotree::video::MIN_FPS, macrotree::video::MAX_FPS)));
+        return Err(value(format!(
+            "fps is {fps}; expected {} … {}",
+            macrotree::video::MIN_FPS,
+            macrotree::video::MAX_FPS
+        )));
     }
     let mut bytes = Vec::with_capacity(frames.len());
     for f in &frames {
         if f.shape() != shape.as_slice() {
-            return Err(value(format!("every frame must have shape {shape:?}, got {:?}", f.shape())));
+            return Err(value(format!(
+                "every frame must have shape {shape:?}, got {:?}",
+                f.shape()
+            )));
         }
         bytes.push(f.as_slice()?.to_vec());
     }

@@ -24,14 +24,13 @@ def same_bits(a: dict[str, np.ndarray], b: dict[str, np.ndarray]) -> bool:
 def test_seeded_reset_and_steps_are_bit_identical(cube_env: macrotree.MacroEnv) -> None:
     runs = []
     for _ in range(2):
+        cube_env.action_space.seed(11)
         obs, _ = cube_env.reset(seed=7)
         trace = [obs]
         for _ in range(3):
             obs, *_ = cube_env.step(cube_env.action_space.sample())
             trace.append(obs)
         runs.append(trace)
-        cube_env.action_space.seed(11)
-    cube_env.action_space.seed(11)
     assert all(same_bits(a, b) for a, b in zip(runs[0], runs[1], strict=True))
 
 
@@ -52,7 +51,9 @@ def test_reach_pose_ends_at_the_pose(cube_env: macrotree.MacroEnv) -> None:
     target = obs["pinch"][:3] + np.array([0.05, 0.0, -0.05], dtype=np.float32)
     quat = obs["pinch"][3:]
     obs, _, _, _, info = cube_env.step(
-        macro(MacroMode.REACH_POSE, position=target, quaternion=quat, steps=[150], settle_steps=[50])
+        macro(
+            MacroMode.REACH_POSE, position=target, quaternion=quat, steps=[150], settle_steps=[50]
+        )
     )
     assert info["failure_kind"] is None, info
     assert np.linalg.norm(obs["pinch"][:3] - target) < 0.01
@@ -104,7 +105,7 @@ def test_a_leaf_runs_by_mapping(cube_env: macrotree.MacroEnv) -> None:
 
 def test_a_bad_leaf_is_a_located_error(cube_env: macrotree.MacroEnv) -> None:
     cube_env.reset(seed=0)
-    with pytest.raises(macrotree.MacrotreeError, match=r"1:\d+.*(reach|did you mean)"):
+    with pytest.raises(macrotree.MacrotreeError, match=r"(?s)action:1:2.*did you mean `reach`"):
         cube_env.step_leaf('{"raech": {"target": "cube"}}')
     with pytest.raises(macrotree.MacrotreeError, match="bowl2"):
         cube_env.step_leaf({"reach": {"target": "bowl2"}})
@@ -113,7 +114,7 @@ def test_a_bad_leaf_is_a_located_error(cube_env: macrotree.MacroEnv) -> None:
 def test_a_failed_action_is_typed_not_raised(cube_env: macrotree.MacroEnv) -> None:
     cube_env.reset(options={"layout": "default"})
     _, _, terminated, truncated, info = cube_env.step(
-        macro(MacroMode.REACH_POSE, position=[1.4, 1.4, 1.4], steps=[10])
+        macro(MacroMode.REACH_POSE, position=[0.84, 0.84, 0.84], steps=[10])
     )
     assert info["failure_kind"] is not None and info["failure_message"]
     assert truncated is False and terminated is False

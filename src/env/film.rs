@@ -30,7 +30,9 @@ impl Film {
     pub fn new(camera: String, width: u32, height: u32, rate: f64) -> Result<Self, Error> {
         if !(rate.is_finite() && rate > 0.0 && rate <= MAX_FRAME_RATE) {
             return Err(Error::Action {
-                message: format!("frame rate {rate}; expected more than 0 and at most {MAX_FRAME_RATE} per second"),
+                message: format!(
+                    "frame rate {rate}; expected more than 0 and at most {MAX_FRAME_RATE} per second"
+                ),
             });
         }
         Ok(Self {
@@ -62,13 +64,17 @@ impl Film {
             self.dropped += 1;
             return Ok(());
         }
-        self.frames.push(render_cell(cell, &self.camera, self.width, self.height)?);
+        self.frames
+            .push(render_cell(cell, &self.camera, self.width, self.height)?);
         Ok(())
     }
 
     /// The frames taken since the last call, and how many were dropped (more than
     /// [`MAX_HELD_FRAMES`] held).
     pub fn take(&mut self) -> (Vec<Image>, u64) {
-        (std::mem::take(&mut self.frames), std::mem::take(&mut self.dropped))
+        (
+            std::mem::take(&mut self.frames),
+            std::mem::take(&mut self.dropped),
+        )
     }
 }

@@ -506,7 +506,13 @@ mod tests {
     #[test]
     fn bad_numbers_are_refused_with_the_value_and_the_range() {
         let cases = [
-            (Primitive::Wait { duration: secs(-1.0), gripper: None }, "duration -1"),
+            (
+                Primitive::Wait {
+                    duration: secs(-1.0),
+                    gripper: None,
+                },
+                "duration -1",
+            ),
             (
                 Primitive::Wait {
                     duration: secs(f64::NAN),

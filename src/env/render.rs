@@ -49,34 +49,39 @@ impl super::MacroEnv {
 }
 
 /// Renders `camera` of `cell` at `width × height` (see [`super::MacroEnv::render`]).
-pub(super) fn render_cell(cell: &crate::actions::Cell, camera: &str, width: u32, height: u32) -> Result<Image, Error> {
-        let scene = cell.sim().scene();
-        let Some(id) = scene.camera_id(camera) else {
-            return Err(Error::Action {
-                message: format!(
-                    "unknown camera `{camera}`; the scene has: {}",
-                    scene.camera_names().join(", ")
-                ),
-            });
-        };
-        let size: FrameSize = format!("{width}x{height}").parse().map_err(|e| Error::Action {
+pub(super) fn render_cell(
+    cell: &crate::actions::Cell,
+    camera: &str,
+    width: u32,
+    height: u32,
+) -> Result<Image, Error> {
+    let scene = cell.sim().scene();
+    let Some(id) = scene.camera_id(camera) else {
+        return Err(Error::Action {
+            message: format!(
+                "unknown camera `{camera}`; the scene has: {}",
+                scene.camera_names().join(", ")
+            ),
+        });
+    };
+    let size: FrameSize = format!("{width}x{height}").parse().map_err(|e| Error::Action {
             message: format!(
                 "image size {width}x{height}: {e} (even sides, {MIN_SIDE} … {MAX_WIDTH} × {MIN_SIDE} … {MAX_HEIGHT})"
             ),
         })?;
-        let model = scene.model.clone();
-        let data = cell.sim().data();
-        let pixels = with_thread_renderer(&model, size, |r| {
-            r.sync(data);
-            r.render(id).map(<[u8]>::to_vec)
-        })
-        .and_then(|x| x)
-        .map_err(|e| Error::Simulator {
-            message: format!("cannot render camera `{camera}`: {e}"),
-        })?;
-        Ok(Image {
-            width,
-            height,
-            pixels,
-        })
+    let model = scene.model.clone();
+    let data = cell.sim().data();
+    let pixels = with_thread_renderer(&model, size, |r| {
+        r.sync(data);
+        r.render(id).map(<[u8]>::to_vec)
+    })
+    .and_then(|x| x)
+    .map_err(|e| Error::Simulator {
+        message: format!("cannot render camera `{camera}`: {e}"),
+    })?;
+    Ok(Image {
+        width,
+        height,
+        pixels,
+    })
 }
