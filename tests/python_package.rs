@@ -5,9 +5,9 @@
 //! reference tutorial, `examples/python/scripted_cube_bowl.py`.
 //!
 //! The virtual environment lives in `target/python-test/venv` and is rebuilt when
-//! `python/requirements-test.txt` changes; the wheel is built in `target/python-test/build` (its
-//! own build folder: this test runs while cargo may still hold `target/release`). Python is
-//! `python3`, or `MACROTREE_PYTHON`. `MACROTREE_SKIP_PYTHON_TESTS=1` skips these tests (never
+//! `python/requirements-test.txt` changes; maturin builds the extension in the workspace's
+//! `target/` (cargo holds no lock on it while tests run), so only the extension crate itself is
+//! compiled here. Python is `python3`, or `MACROTREE_PYTHON`. `MACROTREE_SKIP_PYTHON_TESTS=1` skips these tests (never
 //! under `CI`).
 
 use std::path::{Path, PathBuf};
@@ -104,8 +104,7 @@ fn installed() -> &'static Venv {
                     "--no-deps",
                     "--no-build-isolation",
                 ])
-                .args(["--force-reinstall", "./python"])
-                .env("CARGO_TARGET_DIR", base.join("build")),
+                .args(["--force-reinstall", "./python"]),
             "pip install ./python",
         );
         venv

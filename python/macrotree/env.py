@@ -197,6 +197,17 @@ class MacroEnv(gym.Env[Observation, Any]):
         i = self.object_names.index(name)
         return np.asarray(obs["environment_state"][7 * i : 7 * i + 7])
 
+    def record_controls(self) -> None:
+        """Records the actuator commands of every physics step until the next reset (for
+        :meth:`replay_recorded`)."""
+        self._native.record_controls()
+
+    def replay_recorded(self) -> tuple[float, int, bool]:
+        """Replays the recorded commands with bare ``mj_step`` from this episode's start: wall
+        seconds, physics steps, and whether it ended in this environment's state bit for bit. The
+        benchmark of what the environment costs over physics (``examples/python/bench_env.py``)."""
+        return self._native.replay_recorded()
+
     @property
     def home(self) -> np.ndarray:
         """The UR5e home joint angles, radians."""

@@ -17,6 +17,7 @@ use crate::setup::{self, Settings};
 #[pyclass(module = "macrotree._native")]
 pub struct Env {
     inner: Mutex<MacroEnv>,
+    recording: Mutex<Option<macrotree::episode::replay::Controls>>,
     cameras: Vec<String>,
     image: (u32, u32),
     task: String,
@@ -173,6 +174,7 @@ impl Env {
         }
         Ok(Self {
             inner: Mutex::new(inner),
+            recording: Mutex::new(None),
             cameras,
             image: image_size,
             task,
@@ -306,6 +308,35 @@ impl Env {
     fn take_frames<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyArray3<u8>>>> {
         let frames = self.env().take_frames();
         frames.into_iter().map(|img| image(py, img)).collect()
+    }
+
+    /// Records the actuator commands of every physics step from now until the next reset.
+    fn record_controls(&self) {
+        let log = self.env().record_controls();
+        *self.recording.lock().unwrap_or_else(|e| e.into_inner()) = Some(log);
+    }
+
+    /// Replays the recorded commands on a fresh simulation with bare `mj_step` from this
+    /// episode's start: `(wall seconds, physics steps, ends in this environment's state bit for
+    /// bit)`. For benchmarks: the same controls, no tree, no controllers, no Python.
+    fn replay_recorded(&self, py: Python<'_>) -> PyResult<(f64, usize, bool)> {
+        let log = self
+            .recording
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone()
+            .ok_or_else(|| value("nothing recorded: call record_controls() after reset() first"))?;
+        let env = self.env();
+        let controls = log.lock().unwrap_or_else(|e| e.into_inner()).clone();
+        let nu = env.cell().sim().ctrl().len().max(1);
+        let (scene, placement) = (env.scene(), env.placement());
+        let (wall, state) =
+            py.detach(|| macrotree::episode::replay::replay_controls(scene, placement, &controls));
+        Ok((
+            wall,
+            controls.len() / nu,
+            state == env.cell().sim().state_fingerprint(),
+        ))
     }
 
     fn gripper_command_for_width(&self, width: f64) -> PyResult<f64> {

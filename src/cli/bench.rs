@@ -5,7 +5,7 @@
 //! the two wall times is the overhead of the tree, the controllers, IK and world extraction.
 
 use std::path::PathBuf;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use std::time::Instant;
 
 use clap::Args;
@@ -13,9 +13,9 @@ use serde::Serialize;
 
 use super::run::EpisodeArgs;
 use super::{CliError, load_task};
-use crate::actions::{Cell, StepObserver};
+use crate::actions::Cell;
+use crate::episode::replay::{ControlRecorder, replay_controls};
 use crate::episode::{NoObserver, run_in_cell};
-use crate::sim::{Scene, Sim};
 
 /// Arguments of `bench`.
 #[derive(Debug, Args)]
@@ -69,17 +69,6 @@ fn fnv1a_hex(bits: &[u64]) -> String {
     format!("{h:016x}")
 }
 
-struct Recorder(Arc<Mutex<Vec<f64>>>);
-
-impl StepObserver for Recorder {
-    fn before_step(&mut self, sim: &mut Sim) {
-        self.0
-            .lock()
-            .expect("recorder lock")
-            .extend_from_slice(sim.ctrl());
-    }
-}
-
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
@@ -102,16 +91,15 @@ pub fn bench(app: &crate::App, args: BenchArgs) -> Result<(), CliError> {
     let mut last = None;
     let mut states = None;
     for _ in 0..repeat {
-        let controls = Arc::new(Mutex::new(Vec::new()));
+        let (recorder, controls) = ControlRecorder::new();
         let mut cell = Cell::new(&scene, &crate::sim::Layout::default(), config.control_period);
-        // Not recorded: the first run warms caches; recording costs one copy per step, which is
-        // charged to the episode (conservative).
-        cell.observers.push(Box::new(Recorder(controls.clone())));
+        // Recording costs one copy per step, which is charged to the episode (conservative).
+        cell.observers.push(Box::new(recorder));
         let t = Instant::now();
         let report = run_in_cell(&mut cell, plan.clone(), app.factory(), &config, &mut NoObserver);
         episode_times.push(t.elapsed().as_secs_f64());
         let controls = controls.lock().expect("recorder lock").clone();
-        let (wall, replayed) = replay(&scene, &placement, &controls);
+        let (wall, replayed) = replay_controls(&scene, &placement, &controls);
         replay_times.push(wall);
         states = Some((cell.sim().state_fingerprint(), replayed));
         last = Some(report);
@@ -167,19 +155,4 @@ pub fn bench(app: &crate::App, args: BenchArgs) -> Result<(), CliError> {
         );
     }
     Ok(())
-}
-
-/// Wall time of stepping a fresh simulation through `controls` (nu values per step), seconds,
-/// and the state it ends in ([`Sim::state_fingerprint`]).
-fn replay(scene: &Scene, placement: &crate::scene::Placement, controls: &[f64]) -> (f64, Vec<u64>) {
-    let mut sim = Sim::new(scene);
-    sim.reset_placement(placement);
-    let nu = sim.ctrl().len();
-    let t = Instant::now();
-    for ctrl in controls.chunks_exact(nu) {
-        sim.set_ctrl(ctrl);
-        sim.step();
-    }
-    let wall = t.elapsed().as_secs_f64();
-    (wall, sim.state_fingerprint())
 }

@@ -274,6 +274,15 @@ impl MacroEnv {
         }
     }
 
+    /// Records every physics step's actuator commands from now until the next reset (for a
+    /// bare-physics replay: [`crate::episode::replay::replay_controls`] from
+    /// [`placement`](Self::placement) ends in this environment's state, bit for bit).
+    pub fn record_controls(&mut self) -> crate::episode::replay::Controls {
+        let (recorder, log) = crate::episode::replay::ControlRecorder::new();
+        self.cell.observers.push(Box::new(recorder));
+        log
+    }
+
     /// The observation now.
     pub fn observe(&self) -> Observation {
         Observation::of(&self.cell)

@@ -3,6 +3,7 @@
 //! ([`crate::actions`], [`crate::sim`]).
 
 mod driver;
+pub mod replay;
 mod report;
 pub mod scenario;
 pub mod vectors;
