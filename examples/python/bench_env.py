@@ -102,7 +102,7 @@ def ctrl(repeat: int) -> dict[str, float]:
     }
 
 
-def steps_per_second(step: Callable[[int], None], n_envs: int, repeat: int) -> float:
+def steps_per_second(step: Callable[[int], object], n_envs: int, repeat: int) -> float:
     rates = []
     for _ in range(repeat):
         start = time.perf_counter()
