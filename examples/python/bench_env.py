@@ -141,16 +141,16 @@ def vector(n: int, repeat: int) -> dict[str, float]:
     for name, cls in kinds:
         envs = cls([make] * n)
         envs.reset(seed=0)
-        out[name] = steps_per_second(
-            lambda k, envs=envs: envs.step(batch[k]), n, repeat
-        )
+
+        def step(k: int, envs: Any = envs) -> object:
+            return envs.step(batch[k])
+
+        out[name] = steps_per_second(step, n, repeat)
         envs.close()
 
     native = macrotree.VectorEnv(scene(), num_envs=n, action_mode="ctrl", threads=n)
     native.reset(seed=0)
-    out["macrotree_vector_env"] = steps_per_second(
-        lambda k: native.step(batch[k]), n, repeat
-    )
+    out["macrotree_vector_env"] = steps_per_second(lambda k: native.step(batch[k]), n, repeat)
     native.close()
     out["vector_vs_single"] = out["macrotree_vector_env"] / out["single_env"]
     return out

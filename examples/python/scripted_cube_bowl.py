@@ -53,9 +53,7 @@ def macro(mode: MacroMode, gripper: Gripper = Gripper.KEEP, **fields: Any) -> Ac
     """A macro action; absent fields take their defaults (``steps=0``: closed loop)."""
     action: Action = {"mode": int(mode), "gripper": int(gripper)}
     for key, value in fields.items():
-        action[key] = np.asarray(
-            value, dtype=np.float32 if key != "steps" else np.int64
-        )
+        action[key] = np.asarray(value, dtype=np.float32 if key != "steps" else np.int64)
     return action
 
 
@@ -71,9 +69,7 @@ def reach(
     )
 
 
-def policy(
-    env: macrotree.MacroEnv, close_command: float
-) -> Generator[Action, Obs, None]:
+def policy(env: macrotree.MacroEnv, close_command: float) -> Generator[Action, Obs, None]:
     """The tutorial's script: yields one macro, receives the observation after it."""
     obs = yield macro(MacroMode.WAIT, Gripper.OPEN, steps=[20])
     obs = yield macro(MacroMode.OPEN_GRIPPER, Gripper.OPEN)
@@ -82,12 +78,8 @@ def policy(
     down = obs["pinch"][3:].copy()
     obs = yield reach(cube + [0, 0, 0.18], down, Gripper.OPEN, cartesian=False)
     obs = yield reach(cube + [0, 0, -0.016], down, Gripper.OPEN, cartesian=True)
-    obs = yield macro(
-        MacroMode.CLOSE_GRIPPER, Gripper.CLOSED, gripper_command=[close_command]
-    )
-    obs = yield reach(
-        obs["pinch"][:3] + [0, 0, 0.20], down, Gripper.CLOSED, cartesian=True
-    )
+    obs = yield macro(MacroMode.CLOSE_GRIPPER, Gripper.CLOSED, gripper_command=[close_command])
+    obs = yield reach(obs["pinch"][:3] + [0, 0, 0.20], down, Gripper.CLOSED, cartesian=True)
     start = env.object_pose(obs, "cube")[:2].copy()
     for alpha in (0.25, 0.5, 0.75, 1.0):
         cube_now = env.object_pose(obs, "cube")[:3]
@@ -95,15 +87,11 @@ def policy(
         want = np.array([*(start + alpha * (bowl[:2] - start)), 0.24], dtype=np.float32)
         obs = yield reach(want + grip, down, Gripper.CLOSED, cartesian=True)
     grip = obs["pinch"][:3] - env.object_pose(obs, "cube")[:3]
-    obs = yield reach(
-        np.array([bowl[0], bowl[1], 0.13]) + grip, down, Gripper.CLOSED, True
-    )
+    obs = yield reach(np.array([bowl[0], bowl[1], 0.13]) + grip, down, Gripper.CLOSED, True)
     obs = yield macro(MacroMode.OPEN_GRIPPER, Gripper.OPEN)
     obs = yield macro(MacroMode.WAIT, Gripper.OPEN, steps=[240])
     pinch = obs["pinch"][:3]
-    obs = yield reach(
-        np.array([pinch[0], pinch[1], 0.26]), down, Gripper.OPEN, cartesian=True
-    )
+    obs = yield reach(np.array([pinch[0], pinch[1], 0.26]), down, Gripper.OPEN, cartesian=True)
     obs = yield macro(MacroMode.RESET, Gripper.OPEN)
     yield macro(MacroMode.WAIT, Gripper.OPEN, steps=[100])
 
@@ -170,9 +158,7 @@ def rollout(
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument(
-        "--video", type=Path, help="write the five rollouts as an MP4 here"
-    )
+    parser.add_argument("--video", type=Path, help="write the five rollouts as an MP4 here")
     args = parser.parse_args()
     data = data_dir()
     # The video is small (160 × 120 at 10 frames per simulated second): every frame of the five
