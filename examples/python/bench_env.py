@@ -22,8 +22,9 @@ from collections.abc import Callable
 from typing import Any
 
 import gymnasium as gym
-import macrotree
 import numpy as np
+
+import macrotree
 from macrotree._library import data_dir
 
 #: The action leaves the flagship tree (``trees/cube_to_bowl.yaml``) starts, in order, when its

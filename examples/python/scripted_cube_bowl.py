@@ -26,8 +26,9 @@ from collections.abc import Generator
 from pathlib import Path
 from typing import Any
 
-import macrotree
 import numpy as np
+
+import macrotree
 from macrotree import Gripper, MacroMode
 from macrotree._library import data_dir
 from macrotree.video import write_mp4
@@ -76,10 +77,10 @@ def policy(env: macrotree.MacroEnv, close_command: float) -> Generator[Action, O
     cube = env.object_pose(obs, "cube")[:3]
     bowl = env.object_pose(obs, "bowl")[:3]
     down = obs["pinch"][3:].copy()
-    obs = yield reach(cube + [0, 0, 0.18], down, Gripper.OPEN, cartesian=False)
-    obs = yield reach(cube + [0, 0, -0.016], down, Gripper.OPEN, cartesian=True)
+    obs = yield reach(cube + up(0.18), down, Gripper.OPEN, cartesian=False)
+    obs = yield reach(cube + up(-0.016), down, Gripper.OPEN, cartesian=True)
     obs = yield macro(MacroMode.CLOSE_GRIPPER, Gripper.CLOSED, gripper_command=[close_command])
-    obs = yield reach(obs["pinch"][:3] + [0, 0, 0.20], down, Gripper.CLOSED, cartesian=True)
+    obs = yield reach(obs["pinch"][:3] + up(0.20), down, Gripper.CLOSED, cartesian=True)
     start = env.object_pose(obs, "cube")[:2].copy()
     for alpha in (0.25, 0.5, 0.75, 1.0):
         cube_now = env.object_pose(obs, "cube")[:3]
