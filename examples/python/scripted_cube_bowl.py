@@ -58,6 +58,11 @@ def macro(mode: MacroMode, gripper: Gripper = Gripper.KEEP, **fields: Any) -> Ac
     return action
 
 
+def up(dz: float) -> np.ndarray:
+    """A vertical offset of ``dz`` metres."""
+    return np.array([0.0, 0.0, dz], dtype=np.float32)
+
+
 def reach(
     position: np.ndarray, quaternion: np.ndarray, gripper: Gripper, cartesian: bool
 ) -> Action:
