@@ -167,3 +167,56 @@ fn ported_tutorial_passes_the_references_checks() {
         "no video at {video:?}"
     );
 }
+
+/// TorchRL's `check_env_specs` on the single environment (both action modes) and the vector
+/// environment, in the Python that `MACROTREE_TORCHRL_PYTHON` names (one with torchrl 0.14.1:
+/// torch is too heavy for CI). The package is built as a wheel here and installed there.
+#[test]
+fn torchrl_check_env_specs_passes() {
+    let Ok(python) = std::env::var("MACROTREE_TORCHRL_PYTHON") else {
+        eprintln!("skipped: set MACROTREE_TORCHRL_PYTHON to a Python with torchrl 0.14.1");
+        return;
+    };
+    if skip() {
+        return;
+    }
+    let venv = installed();
+    let wheels = root().join("target/python-test/wheel");
+    let _ = std::fs::remove_dir_all(&wheels);
+    run(
+        venv.command("python")
+            .args([
+                "-m",
+                "pip",
+                "wheel",
+                "--quiet",
+                "--no-deps",
+                "--no-build-isolation",
+            ])
+            .arg("./python")
+            .arg("-w")
+            .arg(&wheels),
+        "pip wheel ./python",
+    );
+    let wheel = std::fs::read_dir(&wheels)
+        .expect("wheel folder")
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .find(|p| p.extension().is_some_and(|x| x == "whl"))
+        .expect("a wheel");
+    run(
+        Command::new(&python)
+            .args(["-m", "pip", "install", "--quiet", "--force-reinstall"])
+            .arg(&wheel),
+        "pip install the wheel into MACROTREE_TORCHRL_PYTHON",
+    );
+    let out = run(
+        Command::new(&python)
+            .arg("python/tests/check_torchrl.py")
+            .current_dir(root())
+            .env_remove("PYTHONPATH"),
+        "python/tests/check_torchrl.py",
+    );
+    eprintln!("{out}");
+    assert_eq!(out.matches(": passed").count(), 3, "{out}");
+}
