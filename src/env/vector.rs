@@ -29,6 +29,8 @@ pub struct VecEnv {
     envs: Vec<Arc<Mutex<MacroEnv>>>,
     jobs: Option<Sender<Job>>,
     done: Receiver<Finished>,
+    /// The job queue the workers take from; the caller takes from it too while it waits.
+    queue: Arc<Mutex<Receiver<Job>>>,
     workers: Vec<JoinHandle<()>>,
     busy: Vec<bool>,
     pending: usize,
@@ -101,6 +103,7 @@ impl VecEnv {
             envs,
             jobs: Some(jobs),
             done,
+            queue,
             workers,
             busy: vec![false; n],
             pending: 0,
@@ -242,6 +245,17 @@ impl VecEnv {
         }
         let mut out = Vec::with_capacity(min_batch);
         while out.len() < min_batch {
+            // Rather than wait for a worker to wake up, run a queued step on this thread. The
+            // queue's lock is busy only while a worker waits on an empty queue: then nothing is
+            // left to take, and this thread waits for results instead.
+            let job = match self.queue.try_lock() {
+                Ok(q) => q.try_recv().ok(),
+                Err(_) => None,
+            };
+            if let Some((i, action)) = job {
+                out.push((i, run_job(&self.envs, i, &action)));
+                continue;
+            }
             let d = self
                 .done
                 .recv()
@@ -294,20 +308,24 @@ fn worker(queue: &Mutex<Receiver<Job>>, envs: &[Arc<Mutex<MacroEnv>>], done: &Se
         let Ok((i, action)) = job else {
             return;
         };
-        let result =
-            catch_unwind(AssertUnwindSafe(|| lock(&envs[i]).step(&action))).unwrap_or_else(|panic| {
-                let what = panic
-                    .downcast_ref::<&str>()
-                    .map(|s| s.to_string())
-                    .or_else(|| panic.downcast_ref::<String>().cloned())
-                    .unwrap_or_default();
-                tracing::error!(target: "macrotree::env", env = i, "a step panicked: {what}");
-                Err(Error::Simulator {
-                    message: format!("environment {i}: the step panicked (a bug): {what}"),
-                })
-            });
-        if done.send((i, result)).is_err() {
+        if done.send((i, run_job(envs, i, &action))).is_err() {
             return;
         }
     }
+}
+
+/// Runs one step of environment `i`; a panic becomes an error result (never crosses threads or
+/// the FFI).
+fn run_job(envs: &[Arc<Mutex<MacroEnv>>], i: usize, action: &Action) -> Result<StepResult, Error> {
+    catch_unwind(AssertUnwindSafe(|| lock(&envs[i]).step(action))).unwrap_or_else(|panic| {
+        let what = panic
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| panic.downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        tracing::error!(target: "macrotree::env", env = i, "a step panicked: {what}");
+        Err(Error::Simulator {
+            message: format!("environment {i}: the step panicked (a bug): {what}"),
+        })
+    })
 }
