@@ -143,3 +143,31 @@ def test_render_gives_an_rgb_image(data: Path) -> None:
     frame = env.render()
     assert frame is not None and frame.shape == (48, 64, 3) and frame.dtype == np.uint8
     assert frame.std() > 0
+
+
+def test_camera_images_are_observations(data: Path) -> None:
+    env = macrotree.MacroEnv(
+        data / "scenes/cube_bowl.yaml", cameras=["front", "wrist"], image_size=(32, 48)
+    )
+    obs, _ = env.reset(seed=0)
+    assert obs in env.observation_space
+    for camera in ("front", "wrist"):
+        image = obs["pixels"][camera]
+        assert image.shape == (32, 48, 3) and image.dtype == np.uint8 and image.std() > 0
+    obs, *_ = env.step({"mode": int(MacroMode.WAIT), "steps": [5]})
+    assert obs in env.observation_space
+
+
+def test_rgb_array_list_films_the_step_at_render_fps(data: Path) -> None:
+    env = macrotree.MacroEnv(
+        data / "scenes/cube_bowl.yaml",
+        render_mode="rgb_array_list",
+        image_size=(32, 48),
+        render_fps=10,
+    )
+    env.reset(seed=0)
+    env.step({"mode": int(MacroMode.WAIT), "steps": [100]})  # one simulated second
+    frames = env.render()
+    # The reset's frame, then one every 0.1 s of simulated time.
+    assert len(frames) == 11 and all(f.shape == (32, 48, 3) for f in frames)
+    assert env.render() == []

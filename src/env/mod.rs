@@ -160,6 +160,7 @@ impl MacroEnv {
         if let Some(f) = &mut self.film {
             f.take();
             f.restart(self.cell.world().time);
+            f.tick(&self.cell)?;
         }
         Ok(self.observe())
     }

@@ -28,17 +28,17 @@ impl super::MacroEnv {
         render_cell(self.cell(), camera, width, height)
     }
 
-    /// Films the steps from now on: frames of `camera` at `width × height`, `rate` per
-    /// simulated second (the first one at once), held until [`take_frames`](Self::take_frames).
+    /// Films the steps from now on: frames of `camera` at `width × height`, one now (and one at
+    /// every reset), then one every `1 / rate` simulated seconds, held until
+    /// [`take_frames`](Self::take_frames).
     ///
     /// # Errors
     /// As [`render`](Self::render), and [`Error::Action`] for a rate out of range.
     pub fn film(&mut self, camera: &str, width: u32, height: u32, rate: f64) -> Result<(), Error> {
-        let first = self.render(camera, width, height)?;
         let mut film = super::film::Film::new(camera.to_string(), width, height, rate)?;
         film.restart(self.cell().world().time);
+        film.tick(self.cell())?;
         self.film = Some(film);
-        let _ = first;
         Ok(())
     }
 
