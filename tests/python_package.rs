@@ -118,9 +118,17 @@ fn python_code_is_linted_formatted_and_typed() {
     }
     let venv = installed();
     let dirs = ["python/macrotree", "python/tests", "examples/python"];
-    run(venv.command("ruff").arg("check").args(dirs), "ruff check");
+    // One configuration for the package, its tests and the examples.
+    let config = ["--config", "python/pyproject.toml"];
     run(
-        venv.command("ruff").args(["format", "--check"]).args(dirs),
+        venv.command("ruff").arg("check").args(config).args(dirs),
+        "ruff check",
+    );
+    run(
+        venv.command("ruff")
+            .args(["format", "--check"])
+            .args(config)
+            .args(dirs),
         "ruff format --check",
     );
     run(
