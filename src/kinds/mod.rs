@@ -16,7 +16,7 @@
 
 mod builtin;
 pub mod catalog;
-mod control;
+pub mod control;
 mod leaf_call;
 pub mod leaves;
 pub mod objects;
@@ -26,7 +26,7 @@ mod registry;
 mod targets;
 
 pub use catalog::{NodeDoc, ParamDoc};
-pub(crate) use control::SchemaCtx;
+pub use control::{Control, ControlKind};
 pub use leaf_call::LeafCall;
 pub use leaves::{
     At, AtHome, Carry, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, GoalMet, Grasp, Grasped,
@@ -35,6 +35,5 @@ pub use leaves::{
 pub use objects::{ObjectRef, ObjectRole};
 pub use param_error::ParamError;
 pub use params::Params;
-pub(crate) use registry::Imp;
 pub use registry::{Category, NodeType, Registry};
 pub use targets::{PathKind, Target, Yaw};

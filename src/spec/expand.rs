@@ -6,13 +6,13 @@
 //! the file:line:column of whatever is wrong, argument or body.
 
 use std::collections::HashMap;
-use std::sync::Arc;
 
 use super::check::{ObjectUse, VarDef};
 use super::file::{SubtreeDef, param_ref};
 use super::node::{Node, NodeKind};
 use crate::kinds::ObjectRole;
-use crate::kinds::leaves::{Leaf, Select};
+use crate::kinds::control::{Control, ControlKind, NodeList, NodeValue, SubtreeParams};
+use crate::kinds::leaves::Leaf;
 use crate::kinds::{Category, NodeType, Registry};
 use crate::yaml::de::DeError;
 use crate::yaml::diag::{Issue, Loc, Sources};
@@ -25,8 +25,6 @@ pub const MAX_TREE_DEPTH: usize = 64;
 pub const MAX_TREE_NODES: usize = 5_000;
 /// Most errors reported for one leaf's parameters.
 pub const MAX_LEAF_ERRORS: usize = 16;
-/// Largest `attempts` / `times`.
-pub const MAX_COUNT: u32 = 1_000;
 
 /// Expands nodes; collects issues.
 pub(crate) struct Expander<'a> {
@@ -201,13 +199,11 @@ impl<'a> Expander<'a> {
         let k = kind.as_str();
         let ty = self.registry.entry(k).cloned();
         let category = ty.as_ref().map(|t| t.category());
-        let node_kind = if category == Some(Category::Composite) {
-            self.composite(k, loc, body, depth)?
-        } else if category == Some(Category::Decorator) {
-            self.decorator(k, loc, body, depth)?
+        let node_kind = if let Some(t) = ty.as_ref().filter(|t| t.control_kind().is_some()) {
+            self.control(t, loc, body, depth)?
         } else if let (Some(parsed), warnings) = crate::yaml::de::collect_warnings(|| {
             ty.as_ref()
-                .and_then(|t| parse_leaf_reporting_all(t, without_name(body)))
+                .and_then(|t| parse_reporting_all(without_name(body), |v| t.parse_leaf(v)))
         }) {
             for w in warnings {
                 let mut issue = Issue::new(w.loc, format!("{} in `{k}`", w.message)).maybe_help(w.help);
@@ -257,20 +253,7 @@ impl<'a> Expander<'a> {
                         {
                             issue.help = Some(help);
                         }
-                        // A value already reported (an undefined `$param` left in place) needs
-                        // no second error for its type.
-                        if self.reported.contains(&issue.loc)
-                            || self.issues.iter().any(|i| i.loc == issue.loc)
-                        {
-                            continue;
-                        }
-                        issue.message = format!("{} in `{k}`", issue.message);
-                        if issue.help.is_none() {
-                            issue.help = Some(format!(
-                                "see `macrotree nodes {k}` (or docs/nodes/{k}.md) for its parameters and units"
-                            ));
-                        }
-                        self.err(issue);
+                        self.param_error(k, issue);
                     }
                     return None;
                 }
@@ -383,178 +366,84 @@ impl<'a> Expander<'a> {
         }
     }
 
-    /// Check that `body` has only `allowed` keys (plus `name`); return them.
-    fn fields<'v>(&mut self, kind: &str, body: &'v Value, allowed: &[&str]) -> HashMap<String, &'v Value> {
-        let mut out = HashMap::new();
-        for (k, v) in body.as_map().unwrap_or(&[]) {
-            match k.as_str() {
-                Some("name") => {}
-                Some(key) if allowed.contains(&key) => {
-                    out.insert(key.to_string(), v);
-                }
-                Some(key) => {
-                    let expected: Vec<String> = allowed
-                        .iter()
-                        .chain(&["name"])
-                        .map(|a| format!("`{a}`"))
-                        .collect();
-                    let mut issue = Issue::new(k.loc, format!("unknown parameter `{key}` in `{kind}`"))
-                        .label(format!("expected one of {}", expected.join(", ")));
-                    issue = issue.maybe_help(did_you_mean(key, allowed.iter().copied().chain(["name"])));
-                    if issue.help.is_none() && key == "children" {
-                        issue = issue.help(format!("`{kind}` takes a single `child:`"));
-                    } else if issue.help.is_none() && key == "child" {
-                        issue = issue.help(format!("`{kind}` takes a list: `children: [...]`"));
+    /// Reports a parameter error of node kind `k` (unless its value was already reported: an
+    /// undefined `$param` left in place needs no second error for its type).
+    fn param_error(&mut self, k: &str, mut issue: Issue) {
+        if self.reported.contains(&issue.loc) || self.issues.iter().any(|i| i.loc == issue.loc) {
+            return;
+        }
+        issue.message = format!("{} in `{k}`", issue.message);
+        if issue.help.is_none() {
+            issue.help = Some(format!(
+                "see `macrotree nodes {k}` (or docs/nodes/{k}.md) for its parameters and units"
+            ));
+        }
+        self.err(issue);
+    }
+
+    /// Reads a composite or decorator of kind `ty`: its parameters through the registry (its
+    /// typed parameter struct; every bad parameter reported at once), then its nodes. After bad
+    /// parameters, the nodes the body holds (in the parameters whose type holds nodes) are still
+    /// read, so that their mistakes are reported too.
+    fn control(&mut self, ty: &NodeType, loc: Loc, body: &Value, depth: usize) -> Option<NodeKind> {
+        let k = ty.name();
+        let kind = ty.control_kind()?;
+        let errors = match parse_reporting_all(without_name(body), |v| ty.parse_control(v))? {
+            Ok(params) => return self.control_nodes(k, kind, params, loc, body, depth),
+            Err(errors) => errors,
+        };
+        let example = crate::kinds::catalog::parse_node_doc(ty.doc()).3;
+        for e in errors {
+            let missing = e.missing_parameter().is_some();
+            let mut issue = e.into_issue(body.loc, |l| self.sources.describe(l));
+            if missing && !example.contains('\n') {
+                issue.help = Some(format!("e.g. `{example}`"));
+            }
+            self.param_error(k, issue);
+        }
+        for key in ty.node_params() {
+            match body.get(&key) {
+                Some(v) if v.as_seq().is_some() => {
+                    for item in v.as_seq().unwrap_or_default() {
+                        self.node(item, depth + 1);
                     }
-                    self.err(issue);
                 }
-                None => self.err(Issue::new(k.loc, "parameter names must be text")),
+                Some(v) => {
+                    self.node(v, depth + 1);
+                }
+                None => {}
             }
         }
-        out
+        None
     }
 
-    fn composite(&mut self, kind: &str, loc: Loc, body: &Value, depth: usize) -> Option<NodeKind> {
-        let f = self.fields(kind, body, &["children"]);
-        let Some(children_v) = f.get("children") else {
-            self.err(
-                Issue::new(loc, format!("`{kind}` needs `children:`"))
-                    .label("expected `children: [...]` with at least one node")
-                    .help(format!("write `{kind}: {{children: [{{home: {{}}}}, ...]}}`")),
-            );
-            return None;
-        };
-        let Some(items) = children_v.as_seq() else {
-            self.err(
-                Issue::new(
-                    children_v.loc,
-                    format!(
-                        "`children` must be a list of nodes, found {}",
-                        children_v.describe()
-                    ),
-                )
-                .label("expected `[...]` or a `- ` list"),
-            );
-            return None;
-        };
-        if items.is_empty() {
-            self.err(
-                Issue::new(children_v.loc, format!("`{kind}` has no children"))
-                    .label("expected at least one node")
-                    .help(format!("add a child node, or remove the empty `{kind}`")),
-            );
-            return None;
-        }
-        let mut children = Vec::with_capacity(items.len());
-        let mut ok = true;
-        for item in items {
-            match self.node(item, depth + 1) {
-                Some(n) => children.push(n),
-                None => ok = false,
-            }
-        }
-        if !ok {
-            return None;
-        }
-        if kind == "reactive_sequence" || kind == "reactive_fallback" {
-            let last = children.len() - 1;
-            for c in &children[..last] {
-                if c.as_check().is_none() {
-                    let what = if kind == "reactive_sequence" {
-                        "holds"
-                    } else {
-                        "fails"
-                    };
-                    self.err(
-                        Issue::new(c.loc, format!("in `{kind}`, only the last child may be `{}`", c.kind.kind_name()))
-                            .label("expected a condition leaf (or an `inverter` of one), re-checked every tick")
-                            .help(format!(
-                                "the children before the last are conditions re-checked every tick while the last one runs \
-                                 (as long as each {what}); use `sequence`/`fallback` for steps that run one after another"
-                            )),
-                    );
-                    ok = false;
-                }
-            }
-            if !ok {
-                return None;
-            }
-        }
-        Some(match kind {
-            "sequence" => NodeKind::Sequence(children),
-            "fallback" => NodeKind::Fallback(children),
-            "reactive_sequence" => NodeKind::ReactiveSequence(children),
-            "reactive_fallback" => NodeKind::ReactiveFallback(children),
-            "parallel" => NodeKind::Parallel(children),
-            _ => NodeKind::Race(children),
-        })
-    }
-
-    fn child(
+    /// Reads the nodes of a control node of kind `kind` with parameters `params`.
+    fn control_nodes(
         &mut self,
-        kind: &str,
+        k: &str,
+        kind: ControlKind,
+        params: Control,
         loc: Loc,
-        f: &HashMap<String, &Value>,
-        key: &str,
+        body: &Value,
         depth: usize,
-    ) -> Option<Box<Node>> {
-        match f.get(key) {
-            Some(v) => self.node(v, depth + 1).map(Box::new),
-            None => {
-                self.err(
-                    Issue::new(loc, format!("`{kind}` needs `{key}:`"))
-                        .label(format!("expected `{key}: <node>`"))
-                        .help(format!(
-                            "e.g. `{kind}: {{{}{key}: {{home: {{}}}}}}`",
-                            extra_example(kind)
-                        )),
-                );
-                None
+    ) -> Option<NodeKind> {
+        use ControlKind as C;
+        let child = |this: &mut Self, v: &NodeValue| this.node(&v.0, depth + 1).map(Box::new);
+        match params {
+            Control::Composite(p) => {
+                let children = self.children(k, kind, &p.children, depth)?;
+                Some(match kind {
+                    C::Sequence => NodeKind::Sequence(children),
+                    C::Fallback => NodeKind::Fallback(children),
+                    C::ReactiveSequence => NodeKind::ReactiveSequence(children),
+                    C::ReactiveFallback => NodeKind::ReactiveFallback(children),
+                    C::Parallel => NodeKind::Parallel(children),
+                    _ => NodeKind::Race(children),
+                })
             }
-        }
-    }
-
-    fn count(&mut self, kind: &str, loc: Loc, f: &HashMap<String, &Value>, key: &str) -> Option<u32> {
-        let Some(v) = f.get(key) else {
-            self.err(
-                Issue::new(loc, format!("`{kind}` needs `{key}:`"))
-                    .label(format!("expected `{key}: N` (an integer ≥ 1)")),
-            );
-            return None;
-        };
-        match v.kind {
-            ValueKind::Int(n) if (1..=i64::from(MAX_COUNT)).contains(&n) => Some(n as u32),
-            ValueKind::Int(n) => {
-                self.err(
-                    Issue::new(
-                        v.loc,
-                        format!("`{key}` must be between 1 and {MAX_COUNT}, found {n}"),
-                    )
-                    .label("expected an integer ≥ 1")
-                    .with_via(v, self.sources),
-                );
-                None
-            }
-            _ => {
-                self.err(
-                    Issue::new(
-                        v.loc,
-                        format!("`{key}` must be an integer, found {}", v.describe()),
-                    )
-                    .label("expected an integer ≥ 1")
-                    .with_via(v, self.sources),
-                );
-                None
-            }
-        }
-    }
-
-    fn decorator(&mut self, kind: &str, loc: Loc, body: &Value, depth: usize) -> Option<NodeKind> {
-        match kind {
-            "guard" => {
-                let f = self.fields(kind, body, &["condition", "child"]);
-                let condition = self.child(kind, loc, &f, "condition", depth);
-                let child = self.child(kind, loc, &f, "child", depth);
+            Control::Guard(p) => {
+                let condition = self.node(&p.condition.0, depth + 1).map(Box::new);
+                let child = child(self, &p.child);
                 let condition = condition?;
                 if condition.as_check().is_none() {
                     self.err(
@@ -578,147 +467,116 @@ impl<'a> Expander<'a> {
                     child: child?,
                 })
             }
-            "retry" => {
-                let f = self.fields(kind, body, &["attempts", "child"]);
-                let attempts = self.count(kind, loc, &f, "attempts");
-                let child = self.child(kind, loc, &f, "child", depth);
-                Some(NodeKind::Retry {
-                    attempts: attempts?,
-                    child: child?,
-                })
-            }
-            "repeat" => {
-                let f = self.fields(kind, body, &["times", "child"]);
-                let times = self.count(kind, loc, &f, "times");
-                let child = self.child(kind, loc, &f, "child", depth);
-                Some(NodeKind::Repeat {
-                    times: times?,
-                    child: child?,
-                })
-            }
-            "for_each" => {
-                let f = self.fields(
-                    kind,
-                    body,
-                    &["select", "as", "goal_as", "max_iterations", "child"],
-                );
-                let max_iterations = self.count(kind, loc, &f, "max_iterations");
-                let child = self.child(kind, loc, &f, "child", depth);
-                let select = self.for_each_select(loc, &f);
-                Some(NodeKind::ForEach {
-                    select: select?,
-                    max_iterations: max_iterations?,
-                    child: child?,
-                })
-            }
-            "timeout" => {
-                let f = self.fields(kind, body, &["seconds", "child"]);
-                let seconds = match f.get("seconds") {
-                    None => {
-                        self.err(
-                            Issue::new(loc, "`timeout` needs `seconds:`")
-                                .label("expected `seconds: S` (simulated seconds > 0)"),
-                        );
-                        None
-                    }
-                    Some(v) => match crate::yaml::de::from_value::<Secs>(v) {
-                        Ok(s) => Some(s.0),
-                        Err(e) => {
-                            let issue = e.into_issue(v.loc, |l| self.sources.describe(l));
-                            self.err(issue);
-                            None
-                        }
-                    },
-                };
-                let child = self.child(kind, loc, &f, "child", depth);
-                Some(NodeKind::Timeout {
-                    seconds: seconds?,
-                    child: child?,
-                })
-            }
-            "inverter" | "force_success" | "force_failure" => {
-                let f = self.fields(kind, body, &["child"]);
-                let child = self.child(kind, loc, &f, "child", depth)?;
-                Some(match kind {
-                    "inverter" => NodeKind::Inverter(child),
-                    "force_success" => NodeKind::ForceSuccess(child),
-                    _ => NodeKind::ForceFailure(child),
-                })
-            }
-            _ => self.subtree_call(loc, body, depth),
-        }
-    }
-
-    /// A `for_each`'s `select:` (the query), `as:` and `goal_as:` read as one [`Select`].
-    fn for_each_select(&mut self, loc: Loc, f: &HashMap<String, &Value>) -> Option<Select> {
-        let Some(var_v) = f.get("as") else {
-            self.err(
-                Issue::new(loc, "`for_each` needs `as:`")
-                    .label("expected `as: NAME`, the variable each selected object is written to")
-                    .help("read it in the child as `{NAME}`, e.g. `reach: {target: \"{block}\"}`"),
-            );
-            return None;
-        };
-        let mut entries = match f.get("select") {
-            None => Vec::new(),
-            Some(v) => match &v.kind {
-                ValueKind::Map(m) => m.clone(),
-                ValueKind::Null => Vec::new(),
-                _ => {
-                    self.err(
-                        Issue::new(
-                            v.loc,
-                            format!("`select` must be a query mapping, found {}", v.describe()),
-                        )
-                        .label("expected e.g. `{kind: block, where: [pending], order: nearest}`"),
-                    );
-                    return None;
-                }
-            },
-        };
-        let key = |k: &str| Value::new(ValueKind::Str(k.into()), loc);
-        entries.push((key("as"), (*var_v).clone()));
-        if let Some(g) = f.get("goal_as") {
-            entries.push((key("goal_as"), (*g).clone()));
-        }
-        let v = Value::new(ValueKind::Map(entries), loc);
-        match crate::yaml::de::from_value::<Select>(&v) {
-            Ok(s) => {
+            Control::Retry(p) => Some(NodeKind::Retry {
+                attempts: p.attempts,
+                child: child(self, &p.child)?,
+            }),
+            Control::Repeat(p) => Some(NodeKind::Repeat {
+                times: p.times,
+                child: child(self, &p.child)?,
+            }),
+            Control::ForEach(p) => {
+                let select = p.select();
+                let at = |key: &str| body.get(key).map(|v| v.loc);
                 self.var_defs.extend(VarDef::from_select(
-                    &s,
-                    var_v.loc,
-                    f.get("goal_as").map(|g| g.loc),
+                    &select,
+                    at("as").unwrap_or(loc),
+                    at("goal_as"),
                 ));
-                Some(s)
+                Some(NodeKind::ForEach {
+                    select,
+                    max_iterations: p.max_iterations,
+                    child: child(self, &p.child)?,
+                })
             }
-            Err(e) => {
-                let mut issue = e.into_issue(loc, |l| self.sources.describe(l));
-                issue.message = format!("{} in `for_each`", issue.message);
-                self.err(issue);
-                None
+            Control::Timeout(p) => Some(NodeKind::Timeout {
+                seconds: p.seconds,
+                child: child(self, &p.child)?,
+            }),
+            Control::Decorated(p) => {
+                let c = child(self, &p.child)?;
+                Some(match kind {
+                    C::Inverter => NodeKind::Inverter(c),
+                    C::ForceSuccess => NodeKind::ForceSuccess(c),
+                    _ => NodeKind::ForceFailure(c),
+                })
             }
+            Control::Subtree(p) => self.subtree_call(loc, body, &p, depth),
         }
     }
 
-    fn subtree_call(&mut self, loc: Loc, body: &Value, depth: usize) -> Option<NodeKind> {
-        let f = self.fields("subtree", body, &["ref", "args"]);
-        let Some(rv) = f.get("ref") else {
-            self.err(
-                Issue::new(loc, "`subtree` needs `ref:`")
-                    .label("expected `ref: NAME` (a subtree defined under `subtrees:`)"),
-            );
-            return None;
-        };
-        let Some(reference) = rv.as_str() else {
+    /// A composite's `children:`: a non-empty list of nodes; before the last, a reactive
+    /// composite takes only checks.
+    fn children(&mut self, k: &str, kind: ControlKind, list: &NodeList, depth: usize) -> Option<Vec<Node>> {
+        let children_v = &list.0;
+        let Some(items) = children_v.as_seq() else {
             self.err(
                 Issue::new(
-                    rv.loc,
-                    format!("`ref` must be a subtree name, found {}", rv.describe()),
+                    children_v.loc,
+                    format!(
+                        "`children` must be a list of nodes, found {}",
+                        children_v.describe()
+                    ),
                 )
-                .label("expected a name defined under `subtrees:`"),
+                .label("expected `[...]` or a `- ` list"),
             );
             return None;
         };
+        if items.is_empty() {
+            self.err(
+                Issue::new(children_v.loc, format!("`{k}` has no children"))
+                    .label("expected at least one node")
+                    .help(format!("add a child node, or remove the empty `{k}`")),
+            );
+            return None;
+        }
+        let mut children = Vec::with_capacity(items.len());
+        let mut ok = true;
+        for item in items {
+            match self.node(item, depth + 1) {
+                Some(n) => children.push(n),
+                None => ok = false,
+            }
+        }
+        if !ok {
+            return None;
+        }
+        let reactive = match kind {
+            ControlKind::ReactiveSequence => Some("holds"),
+            ControlKind::ReactiveFallback => Some("fails"),
+            _ => None,
+        };
+        if let Some(what) = reactive {
+            let last = children.len() - 1;
+            for c in &children[..last] {
+                if c.as_check().is_none() {
+                    self.err(
+                        Issue::new(c.loc, format!("in `{k}`, only the last child may be `{}`", c.kind.kind_name()))
+                            .label("expected a condition leaf (or an `inverter` of one), re-checked every tick")
+                            .help(format!(
+                                "the children before the last are conditions re-checked every tick while the last one runs \
+                                 (as long as each {what}); use `sequence`/`fallback` for steps that run one after another"
+                            )),
+                    );
+                    ok = false;
+                }
+            }
+            if !ok {
+                return None;
+            }
+        }
+        Some(children)
+    }
+
+    fn subtree_call(
+        &mut self,
+        loc: Loc,
+        body: &Value,
+        call: &SubtreeParams,
+        depth: usize,
+    ) -> Option<NodeKind> {
+        let reference = call.reference.as_str();
+        let ref_loc = body.get("ref").map_or(loc, |v| v.loc);
         let Some(def) = self.subtrees.get(reference) else {
             let mut names: Vec<&str> = self.subtrees.keys().map(String::as_str).collect();
             names.sort_unstable();
@@ -735,7 +593,7 @@ impl<'a> Expander<'a> {
                 )
             };
             self.err(
-                Issue::new(rv.loc, format!("undefined subtree `{reference}`"))
+                Issue::new(ref_loc, format!("undefined subtree `{reference}`"))
                     .label(label)
                     .maybe_help(did_you_mean(reference, names.iter().copied()))
                     .help_or("define it under `subtrees:` or include the file that defines it"),
@@ -747,7 +605,7 @@ impl<'a> Expander<'a> {
             chain.push(reference.to_string());
             let start = chain.iter().position(|s| s == reference).unwrap_or(0);
             self.err(
-                Issue::new(rv.loc, format!("recursive subtree: {}", chain[start..].join(" → ")))
+                Issue::new(ref_loc, format!("recursive subtree: {}", chain[start..].join(" → ")))
                     .label("this call leads back to itself")
                     .help("subtrees are expanded in place, so they cannot call themselves; use `retry`/`repeat` for loops"),
             );
@@ -757,7 +615,7 @@ impl<'a> Expander<'a> {
         let mut env: HashMap<String, Value> = HashMap::new();
         let mut arg_texts = Vec::new();
         let mut ok = true;
-        if let Some(av) = f.get("args") {
+        if let Some(av) = call.args.as_ref().map(|a| &a.0) {
             match &av.kind {
                 ValueKind::Null => {}
                 ValueKind::Map(entries) => {
@@ -845,54 +703,26 @@ impl<'a> Expander<'a> {
     }
 }
 
-/// Seconds for `timeout: {seconds}`.
-struct Secs(f64);
-
-impl<'de> serde::Deserialize<'de> for Secs {
-    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        crate::yaml::units::time_limit(d).map(Secs)
-    }
-}
-
-impl Issue {
-    fn with_via(mut self, v: &Value, sources: &Sources) -> Self {
-        if let Some(via) = v.via {
-            self.note = Some(format!(
-                "this value is a subtree argument, used at {}",
-                sources.describe(via)
-            ));
-        }
-        self
-    }
-}
-
-fn extra_example(kind: &str) -> &'static str {
-    match kind {
-        "retry" => "attempts: 3, ",
-        "repeat" => "times: 2, ",
-        "timeout" => "seconds: 10, ",
-        "guard" => "condition: {cube_grasped: {}}, ",
-        _ => "",
-    }
-}
-
 fn valid_name(s: &str) -> bool {
     !s.trim().is_empty() && s.chars().count() <= 80 && !s.contains(['/', '[', ']', '#', '\n', '\r'])
 }
 
-/// Reads a leaf of kind `ty` from `params`, reporting every bad parameter, not just
-/// the first: after an error located in one parameter (its key or anything in its value), that
-/// parameter is set aside and the rest read again. It stops at an error that no parameter
-/// explains (a missing parameter) or after [`MAX_LEAF_ERRORS`] (each retry re-reads the leaf, so
-/// the cap keeps a leaf with thousands of bad keys linear). A "missing" error for a parameter set
-/// aside, or for the one a misspelled key was suggested as, is not repeated. `None` if `ty` is
-/// not a leaf kind.
-fn parse_leaf_reporting_all(ty: &Arc<NodeType>, mut params: Value) -> Option<Result<Leaf, Vec<DeError>>> {
+/// Reads a node body with `parse` (a kind's parameter struct), reporting every bad parameter,
+/// not just the first: after an error located in one parameter (its key or anything in its
+/// value), that parameter is set aside and the rest read again. It stops at an error that no
+/// parameter explains (a missing parameter) or after [`MAX_LEAF_ERRORS`] (each retry re-reads the
+/// body, so the cap keeps a body with thousands of bad keys linear). A "missing" error for a
+/// parameter set aside, or for the one a misspelled key was suggested as, is not repeated.
+/// `None` if `parse` answers `None` (not a kind it reads).
+fn parse_reporting_all<T>(
+    mut params: Value,
+    parse: impl Fn(&Value) -> Option<Result<T, DeError>>,
+) -> Option<Result<T, Vec<DeError>>> {
     let mut errors = Vec::new();
     let mut set_aside: Vec<String> = Vec::new();
     loop {
-        let e = match ty.parse_leaf(&params)? {
-            Ok(leaf) if errors.is_empty() => return Some(Ok(leaf)),
+        let e = match parse(&params)? {
+            Ok(read) if errors.is_empty() => return Some(Ok(read)),
             Ok(_) => return Some(Err(errors)),
             Err(e) => e,
         };
