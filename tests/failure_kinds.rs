@@ -14,7 +14,7 @@ use macrotree::actions::{CONTROL_PERIOD, Cell, MacroAction, Progress, StepObserv
 use macrotree::episode::{EpisodeConfig, EpisodeReport, Goal, NoObserver, run_in_cell};
 use macrotree::factory::Factory;
 use macrotree::faults::FaultKind;
-use macrotree::kinds::ObjectRef;
+use macrotree::kinds::{ActionRole, ObjectRef};
 use macrotree::plan::{Loader, Plan};
 use macrotree::runtime::scripted::ScriptedDriver;
 use macrotree::runtime::substitute::{Substitution, resolve};
@@ -309,8 +309,8 @@ struct CirclingBowl {
 }
 
 impl StepObserver for CirclingBowl {
-    fn on_action_start(&mut self, kind: &str, _world: &World) {
-        self.carrying |= kind == "carry";
+    fn on_action_start(&mut self, _kind: &str, role: ActionRole, _world: &World) {
+        self.carrying |= role == ActionRole::Carry;
     }
     fn before_step(&mut self, sim: &mut Sim) {
         let scene = sim.scene();

@@ -10,6 +10,7 @@ use super::leaves::{
     GripperOpen, Home, In, Lifted, MoveJoints, On, OnTable, Reach, Release,
 };
 use super::registry::{Category, ControlImp, Imp, Registry};
+use super::role::ActionRole;
 
 macro_rules! doc {
     ($kind:literal) => {
@@ -66,12 +67,12 @@ fn register(r: &mut Registry) -> Result<(), crate::error::Error> {
     control!(r, "subtree", Decorator, Subtree, SubtreeParams)?;
 
     // Actions (their controllers are bound in `crate::factory`).
-    r.declare_action::<Reach>("reach", doc!("reach"))?;
+    r.declare_action_as::<Reach>("reach", doc!("reach"), ActionRole::Reach)?;
     r.declare_action::<MoveJoints>("move_joints", doc!("move_joints"))?;
     r.declare_action::<Home>("home", doc!("home"))?;
-    r.declare_action::<Grasp>("grasp", doc!("grasp"))?;
-    r.declare_action::<Carry>("carry", doc!("carry"))?;
-    r.declare_action::<Release>("release", doc!("release"))?;
+    r.declare_action_as::<Grasp>("grasp", doc!("grasp"), ActionRole::Grasp)?;
+    r.declare_action_as::<Carry>("carry", doc!("carry"), ActionRole::Carry)?;
+    r.declare_action_as::<Release>("release", doc!("release"), ActionRole::Release)?;
 
     // Leaves the runtime handles itself.
     r.add("wait", Runtime, doc!("wait"), Imp::Wait)?;

@@ -23,6 +23,7 @@ pub mod objects;
 mod param_error;
 mod params;
 mod registry;
+mod role;
 mod targets;
 
 pub use catalog::{NodeDoc, ParamDoc};
@@ -36,4 +37,5 @@ pub use objects::{ObjectRef, ObjectRole};
 pub use param_error::ParamError;
 pub use params::Params;
 pub use registry::{Category, NodeType, Registry};
+pub use role::ActionRole;
 pub use targets::{PathKind, Target, Yaw};

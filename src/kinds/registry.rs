@@ -16,6 +16,7 @@ use super::leaf_call::LeafCall;
 use super::leaves::{Leaf, Select, Wait};
 use super::objects::ObjectRole;
 use super::params::{DynParams, Params};
+use super::role::ActionRole;
 use crate::error::Error;
 use crate::yaml::de::DeError;
 use crate::yaml::value::Value;
@@ -67,15 +68,17 @@ pub(crate) struct LeafImp {
     schema: fn(&mut SchemaGenerator) -> String,
     objects: &'static [(&'static str, ObjectRole)],
     failures: &'static [&'static str],
+    role: ActionRole,
 }
 
 impl LeafImp {
-    fn of<P: Params>() -> Self {
+    fn of<P: Params>(role: ActionRole) -> Self {
         LeafImp {
             parse: parse_params::<P>,
             schema: schema_of::<P>,
             objects: P::OBJECT_PARAMS,
             failures: P::failure_kinds(),
+            role,
         }
     }
 }
@@ -182,6 +185,15 @@ impl NodeType {
             Imp::Wait => crate::yaml::de::from_value::<Wait>(body).map(Leaf::Wait),
             Imp::Select => crate::yaml::de::from_value::<Select>(body).map(Leaf::Select),
         })
+    }
+
+    /// What an action kind does in the pick-and-place cycle ([`ActionRole::Other`] for every
+    /// other kind).
+    pub fn role(&self) -> ActionRole {
+        match &self.imp {
+            Imp::Action(l) => l.role,
+            _ => ActionRole::Other,
+        }
     }
 
     /// Which control node it is; `None` for leaves.
@@ -306,8 +318,24 @@ impl Registry {
         name: &'static str,
         doc: &'static str,
     ) -> Result<&mut Self, Error> {
+        self.declare_action_as::<P>(name, doc, ActionRole::Other)
+    }
+
+    /// Declares an action leaf like [`declare_action`](Self::declare_action) that plays `role`
+    /// in the pick-and-place cycle: a custom pick declared as [`ActionRole::Grasp`] is counted
+    /// in the report's grasp attempts, gets the grasp checks and arms the grasp faults, like the
+    /// built-in `grasp`.
+    ///
+    /// # Errors
+    /// As for [`declare_action`](Self::declare_action).
+    pub fn declare_action_as<P: Params>(
+        &mut self,
+        name: &'static str,
+        doc: &'static str,
+        role: ActionRole,
+    ) -> Result<&mut Self, Error> {
         check_failure_kinds::<P>(name)?;
-        self.add(name, Category::Action, doc, Imp::Action(LeafImp::of::<P>()))
+        self.add(name, Category::Action, doc, Imp::Action(LeafImp::of::<P>(role)))
     }
 
     /// Declares a condition leaf `name` whose parameters are `P` (an instantaneous check of the
@@ -322,7 +350,12 @@ impl Registry {
         doc: &'static str,
     ) -> Result<&mut Self, Error> {
         check_failure_kinds::<P>(name)?;
-        self.add(name, Category::Condition, doc, Imp::Condition(LeafImp::of::<P>()))
+        self.add(
+            name,
+            Category::Condition,
+            doc,
+            Imp::Condition(LeafImp::of::<P>(ActionRole::Other)),
+        )
     }
 
     pub(crate) fn add(
