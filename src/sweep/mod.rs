@@ -50,7 +50,7 @@ use crate::factory::Factory;
 use crate::failure::FailureKind;
 use crate::faults::FaultKind;
 use crate::plan::Plan;
-use crate::runtime::substitute::Substitution;
+use crate::runtime::substitute::{Resolved, Substitution};
 use crate::scene::{Placement, PlacementError, sample_placement};
 use crate::sim::{Layout, Scene};
 use crate::world::goal::GoalValue;
@@ -210,6 +210,9 @@ pub struct SweepConfig {
     /// Leaves replaced by scripted outcomes in every scenario (see
     /// [`crate::runtime::substitute`]).
     pub substitutions: Vec<Substitution>,
+    /// `substitutions` resolved against the sweep's plan once, handed to every episode (see
+    /// [`EpisodeConfig::resolved`]); `None`: each episode resolves them.
+    pub resolved: Option<Arc<Resolved>>,
     /// The scenario file of `macrotree test` this sweep belongs to, if any.
     pub suite: Option<String>,
     /// The digest of the tree file, its includes and the scene file ([`digest::files_digest`]),
@@ -233,6 +236,7 @@ impl Default for SweepConfig {
             scene_file: None,
             tree: String::new(),
             substitutions: Vec::new(),
+            resolved: None,
             suite: None,
             tree_digest: None,
             program: "macrotree".to_string(),
@@ -282,6 +286,7 @@ impl SweepConfig {
             fault: self.fault,
             goal: self.goal,
             substitutions: self.substitutions.clone(),
+            resolved: self.resolved.clone(),
         }
     }
 
@@ -297,6 +302,7 @@ impl SweepConfig {
             fault: self.fault,
             goal: self.goal,
             substitutions: self.substitutions.clone(),
+            resolved: self.resolved.clone(),
         }
     }
 }
