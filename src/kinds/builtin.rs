@@ -1,5 +1,13 @@
 //! The built-in node kinds, declared in documentation order. The leaves go through the same
 //! [`Registry::declare_action`] / [`Registry::declare_condition`] calls as a user's leaves.
+//!
+//! This is the one declaration of each built-in kind: its name, its doc, its parameter type
+//! (`super::leaves` for the leaves, `super::control` for the composites and decorators) and,
+//! for an action, the [`ActionRole`] it plays. The leaves' parameter types live here in `kinds`
+//! rather than beside their controllers in `actions`, because what a kind *is* (layer 4: read,
+//! checked, documented and diagrammed without MuJoCo) must not depend on how it runs (layer 9);
+//! `crate::factory` binds each action's controller and each condition's check to the declared
+//! name.
 
 use super::control::{
     ChildParams, CompositeParams, ControlKind, ForEachParams, GuardParams, RepeatParams, RetryParams,
