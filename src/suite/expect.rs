@@ -59,7 +59,7 @@ pub struct Expect {
     #[serde(default)]
     pub never_failed: Vec<String>,
     /// How many times the nodes matching a glob ran or failed: exactly, at least or at most,
-    /// over the suite or in every scenario (see [`counts`]).
+    /// over the suite or in every scenario.
     #[serde(default)]
     pub counts: Vec<counts::CountExpect>,
 }

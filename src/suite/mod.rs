@@ -16,13 +16,14 @@
 //!   ran_in_every: ["main/**/subtree[recentre_and_grasp]"]
 //! ```
 
-pub mod counts;
+mod counts;
 mod discover;
 mod expect;
 mod file;
 pub mod junit;
 pub mod names;
 
+pub use counts::{Bounds, CountExpect, MAX_BOUND, Per};
 pub use discover::find_files;
 pub use expect::{Checked, Expect, Outcome, SuiteOutcome, check, offending_commands};
 pub use file::{

@@ -21,8 +21,8 @@
 mod config;
 pub mod digest;
 mod indices;
-pub mod layout;
-pub mod report;
+mod layout;
+mod report;
 mod result;
 pub mod resume;
 mod run;
@@ -33,7 +33,7 @@ pub mod tally;
 pub use config::{SceneScenario, SweepConfig};
 pub use indices::ScenarioIndices;
 pub use layout::{Region, Scenario, ScenarioLayout, sample_scenario, sample_scenario_in};
-pub use report::{MergeError, Merged, merge_results};
+pub use report::{MAX_LINES, MergeError, Merged, merge_results};
 pub use result::ScenarioResult;
 pub(crate) use result::shell_quote;
 pub use run::{

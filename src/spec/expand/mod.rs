@@ -24,7 +24,7 @@ use crate::yaml::value::{Value, ValueKind};
 use std::collections::HashMap;
 
 use leaf::{condition_param_help, parse_reporting_all};
-pub use subtree::{render_value, substitute, undefined_params};
+pub(super) use subtree::undefined_params;
 
 /// Deepest node nesting accepted after subtree expansion.
 pub const MAX_TREE_DEPTH: usize = 64;
