@@ -16,7 +16,7 @@
 
 mod builtin;
 pub mod catalog;
-pub mod control;
+mod control;
 mod leaf_call;
 pub mod leaves;
 pub mod objects;
@@ -27,7 +27,10 @@ mod role;
 mod targets;
 
 pub use catalog::{NodeDoc, ParamDoc};
-pub use control::{Control, ControlKind};
+pub use control::{
+    Arguments, ChildParams, CompositeParams, ConditionValue, Control, ControlKind, ForEachParams,
+    GuardParams, MAX_COUNT, NodeList, NodeValue, RepeatParams, RetryParams, SubtreeParams, TimeoutParams,
+};
 pub use leaf_call::LeafCall;
 pub use leaves::{
     At, AtHome, Carry, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, GoalMet, Grasp, Grasped,

@@ -2,8 +2,8 @@
 //! nodes.
 
 use super::{Expander, parse_reporting_all, without_name};
-use crate::kinds::control::{Control, ControlKind, NodeList, NodeValue};
 use crate::kinds::{Category, NodeType};
+use crate::kinds::{Control, ControlKind, NodeList, NodeValue};
 use crate::spec::check::VarDef;
 use crate::spec::node::{Node, NodeKind};
 use crate::yaml::diag::{Issue, Loc};

@@ -4,7 +4,7 @@
 use std::collections::HashMap;
 
 use super::Expander;
-use crate::kinds::control::SubtreeParams;
+use crate::kinds::SubtreeParams;
 use crate::spec::file::param_ref;
 use crate::spec::node::NodeKind;
 use crate::yaml::diag::{Issue, Loc};
