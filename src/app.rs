@@ -11,7 +11,7 @@ use crate::episode::{EpisodeConfig, EpisodeReport, NoObserver};
 use crate::error::Error;
 use crate::factory::Factory;
 use crate::failure::Failure;
-use crate::kinds::{Params, Registry};
+use crate::kinds::{ActionRole, Params, Registry};
 use crate::plan::{Loader, Plan};
 use crate::sim::{Scene, TIMESTEP};
 use crate::world::World;
@@ -107,8 +107,29 @@ impl App {
         P: Params,
         F: Fn(&P) -> Box<dyn MacroAction> + Send + Sync + 'static,
     {
+        self.register_action_as(name, doc, ActionRole::Other, start)
+    }
+
+    /// Registers an action leaf like [`register_action`](Self::register_action) that plays
+    /// `role` in the pick-and-place cycle (see [`Registry::declare_action_as`]): a custom pick
+    /// registered as [`ActionRole::Grasp`] is counted in the report's `grasp_attempts`, gets
+    /// the tutorial's grasp checks, and arms the `nudge` fault, like the built-in `grasp`.
+    ///
+    /// # Errors
+    /// As for [`register_action`](Self::register_action).
+    pub fn register_action_as<P, F>(
+        &mut self,
+        name: &'static str,
+        doc: &'static str,
+        role: ActionRole,
+        start: F,
+    ) -> Result<&mut Self, Error>
+    where
+        P: Params,
+        F: Fn(&P) -> Box<dyn MacroAction> + Send + Sync + 'static,
+    {
         let mut registry = Registry::clone(self.loader.registry());
-        registry.declare_action::<P>(name, doc)?;
+        registry.declare_action_as::<P>(name, doc, role)?;
         let mut factory = Factory::clone(&self.factory);
         factory.bind_action(name, start).map_err(|e| Error::Registry {
             kind: name.to_string(),

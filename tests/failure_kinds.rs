@@ -14,7 +14,7 @@ use macrotree::actions::{CONTROL_PERIOD, Cell, MacroAction, Progress, StepObserv
 use macrotree::episode::{EpisodeConfig, EpisodeReport, Goal, NoObserver, run_in_cell};
 use macrotree::factory::Factory;
 use macrotree::faults::FaultKind;
-use macrotree::kinds::ObjectRef;
+use macrotree::kinds::{ActionRole, ObjectRef};
 use macrotree::plan::{Loader, Plan};
 use macrotree::runtime::scripted::ScriptedDriver;
 use macrotree::runtime::substitute::{Substitution, resolve};
@@ -206,6 +206,23 @@ fn substitutions_that_do_not_fit_the_tree_are_substitution() {
 }
 
 #[test]
+fn an_episode_runs_the_substitutions_its_command_resolved_once() {
+    // The rules resolved by the command are what the episode runs: it does not resolve
+    // `substitutions` again (these would not even fit the tree).
+    let p = plan("main: {sequence: {children: [{home: {}}, {grasp: {}}]}}");
+    let resolved = resolve(&p, &["main/**/grasp=failure".parse().unwrap()]).unwrap();
+    let config = EpisodeConfig {
+        substitutions: vec!["main/nothing_here=failure".parse().unwrap()],
+        resolved: Some(Arc::new(resolved)),
+        ..tree_goal()
+    };
+    let mut cell = Cell::new(scene(), &Layout::default(), CONTROL_PERIOD);
+    let r = run_in_cell(&mut cell, p, &Factory::builtin(), &config, &mut NoObserver);
+    assert_eq!(kind_of(&r), FailureKind::Substituted);
+    assert_eq!(r.failed_node.as_deref(), Some("main/sequence/grasp"));
+}
+
+#[test]
 fn the_episode_time_limit_is_time_limit() {
     let config = EpisodeConfig {
         max_sim_time: 0.2,
@@ -309,8 +326,8 @@ struct CirclingBowl {
 }
 
 impl StepObserver for CirclingBowl {
-    fn on_action_start(&mut self, kind: &str, _world: &World) {
-        self.carrying |= kind == "carry";
+    fn on_action_start(&mut self, _kind: &str, role: ActionRole, _world: &World) {
+        self.carrying |= role == ActionRole::Carry;
     }
     fn before_step(&mut self, sim: &mut Sim) {
         let scene = sim.scene();

@@ -253,3 +253,28 @@ fn the_tutorial_sampler_follows_the_scene_setting_not_the_scene_name() {
     let (seed, placement) = macrotree::scene::sample_placement(&plain.spec, 11, 3).unwrap();
     assert_eq!((s.seed, s.placement), (seed, placement));
 }
+
+#[test]
+fn load_spec_panicked_in_default_placement_on_an_unsatisfiable_random_placement() {
+    // A scene built in code (never read from a file, so never checked there) whose two
+    // `random:`-only objects must both sit on one point: no draw can separate them.
+    let mut spec = macrotree::scene::SceneSpec::builtin();
+    for o in &mut spec.objects {
+        o.pose = None;
+        o.random = Some(macrotree::scene::RandomPlacement {
+            x: [0.5, 0.5],
+            y: [0.2, 0.2],
+            yaw: None,
+            clearance: 0.01,
+        });
+    }
+    match Scene::load_spec(&spec) {
+        Err(e @ macrotree::sim::SimError::Placement { .. }) => {
+            let text = e.to_string();
+            assert!(text.contains("default placement cannot be drawn"), "{text}");
+            assert!(text.contains("random:"), "says what to change: {text}");
+        }
+        Err(e) => panic!("expected a placement error, got {e}"),
+        Ok(_) => panic!("a scene whose placement cannot be drawn was built"),
+    }
+}

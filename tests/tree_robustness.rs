@@ -194,7 +194,7 @@ fn a_leaf_with_thousands_of_bad_keys_reports_a_capped_number() {
     // Each reported error re-reads the leaf; the cap keeps this linear in the file size.
     let keys: Vec<String> = (0..20_000).map(|i| format!("k{i}: 1")).collect();
     let d = errors(&format!("main:\n  home: {{{}}}\n", keys.join(", ")));
-    assert_eq!(d.len(), macrotree::spec::expand::MAX_LEAF_ERRORS, "{}", d[0]);
+    assert_eq!(d.len(), macrotree::spec::MAX_LEAF_ERRORS, "{}", d[0]);
     assert!(d.iter().all(|e| e.message.starts_with("unknown parameter `k")));
 }
 

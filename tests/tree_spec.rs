@@ -437,3 +437,28 @@ fn out_of_range_numbers_are_located_errors() {
         assert!(d.to_string().contains("bad.yaml:"), "{d}");
     }
 }
+
+#[test]
+fn control_nodes_read_their_typed_parameters_with_located_errors() {
+    let d = errors(
+        "main:\n  sequence:\n    children:\n      - retry: {attempts: 3}\n      - timeout: {seconds: 0, child: {hom: {}}}\n      - inverter: {children: [home: {}]}\n      - for_each: {as: 3b, max_iterations: 2, child: {home: {}}}\n",
+    );
+    let e = find(&d, "missing parameter `child` in `retry`");
+    assert_eq!(at(e), (4, 16));
+    assert_eq!(
+        e.help.as_deref(),
+        Some("e.g. `retry: {attempts: 3, child: {subtree: {ref: pick}}}`"),
+        "the help is the kind's documented example"
+    );
+    assert_eq!(at(find(&d, "a time limit (s) must be > 0")), (5, 28));
+    // A bad parameter does not hide the mistakes of the node's child.
+    assert_eq!(at(find(&d, "unknown node kind `hom`")), (5, 39));
+    let e = find(&d, "unknown parameter `children` in `inverter`");
+    assert_eq!(e.help.as_deref(), Some("did you mean `child`?"));
+    assert_eq!(at(find(&d, "`3b` is not a variable name")), (7, 24));
+    assert_eq!(
+        d.len(),
+        5,
+        "no second error for the `child` the misspelled key was suggested as: {d:#?}"
+    );
+}

@@ -1,6 +1,7 @@
 //! [`Cell`]: the simulated work cell as the macro actions see it — the simulation, the arm's
 //! trajectory tracker, the gripper command and the latest [`World`] snapshot.
 
+use crate::kinds::ActionRole;
 use crate::motion::Trajectory;
 use crate::sim::{Layout, Scene, Sim, TIMESTEP};
 use crate::world::World;
@@ -25,8 +26,10 @@ pub trait StepObserver: Send {
     /// Called after the controls for the coming physics step are set; may act on the physics
     /// (fault injection) or record the controls.
     fn before_step(&mut self, sim: &mut Sim);
-    /// A macro action of `kind` (`"reach"`, `"grasp"`, `"carry"`, …) starts now.
-    fn on_action_start(&mut self, _kind: &str, _world: &World) {}
+    /// A macro action of `kind` (`"reach"`, `"grasp"`, `"carry"`, …) starts now; `role` is what
+    /// its kind declares it does in the pick-and-place cycle (act on the role, not the name, so
+    /// that a custom kind playing the part is treated alike).
+    fn on_action_start(&mut self, _kind: &str, _role: ActionRole, _world: &World) {}
 }
 
 /// The simulated cell: simulation, arm tracker, gripper command and the latest world snapshot.
@@ -73,10 +76,10 @@ impl Cell {
         self.world = self.sim.observe();
     }
 
-    /// Tells the observers that a macro action of `kind` starts.
-    pub fn notify_action_start(&mut self, kind: &str) {
+    /// Tells the observers that a macro action of `kind`, playing `role`, starts.
+    pub fn notify_action_start(&mut self, kind: &str, role: ActionRole) {
         for obs in &mut self.observers {
-            obs.on_action_start(kind, &self.world);
+            obs.on_action_start(kind, role, &self.world);
         }
     }
 

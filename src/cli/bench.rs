@@ -79,8 +79,8 @@ pub fn bench(app: &crate::App, args: BenchArgs) -> Result<(), CliError> {
     args.episode.config()?;
     let (plan, scene) = load_task(app, &args.tree, args.episode.scene.as_deref())?;
     let plan = Arc::new(plan);
-    let config = args.episode.config_on(&scene)?;
-    super::check_substitutions(&plan, &config.substitutions)?;
+    let mut config = args.episode.config_on(&scene)?;
+    config.resolved = Some(super::resolve_substitutions(&plan, &config.substitutions)?);
     let placement = config
         .placement
         .clone()

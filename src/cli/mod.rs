@@ -25,6 +25,7 @@ mod test;
 mod validate;
 
 use std::process::ExitCode;
+use std::sync::Arc;
 
 use clap::{Parser, Subcommand};
 
@@ -252,14 +253,15 @@ fn resolve_shard(
     }
 }
 
-/// Substitutions that do not fit `plan` (no leaf matched, a leaf matched twice, …) are bad
+/// `subs` resolved against `plan`, once for the whole command (every episode reuses them);
+/// substitutions that do not fit `plan` (no leaf matched, a leaf matched twice, …) are bad
 /// input.
-fn check_substitutions(
+fn resolve_substitutions(
     plan: &crate::plan::Plan,
     subs: &[crate::runtime::substitute::Substitution],
-) -> Result<(), CliError> {
+) -> Result<Arc<crate::runtime::substitute::Resolved>, CliError> {
     crate::runtime::substitute::resolve(plan, subs)
-        .map(|_| ())
+        .map(Arc::new)
         .map_err(|e| CliError::Input(format!("error: {e}")))
 }
 

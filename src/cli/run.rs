@@ -208,8 +208,8 @@ pub fn run(app: &crate::App, args: RunArgs) -> Result<(), CliError> {
     args.episode.config()?;
     let (plan, scene) = load_task(app, &args.tree, args.episode.scene.as_deref())?;
     let plan = Arc::new(plan);
-    let config = args.episode.config_on(&scene)?;
-    super::check_substitutions(&plan, &config.substitutions)?;
+    let mut config = args.episode.config_on(&scene)?;
+    config.resolved = Some(super::resolve_substitutions(&plan, &config.substitutions)?);
     let mut inputs = super::outputs::tree_inputs(&args.tree, &plan);
     inputs.extend(args.episode.scene.clone());
     super::output_set::refuse_same_outputs(&[

@@ -102,7 +102,7 @@ pub fn sweep(app: &crate::App, args: SweepArgs) -> Result<(), CliError> {
     }
     let shard = super::resolve_shard(args.shard, args.shard_count)?;
     let (plan, scene) = load_task(app, &args.tree, args.scene.as_deref())?;
-    super::check_substitutions(&plan, &args.substitute)?;
+    let resolved = super::resolve_substitutions(&plan, &args.substitute)?;
     super::run::check_goal(args.goal, &scene)?;
     let plan = Arc::new(plan);
     // Every file the sweep reads: never an output, and digested into every result line.
@@ -119,6 +119,7 @@ pub fn sweep(app: &crate::App, args: SweepArgs) -> Result<(), CliError> {
         scene_file: args.scene.as_ref().map(|p| p.display().to_string()),
         tree: args.tree.display().to_string(),
         substitutions: args.substitute.clone(),
+        resolved: Some(resolved),
         suite: None,
         tree_digest: Some(super::outputs::inputs_digest(&inputs)),
         program: super::program_name(),

@@ -99,8 +99,9 @@ pub fn test(app: &crate::App, args: TestArgs) -> Result<(), CliError> {
             CliError::Input(m) => CliError::Input(format!("{m}\n  (named by {})", s.path.display())),
             other => other,
         })?;
-        crate::runtime::substitute::resolve(&plan, &s.sweep.substitutions)
+        let resolved = crate::runtime::substitute::resolve(&plan, &s.sweep.substitutions)
             .map_err(|e| CliError::Input(format!("error: {}: {e}", s.path.display())))?;
+        s.sweep.resolved = Some(Arc::new(resolved));
         s.check_patterns(&plan)
             .map_err(|e| CliError::Input(format!("error: {e}")))?;
         s.sweep.shard = shard;

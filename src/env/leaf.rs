@@ -135,7 +135,7 @@ mod tests {
     use super::*;
 
     fn compile(text: &str) -> Result<Plan, Error> {
-        compile_leaf(&Loader::default(), &crate::spec::load::builtin_scene(), text)
+        compile_leaf(&Loader::default(), &crate::spec::builtin_scene(), text)
     }
 
     #[test]

@@ -6,7 +6,7 @@ use std::collections::HashMap;
 use crate::actions::{Cell, ChecksRecorder, MacroAction, Progress};
 use crate::factory::Factory;
 use crate::failure::{Failure, FailureKind};
-use crate::kinds::{Leaf, LeafCall};
+use crate::kinds::{ActionRole, Leaf, LeafCall};
 use crate::plan::LeafId;
 use crate::runtime::{LeafDriver, LeafOutcome, Selection};
 use crate::scene::ObjectKind;
@@ -24,9 +24,9 @@ struct Active {
 /// Counters the episode report needs.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct LeafCounters {
-    /// Grasp leaves started.
+    /// Grasp leaves started (of kinds declared [`ActionRole::Grasp`]).
     pub grasp_attempts: u32,
-    /// Carry leaves started.
+    /// Carry leaves started (of kinds declared [`ActionRole::Carry`]).
     pub carries: u32,
     /// Leaves halted.
     pub halts: u32,
@@ -84,13 +84,14 @@ impl<'a> MacroDriver<'a> {
     }
 
     /// A new controller for `action` (`None` if the call is not an action). Counts the grasps
-    /// and carries the report needs, and tells the checks when the gripper opens.
+    /// and carries the report needs, and tells the checks when the gripper opens, by the role
+    /// the action's kind declares.
     fn start_action(&mut self, action: &LeafCall) -> Option<Box<dyn MacroAction>> {
-        match action.kind() {
-            "grasp" => self.counters.grasp_attempts += 1,
-            "carry" => self.counters.carries += 1,
-            "release" => self.checks.on_open(),
-            _ => {}
+        match action.role() {
+            ActionRole::Grasp => self.counters.grasp_attempts += 1,
+            ActionRole::Carry => self.counters.carries += 1,
+            ActionRole::Release => self.checks.on_open(),
+            ActionRole::Reach | ActionRole::Other => {}
         }
         self.factory.start(action)
     }
@@ -132,7 +133,7 @@ impl<'a> MacroDriver<'a> {
     fn finish(&mut self, id: LeafId, leaf: &Leaf, progress: Progress) -> LeafOutcome {
         if !matches!(progress, Progress::Running) {
             self.active.remove(&id);
-            if matches!(leaf, Leaf::Action(a) if a.kind() == "grasp") {
+            if matches!(leaf, Leaf::Action(a) if a.role() == ActionRole::Grasp) {
                 self.checks.after_grasp(self.cell.world());
             }
         }
@@ -172,7 +173,7 @@ impl LeafDriver for MacroDriver<'_> {
             let Some(mut controller) = self.start_action(action) else {
                 return LeafOutcome::Failure(Failure::other(format!("`{}` is not an action", action.kind())));
             };
-            self.cell.notify_action_start(action.kind());
+            self.cell.notify_action_start(action.kind(), action.role());
             if let Err(reason) = controller.start(self.cell) {
                 return self.finish(id, leaf, Progress::Failed(reason));
             }

@@ -18,6 +18,7 @@ use crate::actions::Cell;
 use crate::factory::Factory;
 use crate::failure::{Failure, FailureKind};
 use crate::plan::Plan;
+use crate::runtime::substitute::Resolved;
 use crate::runtime::{TreeRunner, TreeStatus};
 use crate::scene::Placement;
 use crate::sim::{Layout, Scene};
@@ -49,6 +50,11 @@ pub struct EpisodeConfig {
     /// Leaves replaced by scripted outcomes (test doubles, see
     /// [`crate::runtime::substitute`]).
     pub substitutions: Vec<crate::runtime::substitute::Substitution>,
+    /// `substitutions` already resolved against the plan this configuration runs
+    /// ([`crate::runtime::substitute::resolve`]): a command resolves its substitutions once and
+    /// every episode reuses them. `None` (or a resolution of another plan, with another number
+    /// of leaves): the episode resolves `substitutions` itself.
+    pub resolved: Option<Arc<crate::runtime::substitute::Resolved>>,
 }
 
 /// What counts as a successful episode (`run --goal`, `sweep --goal`).
@@ -102,6 +108,7 @@ impl Default for EpisodeConfig {
             fault: None,
             goal: Goal::Scene,
             substitutions: Vec::new(),
+            resolved: None,
         }
     }
 }
@@ -150,7 +157,11 @@ pub fn run_in_cell(
         cell.observers.push(crate::faults::injector(kind, config.seed));
     }
     let dt = cell.control_period();
-    let (subs, bad_subs) = match crate::runtime::substitute::resolve(&plan, &config.substitutions) {
+    let resolved = match &config.resolved {
+        Some(r) if r.by_leaf.len() == plan.leaves.len() => Ok(Resolved::clone(r)),
+        _ => crate::runtime::substitute::resolve(&plan, &config.substitutions),
+    };
+    let (subs, bad_subs) = match resolved {
         Ok(subs) => (subs, None),
         Err(e) => (
             Default::default(),

@@ -8,6 +8,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::push::{Push, block_pos};
 use super::{Fault, uniform};
+use crate::kinds::ActionRole;
 use crate::sim::Sim;
 use crate::world::World;
 
@@ -54,8 +55,8 @@ impl Bump {
 }
 
 impl Fault for Bump {
-    fn on_action_start(&mut self, kind: &str, world: &World) {
-        if kind == "reach" && matches!(self.state, State::Idle) {
+    fn on_action_start(&mut self, role: ActionRole, world: &World) {
+        if role == ActionRole::Reach && matches!(self.state, State::Idle) {
             let Some(block) = world.cube() else {
                 self.state = State::Done;
                 return;

@@ -6,6 +6,7 @@
 use rand_chacha::ChaCha8Rng;
 
 use super::{Fault, uniform};
+use crate::kinds::ActionRole;
 use crate::sim::Sim;
 use crate::world::World;
 
@@ -51,8 +52,8 @@ impl LateBowl {
 }
 
 impl Fault for LateBowl {
-    fn on_action_start(&mut self, kind: &str, _world: &World) {
-        if kind == "carry" && matches!(self.state, State::Idle) {
+    fn on_action_start(&mut self, role: ActionRole, _world: &World) {
+        if role == ActionRole::Carry && matches!(self.state, State::Idle) {
             self.state = State::Armed { at: None };
         }
     }

@@ -19,6 +19,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::{RngCore, SeedableRng};
 
 use crate::actions::StepObserver;
+use crate::kinds::ActionRole;
 use crate::sim::Sim;
 use crate::world::World;
 
@@ -131,8 +132,8 @@ pub fn injector_with_log(kind: FaultKind, seed: u64) -> (Box<dyn StepObserver>, 
 trait Fault: Send {
     /// Before a physics step; `Some(detail)` on the step the fault fires.
     fn before_step(&mut self, sim: &mut Sim) -> Option<String>;
-    /// A macro action starts.
-    fn on_action_start(&mut self, kind: &str, world: &World);
+    /// A macro action playing `role` starts.
+    fn on_action_start(&mut self, role: ActionRole, world: &World);
 }
 
 /// Wraps a [`Fault`]: logs its firing (tracing target `macrotree::fault`) and records it.
@@ -156,8 +157,8 @@ impl StepObserver for Injector {
         }
     }
 
-    fn on_action_start(&mut self, kind: &str, world: &World) {
-        self.fault.on_action_start(kind, world);
+    fn on_action_start(&mut self, _kind: &str, role: ActionRole, world: &World) {
+        self.fault.on_action_start(role, world);
     }
 }
 

@@ -6,6 +6,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::push::{Push, block_pos};
 use super::{Fault, uniform};
+use crate::kinds::ActionRole;
 use crate::sim::Sim;
 use crate::world::World;
 
@@ -44,8 +45,8 @@ impl Nudge {
 }
 
 impl Fault for Nudge {
-    fn on_action_start(&mut self, kind: &str, world: &World) {
-        if kind == "grasp" && matches!(self.state, State::Idle) {
+    fn on_action_start(&mut self, role: ActionRole, world: &World) {
+        if role == ActionRole::Grasp && matches!(self.state, State::Idle) {
             // The block being grasped: the one nearest the pinch point.
             let nearest = world
                 .scene

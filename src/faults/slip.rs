@@ -15,6 +15,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::push::block_pos;
 use super::{Fault, uniform};
+use crate::kinds::ActionRole;
 use crate::motion::gripper::ctrl_for_width;
 use crate::sim::Sim;
 use crate::world::World;
@@ -69,8 +70,8 @@ impl Slip {
 }
 
 impl Fault for Slip {
-    fn on_action_start(&mut self, kind: &str, world: &World) {
-        if kind == "carry"
+    fn on_action_start(&mut self, role: ActionRole, world: &World) {
+        if role == ActionRole::Carry
             && matches!(self.state, State::Idle)
             && let Some(block) = world.held_block(Tolerances::GRASP_OFF_AXIS)
         {

@@ -1,12 +1,24 @@
 //! The built-in node kinds, declared in documentation order. The leaves go through the same
 //! [`Registry::declare_action`] / [`Registry::declare_condition`] calls as a user's leaves.
+//!
+//! This is the one declaration of each built-in kind: its name, its doc, its parameter type
+//! (`super::leaves` for the leaves, `super::control` for the composites and decorators) and,
+//! for an action, the [`ActionRole`] it plays. The leaves' parameter types live here in `kinds`
+//! rather than beside their controllers in `actions`, because what a kind *is* (layer 4: read,
+//! checked, documented and diagrammed without MuJoCo) must not depend on how it runs (layer 9);
+//! `crate::factory` binds each action's controller and each condition's check to the declared
+//! name.
 
-use super::control as c;
+use super::control::{
+    ChildParams, CompositeParams, ControlKind, ForEachParams, GuardParams, RepeatParams, RetryParams,
+    SubtreeParams, TimeoutParams,
+};
 use super::leaves::{
     At, AtHome, Carry, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, GoalMet, Grasp, Grasped,
     GripperOpen, Home, In, Lifted, MoveJoints, On, OnTable, Reach, Release,
 };
-use super::registry::{Category, Imp, Registry};
+use super::registry::{Category, ControlImp, Imp, Registry};
+use super::role::ActionRole;
 
 macro_rules! doc {
     ($kind:literal) => {
@@ -15,15 +27,12 @@ macro_rules! doc {
 }
 
 macro_rules! control {
-    ($reg:expr, $kind:literal, $category:expr, $params:path, $schema:path) => {
+    ($reg:expr, $kind:literal, $category:ident, $tag:ident, $params:ty) => {
         $reg.add(
             $kind,
-            $category,
+            Category::$category,
             doc!($kind),
-            Imp::Control {
-                params: $params,
-                schema: $schema,
-            },
+            Imp::Control(ControlImp::of::<$params>(ControlKind::$tag)),
         )
     };
 }
@@ -36,42 +45,42 @@ pub(super) fn registry() -> Registry {
 }
 
 fn register(r: &mut Registry) -> Result<(), crate::error::Error> {
-    use Category::{Composite, Decorator, Runtime};
-    control!(r, "sequence", Composite, c::composite_params, c::composite_schema)?;
-    control!(r, "fallback", Composite, c::composite_params, c::composite_schema)?;
+    use Category::Runtime;
+    control!(r, "sequence", Composite, Sequence, CompositeParams)?;
+    control!(r, "fallback", Composite, Fallback, CompositeParams)?;
     control!(
         r,
         "reactive_sequence",
         Composite,
-        c::composite_params,
-        c::composite_schema
+        ReactiveSequence,
+        CompositeParams
     )?;
     control!(
         r,
         "reactive_fallback",
         Composite,
-        c::composite_params,
-        c::composite_schema
+        ReactiveFallback,
+        CompositeParams
     )?;
-    control!(r, "parallel", Composite, c::composite_params, c::composite_schema)?;
-    control!(r, "race", Composite, c::composite_params, c::composite_schema)?;
-    control!(r, "guard", Decorator, c::guard_params, c::guard_schema)?;
-    control!(r, "retry", Decorator, c::retry_params, c::retry_schema)?;
-    control!(r, "repeat", Decorator, c::repeat_params, c::repeat_schema)?;
-    control!(r, "for_each", Decorator, c::for_each_params, c::for_each_schema)?;
-    control!(r, "timeout", Decorator, c::timeout_params, c::timeout_schema)?;
-    control!(r, "inverter", Decorator, c::child_params, c::child_schema)?;
-    control!(r, "force_success", Decorator, c::child_params, c::child_schema)?;
-    control!(r, "force_failure", Decorator, c::child_params, c::child_schema)?;
-    control!(r, "subtree", Decorator, c::subtree_params, c::subtree_schema)?;
+    control!(r, "parallel", Composite, Parallel, CompositeParams)?;
+    control!(r, "race", Composite, Race, CompositeParams)?;
+    control!(r, "guard", Decorator, Guard, GuardParams)?;
+    control!(r, "retry", Decorator, Retry, RetryParams)?;
+    control!(r, "repeat", Decorator, Repeat, RepeatParams)?;
+    control!(r, "for_each", Decorator, ForEach, ForEachParams)?;
+    control!(r, "timeout", Decorator, Timeout, TimeoutParams)?;
+    control!(r, "inverter", Decorator, Inverter, ChildParams)?;
+    control!(r, "force_success", Decorator, ForceSuccess, ChildParams)?;
+    control!(r, "force_failure", Decorator, ForceFailure, ChildParams)?;
+    control!(r, "subtree", Decorator, Subtree, SubtreeParams)?;
 
     // Actions (their controllers are bound in `crate::factory`).
-    r.declare_action::<Reach>("reach", doc!("reach"))?;
+    r.declare_action_as::<Reach>("reach", doc!("reach"), ActionRole::Reach)?;
     r.declare_action::<MoveJoints>("move_joints", doc!("move_joints"))?;
     r.declare_action::<Home>("home", doc!("home"))?;
-    r.declare_action::<Grasp>("grasp", doc!("grasp"))?;
-    r.declare_action::<Carry>("carry", doc!("carry"))?;
-    r.declare_action::<Release>("release", doc!("release"))?;
+    r.declare_action_as::<Grasp>("grasp", doc!("grasp"), ActionRole::Grasp)?;
+    r.declare_action_as::<Carry>("carry", doc!("carry"), ActionRole::Carry)?;
+    r.declare_action_as::<Release>("release", doc!("release"), ActionRole::Release)?;
 
     // Leaves the runtime handles itself.
     r.add("wait", Runtime, doc!("wait"), Imp::Wait)?;

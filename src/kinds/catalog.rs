@@ -5,7 +5,8 @@ use schemars::generate::{SchemaGenerator, SchemaSettings};
 use serde::Serialize;
 use serde_json::{Value, json};
 
-use super::{Category, Registry, SchemaCtx};
+use super::control::body_schema;
+use super::{Category, Registry};
 use crate::world::query::Query;
 
 /// One parameter of a node kind.
@@ -76,7 +77,11 @@ fn generator() -> SchemaGenerator {
 
 fn short_type(s: &Value) -> String {
     if let Some(r) = s.get("$ref").and_then(Value::as_str) {
-        return r.rsplit('/').next().unwrap_or(r).to_string();
+        return match r.rsplit('/').next().unwrap_or(r) {
+            "Node" => "node".into(),
+            "Condition" => "condition node".into(),
+            name => name.to_string(),
+        };
     }
     match s.get("type") {
         Some(Value::String(t)) if t == "array" => {
@@ -85,6 +90,7 @@ fn short_type(s: &Value) -> String {
                 Some(n) if s.get("maxItems").and_then(Value::as_u64) == Some(n) => {
                     format!("[{item}; {n}]")
                 }
+                _ if item == "node" => "list of nodes".into(),
                 _ => format!("list of {item}"),
             }
         }
@@ -147,16 +153,12 @@ impl Registry {
     /// behaviour and a YAML example, generated from the Rust types and the kinds' docs.
     pub fn catalog(&self) -> Vec<NodeDoc> {
         let mut g = generator();
-        let leaves: Vec<Option<String>> = self.types().map(|t| t.leaf_schema(&mut g)).collect();
+        let bodies: Vec<String> = self.types().map(|t| t.params_schema(&mut g)).collect();
         let defs = g.take_definitions(true);
         self.types()
-            .zip(leaves)
-            .map(|(t, leaf)| {
-                let params = match (t.imp(), leaf) {
-                    (crate::kinds::Imp::Control { params, .. }, _) => params(),
-                    (_, Some(name)) => defs.get(&name).map(params_from_schema).unwrap_or_default(),
-                    _ => vec![],
-                };
+            .zip(bodies)
+            .map(|(t, body)| {
+                let params = defs.get(&body).map(params_from_schema).unwrap_or_default();
                 let (summary, details, halt, example) = parse_node_doc(t.doc());
                 NodeDoc {
                     kind: t.name(),
@@ -177,7 +179,7 @@ impl Registry {
     /// `macrotree schema` prints; `schema/tree.schema.json` for the built-in kinds).
     pub fn json_schema(&self) -> Value {
         let mut g = generator();
-        let leaves: Vec<Option<String>> = self.types().map(|t| t.leaf_schema(&mut g)).collect();
+        let bodies: Vec<String> = self.types().map(|t| t.params_schema(&mut g)).collect();
         let _ = g.subschema_for::<Query>();
         let mut defs = g.take_definitions(true);
 
@@ -194,41 +196,20 @@ impl Registry {
 
         for template in [false, true] {
             let suffix = if template { "Template" } else { "" };
-            let node_ref = json!({"$ref": format!("#/$defs/Node{suffix}")});
             let cond_ref = json!({"$ref": format!("#/$defs/Condition{suffix}")});
-            let ctx = SchemaCtx {
-                node_ref,
-                cond_ref: cond_ref.clone(),
-                template,
-            };
             let mut variants = Vec::new();
             let mut cond_variants = Vec::new();
-            for (t, leaf) in self.types().zip(&leaves) {
+            for (t, def_name) in self.types().zip(&bodies) {
                 let kind = t.name();
                 let (summary, details, halt, example) = parse_node_doc(t.doc());
-                let b = match (t.imp(), leaf) {
-                    (crate::kinds::Imp::Control { schema, .. }, _) => schema(&ctx),
-                    (_, def_name) => {
-                        let def_name = def_name.clone().unwrap_or_default();
-                        let def = defs.get(&def_name).cloned().unwrap_or(json!({}));
-                        let mut props = def.get("properties").cloned().unwrap_or(json!({}));
-                        if let Some(obj) = props.as_object_mut() {
-                            for v in obj.values_mut() {
-                                *v = ctx.scalar(v.clone());
-                            }
-                        }
-                        let required: Vec<&str> = def
-                            .get("required")
-                            .and_then(Value::as_array)
-                            .map(|r| r.iter().filter_map(Value::as_str).collect())
-                            .unwrap_or_default();
-                        let b = ctx.body(props, &required);
-                        if required.is_empty() {
-                            json!({"anyOf": [b, {"type": "null"}]})
-                        } else {
-                            b
-                        }
-                    }
+                let def = defs.get(def_name).cloned().unwrap_or(json!({}));
+                let (mut props, required) = body_schema(&def, template);
+                props["name"] = json!({"$ref": "#/$defs/NodeName"});
+                let b = json!({"type": "object", "properties": props, "required": required, "additionalProperties": false});
+                let b = if required.is_empty() {
+                    json!({"anyOf": [b, {"type": "null"}]})
+                } else {
+                    b
                 };
                 let description = [summary, details.replace('\n', " "), format!("Halt: {halt}.")]
                     .into_iter()
@@ -265,8 +246,8 @@ impl Registry {
                 json!({"description": "A condition leaf, or an `inverter` of one.", "oneOf": cond_variants}),
             );
         }
-        // Leaf parameter structs are inlined into the node variants; drop their standalone copies.
-        for name in leaves.iter().flatten() {
+        // Parameter structs are inlined into the node variants; drop their standalone copies.
+        for name in &bodies {
             defs.remove(name);
         }
 

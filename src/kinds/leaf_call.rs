@@ -45,6 +45,12 @@ impl LeafCall {
         self.ty.name
     }
 
+    /// What the action does in the pick-and-place cycle, as its kind declares
+    /// ([`ActionRole::Other`](super::ActionRole::Other) for conditions).
+    pub fn role(&self) -> super::ActionRole {
+        self.ty.role()
+    }
+
     /// The registered kind.
     pub fn node_type(&self) -> &NodeType {
         &self.ty

@@ -23,10 +23,14 @@ pub mod objects;
 mod param_error;
 mod params;
 mod registry;
+mod role;
 mod targets;
 
 pub use catalog::{NodeDoc, ParamDoc};
-pub(crate) use control::SchemaCtx;
+pub use control::{
+    Arguments, ChildParams, CompositeParams, ConditionValue, Control, ControlKind, ForEachParams,
+    GuardParams, MAX_COUNT, NodeList, NodeValue, RepeatParams, RetryParams, SubtreeParams, TimeoutParams,
+};
 pub use leaf_call::LeafCall;
 pub use leaves::{
     At, AtHome, Carry, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, GoalMet, Grasp, Grasped,
@@ -35,6 +39,6 @@ pub use leaves::{
 pub use objects::{ObjectRef, ObjectRole};
 pub use param_error::ParamError;
 pub use params::Params;
-pub(crate) use registry::Imp;
 pub use registry::{Category, NodeType, Registry};
+pub use role::ActionRole;
 pub use targets::{PathKind, Target, Yaw};

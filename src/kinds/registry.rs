@@ -10,12 +10,13 @@ use schemars::generate::SchemaGenerator;
 use serde::Serialize;
 
 use super::builtin;
-use super::catalog::{ParamDoc, parse_node_doc};
-use super::control::SchemaCtx;
+use super::catalog::parse_node_doc;
+use super::control::{Control, ControlKind, ControlParams};
 use super::leaf_call::LeafCall;
 use super::leaves::{Leaf, Select, Wait};
 use super::objects::ObjectRole;
 use super::params::{DynParams, Params};
+use super::role::ActionRole;
 use crate::error::Error;
 use crate::yaml::de::DeError;
 use crate::yaml::value::Value;
@@ -67,26 +68,47 @@ pub(crate) struct LeafImp {
     schema: fn(&mut SchemaGenerator) -> String,
     objects: &'static [(&'static str, ObjectRole)],
     failures: &'static [&'static str],
+    role: ActionRole,
 }
 
 impl LeafImp {
-    fn of<P: Params>() -> Self {
+    fn of<P: Params>(role: ActionRole) -> Self {
         LeafImp {
             parse: parse_params::<P>,
             schema: schema_of::<P>,
             objects: P::OBJECT_PARAMS,
             failures: P::failure_kinds(),
+            role,
+        }
+    }
+}
+
+fn parse_control<P: ControlParams>(v: &Value) -> Result<Control, DeError> {
+    crate::yaml::de::from_value::<P>(v).map(Into::into)
+}
+
+/// How a composite's or decorator's parameters are read; the tree reader reads the nodes among
+/// them.
+pub(crate) struct ControlImp {
+    kind: ControlKind,
+    parse: fn(&Value) -> Result<Control, DeError>,
+    schema: fn(&mut SchemaGenerator) -> String,
+}
+
+impl ControlImp {
+    pub(super) fn of<P: ControlParams>(kind: ControlKind) -> Self {
+        ControlImp {
+            kind,
+            parse: parse_control::<P>,
+            schema: schema_of::<P>,
         }
     }
 }
 
 /// How a kind is read.
 pub(crate) enum Imp {
-    /// A composite or decorator: parsed by the tree reader; its parameters and schema are given.
-    Control {
-        params: fn() -> Vec<ParamDoc>,
-        schema: fn(&SchemaCtx) -> serde_json::Value,
-    },
+    /// A composite or decorator.
+    Control(ControlImp),
     /// An action leaf.
     Action(LeafImp),
     /// A condition leaf.
@@ -147,10 +169,6 @@ impl NodeType {
         }
     }
 
-    pub(crate) fn imp(&self) -> &Imp {
-        &self.imp
-    }
-
     /// Reads a leaf of this kind from its YAML body (without `name:`); `None` for composites and
     /// decorators.
     pub(crate) fn parse_leaf(self: &Arc<Self>, body: &Value) -> Option<Result<Leaf, DeError>> {
@@ -161,7 +179,7 @@ impl NodeType {
             })
         };
         Some(match &self.imp {
-            Imp::Control { .. } => return None,
+            Imp::Control(_) => return None,
             Imp::Action(l) => call(l.parse).map(Leaf::Action),
             Imp::Condition(l) => call(l.parse).map(Leaf::Condition),
             Imp::Wait => crate::yaml::de::from_value::<Wait>(body).map(Leaf::Wait),
@@ -169,13 +187,51 @@ impl NodeType {
         })
     }
 
-    /// The parameter type's schema definition name, after adding it to `g` (leaves only).
-    pub(crate) fn leaf_schema(&self, g: &mut SchemaGenerator) -> Option<String> {
+    /// What an action kind does in the pick-and-place cycle ([`ActionRole::Other`] for every
+    /// other kind).
+    pub fn role(&self) -> ActionRole {
         match &self.imp {
-            Imp::Action(l) | Imp::Condition(l) => Some((l.schema)(g)),
-            Imp::Wait => Some(schema_of::<Wait>(g)),
-            Imp::Select => Some(schema_of::<Select>(g)),
-            Imp::Control { .. } => None,
+            Imp::Action(l) => l.role,
+            _ => ActionRole::Other,
+        }
+    }
+
+    /// Which control node it is; `None` for leaves.
+    pub fn control_kind(&self) -> Option<ControlKind> {
+        match &self.imp {
+            Imp::Control(c) => Some(c.kind),
+            _ => None,
+        }
+    }
+
+    /// Reads a composite's or decorator's parameters from its YAML body (without `name:`),
+    /// with its nodes kept as located YAML; `None` for leaves.
+    pub(crate) fn parse_control(&self, body: &Value) -> Option<Result<Control, DeError>> {
+        match &self.imp {
+            Imp::Control(c) => Some((c.parse)(body)),
+            _ => None,
+        }
+    }
+
+    /// The parameters that hold nodes (`child`, `children`, `condition`), read from the
+    /// parameter type's schema; none for leaves.
+    pub(crate) fn node_params(&self) -> Vec<String> {
+        let Imp::Control(c) = &self.imp else {
+            return Vec::new();
+        };
+        let mut g = SchemaGenerator::default();
+        let name = (c.schema)(&mut g);
+        let defs = g.take_definitions(true);
+        super::control::node_params(defs.get(&name).unwrap_or(&serde_json::Value::Null))
+    }
+
+    /// The parameter type's schema definition name, after adding it to `g`.
+    pub(crate) fn params_schema(&self, g: &mut SchemaGenerator) -> String {
+        match &self.imp {
+            Imp::Action(l) | Imp::Condition(l) => (l.schema)(g),
+            Imp::Wait => schema_of::<Wait>(g),
+            Imp::Select => schema_of::<Select>(g),
+            Imp::Control(c) => (c.schema)(g),
         }
     }
 }
@@ -262,8 +318,24 @@ impl Registry {
         name: &'static str,
         doc: &'static str,
     ) -> Result<&mut Self, Error> {
+        self.declare_action_as::<P>(name, doc, ActionRole::Other)
+    }
+
+    /// Declares an action leaf like [`declare_action`](Self::declare_action) that plays `role`
+    /// in the pick-and-place cycle: a custom pick declared as [`ActionRole::Grasp`] is counted
+    /// in the report's grasp attempts, gets the grasp checks and arms the grasp faults, like the
+    /// built-in `grasp`.
+    ///
+    /// # Errors
+    /// As for [`declare_action`](Self::declare_action).
+    pub fn declare_action_as<P: Params>(
+        &mut self,
+        name: &'static str,
+        doc: &'static str,
+        role: ActionRole,
+    ) -> Result<&mut Self, Error> {
         check_failure_kinds::<P>(name)?;
-        self.add(name, Category::Action, doc, Imp::Action(LeafImp::of::<P>()))
+        self.add(name, Category::Action, doc, Imp::Action(LeafImp::of::<P>(role)))
     }
 
     /// Declares a condition leaf `name` whose parameters are `P` (an instantaneous check of the
@@ -278,7 +350,12 @@ impl Registry {
         doc: &'static str,
     ) -> Result<&mut Self, Error> {
         check_failure_kinds::<P>(name)?;
-        self.add(name, Category::Condition, doc, Imp::Condition(LeafImp::of::<P>()))
+        self.add(
+            name,
+            Category::Condition,
+            doc,
+            Imp::Condition(LeafImp::of::<P>(ActionRole::Other)),
+        )
     }
 
     pub(crate) fn add(

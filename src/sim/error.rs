@@ -14,6 +14,14 @@ pub enum SimError {
     },
     /// The scene could not be parsed, attached or compiled.
     Scene(String),
+    /// The scene's default placement cannot be drawn: its `random:` ranges leave no room for an
+    /// object (a scene built in code; a scene file with this problem is refused when read).
+    Placement {
+        /// The scene's name.
+        scene: String,
+        /// Why the draw failed.
+        reason: crate::scene::PlacementError,
+    },
 }
 
 impl std::fmt::Display for SimError {
@@ -23,6 +31,10 @@ impl std::fmt::Display for SimError {
                 write!(f, "missing model file {}: {help}", path.display())
             }
             SimError::Scene(msg) => write!(f, "scene: {msg}"),
+            SimError::Placement { scene, reason } => write!(
+                f,
+                "scene `{scene}`: its default placement cannot be drawn: {reason}; widen the objects' `random:` ranges or lower their `clearance`"
+            ),
         }
     }
 }

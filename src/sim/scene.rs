@@ -93,6 +93,9 @@ pub struct Scene {
     pub arm_gains: [(f64, f64); 6],
     /// Control range of each arm actuator, radians.
     pub arm_ctrlrange: [[f64; 2]; 6],
+    /// Every object's `pose:`, with the `random:`-only objects drawn as scenario 0 of sweep
+    /// seed 0 (drawn once, when the scene is built).
+    default_placement: Placement,
 }
 
 impl std::fmt::Debug for Scene {
@@ -155,16 +158,18 @@ impl Scene {
         if spec.of_kind(ObjectKind::Block).next().is_none() {
             return Err(SimError::Scene(format!("scene `{}` has no block", spec.name)));
         }
+        // Before the compile: a scene whose placement cannot be drawn is refused, typed.
+        let placement = default_placement(spec)?;
         let xml = super::mjcf::cell_mjcf(SCENE_XML, spec);
         let (model, origin) = match cache {
             Some(dir) => cached_model(&xml, &ur5e, &gripper, menagerie, dir)?,
             None => (compile_model(&xml, &ur5e, &gripper)?, ModelOrigin::Compiled),
         };
-        Ok((Self::from_model(model, spec)?, origin))
+        Ok((Self::from_model(model, spec, placement)?, origin))
     }
 
     /// The scene of `spec` around an already compiled `model` (of that scene).
-    fn from_model(model: MjModel, spec: &SceneSpec) -> Result<Self, SimError> {
+    fn from_model(model: MjModel, spec: &SceneSpec, default_placement: Placement) -> Result<Self, SimError> {
         let objects = lookup_objects(&model, spec)?;
         let ids = SceneIds::lookup(&model)?;
         let geom_parts = geom_parts(&model, spec, &objects);
@@ -181,7 +186,22 @@ impl Scene {
             ids,
             arm_gains,
             arm_ctrlrange,
+            default_placement,
         })
+    }
+}
+
+/// The default placement of `spec`: every object's `pose:`; objects with only `random:` as
+/// scenario 0 of sweep seed 0 draws them. An error when that draw cannot be met.
+fn default_placement(spec: &SceneSpec) -> Result<Placement, SimError> {
+    match Placement::fixed(spec) {
+        Some(p) => Ok(p),
+        None => sample_placement(spec, 0, 0)
+            .map(|(_, p)| p)
+            .map_err(|reason| SimError::Placement {
+                scene: spec.name.clone(),
+                reason,
+            }),
     }
 }
 
@@ -302,12 +322,10 @@ impl Scene {
 
     /// The scene's default placement: every object's `pose:`; objects with only `random:` as
     /// scenario 0 of sweep seed 0 draws them.
+    /// (Drawn when the scene was built: building refuses a scene whose placement cannot be
+    /// drawn, with [`SimError::Placement`].)
     pub fn default_placement(&self) -> Placement {
-        Placement::fixed(&self.spec).unwrap_or_else(|| {
-            sample_placement(&self.spec, 0, 0)
-                .map(|(_, p)| p)
-                .expect("a loaded scene's randomization was checked to be satisfiable")
-        })
+        self.default_placement.clone()
     }
 
     /// The placement a legacy [`Layout`] describes: the default placement with the object the

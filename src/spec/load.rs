@@ -38,7 +38,7 @@ pub struct Spec {
     /// The main file's `description:`.
     pub description: Option<String>,
     /// Every object a leaf names or reads from the blackboard (checked against a scene by
-    /// [`super::check::check_scene`]).
+    /// the loader when the tree is compiled).
     pub object_uses: Vec<super::check::ObjectUse>,
     /// Every blackboard variable a `select` or `for_each` writes.
     pub var_defs: Vec<super::check::VarDef>,

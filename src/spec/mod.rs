@@ -1,7 +1,7 @@
 //! YAML → typed, spanned spec.
 //!
 //! The pipeline is: text → [`crate::yaml::value::Value`] (generic YAML with a location on every node, read by
-//! serde-saphyr under resource limits) → [`file::TreeFile`] (`include:`, `subtrees:`, `main:`)
+//! serde-saphyr under resource limits) → `TreeFile` (`include:`, `subtrees:`, `main:`)
 //! → [`node::Node`] (typed tree, subtrees expanded with their arguments, every node located).
 //! Every problem is an [`Issue`] turned into a [`Diagnostic`] with file:line:column.
 //!
@@ -9,14 +9,17 @@
 
 #![warn(missing_docs)]
 
-pub mod check;
+mod check;
 pub(crate) mod confine;
-pub mod expand;
-pub mod file;
-pub mod load;
-pub mod node;
+mod expand;
+mod file;
+mod load;
+mod node;
 
 pub use crate::yaml::{Diagnostic, Issue, Loc, Sources};
-pub use load::Spec;
+pub use check::{Named, ObjectUse, VarDef, VarType};
+pub use expand::{MAX_LEAF_ERRORS, MAX_TREE_DEPTH, MAX_TREE_NODES};
+pub use file::{IncludeRef, ParamDef, SubtreeDef};
 pub(crate) use load::{LoadOptions, Source, load};
+pub use load::{MAX_FILES, MAX_INCLUDE_DEPTH, Spec, builtin_scene};
 pub use node::{Node, NodeKind};

@@ -288,6 +288,38 @@ impl de::Error for DeError {
     }
 }
 
+/// The name a [`RawValue`] asks the deserializer for; [`ValueDe`] answers it with the value
+/// itself (through [`RAW`]) instead of reading it.
+const RAW_TOKEN: &str = "$macrotree::RawValue";
+
+thread_local! {
+    /// The value a [`RawValue`] is being read from, handed over by [`ValueDe`].
+    static RAW: std::cell::RefCell<Option<Value>> = const { std::cell::RefCell::new(None) };
+}
+
+/// A part of a typed struct kept as located YAML, read later (a control node's children are
+/// read as nodes by the tree reader). Only [`from_value`] can read it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RawValue(pub Value);
+
+impl<'de> serde::Deserialize<'de> for RawValue {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Raw;
+        impl Visitor<'_> for Raw {
+            type Value = RawValue;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a YAML value")
+            }
+            fn visit_unit<E: de::Error>(self) -> Result<RawValue, E> {
+                RAW.with(|r| r.borrow_mut().take())
+                    .map(RawValue)
+                    .ok_or_else(|| E::custom("a YAML value can only be kept from a YAML file"))
+            }
+        }
+        d.deserialize_newtype_struct(RAW_TOKEN, Raw)
+    }
+}
+
 /// Read a `T` from a spanned value.
 pub fn from_value<T: DeserializeOwned>(v: &Value) -> Result<T, DeError> {
     T::deserialize(ValueDe(v)).map_err(|e| e.at(v))
@@ -367,10 +399,14 @@ impl<'de> Deserializer<'de> for ValueDe<'_> {
 
     fn deserialize_newtype_struct<V: Visitor<'de>>(
         self,
-        _name: &'static str,
+        name: &'static str,
         visitor: V,
     ) -> Result<V::Value, DeError> {
         let v = self.0;
+        if name == RAW_TOKEN {
+            RAW.with(|r| *r.borrow_mut() = Some(v.clone()));
+            return visitor.visit_unit().map_err(|e: DeError| e.at(v));
+        }
         visitor.visit_newtype_struct(self).map_err(|e| e.at(v))
     }
 

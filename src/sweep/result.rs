@@ -1,0 +1,278 @@
+//! [`ScenarioResult`]: one line of a sweep's JSONL, its reproduction command.
+
+use serde::Serialize;
+
+use crate::actions::Checks;
+use crate::episode::Collision;
+use crate::episode::{EpisodeConfig, EpisodeReport, Goal, NodeReport, ObjectReport};
+use crate::failure::FailureKind;
+use crate::faults::FaultKind;
+use crate::runtime::substitute::Substitution;
+use crate::sweep::{Scenario, ScenarioLayout, SceneScenario, SweepConfig};
+use crate::world::goal::GoalValue;
+
+/// One line of the sweep's JSONL: the scenario and its episode's outcome (the fields of
+/// `run --json`, except the wall time, so that a sweep's output is byte-identical for any number
+/// of jobs and any machine).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ScenarioResult {
+    /// The scenario file of `macrotree test` this result belongs to (absent for sweeps).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub suite: Option<String>,
+    /// The tree file, as given to the sweep.
+    pub tree: String,
+    /// The `--scene` file, if one was given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scene_file: Option<String>,
+    /// Scenarios in the whole sweep (N, before sharding).
+    pub scenarios: u64,
+    /// What counted as success (`--goal`).
+    pub sweep_goal: Goal,
+    /// The per-episode simulated time limit, seconds.
+    pub max_sim_time: f64,
+    /// Substitutions applied in every scenario (`PATTERN=OUTCOME`).
+    #[serde(skip_serializing_if = "Vec::is_empty", serialize_with = "as_rules")]
+    pub substitutions: Vec<Substitution>,
+    /// Scenario index k.
+    pub index: u64,
+    /// Sweep seed S.
+    pub sweep_seed: u64,
+    /// Episode seed (`run --seed`).
+    pub seed: u64,
+    /// The injected fault.
+    pub fault: Option<FaultKind>,
+    /// The layout of a `sampler: tutorial` scene (the built-in one), exactly as sampled (and as
+    /// `run --cube X,Y,YAW --bowl X,Y` takes it); other scenes list every object in `objects`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub layout: Option<ScenarioLayout>,
+    /// The episode met the sweep's goal (by default: the tree succeeded and the cube rests in
+    /// the bowl; see [`Goal`]).
+    pub success: bool,
+    /// Final status of the tree.
+    pub tree_status: &'static str,
+    /// Why it failed, if it did.
+    pub failure_reason: Option<String>,
+    /// Simulated time, seconds.
+    pub sim_time_s: f64,
+    /// Grasp leaves started on the arm (a grasp answered by a substitution is not counted).
+    pub grasp_attempts: u32,
+    /// Leaves preempted while running.
+    pub halts: u32,
+    /// MuJoCo steps taken.
+    pub physics_steps: u64,
+    /// Final centre [x, y, z] of the scene's cube, metres; absent without one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cube_final: Option<[f64; 3]>,
+    /// Bowl target [x, y, z] at the end, metres; absent without a bowl.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bowl_target: Option<[f64; 3]>,
+    /// The reference tutorial's checks.
+    pub checks: Checks,
+    /// The scene's name.
+    pub scene: String,
+    /// Every object's initial and final pose, `[x, y, z, yaw°]`.
+    pub objects: Vec<ObjectReport>,
+    /// Every goal predicate's value at the end.
+    pub goal: Vec<GoalValue>,
+    /// Contacts that should not happen, by name.
+    pub collisions: Vec<Collision>,
+    /// The path of the node whose failure ended the episode, if one did.
+    pub failed_node: Option<String>,
+    /// The kind of failure (`timeout`, `grasp_lost`, …; serialized as its name), for grouping.
+    pub failure_kind: Option<FailureKind>,
+    /// How often every node ran, in plan order.
+    pub nodes: Vec<NodeReport>,
+    /// The digest of the tree, its includes and the scene the sweep ran
+    /// ([`SweepConfig::tree_digest`]); a line that has it also ends with its checksum (`crc32`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tree_digest: Option<String>,
+    /// Wall-clock time of the episode, seconds (not written to the JSONL).
+    #[serde(skip)]
+    pub wall_time_s: f64,
+}
+
+impl ScenarioResult {
+    /// The result of `scenario` (of a `sampler: tutorial` scene) of the sweep `config` from its
+    /// episode report.
+    pub fn new(scenario: &Scenario, config: &SweepConfig, r: EpisodeReport) -> Self {
+        Self::of(config, scenario.index, scenario.seed, Some(scenario.layout), r)
+    }
+
+    /// The result of a scenario of any scene of the sweep `config` from its episode report.
+    pub fn of_scene(scenario: &SceneScenario, config: &SweepConfig, r: EpisodeReport) -> Self {
+        Self::of(config, scenario.index, scenario.seed, scenario.layout, r)
+    }
+
+    fn of(
+        config: &SweepConfig,
+        index: u64,
+        seed: u64,
+        layout: Option<ScenarioLayout>,
+        r: EpisodeReport,
+    ) -> Self {
+        Self {
+            suite: config.suite.clone(),
+            tree: config.tree.clone(),
+            scene_file: config.scene_file.clone(),
+            scenarios: config.scenarios,
+            sweep_goal: config.goal,
+            max_sim_time: config.max_sim_time,
+            substitutions: config.substitutions.clone(),
+            index,
+            sweep_seed: config.seed,
+            seed,
+            fault: config.fault,
+            layout,
+            success: r.success,
+            tree_status: r.tree_status,
+            failure_reason: r.failure_reason,
+            sim_time_s: r.sim_time_s,
+            grasp_attempts: r.grasp_attempts,
+            halts: r.halts,
+            physics_steps: r.physics_steps,
+            cube_final: r.cube_final,
+            bowl_target: r.bowl_target,
+            checks: r.checks,
+            scene: r.scene,
+            objects: r.objects,
+            goal: r.goal,
+            collisions: r.collisions,
+            failure_kind: r.failure_kind,
+            failed_node: r.failed_node,
+            nodes: r.nodes,
+            tree_digest: config.tree_digest.clone(),
+            wall_time_s: r.wall_time_s,
+        }
+    }
+
+    /// A result of the sweep `config` for an episode that could not run (it panicked, or its
+    /// layout could not be drawn).
+    pub(super) fn not_run(
+        config: &SweepConfig,
+        index: u64,
+        seed: u64,
+        layout: Option<ScenarioLayout>,
+        reason: crate::failure::Failure,
+    ) -> Self {
+        Self {
+            suite: config.suite.clone(),
+            tree: config.tree.clone(),
+            scene_file: config.scene_file.clone(),
+            scenarios: config.scenarios,
+            sweep_goal: config.goal,
+            max_sim_time: config.max_sim_time,
+            substitutions: config.substitutions.clone(),
+            index,
+            sweep_seed: config.seed,
+            seed,
+            fault: config.fault,
+            layout,
+            success: false,
+            tree_status: "failure",
+            failure_kind: Some(reason.kind),
+            failure_reason: Some(reason.message),
+            sim_time_s: 0.0,
+            grasp_attempts: 0,
+            halts: 0,
+            physics_steps: 0,
+            cube_final: None,
+            bowl_target: None,
+            checks: Checks {
+                grasp_distance: None,
+                cube_motion_while_closed: 0.0,
+                cube_lift_while_closed: 0.0,
+                home_error: f64::NAN,
+                in_bowl: false,
+            },
+            scene: String::new(),
+            objects: Vec::new(),
+            goal: Vec::new(),
+            collisions: Vec::new(),
+            failed_node: None,
+            nodes: Vec::new(),
+            tree_digest: config.tree_digest.clone(),
+            wall_time_s: 0.0,
+        }
+    }
+
+    /// The result as one JSON line (without the newline).
+    pub fn to_jsonl(&self) -> String {
+        let json = serde_json::to_string(self).expect("a scenario result serializes");
+        if self.tree_digest.is_some() {
+            crate::sweep::digest::with_checksum(&json)
+        } else {
+            json
+        }
+    }
+
+    /// The `macrotree run …` command that reproduces this scenario bit for bit (the program
+    /// named as [`SweepConfig::program`] says). Floats are
+    /// printed with Rust's shortest round-trip formatting, so they parse back to the same bits.
+    pub fn reproduce(&self, tree: &str, config: &SweepConfig) -> String {
+        let mut cmd = match &self.layout {
+            Some(l) => format!(
+                "{} run {} --cube {},{},{} --bowl {},{} --seed {}",
+                config.program,
+                shell_quote(tree),
+                l.cube[0],
+                l.cube[1],
+                l.cube[2],
+                l.bowl[0],
+                l.bowl[1],
+                self.seed
+            ),
+            None => format!(
+                "{} run {} --sweep-seed {} --scenario {}",
+                config.program,
+                shell_quote(tree),
+                self.sweep_seed,
+                self.index
+            ),
+        };
+        if let Some(scene) = &config.scene_file {
+            cmd += &format!(" --scene {}", shell_quote(scene));
+        }
+        if let Some(fault) = self.fault {
+            cmd += &format!(" --fault {fault}");
+        }
+        if config.goal != Goal::default() {
+            cmd += &format!(" --goal {}", config.goal.name());
+        }
+        if config.max_sim_time != EpisodeConfig::default().max_sim_time {
+            cmd += &format!(" --max-sim-time {}", config.max_sim_time);
+        }
+        for sub in &config.substitutions {
+            cmd += &format!(" --substitute {}", shell_quote(&sub.to_string()));
+        }
+        cmd
+    }
+}
+
+/// Substitutions as their `PATTERN=OUTCOME` text.
+fn as_rules<S: serde::Serializer>(subs: &[Substitution], s: S) -> Result<S::Ok, S::Error> {
+    s.collect_seq(subs.iter().map(|x| x.to_string()))
+}
+
+/// Quotes `s` for a POSIX shell when it holds anything but `[A-Za-z0-9_./+-]`.
+pub(crate) fn shell_quote(s: &str) -> String {
+    if !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_./+-".contains(c))
+    {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shell_quoting() {
+        assert_eq!(shell_quote("trees/a_b-1.yaml"), "trees/a_b-1.yaml");
+        assert_eq!(shell_quote("my tree.yaml"), "'my tree.yaml'");
+        assert_eq!(shell_quote("it's.yaml"), r"'it'\''s.yaml'");
+    }
+}
