@@ -29,8 +29,8 @@ mod shard;
 mod summary;
 pub mod tally;
 
-pub use config::{SceneScenario, SweepConfig};
 pub use crate::episode::scenario as layout;
+pub use config::{SceneScenario, SweepConfig};
 pub use indices::ScenarioIndices;
 pub use layout::{Region, Scenario, ScenarioLayout, sample_scenario, sample_scenario_in};
 pub use report::{MAX_LINES, MergeError, Merged, merge_results};
