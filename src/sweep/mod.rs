@@ -29,7 +29,7 @@ mod shard;
 mod summary;
 pub mod tally;
 
-pub use crate::episode::scenario as layout;
+use crate::episode::scenario as layout;
 pub use config::{SceneScenario, SweepConfig};
 pub use indices::ScenarioIndices;
 pub use layout::{Region, Scenario, ScenarioLayout, sample_scenario, sample_scenario_in};
