@@ -17,6 +17,11 @@ use super::timing::PathTrajectory;
 /// Goal configurations whose collisions are asked for when every goal is blocked.
 const NAMED_GOALS: usize = 8;
 
+/// The direct segment is tried to every free goal at most this many times as far (joint-space
+/// distance) as the nearest free goal: a long straight swing to a far IK branch is not preferred
+/// over a short detour to a near one.
+pub const DIRECT_SLACK: f64 = 1.5;
+
 /// A planned motion.
 #[derive(Clone, Debug)]
 pub struct PlannedMotion {
@@ -42,7 +47,7 @@ fn in_bounds(q: &[f64; 6], config: &PlannerConfig) -> bool {
 /// Stages: the start is checked (else [`PlanFailure::StartInCollision`] naming the pairs); goals
 /// outside `config.bounds` or in collision are dropped (none left: [`PlanFailure::NoGoal`] or
 /// [`PlanFailure::GoalInCollision`] naming what blocks them); the straight segment to each free
-/// goal, in the set's order, is tried first; otherwise RRT-Connect searches towards all free goals
+/// goal at most [`DIRECT_SLACK`] times as far as the nearest, in the set's order, is tried first; otherwise RRT-Connect searches towards all free goals
 /// at once (out of iterations: [`PlanFailure::SearchExhausted`] naming what blocked it most).
 /// The path is then shortcut, its corners blended, and timed within `config.limits`. Every
 /// configuration the arm passes through was checked, at `config.resolution` along segments and
@@ -127,10 +132,17 @@ pub fn plan<C: CollisionChecker + ?Sized>(
         };
         return fail(reason, stats, checker.checks);
     }
-    // The direct segment to each free goal, in the set's order.
+    // The direct segment to each free goal not much farther than the nearest, in the set's order.
     let mut found: Option<(Vec<[f64; 6]>, usize)> = None;
+    let nearest = free
+        .iter()
+        .map(|&i| distance(start, &goals.configs[i]))
+        .fold(f64::INFINITY, f64::min);
     for &i in &free {
         let g = &goals.configs[i];
+        if distance(start, g) > DIRECT_SLACK * nearest {
+            continue;
+        }
         if check_segment(&mut checker, start, g, config.resolution).is_ok() {
             found = Some((vec![*start, *g], i));
             stats.direct = true;
