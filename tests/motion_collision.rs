@@ -165,11 +165,18 @@ fn the_planner_goes_around_the_post_and_every_configuration_on_the_way_is_free()
     let goals = GoalSet::down(&goal_pos, 0.0, false, &start);
     assert!(goals.len() >= 4);
     // The direct joint motion to the nearest goal hits the post.
-    assert!(edge::check_segment(&mut c, &start, &goals.configs[0], 0.02).is_err());
-    let config = PlannerConfig {
-        resolution: 0.02,
-        ..PlannerConfig::default()
-    };
+    assert!(
+        edge::check_segment(
+            &mut c,
+            &start,
+            &goals.configs[0],
+            &PlannerConfig::default().edge_resolution()
+        )
+        .is_err()
+    );
+    // The default resolution (0.05 rad, 1 cm of displacement) with a 1 cm margin: nothing
+    // touches between checks.
+    let config = PlannerConfig::default();
     let m = plan(&mut c, &start, &goals, &config).unwrap();
     eprintln!("{}", m.stats.summary());
     let end = fk(&m.trajectory.end()).translation.vector;
@@ -228,4 +235,93 @@ fn each_reason_on_the_real_cell() {
     let far = GoalSet::down(&Vector3::new(1.2, 0.0, 0.15), 0.0, false, &HOME_Q);
     let e = plan(&mut c, &HOME_Q, &far, &config).unwrap_err();
     assert_eq!(e.reason.name(), "no_goal");
+}
+
+#[test]
+fn the_lever_arms_bound_every_robot_geom_at_random_joints() {
+    use macrotree::motion::plan::config::UR5E_LEVER_ARMS;
+    use rand::{Rng, SeedableRng};
+    let scene = cube_bowl();
+    let m = &scene.model;
+    let mut sim = Sim::new(scene);
+    let joints: Vec<usize> = macrotree::motion::ARM_JOINTS
+        .iter()
+        .map(|n| {
+            m.name_to_id(
+                mujoco_rs::prelude::MjtObjBase::mjOBJ_JOINT,
+                &format!("ur5e/{n}_joint"),
+            )
+            .unwrap()
+        })
+        .collect();
+    let (parent, jbody, gbody, rbound) = (
+        m.body_parentid(),
+        m.jnt_bodyid(),
+        m.geom_bodyid(),
+        m.geom_rbound(),
+    );
+    let below = |mut b: usize, top: usize| {
+        while b != 0 {
+            if b == top {
+                return true;
+            }
+            b = parent[b] as usize;
+        }
+        false
+    };
+    // Geoms moved by each joint: those of its body and every body below it.
+    let moved: Vec<Vec<usize>> = joints
+        .iter()
+        .map(|&j| {
+            (0..gbody.len())
+                .filter(|&g| below(gbody[g] as usize, jbody[j] as usize))
+                .collect()
+        })
+        .collect();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    let mut worst = [0.0f64; 6];
+    // The arm stretched out (every wrist pose of it), then random joints.
+    let half = std::f64::consts::FRAC_PI_2;
+    let mut configs: Vec<[f64; 6]> = Vec::new();
+    for w1 in [-half, 0.0, half] {
+        for w2 in [-half, 0.0, half] {
+            configs.push([0.0, 0.0, 0.0, w1, w2, 0.0]);
+        }
+    }
+    configs.extend((0..400).map(|_| std::array::from_fn(|_| rng.random_range(-3.1..3.1))));
+    for q in configs {
+        {
+            let ids = scene.ids.arm_qpos;
+            let qpos = sim.data_mut().qpos_mut();
+            for (i, &a) in ids.iter().enumerate() {
+                qpos[a] = q[i];
+            }
+        }
+        sim.data_mut().kinematics();
+        let d = sim.data();
+        for (k, &j) in joints.iter().enumerate() {
+            let (a, u) = (Vector3::from(d.xanchor()[j]), Vector3::from(d.xaxis()[j]));
+            for &g in &moved[k] {
+                let p = Vector3::from(d.geom_xpos()[g]) - a;
+                let r = (p - u * p.dot(&u)).norm() + rbound[g];
+                worst[k] = worst[k].max(r);
+            }
+        }
+    }
+    // Room for a held block (half diagonal of a 7 cm cube, 6.1 cm, centred on the pinch) beyond
+    // the robot's own geoms; on wrist 3's own axis the block only reaches its half diagonal.
+    for k in 0..5 {
+        assert!(
+            worst[k] + 0.061 <= UR5E_LEVER_ARMS[k],
+            "joint {}: a geom reaches {:.3} m from the axis",
+            k + 1,
+            worst[k]
+        );
+    }
+    assert!(
+        worst[5].max(0.061) <= UR5E_LEVER_ARMS[5],
+        "wrist 3: {:.3} m",
+        worst[5]
+    );
+    eprintln!("largest radius of a robot geom about each joint: {worst:.3?} m");
 }

@@ -4,6 +4,7 @@
 //! resolution and shrunk until free. A corner left unblended (or a reversal) is a stop.
 
 use super::checker::CollisionChecker;
+use super::edge::Resolution;
 use super::stats::distance;
 
 /// One piece of the smoothed path, parameterised by joint-space arc length (radians).
@@ -127,9 +128,9 @@ fn corner(
     ))
 }
 
-/// True when the arc is free at `resolution` (its ends lie on the checked segments).
-fn arc_free<C: CollisionChecker + ?Sized>(checker: &mut C, arc: &Piece, resolution: f64) -> bool {
-    let n = ((arc.len() / resolution).ceil() as usize).max(1);
+/// True when the arc is free at `res` (its ends lie on the checked segments).
+fn arc_free<C: CollisionChecker + ?Sized>(checker: &mut C, arc: &Piece, res: &Resolution) -> bool {
+    let n = res.curve_steps(arc.len());
     (1..n).all(|k| checker.is_free(&arc.eval(arc.len() * k as f64 / n as f64).0))
 }
 
@@ -142,7 +143,7 @@ pub(crate) fn smooth<C: CollisionChecker + ?Sized>(
     checker: &mut C,
     path: &[[f64; 6]],
     deviation: f64,
-    resolution: f64,
+    res: &Resolution,
 ) -> Smoothed {
     let mut v: Vec<[f64; 6]> = Vec::with_capacity(path.len());
     for q in path {
@@ -174,7 +175,7 @@ pub(crate) fn smooth<C: CollisionChecker + ?Sized>(
         let mut found = None;
         for _ in 0..=HALVINGS {
             match corner(&v[i], y_in, y_out, dev, 0.5 * l_in.min(*l_out)) {
-                Some((arc, t)) if arc_free(checker, &arc, resolution) => {
+                Some((arc, t)) if arc_free(checker, &arc, res) => {
                     found = Some((arc, t));
                     break;
                 }
@@ -233,7 +234,7 @@ mod tests {
             [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
             [1.0, 1.0, 0.0, 0.0, 0.0, 0.0],
         ];
-        let s = smooth(&mut Free, &path, 0.1, 0.05);
+        let s = smooth(&mut Free, &path, 0.1, &Resolution::joint(0.05));
         assert_eq!(s.blends, 1);
         assert_eq!(s.pieces.len(), 3);
         let (arc, _) = &s.pieces[1];
@@ -267,7 +268,7 @@ mod tests {
             [0.0, 1.0, 0.0, 0.0, 0.0, 0.0],
             [1.0, 1.0, 0.0, 0.0, 0.0, 0.0],
         ];
-        let s = smooth(&mut OnlyTheCorner, &path, 0.1, 0.002);
+        let s = smooth(&mut OnlyTheCorner, &path, 0.1, &Resolution::joint(0.002));
         assert_eq!(s.blends, 0);
         assert_eq!(s.pieces.len(), 2);
         assert!(s.pieces[1].1, "the arm stops at the corner");

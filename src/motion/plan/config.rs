@@ -11,6 +11,13 @@ use crate::motion::trajectory::MotionLimits;
 /// no joint acceleration rating.
 pub const UR5E_RATED_JOINT_SPEED: f64 = std::f64::consts::PI;
 
+/// Lever arms of the UR5e with the 2F-85 and a held block of up to 7 cm, metres: an upper bound
+/// on the distance of any point of the moving robot from each joint's axis, base to wrist 3.
+/// Measured on the Menagerie models (`tests/motion_collision.rs`: the largest distance of a
+/// collision geom's bounding sphere from each axis, over the stretched arm and random joints,
+/// is 1.08, 1.11, 0.70, 0.31, 0.27, 0.10 m), plus a held block's 6.1 cm half diagonal.
+pub const UR5E_LEVER_ARMS: [f64; 6] = [1.16, 1.19, 0.77, 0.38, 0.34, 0.12];
+
 /// Per-joint speed and acceleration limits a planned trajectory keeps, base to wrist 3.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct JointLimits {
@@ -74,6 +81,14 @@ pub struct PlannerConfig {
     /// checked along a straight joint-space segment, radians. Default 0.05 rad (a point on the
     /// arm moves at most about 1 m per radian, so ≲ 5 cm between checks at the wrist).
     pub resolution: f64,
+    /// Largest displacement of any point of the robot between two checked configurations,
+    /// metres, bounded through `lever_arms` (see [`Resolution`](super::edge::Resolution)).
+    /// Default 0.01 m: with a checker margin of at least half of it (the MuJoCo checker's default
+    /// is 5 mm), nothing touches between checks either. `f64::INFINITY` turns the bound off.
+    pub max_displacement: f64,
+    /// Lever arm of each joint, metres: an upper bound on how far any point of the moving robot
+    /// (and a held block) lies from the joint's axis. Default [`UR5E_LEVER_ARMS`].
+    pub lever_arms: [f64; 6],
     /// Longest step the search tree grows by in one extension, radians (Euclidean in joint
     /// space). Default 1.0 rad.
     pub range: f64,
@@ -100,12 +115,14 @@ pub struct PlannerConfig {
 }
 
 impl Default for PlannerConfig {
-    /// Seed 0, 0.05 rad resolution, 1.0 rad range, 2000 iterations, 20 000 nodes, 48 shortcuts,
+    /// Seed 0, 0.05 rad and 0.01 m resolution with [`UR5E_LEVER_ARMS`], 1.0 rad range, 2000 iterations, 20 000 nodes, 48 shortcuts,
     /// 0.1 rad blends, the joint limits as bounds, [`JointLimits::default`], no time cap.
     fn default() -> Self {
         Self {
             seed: 0,
             resolution: 0.05,
+            max_displacement: 0.01,
+            lever_arms: UR5E_LEVER_ARMS,
             range: 1.0,
             max_iterations: 2000,
             max_nodes: 20_000,
@@ -119,6 +136,15 @@ impl Default for PlannerConfig {
 }
 
 impl PlannerConfig {
+    /// The edge-checking resolution these settings describe.
+    pub fn edge_resolution(&self) -> super::edge::Resolution {
+        super::edge::Resolution {
+            joint: self.resolution,
+            displacement: self.max_displacement,
+            lever_arms: self.lever_arms,
+        }
+    }
+
     /// Checks every setting is in range.
     ///
     /// # Errors
@@ -128,6 +154,22 @@ impl PlannerConfig {
             return Err(format!(
                 "edge resolution {} rad: use a value in [0.0001, 0.5]",
                 self.resolution
+            ));
+        }
+        if self.max_displacement.is_nan() || self.max_displacement < 1e-4 {
+            return Err(format!(
+                "max_displacement {} m: use a value of at least 0.0001 (or infinity for no bound)",
+                self.max_displacement
+            ));
+        }
+        if !self
+            .lever_arms
+            .iter()
+            .all(|r| r.is_finite() && (0.0..=10.0).contains(r))
+        {
+            return Err(format!(
+                "lever_arms {:?} m: use values in [0, 10]",
+                self.lever_arms
             ));
         }
         if !(self.range.is_finite() && self.range >= self.resolution && self.range <= 10.0) {

@@ -1,13 +1,55 @@
-//! Straight joint-space segments checked at a resolution: the largest change of any joint
-//! between two checked configurations.
+//! Straight joint-space segments checked at a resolution: between two checked configurations
+//! no joint turns more than a set angle and no point of the robot moves more than a set distance.
 
 use super::checker::CollisionChecker;
 
+/// How finely motions are checked.
+///
+/// The displacement bound uses lever arms: `r_j` bounds the distance of every point of the
+/// moving robot (and a held block) from joint `j`'s axis, so a point moves at most
+/// `Σ_j r_j |Δq_j|` metres when the joints change by `Δq`. With a checker whose clearance margin
+/// is at least half the displacement bound, every configuration *between* two checked ones is
+/// free of contact too: a point is then within half a step of where it was at a checked
+/// configuration, where it kept the margin.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Resolution {
+    /// Largest change of any joint between checked configurations, radians.
+    pub joint: f64,
+    /// Largest displacement of any point of the robot between checked configurations, metres;
+    /// `f64::INFINITY` bounds the joints only.
+    pub displacement: f64,
+    /// Lever arm of each joint, metres (see the type's docs).
+    pub lever_arms: [f64; 6],
+}
+
+impl Resolution {
+    /// Joint steps of at most `joint` radians, no displacement bound.
+    pub fn joint(joint: f64) -> Self {
+        Self {
+            joint,
+            displacement: f64::INFINITY,
+            lever_arms: [0.0; 6],
+        }
+    }
+
+    /// Steps needed along a joint-space curve of Euclidean length `len` radians (each joint then
+    /// changes by at most `len`, and `Σ_j r_j |Δq_j| ≤ len · Σ_j r_j`).
+    pub fn curve_steps(&self, len: f64) -> usize {
+        let per_rad = (1.0 / self.joint).max(self.lever_arms.iter().sum::<f64>() / self.displacement);
+        ((len * per_rad).ceil() as usize).max(1)
+    }
+}
+
 /// Number of equal steps a segment from `a` to `b` is cut into so that no joint moves more than
-/// `resolution` radians per step (at least 1).
-pub fn steps(a: &[f64; 6], b: &[f64; 6], resolution: f64) -> usize {
-    let span = (0..6).map(|j| (b[j] - a[j]).abs()).fold(0.0, f64::max);
-    ((span / resolution).ceil() as usize).max(1)
+/// `res.joint` radians and no point more than `res.displacement` metres per step (at least 1).
+pub fn steps(a: &[f64; 6], b: &[f64; 6], res: &Resolution) -> usize {
+    let (mut span, mut sweep) = (0.0f64, 0.0);
+    for j in 0..6 {
+        let d = (b[j] - a[j]).abs();
+        span = span.max(d);
+        sweep += res.lever_arms[j] * d;
+    }
+    ((span / res.joint).max(sweep / res.displacement).ceil() as usize).max(1)
 }
 
 /// The point `k / n` of the way from `a` to `b`.
@@ -21,17 +63,17 @@ pub fn lerp(a: &[f64; 6], b: &[f64; 6], k: usize, n: usize) -> [f64; 6] {
     q
 }
 
-/// True when every configuration strictly between `a` and `b`, at [`steps`] equal steps, is
-/// free; `a` and `b` themselves are the caller's (checked before). The steps are visited in
+/// True when every configuration strictly between `a` and `b`, at [`steps`] equal steps of
+/// `res`, is free; `a` and `b` themselves are the caller's (checked before). The steps are visited in
 /// bisection order (the middle, then the quarters, …) so a blocked segment is usually found
 /// after few checks. On a hit, returns the blocked configuration in `Err`.
 pub fn check_segment<C: CollisionChecker + ?Sized>(
     checker: &mut C,
     a: &[f64; 6],
     b: &[f64; 6],
-    resolution: f64,
+    res: &Resolution,
 ) -> Result<(), [f64; 6]> {
-    let n = steps(a, b, resolution);
+    let n = steps(a, b, res);
     if n < 2 {
         return Ok(());
     }
@@ -71,8 +113,8 @@ mod tests {
         let a = [0.0; 6];
         let b = [1.0, -0.5, 0.0, 0.0, 0.0, 0.0];
         let mut log = Log(Vec::new());
-        check_segment(&mut log, &a, &b, 0.1).unwrap();
-        assert_eq!(steps(&a, &b, 0.1), 10);
+        check_segment(&mut log, &a, &b, &Resolution::joint(0.1)).unwrap();
+        assert_eq!(steps(&a, &b, &Resolution::joint(0.1)), 10);
         assert_eq!(log.0.len(), 9);
         assert!((log.0[0][0] - 0.5).abs() < 1e-12, "{:?}", log.0[0]);
         let mut xs: Vec<f64> = log.0.iter().map(|q| q[0]).collect();
@@ -87,7 +129,26 @@ mod tests {
     #[test]
     fn a_short_segment_needs_no_check() {
         let mut log = Log(Vec::new());
-        check_segment(&mut log, &[0.0; 6], &[0.04; 6], 0.05).unwrap();
+        check_segment(&mut log, &[0.0; 6], &[0.04; 6], &Resolution::joint(0.05)).unwrap();
         assert!(log.0.is_empty());
+    }
+
+    #[test]
+    fn the_displacement_bound_adds_steps_for_long_lever_arms() {
+        let res = Resolution {
+            joint: 0.05,
+            displacement: 0.01,
+            lever_arms: [1.0, 1.0, 0.5, 0.25, 0.25, 0.1],
+        };
+        // 0.1 rad of the base joint: 2 joint steps, but 0.1 m of sweep: 10 steps of 1 cm.
+        assert_eq!(steps(&[0.0; 6], &[0.1, 0.0, 0.0, 0.0, 0.0, 0.0], &res), 10);
+        // 0.1 rad of wrist 3: 0.01 m of sweep, the joint bound (2 steps) decides.
+        assert_eq!(steps(&[0.0; 6], &[0.0, 0.0, 0.0, 0.0, 0.0, 0.1], &res), 2);
+        // Along a curve every joint may move the whole length: 0.1 rad · 3.1 m/rad = 31 cm.
+        assert!(
+            (31..=32).contains(&res.curve_steps(0.1)),
+            "{}",
+            res.curve_steps(0.1)
+        );
     }
 }

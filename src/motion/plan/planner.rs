@@ -50,8 +50,8 @@ fn in_bounds(q: &[f64; 6], config: &PlannerConfig) -> bool {
 /// goal at most [`DIRECT_SLACK`] times as far as the nearest, in the set's order, is tried first; otherwise RRT-Connect searches towards all free goals
 /// at once (out of iterations: [`PlanFailure::SearchExhausted`] naming what blocked it most).
 /// The path is then shortcut, its corners blended, and timed within `config.limits`. Every
-/// configuration the arm passes through was checked, at `config.resolution` along segments and
-/// arcs.
+/// configuration the arm passes through was checked, at the edge resolution
+/// ([`PlannerConfig::edge_resolution`]) along segments and arcs.
 ///
 /// # Errors
 /// A [`PlanError`]: the typed reason, and the statistics of the attempt.
@@ -78,6 +78,7 @@ pub fn plan<C: CollisionChecker + ?Sized>(
     if let Err(e) = config.check() {
         return fail(PlanFailure::InvalidQuery { reason: e }, stats, 0);
     }
+    let res = config.edge_resolution();
     if !in_bounds(start, config) {
         let reason = format!(
             "start {start:?} is not finite or lies outside the joint bounds {:?} (radians)",
@@ -143,7 +144,7 @@ pub fn plan<C: CollisionChecker + ?Sized>(
         if distance(start, g) > DIRECT_SLACK * nearest {
             continue;
         }
-        if check_segment(&mut checker, start, g, config.resolution).is_ok() {
+        if check_segment(&mut checker, start, g, &res).is_ok() {
             found = Some((vec![*start, *g], i));
             stats.direct = true;
             break;
@@ -181,7 +182,7 @@ pub fn plan<C: CollisionChecker + ?Sized>(
             &mut checker,
             raw_path.clone(),
             config.shortcut_attempts,
-            config.resolution,
+            &res,
             config.seed,
         )
     } else {
@@ -189,7 +190,7 @@ pub fn plan<C: CollisionChecker + ?Sized>(
     };
     stats.length = path_length(&path);
     stats.waypoints = path.len();
-    let smoothed = smooth(&mut checker, &path, config.blend_deviation, config.resolution);
+    let smoothed = smooth(&mut checker, &path, config.blend_deviation, &res);
     stats.blends = smoothed.blends;
     let trajectory = PathTrajectory::new(smoothed, path, &config.limits);
     stats.duration = crate::motion::trajectory::Trajectory::duration(&trajectory);

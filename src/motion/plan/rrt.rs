@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use super::checker::CollisionChecker;
 use super::config::PlannerConfig;
-use super::edge::check_segment;
+use super::edge::{Resolution, check_segment};
 use super::rng::Stream;
 use super::stats::{distance, distance2};
 
@@ -111,6 +111,7 @@ impl SearchLog {
 struct Grower<'a, C: CollisionChecker + ?Sized> {
     checker: &'a mut C,
     config: &'a PlannerConfig,
+    res: Resolution,
     log: SearchLog,
 }
 
@@ -138,7 +139,7 @@ impl<C: CollisionChecker + ?Sized> Grower<'_, C> {
             self.log.note_blocked(q);
             return Step::Trapped;
         }
-        if let Err(hit) = check_segment(self.checker, &from, &q, self.config.resolution) {
+        if let Err(hit) = check_segment(self.checker, &from, &q, &self.res) {
             self.log.note_blocked(hit);
             return Step::Trapped;
         }
@@ -189,6 +190,7 @@ pub(crate) fn rrt_connect<C: CollisionChecker + ?Sized>(
     let mut grower = Grower {
         checker,
         config,
+        res: config.edge_resolution(),
         log: SearchLog {
             iterations: 0,
             nodes: 0,

@@ -1,9 +1,9 @@
 //! Shortcutting: seeded random shortcuts between points anywhere on the path (not only its
-//! vertices), each new segment checked at the resolution, then a sweep that drops every vertex
+//! vertices), each new segment checked at the edge resolution, then a sweep that drops every vertex
 //! its neighbours see each other past.
 
 use super::checker::CollisionChecker;
-use super::edge::check_segment;
+use super::edge::{Resolution, check_segment};
 use super::rng::Stream;
 use super::stats::distance;
 
@@ -36,13 +36,13 @@ fn cumulative(path: &[[f64; 6]]) -> Vec<f64> {
 }
 
 /// Shortens `path` (start and end kept exactly) with `attempts` seeded random shortcuts and a
-/// final vertex-dropping sweep. Every segment of the result is free at `resolution`, given the
+/// final vertex-dropping sweep. Every segment of the result is free at `res`, given the
 /// input's segments were.
 pub(crate) fn shortcut<C: CollisionChecker + ?Sized>(
     checker: &mut C,
     path: Vec<[f64; 6]>,
     attempts: usize,
-    resolution: f64,
+    res: &Resolution,
     seed: u64,
 ) -> Vec<[f64; 6]> {
     let mut path = path;
@@ -66,7 +66,7 @@ pub(crate) fn shortcut<C: CollisionChecker + ?Sized>(
         if !checker.is_free(&p1) || !checker.is_free(&p2) {
             continue;
         }
-        if check_segment(checker, &p1, &p2, resolution).is_err() {
+        if check_segment(checker, &p1, &p2, res).is_err() {
             continue;
         }
         let mut next = Vec::with_capacity(path.len());
@@ -83,7 +83,7 @@ pub(crate) fn shortcut<C: CollisionChecker + ?Sized>(
     // Drop every vertex whose neighbours are joined by a free segment.
     let mut i = 1;
     while i + 1 < path.len() {
-        if check_segment(checker, &path[i - 1], &path[i + 1], resolution).is_ok() {
+        if check_segment(checker, &path[i - 1], &path[i + 1], res).is_ok() {
             path.remove(i);
         } else {
             i += 1;
