@@ -5,6 +5,7 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
+use super::planning::{check_motion, check_straight, describe};
 use super::targets::{resolve, segment_distance, target_object};
 use crate::failure::{Failure, FailureKind};
 use crate::kinds::Carry as CarrySpec;
@@ -225,11 +226,8 @@ impl Carry {
             ..MotionLimits::default()
         };
         let from = cell.arm_setpoint();
-        match CartesianMove::new(from, pose, &limits) {
-            Ok(mv) => {
-                self.goal_q = mv.end();
-                cell.track(Box::new(mv));
-            }
+        let mv: Box<dyn Trajectory> = match CartesianMove::new(from, pose, &limits) {
+            Ok(mv) => Box::new(mv),
             // The transfer runs at a height that clears everything: when its straight line
             // crosses a wrist singularity or a branch flip, a joint move to the same pose does.
             Err(line) if phase == Phase::Transfer => {
@@ -243,8 +241,7 @@ impl Carry {
                     )
                 })?;
                 tracing::debug!(target: "macrotree::actions", "carry: straight transfer impossible ({line}); joint move instead");
-                self.goal_q = goal;
-                cell.track(Box::new(JointMove::new(from, goal, &limits)));
+                Box::new(JointMove::new(from, goal, &limits))
             }
             Err(e) => {
                 return Err(Failure::new(
@@ -252,10 +249,76 @@ impl Carry {
                     format!("unreachable carry path ({}): {e}", phase.name()),
                 ));
             }
+        };
+        if phase == Phase::Transfer {
+            if let Some((_, pairs)) = check_motion(cell, &[mv.as_ref()], &[], false) {
+                tracing::debug!(target: "macrotree::actions", "carry: the transfer would touch {}; planning", describe(&pairs));
+                let motion = self.plan_transfer(cell, &from, &end)?;
+                self.goal_q = motion.trajectory.end();
+                cell.track(Box::new(motion.trajectory));
+                self.phase = phase;
+                self.phase_end = end;
+                return Ok(());
+            }
+        } else {
+            // Lift and set-down stay straight; only real contact counts, with the destination
+            // intended (its floor, the block it goes on).
+            let w = cell.world();
+            let intended: Vec<String> = match phase {
+                Phase::Lower => self
+                    .destination(w)
+                    .map(|d| w.name(d).to_string())
+                    .into_iter()
+                    .collect(),
+                _ => Vec::new(),
+            };
+            let what = if phase == Phase::Lift { "lift" } else { "set-down" };
+            check_straight(cell, what, mv.as_ref(), &intended);
         }
+        self.goal_q = mv.end();
+        cell.track(mv);
         self.phase = phase;
         self.phase_end = end;
         Ok(())
+    }
+
+    /// Plans the transfer from `from` to above the place, the held block's centre at `end`
+    /// (metres): every IK branch of the tool turned by quarter turns about the vertical (a cube
+    /// looks the same), each with the block's offset turned with it. The tool orientation and the
+    /// block's offset follow the goal reached, so the set-down stays consistent with the grasp.
+    fn plan_transfer(
+        &mut self,
+        cell: &mut Cell,
+        from: &[f64; 6],
+        end: &Vector3<f64>,
+    ) -> Result<crate::motion::plan::PlannedMotion, Failure> {
+        let turns: Vec<UnitQuaternion<f64>> = (0..4)
+            .map(|k| {
+                UnitQuaternion::from_axis_angle(&Vector3::z_axis(), k as f64 * std::f64::consts::FRAC_PI_2)
+            })
+            .collect();
+        let poses: Vec<Isometry3<f64>> = turns
+            .iter()
+            .map(|r| {
+                Isometry3::from_parts(
+                    Translation3::from(end + r * self.pinch_from_block),
+                    r * self.rotation,
+                )
+            })
+            .collect();
+        let goals = crate::motion::plan::GoalSet::poses(&poses, from);
+        let motion = super::planning::plan_motion(cell, "carry transfer", from, &goals)?;
+        let reached = crate::motion::fk(&motion.trajectory.end()).rotation;
+        let k = (0..4)
+            .min_by(|&a, &b| {
+                reached
+                    .angle_to(&(turns[a] * self.rotation))
+                    .total_cmp(&reached.angle_to(&(turns[b] * self.rotation)))
+            })
+            .unwrap_or(0);
+        self.pinch_from_block = turns[k] * self.pinch_from_block;
+        self.rotation = turns[k] * self.rotation;
+        Ok(motion)
     }
 
     /// The current phase's motion has ended: start the next one (or re-plan the transfer).

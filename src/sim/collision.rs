@@ -64,7 +64,16 @@ pub struct SceneChecker {
     snapshot_q: [f64; 6],
     held: Option<Held>,
     margin: f64,
+    /// What the private data was built for: (held block, margin bits); `None` before the first
+    /// build.
+    built_for: Option<(Option<usize>, u64)>,
+    /// Private data built before for other (held block, margin) pairs, so a hold or release
+    /// swaps data instead of copying the model again (a copy takes tens of milliseconds).
+    built: Vec<((Option<usize>, u64), MjData<Arc<MjModel>>)>,
 }
+
+/// Most private data kept for other (held block, margin) pairs.
+const MAX_BUILT: usize = 16;
 
 /// `a` if the geom's name is set, else its body's; the scene-object prefix dropped; the floor
 /// is `table`.
@@ -150,6 +159,8 @@ impl SceneChecker {
             snapshot_q: [0.0; 6],
             held: None,
             margin,
+            built_for: None,
+            built: Vec::new(),
         };
         checker.rebuild_model();
         checker.sync(data)?;
@@ -167,6 +178,57 @@ impl SceneChecker {
     /// Writes the contact bitmasks and margins of the private model for the current groups
     /// (a held block joins the wrist-3 group) and margin.
     fn rebuild_model(&mut self) {
+        let key = (self.held.as_ref().map(|h| h.object), self.margin.to_bits());
+        if self.built_for == Some(key) {
+            return;
+        }
+        let data = match self.built.iter().position(|(k, _)| *k == key) {
+            Some(i) => {
+                let (_, mut data) = self.built.swap_remove(i);
+                data.qpos_mut().copy_from_slice(self.data.qpos());
+                data.mocap_pos_mut().copy_from_slice(self.data.mocap_pos());
+                data.mocap_quat_mut().copy_from_slice(self.data.mocap_quat());
+                data
+            }
+            None => self.build_data(),
+        };
+        let old = std::mem::replace(&mut self.data, data);
+        if let Some(k) = self.built_for.replace(key) {
+            if self.built.len() >= MAX_BUILT {
+                self.built.remove(0);
+            }
+            self.built.push((k, old));
+        }
+    }
+
+    /// Builds every private data a hold of one of `blocks` (scene indices) needs now, so the
+    /// holds during an episode cost no model copy; the checker's state does not change.
+    ///
+    /// # Errors
+    /// An index that is not a block of the scene.
+    pub fn prepare_holds(&mut self, blocks: &[usize]) -> Result<(), SimError> {
+        let before = self.held.clone();
+        for &b in blocks {
+            let qpos = self
+                .scene
+                .objects
+                .get(b)
+                .and_then(|o| o.qpos)
+                .ok_or_else(|| SimError::Scene(format!("object {b} is not a block of the scene")))?;
+            self.held = Some(Held {
+                object: b,
+                qpos,
+                in_pinch: Isometry3::identity(),
+            });
+            self.rebuild_model();
+        }
+        self.held = before;
+        self.rebuild_model();
+        Ok(())
+    }
+
+    /// A fresh private data of the model edited for the current groups and margin.
+    fn build_data(&self) -> MjData<Arc<MjModel>> {
         let mut group = self.group.clone();
         if let Some(h) = &self.held {
             let [g0, g1] = self.scene.objects[h.object].geoms;
@@ -221,7 +283,7 @@ impl SceneChecker {
         data.qpos_mut().copy_from_slice(self.data.qpos());
         data.mocap_pos_mut().copy_from_slice(self.data.mocap_pos());
         data.mocap_quat_mut().copy_from_slice(self.data.mocap_quat());
-        self.data = data;
+        data
     }
 
     /// Takes a new snapshot from `data` (a running simulation of the same scene): every block's

@@ -1,5 +1,5 @@
 //! Planned motions in the cell: the planner ([`crate::motion::plan`]) on the cell's MuJoCo
-//! geometry ([`SceneChecker`]), its reasons turned into typed [`Failure`]s.
+//! geometry ([`SceneChecker`](super::collision::SceneChecker)), its reasons turned into typed [`Failure`]s.
 //!
 //! | planner reason | failure kind |
 //! |---|---|
@@ -9,9 +9,10 @@
 //! | `search_exhausted`, `time_cap` | [`FailureKind::NoPath`] |
 //! | `invalid_query` (a bad setting or start: a bug of the caller) | [`FailureKind::Other`] |
 
-use super::collision::SceneChecker;
 use crate::failure::{Failure, FailureKind};
-use crate::motion::plan::{GoalSet, PlanError, PlanFailure, PlannedMotion, PlannerConfig, plan};
+use crate::motion::plan::{
+    CollisionChecker, GoalSet, PlanError, PlanFailure, PlannedMotion, PlannerConfig, plan,
+};
 
 /// The failure kind of a planner reason (see the module table).
 pub fn failure_kind(reason: &PlanFailure) -> FailureKind {
@@ -39,13 +40,13 @@ pub fn plan_failure(e: &PlanError) -> Failure {
 }
 
 /// Plans the arm from `start` to any of `goals` (radians) against the checker's snapshot of the
-/// cell; a typed [`Failure`] when there is no motion. Logs each plan at debug level (query,
+/// cell (a [`SceneChecker`](super::collision::SceneChecker), or one wrapping it with allowances); a typed [`Failure`] when there is no motion. Logs each plan at debug level (query,
 /// time, nodes, path length, duration).
 ///
 /// # Errors
 /// [`plan_failure`] of the planner's reason.
-pub fn plan_in_cell(
-    checker: &mut SceneChecker,
+pub fn plan_in_cell<C: CollisionChecker + ?Sized>(
+    checker: &mut C,
     start: &[f64; 6],
     goals: &GoalSet,
     config: &PlannerConfig,
