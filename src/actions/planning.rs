@@ -144,10 +144,21 @@ impl CollisionChecker for Allowing<'_> {
     }
 }
 
+/// Resolution of the check of a leaf's direct motion: samples at most 0.05 rad of any joint
+/// apart, and no displacement bound (the planner's edges add one of 1 cm). The check decides
+/// whether to plan; it is coarser than the planner's own edges so that free-space moves cost
+/// little beside the physics (`macrotree bench`), at the price of possibly missing a graze
+/// between two samples.
+pub(crate) const DIRECT_RESOLUTION: Resolution = Resolution {
+    joint: 0.05,
+    displacement: f64::INFINITY,
+    lever_arms: [0.0; 6],
+};
+
 /// Configurations along `traj` from its start to its end, no two consecutive ones farther apart
 /// than `res` (time-subdivided where the joint path bends).
 fn samples(traj: &dyn Trajectory, res: &Resolution) -> Vec<[f64; 6]> {
-    const COARSE: usize = 16;
+    const COARSE: usize = 4;
     let d = traj.duration();
     let at = |t: f64| if t >= d { traj.end() } else { traj.sample(t).0 };
     let mut out = vec![at(0.0)];
@@ -176,7 +187,7 @@ pub(crate) fn check_motion(
     contact_only: bool,
 ) -> Option<([f64; 6], Vec<Collision>)> {
     let t = Instant::now();
-    let res = PlannerConfig::default().edge_resolution();
+    let res = DIRECT_RESOLUTION;
     let start = legs.first()?.sample(0.0).0;
     let checker = cell.checker()?;
     let mut allow = Allowing::new(checker, &start, intended, contact_only);
