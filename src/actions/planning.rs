@@ -115,9 +115,10 @@ impl<'a> Allowing<'a> {
     }
 
     fn counts(&self, c: &Collision) -> bool {
-        !(self.contact_only && c.distance >= 0.0)
-            && !self.pairs.iter().any(|(a, b)| *a == c.a && *b == c.b)
-            && !self.intended.iter().any(|o| names(c, o))
+        let near_only = self.contact_only && c.distance >= 0.0;
+        let allowed = self.pairs.iter().any(|(a, b)| *a == c.a && *b == c.b);
+        let intended = self.intended.iter().any(|o| names(c, o));
+        !(near_only || allowed || intended)
     }
 
     /// The pairs that count at `q`.

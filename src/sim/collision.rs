@@ -66,11 +66,14 @@ pub struct SceneChecker {
     margin: f64,
     /// What the private data was built for: (held block, margin bits); `None` before the first
     /// build.
-    built_for: Option<(Option<usize>, u64)>,
+    built_for: Option<BuildKey>,
     /// Private data built before for other (held block, margin) pairs, so a hold or release
     /// swaps data instead of copying the model again (a copy takes tens of milliseconds).
-    built: Vec<((Option<usize>, u64), MjData<Arc<MjModel>>)>,
+    built: Vec<(BuildKey, MjData<Arc<MjModel>>)>,
 }
+
+/// What a private model is edited for: the held block (scene index), the margin's bits.
+type BuildKey = (Option<usize>, u64);
 
 /// Most private data kept for other (held block, margin) pairs.
 const MAX_BUILT: usize = 16;
