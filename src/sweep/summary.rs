@@ -94,9 +94,13 @@ pub struct Summary {
     /// physics (1 would be a sweep that does nothing but `mj_step`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub physics_share: Option<f64>,
-    /// Motions checked and planned over the sweep, and the workers' time it took.
+    /// Motions checked and planned over the sweep.
     pub planning: PlanningTotals,
-    /// `planning.wall_time_s / (jobs × process_wall_time_s)`: the share of the workers' time
+    /// Wall-clock time the workers spent checking and planning motions, summed over workers,
+    /// seconds (`None` until [`Summary::with_physics`] sets it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub planning_time_s: Option<f64>,
+    /// `planning_time_s / (jobs × process_wall_time_s)`: the share of the workers' time
     /// spent checking and planning motions, beside [`physics_share`](Self::physics_share).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub planning_share: Option<f64>,
@@ -127,7 +131,9 @@ pub struct PlanningTotals {
     pub plan_failures: u64,
     /// Scenarios in which the planner ran at least once.
     pub scenarios_planned: u64,
-    /// Wall-clock time the workers spent checking and planning, summed, seconds.
+    /// Wall-clock time the workers spent checking and planning, summed, seconds (written as the
+    /// summary's `planning_time_s`, a measurement beside `physics_time_s`, not a result).
+    #[serde(skip)]
     pub wall_time_s: f64,
 }
 
@@ -216,6 +222,7 @@ impl Summary {
         } else {
             0.0
         });
+        self.planning_time_s = Some(self.planning.wall_time_s);
         self.planning_share = Some(if capacity > 0.0 {
             self.planning.wall_time_s / capacity
         } else {

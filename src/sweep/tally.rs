@@ -222,6 +222,7 @@ impl Tally {
             process_wall_time_s: None,
             physics_share: None,
             planning: self.planning,
+            planning_time_s: None,
             planning_share: None,
         }
     }
