@@ -75,6 +75,15 @@ pub enum FailureKind {
     Forced,
     /// `max_iterations`: a `for_each` still found a match after its `max_iterations`.
     MaxIterations,
+    /// `start_in_collision`: a planned motion cannot start: the arm (or the block it holds) is
+    /// already in collision; the message names the pairs.
+    StartInCollision,
+    /// `goal_in_collision`: every arm configuration that reaches the goal (each IK branch) is in
+    /// collision; the message names what blocks them.
+    GoalInCollision,
+    /// `no_path`: the goal configurations are free but the motion planner found no
+    /// collision-free path to any within its budget; the message names what blocked it most.
+    NoPath,
     /// `other`: a failure of no more specific kind (an unknown object, an unresolved variable,
     /// a leaf the driver cannot run, …).
     Other,
@@ -85,7 +94,7 @@ pub enum FailureKind {
 
 impl FailureKind {
     /// Every built-in kind (all but [`Custom`](Self::Custom)).
-    pub const BUILTIN: [FailureKind; 20] = [
+    pub const BUILTIN: [FailureKind; 23] = [
         FailureKind::TimeLimit,
         FailureKind::Unstable,
         FailureKind::GoalNotMet,
@@ -105,6 +114,9 @@ impl FailureKind {
         FailureKind::Inverted,
         FailureKind::Forced,
         FailureKind::MaxIterations,
+        FailureKind::StartInCollision,
+        FailureKind::GoalInCollision,
+        FailureKind::NoPath,
         FailureKind::Other,
     ];
 
@@ -130,6 +142,9 @@ impl FailureKind {
             FailureKind::Inverted => "inverted",
             FailureKind::Forced => "forced",
             FailureKind::MaxIterations => "max_iterations",
+            FailureKind::StartInCollision => "start_in_collision",
+            FailureKind::GoalInCollision => "goal_in_collision",
+            FailureKind::NoPath => "no_path",
             FailureKind::Other => "other",
             FailureKind::Custom(name) => name,
         }

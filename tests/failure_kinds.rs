@@ -15,10 +15,13 @@ use macrotree::episode::{EpisodeConfig, EpisodeReport, Goal, NoObserver, run_in_
 use macrotree::factory::Factory;
 use macrotree::faults::FaultKind;
 use macrotree::kinds::{ActionRole, ObjectRef};
+use macrotree::motion::plan::{GoalSet, PlannerConfig};
 use macrotree::plan::{Loader, Plan};
 use macrotree::runtime::scripted::ScriptedDriver;
 use macrotree::runtime::substitute::{Substitution, resolve};
 use macrotree::runtime::{LeafOutcome, NodeStatus, TreeRunner, TreeStatus};
+use macrotree::sim::collision::SceneChecker;
+use macrotree::sim::planning::plan_in_cell;
 use macrotree::sim::{Layout, Scene, Sim};
 use macrotree::sweep::{SweepConfig, run_scene_scenario, run_sweep_with};
 use macrotree::world::World;
@@ -570,6 +573,58 @@ fn a_custom_condition_fails_with_its_declared_kind() {
     assert_eq!(kind_of(&r), FailureKind::Custom("jammed"));
 }
 
+/// The planner on the real cell (`sim::planning::plan_in_cell`), in `scene` with the arm at home.
+fn planned(scene: &Scene, start: &[f64; 6], goals: &GoalSet, config: &PlannerConfig) -> Failure {
+    let sim = Sim::new(scene);
+    let mut checker = SceneChecker::from_sim(&sim, macrotree::sim::collision::DEFAULT_MARGIN).unwrap();
+    plan_in_cell(&mut checker, start, goals, config).expect_err("no motion")
+}
+
+#[test]
+fn a_planned_motion_from_inside_the_table_is_start_in_collision() {
+    use std::f64::consts::FRAC_PI_2;
+    let into_table = [-FRAC_PI_2, 0.4, 0.0, -FRAC_PI_2, -FRAC_PI_2, 0.0];
+    let goals = GoalSet::configs(vec![macrotree::sim::HOME_Q]);
+    let f = planned(scene(), &into_table, &goals, &PlannerConfig::default());
+    assert_eq!(f.kind, FailureKind::StartInCollision);
+    assert!(f.message.contains("table"), "{f}");
+}
+
+#[test]
+fn a_planned_motion_into_the_table_is_goal_in_collision() {
+    let home = macrotree::sim::HOME_Q;
+    let goals = GoalSet::down(&nalgebra::Vector3::new(0.45, 0.2, -0.02), 0.0, false, &home);
+    assert!(!goals.is_empty());
+    let f = planned(scene(), &home, &goals, &PlannerConfig::default());
+    assert_eq!(f.kind, FailureKind::GoalInCollision);
+    assert!(f.message.contains("table"), "{f}");
+}
+
+#[test]
+fn a_planned_motion_past_a_post_stopped_by_its_time_cap_is_no_path() {
+    let yaml = "objects:\n  cube: {block: {size: 0.044}, pose: [0.45, -0.25]}\n  post: {obstacle: {size: [0.06, 0.06, 0.30]}, pose: [0.45, 0.0]}\n";
+    let spec = macrotree::scene::SceneSpec::from_str(yaml, "post.yaml").unwrap();
+    let post = Scene::load_spec(&spec).unwrap();
+    let home = macrotree::sim::HOME_Q;
+    let start = macrotree::motion::ik(
+        &macrotree::motion::down_pose(&nalgebra::Vector3::new(0.45, -0.2, 0.15), 0.0),
+        &home,
+    )
+    .unwrap();
+    let goal = macrotree::motion::ik(
+        &macrotree::motion::down_pose(&nalgebra::Vector3::new(0.45, 0.2, 0.15), 0.0),
+        &start,
+    )
+    .unwrap();
+    let config = PlannerConfig {
+        time_cap: Some(std::time::Duration::ZERO),
+        ..PlannerConfig::default()
+    };
+    let f = planned(&post, &start, &GoalSet::configs(vec![goal]), &config);
+    assert_eq!(f.kind, FailureKind::NoPath);
+    assert!(f.message.contains("time cap"), "{f}");
+}
+
 #[test]
 fn every_built_in_kind_is_tested() {
     // The kinds this file and the two named at its top produce; a new kind needs a test.
@@ -593,6 +648,9 @@ fn every_built_in_kind_is_tested() {
         "inverted",
         "forced",
         "max_iterations",
+        "start_in_collision",
+        "goal_in_collision",
+        "no_path",
         "other",
     ];
     let all: Vec<&str> = FailureKind::BUILTIN.iter().map(|k| k.as_str()).collect();

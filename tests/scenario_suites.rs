@@ -396,6 +396,8 @@ fn four_sweep_shards_as_processes_merge_into_the_unsharded_report() {
             "physics_share",
             "physics_time_s",
             "process_wall_time_s",
+            "planning_time_s",
+            "planning_share",
         ] {
             v.as_object_mut().unwrap().remove(k);
         }

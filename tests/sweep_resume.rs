@@ -21,6 +21,8 @@ fn summary(out: &Output) -> serde_json::Value {
         "physics_time_s",
         "process_wall_time_s",
         "physics_share",
+        "planning_time_s",
+        "planning_share",
     ] {
         v.as_object_mut().unwrap().remove(k).expect("summary field");
     }

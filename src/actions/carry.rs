@@ -5,6 +5,7 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
+use super::planning::{check_motion, check_straight, describe};
 use super::targets::{resolve, segment_distance, target_object};
 use crate::failure::{Failure, FailureKind};
 use crate::kinds::Carry as CarrySpec;
@@ -225,11 +226,8 @@ impl Carry {
             ..MotionLimits::default()
         };
         let from = cell.arm_setpoint();
-        match CartesianMove::new(from, pose, &limits) {
-            Ok(mv) => {
-                self.goal_q = mv.end();
-                cell.track(Box::new(mv));
-            }
+        let mv: Box<dyn Trajectory> = match CartesianMove::new(from, pose, &limits) {
+            Ok(mv) => Box::new(mv),
             // The transfer runs at a height that clears everything: when its straight line
             // crosses a wrist singularity or a branch flip, a joint move to the same pose does.
             Err(line) if phase == Phase::Transfer => {
@@ -243,8 +241,7 @@ impl Carry {
                     )
                 })?;
                 tracing::debug!(target: "macrotree::actions", "carry: straight transfer impossible ({line}); joint move instead");
-                self.goal_q = goal;
-                cell.track(Box::new(JointMove::new(from, goal, &limits)));
+                Box::new(JointMove::new(from, goal, &limits))
             }
             Err(e) => {
                 return Err(Failure::new(
@@ -252,10 +249,133 @@ impl Carry {
                     format!("unreachable carry path ({}): {e}", phase.name()),
                 ));
             }
+        };
+        if phase == Phase::Transfer {
+            let blocked = check_motion(cell, &[mv.as_ref()], &[], false);
+            let place = self.place(cell.world())?;
+            // The set-down that follows stays straight: when it would hit something from where
+            // the transfer ends (the wrist on a post beside the goal), the transfer is planned to
+            // a pre-place configuration whose set-down is free.
+            let lower_blocked = blocked.is_none() && self.set_down_hits(cell, &mv.end(), &place, 0);
+            if blocked.is_some() || lower_blocked {
+                match &blocked {
+                    Some((_, pairs)) => {
+                        tracing::debug!(target: "macrotree::actions", "carry: the transfer would touch {}; planning", describe(pairs))
+                    }
+                    None => {
+                        tracing::debug!(target: "macrotree::actions", "carry: the set-down from the transfer's end would touch something; planning the transfer to another arm configuration")
+                    }
+                }
+                let motion = self.plan_transfer(cell, &from, &end, &place)?;
+                self.goal_q = motion.trajectory.end();
+                cell.track(Box::new(motion.trajectory));
+                self.phase = phase;
+                self.phase_end = end;
+                return Ok(());
+            }
+        } else {
+            // Lift and set-down stay straight; only real contact counts, with the destination
+            // intended (its floor, the block it goes on).
+            let w = cell.world();
+            let intended: Vec<String> = match phase {
+                Phase::Lower => self
+                    .destination(w)
+                    .map(|d| w.name(d).to_string())
+                    .into_iter()
+                    .collect(),
+                _ => Vec::new(),
+            };
+            let what = if phase == Phase::Lift { "lift" } else { "set-down" };
+            check_straight(cell, what, mv.as_ref(), &intended);
         }
+        self.goal_q = mv.end();
+        cell.track(mv);
         self.phase = phase;
         self.phase_end = end;
         Ok(())
+    }
+
+    /// The tool orientations a cube allows at the goal: the carry's, turned by `k` quarter turns
+    /// about the vertical, and the block's offset from the pinch turned with it.
+    fn turned(&self, k: usize) -> (UnitQuaternion<f64>, Vector3<f64>) {
+        let r = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), k as f64 * std::f64::consts::FRAC_PI_2);
+        (r * self.rotation, r * self.pinch_from_block)
+    }
+
+    /// True when the straight set-down from `q` (the arm above the place, tool turned `k`
+    /// quarter turns) to the block centre `place` would touch something other than the
+    /// destination.
+    fn set_down_hits(&self, cell: &mut Cell, q: &[f64; 6], place: &Vector3<f64>, k: usize) -> bool {
+        let (rotation, offset) = self.turned(k);
+        let pose = Isometry3::from_parts(Translation3::from(place + offset), rotation);
+        let limits = MotionLimits {
+            tool_speed: self.spec.speed,
+            ..MotionLimits::default()
+        };
+        let Ok(lower) = CartesianMove::new(*q, pose, &limits) else {
+            return false;
+        };
+        let w = cell.world();
+        let intended: Vec<String> = self
+            .destination(w)
+            .map(|d| w.name(d).to_string())
+            .into_iter()
+            .collect();
+        check_motion(cell, &[&lower], &intended, true).is_some()
+    }
+
+    /// Plans the transfer from `from` to above the place, the held block's centre at `end`
+    /// (metres): every IK branch of the tool turned by quarter turns about the vertical (a cube
+    /// looks the same), each with the block's offset turned with it, keeping those from which
+    /// the straight set-down to `place` is free (all of them when none is). The tool orientation
+    /// and the block's offset follow the goal reached, so the set-down stays consistent with
+    /// the grasp.
+    fn plan_transfer(
+        &mut self,
+        cell: &mut Cell,
+        from: &[f64; 6],
+        end: &Vector3<f64>,
+        place: &Vector3<f64>,
+    ) -> Result<crate::motion::plan::PlannedMotion, Failure> {
+        let mut all: Vec<(f64, usize, [f64; 6])> = Vec::new();
+        for k in 0..4 {
+            let (rotation, offset) = self.turned(k);
+            let pose = Isometry3::from_parts(Translation3::from(end + offset), rotation);
+            for q in crate::motion::plan::GoalSet::pose(&pose, from).configs {
+                all.push((crate::motion::plan::stats::distance2(&q, from), k, q));
+            }
+        }
+        all.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut free: Vec<[f64; 6]> = Vec::new();
+        for (_, k, q) in &all {
+            if !self.set_down_hits(cell, q, place, *k) {
+                free.push(*q);
+            }
+        }
+        let goals = if free.is_empty() {
+            // Every pre-place configuration's set-down touches: plan to any (the goal's own
+            // reasons, if any, name why) and let the set-down run as the leaf asks.
+            let poses: Vec<Isometry3<f64>> = (0..4)
+                .map(|k| {
+                    let (rotation, offset) = self.turned(k);
+                    Isometry3::from_parts(Translation3::from(end + offset), rotation)
+                })
+                .collect();
+            crate::motion::plan::GoalSet::poses(&poses, from)
+        } else {
+            crate::motion::plan::GoalSet::configs(free)
+        };
+        let motion = super::planning::plan_motion(cell, "carry transfer", from, &goals)?;
+        let reached = crate::motion::fk(&motion.trajectory.end()).rotation;
+        let k = (0..4)
+            .min_by(|&a, &b| {
+                reached
+                    .angle_to(&self.turned(a).0)
+                    .total_cmp(&reached.angle_to(&self.turned(b).0))
+            })
+            .unwrap_or(0);
+        (self.rotation, self.pinch_from_block) = self.turned(k);
+        Ok(motion)
     }
 
     /// The current phase's motion has ended: start the next one (or re-plan the transfer).

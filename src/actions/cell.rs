@@ -3,8 +3,11 @@
 
 use crate::kinds::ActionRole;
 use crate::motion::Trajectory;
+use crate::sim::collision::{DEFAULT_MARGIN, SceneChecker};
 use crate::sim::{Layout, Scene, Sim, TIMESTEP};
 use crate::world::World;
+
+pub use super::planning::{PlanCounts, PlanningTally};
 
 /// Default control period: the tree is ticked every 4 ms of simulated time (2 physics steps).
 pub const CONTROL_PERIOD: f64 = 0.004;
@@ -39,6 +42,12 @@ pub struct Cell {
     arm: ArmPlan,
     gripper_ctrl: f64,
     steps_per_tick: u32,
+    /// The motion planner's collision checker of this cell (built with the cell, synced from the
+    /// simulation before each check), `None` when it could not be built (then motions run
+    /// unchecked, as before).
+    checker: Option<SceneChecker>,
+    /// What motion checking and planning cost in this episode.
+    tally: PlanningTally,
     /// Per-step hooks (fault injection, control recording), called in order.
     pub observers: Vec<Box<dyn StepObserver>>,
 }
@@ -50,12 +59,26 @@ impl Cell {
         let sim = Sim::new(scene);
         let world = sim.observe();
         let steps_per_tick = ((control_period / TIMESTEP).round() as u32).max(1);
+        let blocks: Vec<usize> = (0..scene.objects.len())
+            .filter(|&i| scene.objects[i].qpos.is_some())
+            .collect();
+        let checker = match SceneChecker::from_sim(&sim, DEFAULT_MARGIN)
+            .and_then(|mut c| c.prepare_holds(&blocks).map(|()| c))
+        {
+            Ok(c) => Some(c),
+            Err(e) => {
+                tracing::warn!(target: "macrotree::plan", "no collision checker for this cell, motions run unchecked: {e}");
+                None
+            }
+        };
         let mut cell = Self {
             sim,
             world,
             arm: ArmPlan::Hold(crate::sim::HOME_Q),
             gripper_ctrl: 0.0,
             steps_per_tick,
+            checker,
+            tally: PlanningTally::default(),
             observers: Vec::new(),
         };
         cell.reset(layout);
@@ -74,6 +97,43 @@ impl Cell {
         self.arm = ArmPlan::Hold(crate::sim::HOME_Q);
         self.gripper_ctrl = 0.0;
         self.world = self.sim.observe();
+        if let Some(c) = &mut self.checker {
+            c.release();
+        }
+        self.tally = PlanningTally::default();
+    }
+
+    /// The cell's collision checker synced to the simulation as it is now (every object's pose,
+    /// the gripper's opening), holding the block the gripper holds now (grasp and release are
+    /// followed from the world: [`World::held_block`]), or `None` when the cell has none.
+    pub fn checker(&mut self) -> Option<&mut SceneChecker> {
+        let c = self.checker.as_mut()?;
+        let held = self
+            .world
+            .held_block(crate::world::conditions::Tolerances::GRASP_OFF_AXIS);
+        let synced = c.sync(self.sim.data()).and_then(|()| match held {
+            Some(b) if c.held() != Some(b) => c.hold(b),
+            None if c.held().is_some() => {
+                c.release();
+                Ok(())
+            }
+            _ => Ok(()),
+        });
+        if let Err(e) = synced {
+            tracing::warn!(target: "macrotree::plan", "collision checker out of step with the simulation: {e}");
+            return None;
+        }
+        Some(c)
+    }
+
+    /// What motion checking and planning cost so far in this episode.
+    pub fn planning(&self) -> &PlanningTally {
+        &self.tally
+    }
+
+    /// The tally, to add to.
+    pub(crate) fn planning_mut(&mut self) -> &mut PlanningTally {
+        &mut self.tally
     }
 
     /// Tells the observers that a macro action of `kind`, playing `role`, starts.

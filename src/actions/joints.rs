@@ -2,6 +2,8 @@
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
+use super::planning::{check_motion, describe, plan_motion};
+use crate::motion::plan::GoalSet;
 use crate::motion::{JointMove, MotionLimits};
 
 /// Moves the arm in joint space to fixed joint angles (radians).
@@ -28,11 +30,17 @@ impl MoveJoints {
 impl MacroAction for MoveJoints {
     fn start(&mut self, cell: &mut Cell) -> Result<(), crate::failure::Failure> {
         let from = cell.arm_setpoint();
-        cell.track(Box::new(JointMove::new(
-            from,
-            self.goal_q,
-            &MotionLimits::default(),
-        )));
+        let mv = JointMove::new(from, self.goal_q, &MotionLimits::default());
+        if let Some((_, pairs)) = check_motion(cell, &[&mv], &[], false) {
+            // The straight joint move would collide: plan around whatever is in the way to
+            // exactly these joint angles.
+            tracing::debug!(target: "macrotree::actions", "move_joints: the direct joint move would touch {}; planning", describe(&pairs));
+            let goals = GoalSet::configs(vec![self.goal_q]);
+            let motion = plan_motion(cell, "move_joints", &from, &goals)?;
+            cell.track(Box::new(motion.trajectory));
+            return Ok(());
+        }
+        cell.track(Box::new(mv));
         Ok(())
     }
 

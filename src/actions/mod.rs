@@ -12,12 +12,13 @@ mod checks;
 mod grasp;
 mod joints;
 mod macro_action;
+mod planning;
 mod reach;
 mod release;
 mod targets;
 
 pub(crate) use carry::Carry as CarryAction;
-pub use cell::{CONTROL_PERIOD, Cell, StepObserver};
+pub use cell::{CONTROL_PERIOD, Cell, PlanCounts, PlanningTally, StepObserver};
 pub use checks::{Checks, ChecksRecorder, pad_block_distance};
 pub(crate) use grasp::Grasp as GraspAction;
 pub(crate) use joints::MoveJoints as MoveJointsAction;

@@ -4,9 +4,11 @@ use nalgebra::{Isometry3, Translation3, Vector3};
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
+use super::planning::{check_motion, check_straight, describe, plan_motion};
 use super::targets::{resolve, segment_distance, target_block, target_object, tool_yaw};
 use crate::failure::{Failure, FailureKind};
 use crate::kinds::{PathKind, Reach as ReachSpec, Yaw};
+use crate::motion::plan::GoalSet;
 use crate::motion::{CartesianMove, JointMove, MotionLimits, Trajectory, down_pose, fk, ik_down};
 use crate::world::World;
 
@@ -97,8 +99,12 @@ impl MacroAction for Reach {
         match self.spec.path {
             PathKind::Joint => {
                 let skip = target_object(&self.spec.target, w);
-                match joint_path_conflict(w, &from, &goal_q, skip) {
-                    None => cell.track(Box::new(JointMove::new(from, goal_q, &limits))),
+                // Today's motion: straight in joint space, or up, over and down around an
+                // object the pinch would pass low over.
+                let (legs, goal_q): (Vec<Box<dyn Trajectory>>, [f64; 6]) = match joint_path_conflict(
+                    w, &from, &goal_q, skip,
+                ) {
+                    None => (vec![Box::new(JointMove::new(from, goal_q, &limits))], goal_q),
                     Some(j) => {
                         // Up, over at a height that clears everything in the way, then down.
                         let here = fk(&from);
@@ -117,17 +123,40 @@ impl MacroAction for Reach {
                         let down_pose = down_pose(&position, yaw_of_solution(&over_q));
                         let down = CartesianMove::new(over_q, down_pose, &limits)
                             .map_err(|e| unreachable(format!("unreachable detour (down): {e}")))?;
-                        self.goal_q = down.end();
-                        cell.track(Box::new(rise));
-                        self.pending = vec![Box::new(down), Box::new(over)];
-                        return Ok(());
+                        let end = down.end();
+                        (vec![Box::new(rise), Box::new(over), Box::new(down)], end)
                     }
+                };
+                let refs: Vec<&dyn Trajectory> = legs.iter().map(|l| l.as_ref()).collect();
+                if let Some((_, pairs)) = check_motion(cell, &refs, &[], false) {
+                    // The motion would collide: plan one to the same pose (any IK branch, any
+                    // equivalent grasp yaw) around whatever is in the way.
+                    tracing::debug!(target: "macrotree::actions", "reach: the {} would touch {}; planning", if legs.len() == 1 { "direct joint move" } else { "detour" }, describe(&pairs));
+                    let goals = GoalSet::down(&position, yaw, quarter, &from);
+                    let motion = plan_motion(cell, "reach", &from, &goals)?;
+                    self.goal_q = motion.trajectory.end();
+                    cell.track(Box::new(motion.trajectory));
+                    return Ok(());
                 }
+                let mut legs = legs;
+                self.goal_q = goal_q;
+                let first = legs.remove(0);
+                legs.reverse();
+                self.pending = legs;
+                cell.track(first);
+                return Ok(());
             }
             PathKind::Cartesian => {
                 let pose = down_pose(&position, yaw_of_solution(&goal_q));
                 let mv = CartesianMove::new(from, pose, &limits)
                     .map_err(|e| unreachable(format!("unreachable path: {e}")))?;
+                // A straight final approach: only real contact counts, and the target may be
+                // touched.
+                let intended: Vec<String> = target_object(&self.spec.target, w)
+                    .map(|j| w.name(j).to_string())
+                    .into_iter()
+                    .collect();
+                check_straight(cell, "descent", &mv, &intended);
                 cell.track(Box::new(mv));
             }
         }

@@ -223,6 +223,7 @@ pub fn run_in_cell(
     report.layout = LayoutJson::of(&placement, &world.scene);
     report.add_scene(&initial, &world, collisions, unstable);
     report.nodes = NodeReport::of(&runner);
+    report.planning = cell.planning().clone();
     if !report.success {
         report.failed_node = runner.last_failed_path();
     }

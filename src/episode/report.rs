@@ -66,6 +66,8 @@ pub struct EpisodeReport {
     pub failure: Option<Failure>,
     /// How often every node ran, in plan order (preorder).
     pub nodes: Vec<NodeReport>,
+    /// Motions checked and planned in this episode, and the wall-clock time it took.
+    pub planning: crate::actions::PlanningTally,
 }
 
 /// One node's counts in a report: how often it started, succeeded, failed and was halted.
@@ -219,6 +221,7 @@ impl EpisodeReport {
             failure_kind: failure.as_ref().map(|f| f.kind),
             failure,
             nodes: Vec::new(),
+            planning: Default::default(),
         }
     }
 

@@ -371,6 +371,88 @@ pub fn ik(target: &Isometry3<f64>, seed: &[f64; 6]) -> Result<[f64; 6], IkError>
     solve(&p, &r, seed, TAU).map(|(q, _)| q)
 }
 
+/// Every admissible IK solution of `target` (the pinch pose in the world frame, metres): each
+/// closed-form branch (up to 8) with its joints moved by multiples of 2π to the equivalent nearest
+/// `seed` (radians) within [`JOINT_LIMITS`], polished and verified like [`ik`]; nearest to the
+/// seed first, duplicates (branches that coincide, e.g. at a singularity) dropped. This is the
+/// goal set a planner chooses from, instead of the single branch [`ik`] picks.
+///
+/// # Errors
+/// As [`ik`]: unreachable (no branch), joint limits (no branch within them), or no converged
+/// solution — the error of the branch nearest to success.
+pub fn ik_all(target: &Isometry3<f64>, seed: &[f64; 6]) -> Result<Vec<[f64; 6]>, IkError> {
+    let p = target.translation.vector;
+    let r = *target.rotation.to_rotation_matrix().matrix();
+    if !(p.iter().chain(r.iter()).chain(seed.iter()).all(|v| v.is_finite())) {
+        return Err(IkError::Unreachable {
+            reason: format!("non-finite target {:?} or seed {seed:?}", p.as_slice()),
+        });
+    }
+    let raw = closed_form(&p, &r, seed);
+    if raw.n == 0 {
+        return Err(IkError::Unreachable {
+            reason: raw.why.unwrap_or_else(|| "no closed-form branch".into()),
+        });
+    }
+    let mut out: Vec<(f64, [f64; 6])> = Vec::with_capacity(raw.n);
+    let mut last_err: Option<IkError> = None;
+    'branches: for sol in &raw.sols[..raw.n] {
+        let mut q = [0.0; 6];
+        for j in 0..6 {
+            match nearest_equivalent(sol[j], seed[j], TAU, JOINT_LIMITS[j]) {
+                Some(v) => q[j] = v,
+                None => {
+                    if !matches!(last_err, Some(IkError::NoConvergence { .. })) {
+                        last_err = Some(IkError::JointLimits {
+                            reason: format!(
+                                "{} would need {:.4} rad, outside its range [{}, {}]",
+                                ARM_JOINTS[j], sol[j], JOINT_LIMITS[j].0, JOINT_LIMITS[j].1
+                            ),
+                        });
+                    }
+                    continue 'branches;
+                }
+            }
+        }
+        let (res_m, res_rad) = polish(&mut q, &p, &r);
+        if let Some((j, v)) = q
+            .iter()
+            .enumerate()
+            .find(|(j, v)| **v < JOINT_LIMITS[*j].0 || **v > JOINT_LIMITS[*j].1)
+        {
+            last_err = Some(IkError::JointLimits {
+                reason: format!(
+                    "{} at {:.4} rad after polishing, outside its range [{}, {}]",
+                    ARM_JOINTS[j], v, JOINT_LIMITS[j].0, JOINT_LIMITS[j].1
+                ),
+            });
+            continue;
+        }
+        if !(res_m <= POSITION_TOLERANCE && res_rad <= ROTATION_TOLERANCE) {
+            last_err = Some(IkError::NoConvergence {
+                residual_m: res_m,
+                residual_rad: res_rad,
+            });
+            continue;
+        }
+        if out
+            .iter()
+            .any(|(_, o)| o.iter().zip(&q).all(|(a, b)| (a - b).abs() < 1e-9))
+        {
+            continue;
+        }
+        let d2: f64 = q.iter().zip(seed).map(|(a, b)| (a - b) * (a - b)).sum();
+        out.push((d2, q));
+    }
+    if out.is_empty() {
+        return Err(last_err.unwrap_or_else(|| IkError::JointLimits {
+            reason: "no branch within the joint limits".into(),
+        }));
+    }
+    out.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(out.into_iter().map(|(_, q)| q).collect())
+}
+
 /// Every closed-form solution of `target` (up to 8, angles in (−π, π], not wrapped to a seed,
 /// not filtered by limits), for diagnostics and tests. Empty when unreachable.
 pub fn ik_branches(target: &Isometry3<f64>) -> Vec<[f64; 6]> {
@@ -519,6 +601,23 @@ mod tests {
                 assert!((pose.rotation * Vector3::z() + Vector3::z()).norm() < 1e-12);
             }
         }
+    }
+
+    #[test]
+    fn ik_all_gives_every_branch_nearest_first_and_the_single_ik_is_the_first() {
+        let target = down_pose(&Vector3::new(0.4, -0.2, 0.15), 0.7);
+        let all = ik_all(&target, &HOME_Q).unwrap();
+        assert!(all.len() >= 4, "{} branches", all.len());
+        for q in &all {
+            let reached = fk(q);
+            assert!((reached.translation.vector - target.translation.vector).norm() < 1e-6);
+            assert!(reached.rotation.angle_to(&target.rotation) < 1e-5);
+        }
+        let single = ik(&target, &HOME_Q).unwrap();
+        for j in 0..6 {
+            assert!((all[0][j] - single[j]).abs() < 1e-9, "{:?} vs {single:?}", all[0]);
+        }
+        assert!(ik_all(&down_pose(&Vector3::new(1.3, 0.0, 0.2), 0.0), &HOME_Q).is_err());
     }
 
     #[test]

@@ -7,17 +7,19 @@
 //! | module | what |
 //! |---|---|
 //! | [`kinematics`] | [`fk`], [`jacobian`], the chain's dimensions and [`JOINT_LIMITS`] |
-//! | [`mod@ik`] | closed-form [`ik()`] with nearest-to-seed branch choice, [`ik_down`], [`down_pose`], [`IkError`], [`ik_benchmark`] |
+//! | [`mod@ik`] | closed-form [`ik()`] with nearest-to-seed branch choice, every branch ([`ik_all`]), [`ik_down`], [`down_pose`], [`IkError`], [`ik_benchmark`] |
+//! | [`mod@plan`] | collision-aware joint-space planning: RRT-Connect to goal sets, shortcutting, blends, timing, typed failure reasons |
 //! | [`trajectory`] | the [`Trajectory`] trait, [`JointMove`], [`CartesianMove`], [`Hold`], [`MotionLimits`] |
 //! | [`gripper`] | command ↔ opening calibration of the simulated 2F-85 |
 
 pub mod gripper;
 pub mod ik;
 pub mod kinematics;
+pub mod plan;
 pub mod trajectory;
 
 pub use gripper::{CLOSED_CTRL, OPEN_CTRL, ctrl_for_width, width_for_ctrl};
-pub use ik::{IkError, down_pose, ik, ik_benchmark, ik_down, ik_down_with_pose};
+pub use ik::{IkError, down_pose, ik, ik_all, ik_benchmark, ik_down, ik_down_with_pose};
 pub use kinematics::{ARM_JOINTS, JOINT_LIMITS, fk, jacobian};
 pub use trajectory::{CartesianMove, Hold, JointMove, MotionLimits, Trajectory};
 

@@ -2,12 +2,15 @@
 //! Nothing outside this module (and the viewer) touches MuJoCo types.
 
 pub mod cache;
+pub mod collision;
 pub mod error;
 pub mod layout;
 pub mod mjcf;
+pub mod planning;
 pub mod scene;
 pub mod simulator;
 
+pub use collision::SceneChecker;
 pub use error::SimError;
 pub use layout::Layout;
 pub use scene::{ModelOrigin, ObjectIds, Scene};

@@ -86,9 +86,15 @@ pub struct ScenarioResult {
     /// ([`SweepConfig::tree_digest`]); a line that has it also ends with its checksum (`crc32`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tree_digest: Option<String>,
+    /// Motions checked and planned in the episode.
+    pub planning: crate::actions::PlanCounts,
     /// Wall-clock time of the episode, seconds (not written to the JSONL).
     #[serde(skip)]
     pub wall_time_s: f64,
+    /// Wall-clock time the episode spent checking and planning motions, seconds (not written to
+    /// the JSONL).
+    #[serde(skip)]
+    pub planning_wall_s: f64,
 }
 
 impl ScenarioResult {
@@ -142,6 +148,8 @@ impl ScenarioResult {
             nodes: r.nodes,
             tree_digest: config.tree_digest.clone(),
             wall_time_s: r.wall_time_s,
+            planning: r.planning.counts(),
+            planning_wall_s: r.planning.planning_wall_s,
         }
     }
 
@@ -192,6 +200,8 @@ impl ScenarioResult {
             nodes: Vec::new(),
             tree_digest: config.tree_digest.clone(),
             wall_time_s: 0.0,
+            planning: Default::default(),
+            planning_wall_s: 0.0,
         }
     }
 

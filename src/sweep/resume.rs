@@ -412,6 +412,11 @@ pub fn parse_line(line: &str) -> Result<ScenarioResult, String> {
         nodes: serde_json::from_value(parsed("nodes")?).map_err(|e| format!("`nodes`: {e}"))?,
         tree_digest,
         wall_time_s: 0.0,
+        planning: match v.get("planning") {
+            None => Default::default(),
+            Some(p) => serde_json::from_value(p.clone()).map_err(|e| format!("`planning`: {e}"))?,
+        },
+        planning_wall_s: 0.0,
     })
 }
 

@@ -94,6 +94,16 @@ pub struct Summary {
     /// physics (1 would be a sweep that does nothing but `mj_step`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub physics_share: Option<f64>,
+    /// Motions checked and planned over the sweep.
+    pub planning: PlanningTotals,
+    /// Wall-clock time the workers spent checking and planning motions, summed over workers,
+    /// seconds (`None` until [`Summary::with_physics`] sets it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub planning_time_s: Option<f64>,
+    /// `planning_time_s / (jobs × process_wall_time_s)`: the share of the workers' time
+    /// spent checking and planning motions, beside [`physics_share`](Self::physics_share).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub planning_share: Option<f64>,
     /// The failing scenarios, by index: the first [`super::tally::MAX_FAILURES_KEPT`] (the
     /// JSONL has every one).
     pub failures: Vec<Failure>,
@@ -108,6 +118,34 @@ pub struct Summary {
     pub nodes: Vec<NodeTotals>,
     /// Tree coverage: which nodes never ran, never succeeded, never failed over the sweep.
     pub coverage: Coverage,
+}
+
+/// Motion checking and planning summed over a sweep's scenarios.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Default)]
+pub struct PlanningTotals {
+    /// Leaf motions checked along their length.
+    pub motions_checked: u64,
+    /// Motions that went to the planner (their direct motion would have collided).
+    pub plans: u64,
+    /// Plans that failed.
+    pub plan_failures: u64,
+    /// Scenarios in which the planner ran at least once.
+    pub scenarios_planned: u64,
+    /// Wall-clock time the workers spent checking and planning, summed, seconds (written as the
+    /// summary's `planning_time_s`, a measurement beside `physics_time_s`, not a result).
+    #[serde(skip)]
+    pub wall_time_s: f64,
+}
+
+impl PlanningTotals {
+    /// Adds one scenario's counts and time.
+    pub fn add(&mut self, r: &ScenarioResult) {
+        self.motions_checked += u64::from(r.planning.motions_checked);
+        self.plans += u64::from(r.planning.plans);
+        self.plan_failures += u64::from(r.planning.plan_failures);
+        self.scenarios_planned += u64::from(r.planning.plans > 0);
+        self.wall_time_s += r.planning_wall_s;
+    }
 }
 
 /// One node's counts summed over a sweep.
@@ -181,6 +219,12 @@ impl Summary {
         let capacity = self.jobs as f64 * process_wall_time_s;
         self.physics_share = Some(if capacity > 0.0 {
             physics_time_s / capacity
+        } else {
+            0.0
+        });
+        self.planning_time_s = Some(self.planning.wall_time_s);
+        self.planning_share = Some(if capacity > 0.0 {
+            self.planning.wall_time_s / capacity
         } else {
             0.0
         });
@@ -264,6 +308,14 @@ impl Summary {
                 s,
                 "  physics share {:.3}: {physics:.2} s inside mj_step over {} job(s) × {process:.2} s of the whole process",
                 share, self.jobs
+            );
+        }
+        if let Some(share) = self.planning_share {
+            let p = &self.planning;
+            let _ = writeln!(
+                s,
+                "  planning share {share:.4}: {:.3} s checking {} motions and planning {} ({} failed, in {} scenario(s))",
+                p.wall_time_s, p.motions_checked, p.plans, p.plan_failures, p.scenarios_planned
             );
         }
         if !self.failure_groups.is_empty() {

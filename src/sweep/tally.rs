@@ -15,7 +15,7 @@
 
 use std::collections::{BTreeMap, HashMap};
 
-use super::summary::{Coverage, Failure, FailureGroup, NodeTotals, Summary, wilson_interval};
+use super::summary::{Coverage, Failure, FailureGroup, NodeTotals, PlanningTotals, Summary, wilson_interval};
 use super::{ScenarioResult, Shard, SweepConfig};
 
 /// Most failing scenarios a summary lists (its JSON `failures`); `failures_not_listed` counts
@@ -39,6 +39,7 @@ pub struct Tally {
     groups: BTreeMap<(String, String), (u64, Vec<u64>)>,
     nodes: Vec<NodeTotals>,
     node_at: HashMap<String, usize>,
+    planning: PlanningTotals,
 }
 
 /// A key that orders like [`f64::total_cmp`].
@@ -66,6 +67,7 @@ impl Tally {
             groups: BTreeMap::new(),
             nodes: Vec::new(),
             node_at: HashMap::new(),
+            planning: PlanningTotals::default(),
         }
     }
 
@@ -83,6 +85,7 @@ impl Tally {
     pub fn add(&mut self, r: &ScenarioResult) {
         self.n += 1;
         self.successes += u64::from(r.success);
+        self.planning.add(r);
         *self.attempts.entry(r.grasp_attempts).or_insert(0) += 1;
         *self.times.entry(order_key(r.sim_time_s)).or_insert(0) += 1;
         for node in &r.nodes {
@@ -218,6 +221,9 @@ impl Tally {
             physics_time_s: None,
             process_wall_time_s: None,
             physics_share: None,
+            planning: self.planning,
+            planning_time_s: None,
+            planning_share: None,
         }
     }
 }

@@ -1,0 +1,279 @@
+//! The arm's motions checked and, when blocked, planned: every leaf motion is first tried as it
+//! always was (a joint move, a straight line, a detour over an object) and checked along its
+//! length with the cell's [`SceneChecker`]; only a motion that would collide is replaced by a
+//! planned one ([`crate::sim::planning::plan_in_cell`]), so free-space moves stay exactly as
+//! they were.
+//!
+//! Allowances (what may touch, see docs/motion.md "Contact allowances"):
+//! - pairs already closer than the margin at the start of a motion may stay so during it (a block
+//!   resting on the table as it is lifted, the fingers next to a block just released): the
+//!   motion is blocked only by a pair that is not touching at its start;
+//! - a straight final segment (a Cartesian `reach`, the carry's lift and set-down) counts only
+//!   real contact (penetration), not the clearance margin, and contact with the object the leaf
+//!   goes to (the reach's target, the carry's destination) is intended;
+//! - a planned motion keeps the full margin from everything except the pairs touching at its
+//!   start, and ends at the pre-grasp or pre-place pose, never in contact.
+
+use std::time::{Duration, Instant};
+
+use serde::Serialize;
+
+use super::cell::Cell;
+use crate::failure::Failure;
+use crate::motion::Trajectory;
+use crate::motion::plan::edge::{Resolution, steps};
+use crate::motion::plan::{Collision, CollisionChecker, GoalSet, PlannedMotion, PlannerConfig};
+use crate::sim::collision::SceneChecker;
+
+/// What motion checking and planning cost in one episode (reported per episode in `run --json`
+/// and sweep JSONL).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct PlanningTally {
+    /// Leaf motions checked along their length before they ran.
+    pub motions_checked: u32,
+    /// Motions that would have collided and went to the planner.
+    pub plans: u32,
+    /// Plans that failed (the leaf failed with the planner's reason).
+    pub plan_failures: u32,
+    /// Straight segments (Cartesian approach, lift, set-down) that the check found touching
+    /// something not allowed; they run anyway (see docs/motion.md).
+    pub straight_contacts: u32,
+    /// Configurations given to the collision checker, checks and plans together.
+    pub collision_checks: u64,
+    /// Wall-clock time spent checking and planning, seconds (for reports only).
+    pub planning_wall_s: f64,
+}
+
+/// The counts of a [`PlanningTally`] (no wall-clock term: a sweep's JSONL stays the same for
+/// any `--jobs` and machine).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, serde::Deserialize)]
+pub struct PlanCounts {
+    /// Leaf motions checked along their length before they ran.
+    pub motions_checked: u32,
+    /// Motions that would have collided and went to the planner.
+    pub plans: u32,
+    /// Plans that failed.
+    pub plan_failures: u32,
+    /// Straight segments found touching something not allowed (they ran anyway).
+    pub straight_contacts: u32,
+}
+
+impl PlanningTally {
+    /// The counts, without the wall-clock time.
+    pub fn counts(&self) -> PlanCounts {
+        PlanCounts {
+            motions_checked: self.motions_checked,
+            plans: self.plans,
+            plan_failures: self.plan_failures,
+            straight_contacts: self.straight_contacts,
+        }
+    }
+
+    fn add_time(&mut self, t: Duration) {
+        self.planning_wall_s += t.as_secs_f64();
+    }
+}
+
+/// True when the robot–scene pair `c` names object `name` (the object itself or one of its
+/// parts, e.g. `bin/wall_px`).
+fn names(c: &Collision, name: &str) -> bool {
+    let is = |s: &str| s == name || s.strip_prefix(name).is_some_and(|r| r.starts_with('/'));
+    is(&c.a) || is(&c.b)
+}
+
+/// A checker that lets some pairs touch: the pairs touching at a motion's start and contact
+/// with the objects the leaf means to reach.
+pub(crate) struct Allowing<'a> {
+    inner: &'a mut SceneChecker,
+    /// Pairs `(a, b)` allowed to stay closer than the margin.
+    pairs: Vec<(String, String)>,
+    /// Objects contact with which is intended.
+    intended: Vec<String>,
+    /// Count only penetration, not the clearance margin.
+    contact_only: bool,
+    /// Configurations checked.
+    pub(crate) checks: u64,
+}
+
+impl<'a> Allowing<'a> {
+    /// Allows on `inner` the pairs touching at `start` and contact with `intended` objects;
+    /// `contact_only` ignores the margin (straight final segments).
+    pub(crate) fn new(
+        inner: &'a mut SceneChecker,
+        start: &[f64; 6],
+        intended: &[String],
+        contact_only: bool,
+    ) -> Self {
+        let pairs = inner.collisions(start).into_iter().map(|c| (c.a, c.b)).collect();
+        Self {
+            inner,
+            pairs,
+            intended: intended.to_vec(),
+            contact_only,
+            checks: 1,
+        }
+    }
+
+    fn counts(&self, c: &Collision) -> bool {
+        let near_only = self.contact_only && c.distance >= 0.0;
+        let allowed = self.pairs.iter().any(|(a, b)| *a == c.a && *b == c.b);
+        let intended = self.intended.iter().any(|o| names(c, o));
+        !(near_only || allowed || intended)
+    }
+
+    /// The pairs that count at `q`.
+    pub(crate) fn blocking(&mut self, q: &[f64; 6]) -> Vec<Collision> {
+        self.checks += 1;
+        if self.inner.is_free(q) {
+            return Vec::new();
+        }
+        let mut all = self.inner.collisions(q);
+        all.retain(|c| self.counts(c));
+        all
+    }
+}
+
+impl CollisionChecker for Allowing<'_> {
+    fn is_free(&mut self, q: &[f64; 6]) -> bool {
+        self.blocking(q).is_empty()
+    }
+
+    fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
+        let mut all = self.inner.collisions(q);
+        all.retain(|c| self.counts(c));
+        all
+    }
+}
+
+/// Resolution of the check of a leaf's direct motion: samples at most 0.05 rad of any joint
+/// apart, and no displacement bound (the planner's edges add one of 1 cm). The check decides
+/// whether to plan; it is coarser than the planner's own edges so that free-space moves cost
+/// little beside the physics (`macrotree bench`), at the price of possibly missing a graze
+/// between two samples.
+pub(crate) const DIRECT_RESOLUTION: Resolution = Resolution {
+    joint: 0.05,
+    displacement: f64::INFINITY,
+    lever_arms: [0.0; 6],
+};
+
+/// Configurations along `traj` from its start to its end, no two consecutive ones farther apart
+/// than `res` (time-subdivided where the joint path bends).
+fn samples(traj: &dyn Trajectory, res: &Resolution) -> Vec<[f64; 6]> {
+    const COARSE: usize = 4;
+    let d = traj.duration();
+    let at = |t: f64| if t >= d { traj.end() } else { traj.sample(t).0 };
+    let mut out = vec![at(0.0)];
+    let (mut t0, mut q0) = (0.0, out[0]);
+    for i in 1..=COARSE {
+        let t1 = d * i as f64 / COARSE as f64;
+        let q1 = at(t1);
+        let n = steps(&q0, &q1, res).min(4096);
+        for k in 1..n {
+            out.push(at(t0 + (t1 - t0) * k as f64 / n as f64));
+        }
+        out.push(q1);
+        (t0, q0) = (t1, q1);
+    }
+    out
+}
+
+/// The first configuration along `legs` (motions run one after the other) where something
+/// that is not allowed touches, with the pairs; `None` when the motion is free or the cell has no
+/// checker. Straight final segments pass `contact_only`; `intended` names the objects the leaf
+/// goes to.
+pub(crate) fn check_motion(
+    cell: &mut Cell,
+    legs: &[&dyn Trajectory],
+    intended: &[String],
+    contact_only: bool,
+) -> Option<([f64; 6], Vec<Collision>)> {
+    let t = Instant::now();
+    let res = DIRECT_RESOLUTION;
+    let start = legs.first()?.sample(0.0).0;
+    let checker = cell.checker()?;
+    let mut allow = Allowing::new(checker, &start, intended, contact_only);
+    let mut hit = None;
+    'legs: for leg in legs {
+        for q in samples(*leg, &res).into_iter().skip(1) {
+            let b = allow.blocking(&q);
+            if !b.is_empty() {
+                hit = Some((q, b));
+                break 'legs;
+            }
+        }
+    }
+    let checks = allow.checks;
+    let tally = cell.planning_mut();
+    tally.motions_checked += 1;
+    tally.collision_checks += checks;
+    tally.add_time(t.elapsed());
+    hit
+}
+
+/// Checks a straight segment (`what`: "descent", "lift", "set-down") along its length, only
+/// real contact counting and contact with `intended` objects allowed; a hit is logged and
+/// counted in the tally, and the segment runs anyway (the leaf asked for a straight line, and
+/// its physics is what it was before the check).
+pub(crate) fn check_straight(cell: &mut Cell, what: &str, mv: &dyn Trajectory, intended: &[String]) {
+    if let Some((q, pairs)) = check_motion(cell, &[mv], intended, true) {
+        let p = crate::motion::fk(&q).translation.vector;
+        tracing::debug!(target: "macrotree::plan", "the straight {what} touches {} (pinch at ({:.3}, {:.3}, {:.3}) m)", describe(&pairs), p.x, p.y, p.z);
+        cell.planning_mut().straight_contacts += 1;
+    }
+}
+
+/// Pairs as text for messages: `a–b (−1.2 mm)`, at most four.
+pub(crate) fn describe(pairs: &[Collision]) -> String {
+    let mut s: Vec<String> = pairs
+        .iter()
+        .take(4)
+        .map(|c| format!("{} with {} ({:+.1} mm)", c.a, c.b, c.distance * 1e3))
+        .collect();
+    if pairs.len() > 4 {
+        s.push(format!("{} more", pairs.len() - 4));
+    }
+    s.join(", ")
+}
+
+/// Plans the arm from `start` to any of `goals` in the cell, the pairs touching at `start`
+/// allowed; logs the query; counts it in the tally. The cell's `n`-th plan of the episode is
+/// seeded with `n`, so an episode replays the same plans.
+///
+/// # Errors
+/// The planner's typed failure ([`crate::sim::planning::plan_failure`]).
+pub(crate) fn plan_motion(
+    cell: &mut Cell,
+    what: &str,
+    start: &[f64; 6],
+    goals: &GoalSet,
+) -> Result<PlannedMotion, Failure> {
+    let t = Instant::now();
+    let config = PlannerConfig {
+        seed: 0x6d61_6372_6f74_7265 ^ u64::from(cell.planning().plans),
+        ..PlannerConfig::default()
+    };
+    let sim_time = cell.sim().time();
+    let Some(checker) = cell.checker() else {
+        return Err(Failure::new(
+            crate::failure::FailureKind::NoPath,
+            format!("{what}: the direct motion collides and the cell has no collision checker to plan with"),
+        ));
+    };
+    let mut allow = Allowing::new(checker, start, &[], false);
+    let result = crate::sim::planning::plan_in_cell(&mut allow, start, goals, &config);
+    let checks = allow.checks;
+    let tally = cell.planning_mut();
+    tally.plans += 1;
+    tally.collision_checks += checks;
+    tally.add_time(t.elapsed());
+    match &result {
+        Ok(m) => {
+            tracing::debug!(target: "macrotree::plan", sim_time, "plan {what}: {} goals; {}", goals.len(), m.stats.summary());
+        }
+        Err(f) => {
+            tally.plan_failures += 1;
+            tracing::debug!(target: "macrotree::plan", sim_time, "plan {what}: {} goals; failed: {f}", goals.len());
+        }
+    }
+    result
+}

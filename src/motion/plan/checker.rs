@@ -1,0 +1,99 @@
+//! What the planner asks of a collision model: is a configuration free, and if not, what touches.
+
+use std::fmt;
+
+/// A collision model of the arm in its cell, queried one joint configuration at a time.
+///
+/// The planner only calls [`is_free`](Self::is_free) while it searches; it asks
+/// [`collisions`](Self::collisions) for the few configurations it names in a failure (the
+/// start, the goals, the places that blocked the search most). An implementation keeps its own
+/// scratch state (hence `&mut self`), so use one checker per thread.
+pub trait CollisionChecker {
+    /// True when the arm at `q` (six joint angles, radians, base to wrist 3) keeps at least the
+    /// checker's clearance margin from everything it must not touch.
+    fn is_free(&mut self, q: &[f64; 6]) -> bool;
+
+    /// The pairs in collision at `q` (radians), for failure messages; empty when `q` is free or
+    /// the checker cannot name them (the default).
+    fn collisions(&mut self, _q: &[f64; 6]) -> Vec<Collision> {
+        Vec::new()
+    }
+}
+
+impl<C: CollisionChecker + ?Sized> CollisionChecker for &mut C {
+    fn is_free(&mut self, q: &[f64; 6]) -> bool {
+        (**self).is_free(q)
+    }
+    fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
+        (**self).collisions(q)
+    }
+}
+
+/// Two named things that touch (or come closer than the margin) at one configuration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Collision {
+    /// The robot's part (a body or geom name), e.g. `forearm_link`.
+    pub a: String,
+    /// What it touches: a scene object, the table, another robot part, the held block.
+    pub b: String,
+    /// Signed distance between the two, metres: negative is penetration, positive is closer than
+    /// the clearance margin but not touching.
+    pub distance: f64,
+}
+
+impl Collision {
+    /// The pair as one stable label, `a–b`, for counting and messages.
+    pub fn pair(&self) -> String {
+        format!("{}–{}", self.a, self.b)
+    }
+}
+
+impl fmt::Display for Collision {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.distance < 0.0 {
+            write!(f, "{} in {} by {:.1} mm", self.a, self.b, -self.distance * 1e3)
+        } else {
+            write!(f, "{} within {:.1} mm of {}", self.a, self.distance * 1e3, self.b)
+        }
+    }
+}
+
+/// A checker that counts the configurations it is asked about (the planner's statistics).
+pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
+    pub(crate) inner: &'a mut C,
+    pub(crate) checks: u64,
+}
+
+impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
+    pub(crate) fn new(inner: &'a mut C) -> Self {
+        Self { inner, checks: 0 }
+    }
+}
+
+impl<C: CollisionChecker + ?Sized> CollisionChecker for Counting<'_, C> {
+    fn is_free(&mut self, q: &[f64; 6]) -> bool {
+        self.checks += 1;
+        self.inner.is_free(q)
+    }
+    fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
+        self.inner.collisions(q)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn collision_reads_as_depth_or_clearance() {
+        let c = Collision {
+            a: "forearm_link".into(),
+            b: "post".into(),
+            distance: -0.0042,
+        };
+        assert_eq!(c.to_string(), "forearm_link in post by 4.2 mm");
+        assert_eq!(c.pair(), "forearm_link–post");
+        let near = Collision { distance: 0.003, ..c };
+        assert_eq!(near.to_string(), "forearm_link within 3.0 mm of post");
+    }
+}

@@ -1,0 +1,234 @@
+//! The planner's settings: search caps, edge resolution, smoothing and the joint limits the
+//! timing keeps, each range-checked.
+
+use std::time::Duration;
+
+use crate::motion::kinematics::JOINT_LIMITS;
+use crate::motion::trajectory::MotionLimits;
+
+/// The UR5e's rated joint speed, rad/s: 180 °/s for every joint (base, shoulder, elbow and the
+/// three wrists), from Universal Robots' UR5e technical specifications / user manual. UR publishes
+/// no joint acceleration rating.
+pub const UR5E_RATED_JOINT_SPEED: f64 = std::f64::consts::PI;
+
+/// Lever arms of the UR5e with the 2F-85 and a held block of up to 7 cm, metres: an upper bound
+/// on the distance of any point of the moving robot from each joint's axis, base to wrist 3.
+/// Measured on the Menagerie models (`tests/motion_collision.rs`: the largest distance of a
+/// collision geom's bounding sphere from each axis, over the stretched arm and random joints,
+/// is 1.08, 1.11, 0.70, 0.31, 0.27, 0.10 m), plus a held block's 6.1 cm half diagonal.
+pub const UR5E_LEVER_ARMS: [f64; 6] = [1.16, 1.19, 0.77, 0.38, 0.34, 0.12];
+
+/// Per-joint speed and acceleration limits a planned trajectory keeps, base to wrist 3.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointLimits {
+    /// Largest speed of each joint, rad/s; at most [`UR5E_RATED_JOINT_SPEED`].
+    pub velocity: [f64; 6],
+    /// Largest acceleration of each joint, rad/s².
+    pub acceleration: [f64; 6],
+}
+
+impl JointLimits {
+    /// The same speed and acceleration for every joint, from the limits every other motion of
+    /// the crate keeps ([`MotionLimits::max_joint_speed`], [`MotionLimits::max_joint_acc`]).
+    pub fn from_motion(limits: &MotionLimits) -> Self {
+        Self {
+            velocity: [limits.max_joint_speed; 6],
+            acceleration: [limits.max_joint_acc; 6],
+        }
+    }
+
+    /// Checks every limit is finite and positive, and no speed exceeds the UR5e's rating.
+    ///
+    /// # Errors
+    /// The first limit out of range, and what to do.
+    pub fn check(&self) -> Result<(), String> {
+        for j in 0..6 {
+            let (v, a) = (self.velocity[j], self.acceleration[j]);
+            if !(v.is_finite() && v > 0.0 && v <= UR5E_RATED_JOINT_SPEED) {
+                return Err(format!(
+                    "joint {} speed limit {v} rad/s: use a value in (0, {UR5E_RATED_JOINT_SPEED:.4}] (the UR5e's rated 180 °/s)",
+                    j + 1
+                ));
+            }
+            if !(a.is_finite() && a > 0.0 && a <= 1000.0) {
+                return Err(format!(
+                    "joint {} acceleration limit {a} rad/s²: use a value in (0, 1000]",
+                    j + 1
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Default for JointLimits {
+    /// [`JointLimits::from_motion`] of [`MotionLimits::default`]: the speed just under the UR5e's
+    /// rated π rad/s and the acceleration the Menagerie servos track well.
+    fn default() -> Self {
+        Self::from_motion(&MotionLimits::default())
+    }
+}
+
+/// How the planner searches, smooths and times a path. Every decision is driven by `seed` and
+/// the counts here; `time_cap` is the only wall-clock term, and it can only end a search early
+/// (with [`PlanFailure::TimeCap`](super::PlanFailure::TimeCap)), never change a path.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlannerConfig {
+    /// Seed of the search and the shortcutting (ChaCha8): the same seed, checker and query give
+    /// the same path, bit for bit.
+    pub seed: u64,
+    /// Edge-checking resolution: the largest change of any joint between two configurations
+    /// checked along a straight joint-space segment, radians. Default 0.05 rad (a point on the
+    /// arm moves at most about 1 m per radian, so ≲ 5 cm between checks at the wrist).
+    pub resolution: f64,
+    /// Largest displacement of any point of the robot between two checked configurations,
+    /// metres, bounded through `lever_arms` (see [`Resolution`](super::edge::Resolution)).
+    /// Default 0.01 m: with a checker margin of at least half of it (the MuJoCo checker's default
+    /// is 5 mm), nothing touches between checks either. `f64::INFINITY` turns the bound off.
+    pub max_displacement: f64,
+    /// Lever arm of each joint, metres: an upper bound on how far any point of the moving robot
+    /// (and a held block) lies from the joint's axis. Default [`UR5E_LEVER_ARMS`].
+    pub lever_arms: [f64; 6],
+    /// Longest step the search tree grows by in one extension, radians (Euclidean in joint
+    /// space). Default 1.0 rad.
+    pub range: f64,
+    /// Search iterations at most (one sample, one extension, one connection attempt each).
+    /// Default 2000.
+    pub max_iterations: usize,
+    /// Tree nodes at most (both trees together). Default 20 000.
+    pub max_nodes: usize,
+    /// Random shortcut attempts on the found path. Default 48.
+    pub shortcut_attempts: usize,
+    /// Largest joint-space deviation of a corner blend from the path's corner, radians. Blends
+    /// are collision-checked at `resolution` and halved (down to none: the arm stops at the
+    /// corner) until free. Default 0.1 rad; 0 turns blending off.
+    pub blend_deviation: f64,
+    /// The box the search samples in and every path stays in, radians per joint. Default
+    /// [`JOINT_LIMITS`].
+    pub bounds: [(f64, f64); 6],
+    /// Speed and acceleration limits of the timed trajectory.
+    pub limits: JointLimits,
+    /// Optional wall-clock cap on the search; reaching it ends the plan with
+    /// [`PlanFailure::TimeCap`](super::PlanFailure::TimeCap). Default none (the iteration cap
+    /// decides alone, so outcomes never depend on the machine's speed).
+    pub time_cap: Option<Duration>,
+}
+
+impl Default for PlannerConfig {
+    /// Seed 0, 0.05 rad and 0.01 m resolution with [`UR5E_LEVER_ARMS`], 1.0 rad range, 2000 iterations, 20 000 nodes, 48 shortcuts,
+    /// 0.1 rad blends, the joint limits as bounds, [`JointLimits::default`], no time cap.
+    fn default() -> Self {
+        Self {
+            seed: 0,
+            resolution: 0.05,
+            max_displacement: 0.01,
+            lever_arms: UR5E_LEVER_ARMS,
+            range: 1.0,
+            max_iterations: 2000,
+            max_nodes: 20_000,
+            shortcut_attempts: 48,
+            blend_deviation: 0.1,
+            bounds: JOINT_LIMITS,
+            limits: JointLimits::default(),
+            time_cap: None,
+        }
+    }
+}
+
+impl PlannerConfig {
+    /// The edge-checking resolution these settings describe.
+    pub fn edge_resolution(&self) -> super::edge::Resolution {
+        super::edge::Resolution {
+            joint: self.resolution,
+            displacement: self.max_displacement,
+            lever_arms: self.lever_arms,
+        }
+    }
+
+    /// Checks every setting is in range.
+    ///
+    /// # Errors
+    /// The first setting out of range, and the range to use.
+    pub fn check(&self) -> Result<(), String> {
+        if !(self.resolution.is_finite() && (1e-4..=0.5).contains(&self.resolution)) {
+            return Err(format!(
+                "edge resolution {} rad: use a value in [0.0001, 0.5]",
+                self.resolution
+            ));
+        }
+        if self.max_displacement.is_nan() || self.max_displacement < 1e-4 {
+            return Err(format!(
+                "max_displacement {} m: use a value of at least 0.0001 (or infinity for no bound)",
+                self.max_displacement
+            ));
+        }
+        if !self
+            .lever_arms
+            .iter()
+            .all(|r| r.is_finite() && (0.0..=10.0).contains(r))
+        {
+            return Err(format!(
+                "lever_arms {:?} m: use values in [0, 10]",
+                self.lever_arms
+            ));
+        }
+        if !(self.range.is_finite() && self.range >= self.resolution && self.range <= 10.0) {
+            return Err(format!(
+                "range {} rad: use a value in [resolution, 10]",
+                self.range
+            ));
+        }
+        if self.max_iterations == 0 || self.max_iterations > 10_000_000 {
+            return Err(format!(
+                "max_iterations {}: use 1 to 10 000 000",
+                self.max_iterations
+            ));
+        }
+        if self.max_nodes < 2 || self.max_nodes > 10_000_000 {
+            return Err(format!("max_nodes {}: use 2 to 10 000 000", self.max_nodes));
+        }
+        if self.shortcut_attempts > 100_000 {
+            return Err(format!(
+                "shortcut_attempts {}: use at most 100 000",
+                self.shortcut_attempts
+            ));
+        }
+        if !(self.blend_deviation.is_finite() && (0.0..=1.0).contains(&self.blend_deviation)) {
+            return Err(format!(
+                "blend_deviation {} rad: use a value in [0, 1]",
+                self.blend_deviation
+            ));
+        }
+        for (j, &(lo, hi)) in self.bounds.iter().enumerate() {
+            let (jl, jh) = JOINT_LIMITS[j];
+            if !(lo.is_finite() && hi.is_finite() && lo < hi && lo >= jl && hi <= jh) {
+                return Err(format!(
+                    "bounds of joint {} [{lo}, {hi}] rad: use lo < hi inside the joint limits [{jl}, {jh}]",
+                    j + 1
+                ));
+            }
+        }
+        self.limits.check()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_defaults_pass_their_own_check_and_bad_values_are_named() {
+        PlannerConfig::default().check().unwrap();
+        let c = PlannerConfig {
+            resolution: 0.0,
+            ..PlannerConfig::default()
+        };
+        assert!(c.check().unwrap_err().contains("resolution"));
+        let mut c = PlannerConfig::default();
+        c.limits.velocity[2] = 4.0;
+        assert!(c.check().unwrap_err().contains("joint 3 speed"));
+        let mut c = PlannerConfig::default();
+        c.bounds[0] = (1.0, f64::NAN);
+        assert!(c.check().unwrap_err().contains("joint 1"));
+    }
+}

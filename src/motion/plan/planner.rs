@@ -1,0 +1,206 @@
+//! One planning query: check the start and the goals, try the direct segment, search, shortcut,
+//! smooth and time.
+
+use std::time::Instant;
+
+use super::blend::smooth;
+use super::checker::{CollisionChecker, Counting};
+use super::config::PlannerConfig;
+use super::edge::check_segment;
+use super::goal::GoalSet;
+use super::reason::{PlanError, PlanFailure, tally};
+use super::rrt::{Search, rrt_connect};
+use super::shortcut::shortcut;
+use super::stats::{PlanStats, distance, path_length};
+use super::timing::PathTrajectory;
+
+/// Goal configurations whose collisions are asked for when every goal is blocked.
+const NAMED_GOALS: usize = 8;
+
+/// The direct segment is tried to every free goal at most this many times as far (joint-space
+/// distance) as the nearest free goal: a long straight swing to a far IK branch is not preferred
+/// over a short detour to a near one.
+pub const DIRECT_SLACK: f64 = 1.5;
+
+/// A planned motion.
+#[derive(Clone, Debug)]
+pub struct PlannedMotion {
+    /// Index of the reached goal in the [`GoalSet`] given.
+    pub goal: usize,
+    /// The path the search found, radians (start and goal included; every segment checked).
+    pub raw_path: Vec<[f64; 6]>,
+    /// The timed, smoothed trajectory along the shortcut path.
+    pub trajectory: PathTrajectory,
+    /// What the query cost.
+    pub stats: PlanStats,
+}
+
+fn in_bounds(q: &[f64; 6], config: &PlannerConfig) -> bool {
+    q.iter()
+        .zip(&config.bounds)
+        .all(|(v, (lo, hi))| v.is_finite() && *v >= *lo && *v <= *hi)
+}
+
+/// Plans a collision-free motion for the arm from `start` to any configuration of `goals`
+/// (radians), with `checker` deciding what is free.
+///
+/// Stages: the start is checked (else [`PlanFailure::StartInCollision`] naming the pairs); goals
+/// outside `config.bounds` or in collision are dropped (none left: [`PlanFailure::NoGoal`] or
+/// [`PlanFailure::GoalInCollision`] naming what blocks them); the straight segment to each free
+/// goal at most [`DIRECT_SLACK`] times as far as the nearest, in the set's order, is tried first; otherwise RRT-Connect searches towards all free goals
+/// at once (out of iterations: [`PlanFailure::SearchExhausted`] naming what blocked it most).
+/// The path is then shortcut, its corners blended, and timed within `config.limits`. Every
+/// configuration the arm passes through was checked, at the edge resolution
+/// ([`PlannerConfig::edge_resolution`]) along segments and arcs.
+///
+/// # Errors
+/// A [`PlanError`]: the typed reason, and the statistics of the attempt.
+pub fn plan<C: CollisionChecker + ?Sized>(
+    checker: &mut C,
+    start: &[f64; 6],
+    goals: &GoalSet,
+    config: &PlannerConfig,
+) -> Result<PlannedMotion, PlanError> {
+    let started = Instant::now();
+    let mut stats = PlanStats {
+        goals: goals.len(),
+        ..PlanStats::default()
+    };
+    let mut checker = Counting::new(checker);
+    let fail = |reason: PlanFailure, mut stats: PlanStats, checks: u64| {
+        stats.collision_checks = checks;
+        stats.planning_time = started.elapsed();
+        Err(PlanError {
+            reason,
+            stats: Box::new(stats),
+        })
+    };
+    if let Err(e) = config.check() {
+        return fail(PlanFailure::InvalidQuery { reason: e }, stats, 0);
+    }
+    let res = config.edge_resolution();
+    if !in_bounds(start, config) {
+        let reason = format!(
+            "start {start:?} is not finite or lies outside the joint bounds {:?} (radians)",
+            config.bounds
+        );
+        return fail(PlanFailure::InvalidQuery { reason }, stats, 0);
+    }
+    if !checker.is_free(start) {
+        let collisions = checker.collisions(start);
+        return fail(
+            PlanFailure::StartInCollision { collisions },
+            stats,
+            checker.checks,
+        );
+    }
+    if goals.is_empty() {
+        let reason = goals
+            .ik_failure
+            .clone()
+            .unwrap_or_else(|| "the goal set is empty".into());
+        return fail(PlanFailure::NoGoal { reason }, stats, checker.checks);
+    }
+    let inside: Vec<usize> = (0..goals.len())
+        .filter(|&i| in_bounds(&goals.configs[i], config))
+        .collect();
+    let out_of_bounds = goals.len() - inside.len();
+    if inside.is_empty() {
+        let reason = format!("all {out_of_bounds} goal configurations lie outside the joint bounds");
+        return fail(PlanFailure::NoGoal { reason }, stats, checker.checks);
+    }
+    let mut free: Vec<usize> = Vec::with_capacity(inside.len());
+    let mut blocked: Vec<usize> = Vec::new();
+    for &i in &inside {
+        if checker.is_free(&goals.configs[i]) {
+            free.push(i);
+        } else {
+            blocked.push(i);
+        }
+    }
+    stats.free_goals = free.len();
+    if free.is_empty() {
+        let named: Vec<_> = blocked
+            .iter()
+            .take(NAMED_GOALS)
+            .map(|&i| checker.collisions(&goals.configs[i]))
+            .collect();
+        let reason = PlanFailure::GoalInCollision {
+            goals: goals.len(),
+            out_of_bounds,
+            in_collision: blocked.len(),
+            collisions: tally(named),
+        };
+        return fail(reason, stats, checker.checks);
+    }
+    // The direct segment to each free goal not much farther than the nearest, in the set's order.
+    let mut found: Option<(Vec<[f64; 6]>, usize)> = None;
+    let nearest = free
+        .iter()
+        .map(|&i| distance(start, &goals.configs[i]))
+        .fold(f64::INFINITY, f64::min);
+    for &i in &free {
+        let g = &goals.configs[i];
+        if distance(start, g) > DIRECT_SLACK * nearest {
+            continue;
+        }
+        if check_segment(&mut checker, start, g, &res).is_ok() {
+            found = Some((vec![*start, *g], i));
+            stats.direct = true;
+            break;
+        }
+    }
+    if found.is_none() {
+        let free_configs: Vec<[f64; 6]> = free.iter().map(|&i| goals.configs[i]).collect();
+        let (outcome, log) = rrt_connect(&mut checker, start, &free_configs, config, started);
+        stats.iterations = log.iterations;
+        stats.nodes = log.nodes;
+        match outcome {
+            Search::Found { path, goal } => found = Some((path, free[goal])),
+            Search::Exhausted => {
+                let named: Vec<_> = log.blocked.iter().map(|q| checker.collisions(q)).collect();
+                let reason = PlanFailure::SearchExhausted {
+                    iterations: log.iterations,
+                    nodes: log.nodes,
+                    blocking: tally(named),
+                };
+                return fail(reason, stats, checker.checks);
+            }
+            Search::TimeCap => {
+                let reason = PlanFailure::TimeCap {
+                    cap_s: config.time_cap.map_or(0.0, |d| d.as_secs_f64()),
+                    iterations: log.iterations,
+                };
+                return fail(reason, stats, checker.checks);
+            }
+        }
+    }
+    let (raw_path, goal) = found.expect("set above");
+    stats.raw_length = path_length(&raw_path);
+    let path = if raw_path.len() > 2 {
+        shortcut(
+            &mut checker,
+            raw_path.clone(),
+            config.shortcut_attempts,
+            &res,
+            config.seed,
+        )
+    } else {
+        raw_path.clone()
+    };
+    stats.length = path_length(&path);
+    stats.waypoints = path.len();
+    let smoothed = smooth(&mut checker, &path, config.blend_deviation, &res);
+    stats.blends = smoothed.blends;
+    let trajectory = PathTrajectory::new(smoothed, path, &config.limits);
+    stats.duration = crate::motion::trajectory::Trajectory::duration(&trajectory);
+    stats.collision_checks = checker.checks;
+    stats.planning_time = started.elapsed();
+    debug_assert!(distance(&trajectory.start(), start) == 0.0);
+    Ok(PlannedMotion {
+        goal,
+        raw_path,
+        trajectory,
+        stats,
+    })
+}

@@ -1,0 +1,390 @@
+//! The planner on a synthetic checker (boxes in joint space): direct motions, detours, goal
+//! sets, determinism, every failure reason, and the timing's limits.
+
+use std::time::Duration;
+
+use super::*;
+use crate::motion::Trajectory;
+
+const FULL: (f64, f64) = (-7.0, 7.0);
+
+/// Half the default edge resolution (and a hair): the margin that makes checking at the
+/// resolution exact for boxes in joint space.
+const HALF_RES: f64 = 0.025 + 1e-9;
+
+/// A wall across joint 1 at `[lo, hi]`, spanning joint 2 over `[lo2, hi2]` and every other joint.
+fn wall(name: &str, (lo, hi): (f64, f64), (lo2, hi2): (f64, f64)) -> JointBox {
+    JointBox::new(
+        name,
+        [lo, lo2, FULL.0, FULL.0, FULL.0, FULL.0],
+        [hi, hi2, FULL.1, FULL.1, FULL.1, FULL.1],
+    )
+}
+
+fn q(a: f64, b: f64) -> [f64; 6] {
+    [a, b, 0.0, 0.0, 0.0, 0.0]
+}
+
+/// Every configuration the trajectory passes through, sampled every 2 ms, is free of the boxes
+/// themselves (the planner checked them grown by half its resolution).
+fn assert_trajectory_free(checker: &JointBoxes, t: &PathTrajectory) {
+    let mut checker = JointBoxes::new(checker.boxes.clone());
+    let n = (t.duration() / 0.002).ceil() as usize;
+    for k in 0..=n {
+        let (qk, _) = t.sample(k as f64 * 0.002);
+        assert!(
+            checker.collisions(&qk).is_empty(),
+            "t = {:.3} s: {qk:?} collides: {:?}",
+            k as f64 * 0.002,
+            checker.collisions(&qk)
+        );
+    }
+}
+
+#[test]
+fn a_free_query_is_the_direct_segment_without_search() {
+    let mut c = JointBoxes::default();
+    let goal = [0.5, -1.0, 1.2, -0.3, 0.4, 2.0];
+    let m = plan(
+        &mut c,
+        &crate::motion::HOME_Q,
+        &GoalSet::configs(vec![goal]),
+        &PlannerConfig::default(),
+    )
+    .unwrap();
+    assert!(m.stats.direct);
+    assert_eq!(m.stats.iterations, 0);
+    assert_eq!(m.raw_path.len(), 2);
+    assert_eq!(m.trajectory.end(), goal);
+    assert_eq!(m.trajectory.sample(m.trajectory.duration() + 1.0).0, goal);
+    assert_eq!(m.trajectory.sample(0.0).0, crate::motion::HOME_Q);
+    assert!(m.stats.collision_checks > 2 && m.stats.duration > 0.0);
+}
+
+#[test]
+fn a_wall_in_the_way_is_gone_around_and_every_configuration_on_the_way_is_free() {
+    let mut c = JointBoxes::new(vec![wall("post", (-0.3, 0.3), (-1.0, 1.0))]).with_margin(HALF_RES);
+    let (start, goal) = (q(-1.0, 0.0), q(1.0, 0.0));
+    let m = plan(
+        &mut c,
+        &start,
+        &GoalSet::configs(vec![goal]),
+        &PlannerConfig::default(),
+    )
+    .unwrap();
+    assert!(!m.stats.direct);
+    assert!(m.stats.iterations > 0 && m.stats.nodes > 2);
+    assert!(m.raw_path.len() >= 3);
+    // Around the post: some waypoint clears it in joint 2.
+    assert!(
+        m.trajectory.waypoints().iter().any(|w| w[1].abs() > 1.0),
+        "{:?}",
+        m.trajectory.waypoints()
+    );
+    assert!(m.stats.length <= m.stats.raw_length + 1e-12);
+    assert!(m.stats.length >= 2.0);
+    assert_eq!(m.trajectory.end(), goal);
+    assert_trajectory_free(&c, &m.trajectory);
+}
+
+#[test]
+fn the_planner_chooses_a_reachable_goal_of_the_set() {
+    // The first goal is boxed in (free itself, but enclosed by a shell); the second is open.
+    let shell = |name: &str, lo: f64, hi: f64| wall(name, (lo, hi), FULL);
+    let mut c = JointBoxes::new(vec![shell("left", 1.6, 1.8), shell("right", 2.2, 2.4)]);
+    let goals = GoalSet::configs(vec![q(2.0, 0.0), q(-2.0, 0.5)]);
+    let m = plan(&mut c, &q(0.0, 0.0), &goals, &PlannerConfig::default()).unwrap();
+    assert_eq!(m.goal, 1);
+    assert_eq!(m.trajectory.end(), q(-2.0, 0.5));
+}
+
+fn bits(path: &[[f64; 6]]) -> Vec<u64> {
+    path.iter().flatten().map(|v| v.to_bits()).collect()
+}
+
+#[test]
+fn the_same_seed_gives_the_same_path_bit_for_bit() {
+    let boxes = vec![
+        wall("post", (-0.3, 0.3), (-1.0, 1.0)),
+        wall("shelf", (0.6, 0.9), (0.5, 3.0)),
+    ];
+    let run = |seed: u64| {
+        let mut c = JointBoxes::new(boxes.clone());
+        let config = PlannerConfig {
+            seed,
+            ..PlannerConfig::default()
+        };
+        let m = plan(
+            &mut c,
+            &q(-1.0, 0.0),
+            &GoalSet::configs(vec![q(1.5, 0.0)]),
+            &config,
+        )
+        .unwrap();
+        let samples: Vec<u64> = (0..50)
+            .flat_map(|k| m.trajectory.sample(k as f64 * 0.05).0)
+            .map(f64::to_bits)
+            .collect();
+        (
+            bits(&m.raw_path),
+            bits(m.trajectory.waypoints()),
+            samples,
+            m.stats.collision_checks,
+        )
+    };
+    let a = run(11);
+    assert_eq!(a, run(11));
+    let b = run(12);
+    assert_ne!(a.0, b.0, "another seed searches differently");
+}
+
+#[test]
+fn a_start_in_collision_names_the_pair() {
+    let mut c = JointBoxes::new(vec![wall("table", (-0.5, 0.5), FULL)]);
+    let e = plan(
+        &mut c,
+        &q(0.0, 0.0),
+        &GoalSet::configs(vec![q(1.0, 0.0)]),
+        &PlannerConfig::default(),
+    )
+    .unwrap_err();
+    match &e.reason {
+        PlanFailure::StartInCollision { collisions } => {
+            assert_eq!(collisions.len(), 1);
+            assert_eq!(collisions[0].pair(), "arm–table");
+            assert!(collisions[0].distance < 0.0);
+        }
+        r => panic!("{r}"),
+    }
+    assert_eq!(e.reason.name(), "start_in_collision");
+    assert!(e.to_string().contains("arm in table"), "{e}");
+    assert_eq!(e.stats.collision_checks, 1);
+}
+
+#[test]
+fn goals_all_in_collision_are_counted_and_named() {
+    let mut c = JointBoxes::new(vec![wall("bin_wall", (0.9, 1.1), FULL)]);
+    let mut out = q(0.0, 0.0);
+    out[2] = 9.0; // outside the elbow's ±π
+    let goals = GoalSet::configs(vec![q(1.0, 0.0), q(1.0, 0.7), out]);
+    let e = plan(&mut c, &q(-1.0, 0.0), &goals, &PlannerConfig::default()).unwrap_err();
+    match &e.reason {
+        PlanFailure::GoalInCollision {
+            goals,
+            out_of_bounds,
+            in_collision,
+            collisions,
+        } => {
+            assert_eq!((*goals, *out_of_bounds, *in_collision), (3, 1, 2));
+            assert_eq!(collisions[0].0.pair(), "arm–bin_wall");
+            assert_eq!(collisions[0].1, 2);
+        }
+        r => panic!("{r}"),
+    }
+    assert_eq!(e.reason.name(), "goal_in_collision");
+    assert!(e.to_string().contains("2 in collision, 1 outside"), "{e}");
+}
+
+#[test]
+fn no_ik_solution_is_no_goal_with_the_ik_reason() {
+    let mut c = JointBoxes::default();
+    let goals = GoalSet::down(
+        &nalgebra::Vector3::new(2.0, 0.0, 0.2),
+        0.0,
+        false,
+        &crate::motion::HOME_Q,
+    );
+    let e = plan(&mut c, &crate::motion::HOME_Q, &goals, &PlannerConfig::default()).unwrap_err();
+    assert_eq!(e.reason.name(), "no_goal");
+    assert!(
+        e.to_string().contains("no IK solution") && e.to_string().contains("reach"),
+        "{e}"
+    );
+    let mut out = q(0.0, 0.0);
+    out[2] = 4.0;
+    let e = plan(
+        &mut c,
+        &q(0.0, 0.0),
+        &GoalSet::configs(vec![out]),
+        &PlannerConfig::default(),
+    )
+    .unwrap_err();
+    assert_eq!(e.reason.name(), "no_goal");
+    assert!(e.to_string().contains("outside the joint bounds"), "{e}");
+}
+
+#[test]
+fn a_disconnected_goal_exhausts_the_search_and_names_what_blocked_it() {
+    let mut c = JointBoxes::new(vec![wall("fence", (-0.2, 0.2), FULL)]);
+    let config = PlannerConfig {
+        max_iterations: 300,
+        ..PlannerConfig::default()
+    };
+    let e = plan(
+        &mut c,
+        &q(-1.0, 0.0),
+        &GoalSet::configs(vec![q(1.0, 0.0)]),
+        &config,
+    )
+    .unwrap_err();
+    match &e.reason {
+        PlanFailure::SearchExhausted {
+            iterations,
+            nodes,
+            blocking,
+        } => {
+            assert_eq!(*iterations, 300);
+            assert!(*nodes > 2);
+            assert_eq!(blocking[0].0.pair(), "arm–fence");
+        }
+        r => panic!("{r}"),
+    }
+    assert_eq!(e.reason.name(), "search_exhausted");
+    assert_eq!(e.stats.iterations, 300);
+}
+
+#[test]
+fn the_node_cap_also_ends_the_search() {
+    let mut c = JointBoxes::new(vec![wall("fence", (-0.2, 0.2), FULL)]);
+    let config = PlannerConfig {
+        max_nodes: 40,
+        ..PlannerConfig::default()
+    };
+    let e = plan(
+        &mut c,
+        &q(-1.0, 0.0),
+        &GoalSet::configs(vec![q(1.0, 0.0)]),
+        &config,
+    )
+    .unwrap_err();
+    assert_eq!(e.reason.name(), "search_exhausted");
+    assert!(e.stats.nodes <= 40 + 20, "{}", e.stats.nodes);
+}
+
+#[test]
+fn the_time_cap_ends_the_search_with_its_own_reason() {
+    let mut c = JointBoxes::new(vec![wall("fence", (-0.2, 0.2), FULL)]);
+    let config = PlannerConfig {
+        time_cap: Some(Duration::ZERO),
+        ..PlannerConfig::default()
+    };
+    let e = plan(
+        &mut c,
+        &q(-1.0, 0.0),
+        &GoalSet::configs(vec![q(1.0, 0.0)]),
+        &config,
+    )
+    .unwrap_err();
+    assert!(
+        matches!(e.reason, PlanFailure::TimeCap { iterations: 0, .. }),
+        "{}",
+        e.reason
+    );
+    assert_eq!(e.reason.name(), "time_cap");
+}
+
+#[test]
+fn a_malformed_query_is_refused_before_any_check() {
+    let mut c = JointBoxes::default();
+    let mut start = q(0.0, 0.0);
+    start[3] = f64::NAN;
+    let e = plan(
+        &mut c,
+        &start,
+        &GoalSet::configs(vec![q(1.0, 0.0)]),
+        &PlannerConfig::default(),
+    )
+    .unwrap_err();
+    assert_eq!(e.reason.name(), "invalid_query");
+    let bad = PlannerConfig {
+        range: -1.0,
+        ..PlannerConfig::default()
+    };
+    let e = plan(&mut c, &q(0.0, 0.0), &GoalSet::configs(vec![q(1.0, 0.0)]), &bad).unwrap_err();
+    assert_eq!(e.reason.name(), "invalid_query");
+    assert_eq!(c.checks, 0);
+}
+
+#[test]
+fn the_timed_trajectory_keeps_every_joint_within_its_speed_and_acceleration() {
+    let mut c = JointBoxes::new(vec![
+        wall("post", (-0.3, 0.3), (-1.0, 1.0)),
+        JointBox::new(
+            "block",
+            [0.8, -7.0, -0.5, -7.0, -7.0, -7.0],
+            [1.2, 7.0, 0.5, 7.0, 7.0, 7.0],
+        ),
+    ])
+    .with_margin(HALF_RES);
+    let limits = JointLimits {
+        velocity: [3.0, 2.5, 3.0, 1.0, 2.0, 3.0],
+        acceleration: [15.0, 10.0, 12.0, 5.0, 8.0, 15.0],
+    };
+    let config = PlannerConfig {
+        limits,
+        seed: 3,
+        ..PlannerConfig::default()
+    };
+    let goal = [2.0, 0.3, 1.0, 1.5, -0.5, 0.2];
+    let m = plan(&mut c, &q(-1.0, 0.0), &GoalSet::configs(vec![goal]), &config).unwrap();
+    assert!(
+        m.stats.blends > 0 || m.stats.waypoints == 2,
+        "{}",
+        m.stats.summary()
+    );
+    let t = &m.trajectory;
+    let dt = 1e-4;
+    let n = (t.duration() / dt).ceil() as usize;
+    let (mut vmax, mut amax) = ([0.0f64; 6], [0.0f64; 6]);
+    let mut prev = t.sample(0.0).0;
+    for k in 0..=n {
+        let tk = k as f64 * dt;
+        let (qk, qd, qdd) = t.sample_full(tk);
+        for j in 0..6 {
+            vmax[j] = vmax[j].max(qd[j].abs());
+            amax[j] = amax[j].max(qdd[j].abs());
+            // The reported velocity is the derivative of the position.
+            if k > 0 {
+                let fd = (qk[j] - prev[j]) / dt;
+                assert!(
+                    fd.abs() <= limits.velocity[j] * (1.0 + 1e-6) + 1e-9,
+                    "joint {j} at {tk}: {fd}"
+                );
+            }
+        }
+        prev = qk;
+    }
+    for j in 0..6 {
+        assert!(
+            vmax[j] <= limits.velocity[j] * (1.0 + 1e-9),
+            "joint {j} speed {}",
+            vmax[j]
+        );
+        assert!(
+            amax[j] <= limits.acceleration[j] * (1.0 + 1e-9),
+            "joint {j} acceleration {}",
+            amax[j]
+        );
+    }
+    // Some joint runs at its limit somewhere (the profile is not needlessly slow).
+    assert!((0..6).any(|j| vmax[j] > 0.95 * limits.velocity[j]), "{vmax:?}");
+    assert_eq!(t.sample(0.0).1, [0.0; 6]);
+    assert_eq!(t.sample(t.duration()).0, goal);
+    assert_trajectory_free(&c, t);
+}
+
+#[test]
+fn the_stats_summary_is_one_line_with_the_counts() {
+    let mut c = JointBoxes::new(vec![wall("post", (-0.3, 0.3), (-1.0, 1.0))]);
+    let m = plan(
+        &mut c,
+        &q(-1.0, 0.0),
+        &GoalSet::configs(vec![q(1.0, 0.0)]),
+        &PlannerConfig::default(),
+    )
+    .unwrap();
+    let s = m.stats.summary();
+    assert!(!s.contains('\n'));
+    assert!(s.contains(&format!("{} nodes", m.stats.nodes)), "{s}");
+    assert_eq!(m.stats.collision_checks, c.checks);
+}

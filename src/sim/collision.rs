@@ -1,0 +1,474 @@
+//! [`SceneChecker`]: the planner's [`CollisionChecker`] on MuJoCo's own geometry of the cell —
+//! a scratch `MjData` of a private copy of the scene's model, posed by `mj_kinematics` and tested
+//! by `mj_collision`.
+//!
+//! What is checked: every collidable geom of the UR5e and the 2F-85 against every collidable
+//! geom of the scene (the table, containers, obstacles, the blocks at their snapshot poses) and
+//! against the robot's own geoms, and, when a block is held, that block (posed rigidly from the
+//! pinch) against the scene and the arm. Pairs that cannot change with the arm's joints are never
+//! tested: geoms moved by the same arm joint (a link's own geoms; the gripper's geoms with each
+//! other and with a held block, the fingers being held at their snapshot opening), the robot's
+//! fixed base against the table, and scene objects against each other. MuJoCo's own filters
+//! (parent–child bodies, `<exclude>`) still apply. The private copy implements this with
+//! contact bitmasks (one bit per arm joint) and sets the clearance margin as `geom_margin` on the
+//! moving geoms, so MuJoCo reports every pair closer than the margin; the scene's model is not
+//! changed.
+//!
+//! One checker per thread: it owns its `MjData`. [`SceneChecker::sync`] takes a new snapshot
+//! (block poses, container and obstacle poses, the gripper's opening) from the running
+//! simulation without copying the model again.
+
+use std::sync::Arc;
+
+use mujoco_rs::prelude::*;
+use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
+
+use super::error::SimError;
+use super::scene::{ARM_JOINTS, Scene};
+use crate::motion::fk;
+use crate::motion::plan::{Collision, CollisionChecker};
+use crate::scene::OBJECT_PREFIX;
+
+/// Default clearance margin, metres: the arm, gripper and held block must stay this far from
+/// everything they must not touch.
+pub const DEFAULT_MARGIN: f64 = 0.005;
+
+/// Largest clearance margin accepted, metres.
+pub const MAX_MARGIN: f64 = 0.1;
+
+/// The arm-joint group of the wrist 3 link, which carries the gripper and a held block.
+const WRIST_3: u8 = 6;
+
+/// A block held in the gripper: posed from the pinch at query time.
+#[derive(Clone, Debug)]
+struct Held {
+    /// Scene index of the block.
+    object: usize,
+    /// `qpos` address of its free joint.
+    qpos: usize,
+    /// Its pose in the pinch frame.
+    in_pinch: Isometry3<f64>,
+}
+
+/// A MuJoCo collision checker of the cell for the motion planner (see the module docs).
+pub struct SceneChecker {
+    scene: Scene,
+    data: MjData<Arc<MjModel>>,
+    /// Arm group of each geom: 0 = fixed (scene, robot base), 1..=6 = moved by that arm joint.
+    group: Vec<u8>,
+    /// Collidable in the scene's model (contype or conaffinity set).
+    collidable: Vec<bool>,
+    /// A label per geom for messages.
+    labels: Vec<String>,
+    /// The snapshot's arm joints, radians.
+    snapshot_q: [f64; 6],
+    held: Option<Held>,
+    margin: f64,
+    /// What the private data was built for: (held block, margin bits); `None` before the first
+    /// build.
+    built_for: Option<BuildKey>,
+    /// Private data built before for other (held block, margin) pairs, so a hold or release
+    /// swaps data instead of copying the model again (a copy takes tens of milliseconds).
+    built: Vec<(BuildKey, MjData<Arc<MjModel>>)>,
+}
+
+/// What a private model is edited for: the held block (scene index), the margin's bits.
+type BuildKey = (Option<usize>, u64);
+
+/// Most private data kept for other (held block, margin) pairs.
+const MAX_BUILT: usize = 16;
+
+/// `a` if the geom's name is set, else its body's; the scene-object prefix dropped; the floor
+/// is `table`.
+fn label(m: &MjModel, g: usize) -> String {
+    let name = m
+        .id_to_name(MjtObjBase::mjOBJ_GEOM, g)
+        .unwrap_or_default()
+        .to_string();
+    let name = if name.is_empty() {
+        let b = m.geom_bodyid()[g] as usize;
+        m.id_to_name(MjtObjBase::mjOBJ_BODY, b)
+            .unwrap_or_default()
+            .to_string()
+    } else {
+        name
+    };
+    if name == "floor" {
+        return "table".into();
+    }
+    name.strip_prefix(OBJECT_PREFIX)
+        .map(str::to_string)
+        .unwrap_or(name)
+}
+
+impl SceneChecker {
+    /// A checker of `scene` with its current state taken from `data` (a running simulation's
+    /// data of the same scene: block, container and obstacle poses, the gripper's opening) and a
+    /// clearance `margin` in metres (0 to [`MAX_MARGIN`]).
+    ///
+    /// # Errors
+    /// A margin out of range, or `data` not of this scene's model.
+    pub fn new(scene: &Scene, data: &MjData<Arc<MjModel>>, margin: f64) -> Result<Self, SimError> {
+        if !(margin.is_finite() && (0.0..=MAX_MARGIN).contains(&margin)) {
+            return Err(SimError::Scene(format!(
+                "collision margin {margin} m: use a value in [0, {MAX_MARGIN}] metres"
+            )));
+        }
+        let src = &scene.model;
+        let ngeom = src.ffi().ngeom as usize;
+        if data.qpos().len() != src.ffi().nq as usize || data.mocap_pos().len() != src.ffi().nmocap as usize {
+            return Err(SimError::Scene(
+                "the checker's snapshot is not of this scene's model".into(),
+            ));
+        }
+        let arm_joints: Vec<usize> = ARM_JOINTS
+            .iter()
+            .map(|n| {
+                src.name_to_id(MjtObjBase::mjOBJ_JOINT, &format!("ur5e/{n}_joint"))
+                    .ok_or_else(|| SimError::Scene(format!("no joint ur5e/{n}_joint")))
+            })
+            .collect::<Result<_, _>>()?;
+        let (parent, jadr, jnum) = (src.body_parentid(), src.body_jntadr(), src.body_jntnum());
+        let body_group = |mut b: usize| -> u8 {
+            while b != 0 {
+                let (a, n) = (jadr[b], jnum[b]);
+                if a >= 0 {
+                    for j in a as usize..(a + n) as usize {
+                        if let Some(k) = arm_joints.iter().position(|&x| x == j) {
+                            return k as u8 + 1;
+                        }
+                    }
+                }
+                b = parent[b] as usize;
+            }
+            0
+        };
+        let group: Vec<u8> = src
+            .geom_bodyid()
+            .iter()
+            .map(|&b| body_group(b as usize))
+            .collect();
+        let collidable: Vec<bool> = (0..ngeom)
+            .map(|g| src.geom_contype()[g] != 0 || src.geom_conaffinity()[g] != 0)
+            .collect();
+        let labels = (0..ngeom).map(|g| label(src, g)).collect();
+        let mut checker = Self {
+            scene: scene.clone(),
+            // Replaced by a private copy of the model in `rebuild_model` below.
+            data: MjData::new(scene.model.clone()),
+            group,
+            collidable,
+            labels,
+            snapshot_q: [0.0; 6],
+            held: None,
+            margin,
+            built_for: None,
+            built: Vec::new(),
+        };
+        checker.rebuild_model();
+        checker.sync(data)?;
+        Ok(checker)
+    }
+
+    /// A checker of `sim`'s scene and current state with the clearance `margin` (metres).
+    ///
+    /// # Errors
+    /// As [`SceneChecker::new`].
+    pub fn from_sim(sim: &super::Sim, margin: f64) -> Result<Self, SimError> {
+        Self::new(sim.scene(), sim.data(), margin)
+    }
+
+    /// Writes the contact bitmasks and margins of the private model for the current groups
+    /// (a held block joins the wrist-3 group) and margin.
+    fn rebuild_model(&mut self) {
+        let key = (self.held.as_ref().map(|h| h.object), self.margin.to_bits());
+        if self.built_for == Some(key) {
+            return;
+        }
+        let data = match self.built.iter().position(|(k, _)| *k == key) {
+            Some(i) => {
+                let (_, mut data) = self.built.swap_remove(i);
+                data.qpos_mut().copy_from_slice(self.data.qpos());
+                data.mocap_pos_mut().copy_from_slice(self.data.mocap_pos());
+                data.mocap_quat_mut().copy_from_slice(self.data.mocap_quat());
+                data
+            }
+            None => self.build_data(),
+        };
+        let old = std::mem::replace(&mut self.data, data);
+        if let Some(k) = self.built_for.replace(key) {
+            if self.built.len() >= MAX_BUILT {
+                self.built.remove(0);
+            }
+            self.built.push((k, old));
+        }
+    }
+
+    /// Builds every private data a hold of one of `blocks` (scene indices) needs now, so the
+    /// holds during an episode cost no model copy; the checker's state does not change.
+    ///
+    /// # Errors
+    /// An index that is not a block of the scene.
+    pub fn prepare_holds(&mut self, blocks: &[usize]) -> Result<(), SimError> {
+        let before = self.held.clone();
+        for &b in blocks {
+            let qpos = self
+                .scene
+                .objects
+                .get(b)
+                .and_then(|o| o.qpos)
+                .ok_or_else(|| SimError::Scene(format!("object {b} is not a block of the scene")))?;
+            self.held = Some(Held {
+                object: b,
+                qpos,
+                in_pinch: Isometry3::identity(),
+            });
+            self.rebuild_model();
+        }
+        self.held = before;
+        self.rebuild_model();
+        Ok(())
+    }
+
+    /// A fresh private data of the model edited for the current groups and margin.
+    fn build_data(&self) -> MjData<Arc<MjModel>> {
+        let mut group = self.group.clone();
+        if let Some(h) = &self.held {
+            let [g0, g1] = self.scene.objects[h.object].geoms;
+            for g in group.iter_mut().take(g1).skip(g0) {
+                *g = WRIST_3;
+            }
+        }
+        let margin = self.margin;
+        let collidable = self.collidable.clone();
+        // A fresh copy of the scene's model, edited, and the data rebuilt around it (only on
+        // construction, hold / release and margin changes).
+        let mut model = (*self.scene.model).clone();
+        // Bits: 0 = fixed scene geoms, 1..=6 = moved by arm joint k, 7 = the table. A geom of
+        // group k collides with every bit but its own (and but the table's for k = 1: the
+        // shoulder link only turns about the vertical axis above the table, its distance to it
+        // never changes); fixed geoms and the table collide with nothing by themselves.
+        let floor = self.scene.ids.floor_geom;
+        {
+            let ct = model.geom_contype_mut();
+            for (g, c) in ct.iter_mut().enumerate() {
+                *c = match (collidable[g], group[g]) {
+                    (false, _) => 0,
+                    (true, 0) if g == floor => 1 << 7,
+                    (true, 0) => 1,
+                    (true, k) => 1 << k,
+                };
+            }
+        }
+        {
+            let ca = model.geom_conaffinity_mut();
+            for (g, c) in ca.iter_mut().enumerate() {
+                *c = match (collidable[g], group[g]) {
+                    (false, _) | (true, 0) => 0,
+                    (true, 1) => 0x7F & !(1 << 1),
+                    (true, k) => 0xFF & !(1 << k),
+                };
+            }
+        }
+        for (g, m) in model.geom_margin_mut().iter_mut().enumerate() {
+            *m = if collidable[g] && group[g] != 0 {
+                margin
+            } else {
+                0.0
+            };
+        }
+        for (g, m) in model.geom_gap_mut().iter_mut().enumerate() {
+            if collidable[g] && group[g] != 0 {
+                *m = 0.0;
+            }
+        }
+        let mut data = MjData::new(Arc::new(model));
+        data.qpos_mut().copy_from_slice(self.data.qpos());
+        data.mocap_pos_mut().copy_from_slice(self.data.mocap_pos());
+        data.mocap_quat_mut().copy_from_slice(self.data.mocap_quat());
+        data
+    }
+
+    /// Takes a new snapshot from `data` (a running simulation of the same scene): every block's
+    /// pose, every container's and obstacle's pose, the gripper's opening and the arm's joints
+    /// (the reference for a held block's pose). A held block stays held, at its pose relative to
+    /// the pinch in this snapshot.
+    ///
+    /// # Errors
+    /// `data` not of this scene's model.
+    pub fn sync(&mut self, data: &MjData<Arc<MjModel>>) -> Result<(), SimError> {
+        if data.qpos().len() != self.data.qpos().len()
+            || data.mocap_pos().len() != self.data.mocap_pos().len()
+        {
+            return Err(SimError::Scene(
+                "the checker's snapshot is not of this scene's model".into(),
+            ));
+        }
+        self.data.qpos_mut().copy_from_slice(data.qpos());
+        self.data.mocap_pos_mut().copy_from_slice(data.mocap_pos());
+        self.data.mocap_quat_mut().copy_from_slice(data.mocap_quat());
+        let ids = &self.scene.ids;
+        self.snapshot_q = ids.arm_qpos.map(|a| data.qpos()[a]);
+        if let Some(h) = self.held.clone() {
+            self.hold(h.object)?;
+        }
+        Ok(())
+    }
+
+    /// Treats block `object` (its index in the scene) as held: from now on it moves rigidly with
+    /// the pinch, at its pose relative to the pinch in the current snapshot, and is checked
+    /// against the scene and the arm (not against the gripper holding it).
+    ///
+    /// # Errors
+    /// `object` is not a block of the scene.
+    pub fn hold(&mut self, object: usize) -> Result<(), SimError> {
+        let qpos = self
+            .scene
+            .objects
+            .get(object)
+            .and_then(|o| o.qpos)
+            .ok_or_else(|| SimError::Scene(format!("object {object} is not a block of the scene")))?;
+        let p = &self.data.qpos()[qpos..qpos + 7];
+        let block = Isometry3::from_parts(
+            Translation3::new(p[0], p[1], p[2]),
+            UnitQuaternion::from_quaternion(Quaternion::new(p[3], p[4], p[5], p[6])),
+        );
+        let in_pinch = fk(&self.snapshot_q).inverse() * block;
+        let regroup = self.held.as_ref().is_none_or(|h| h.object != object);
+        self.held = Some(Held {
+            object,
+            qpos,
+            in_pinch,
+        });
+        if regroup {
+            self.rebuild_model();
+        }
+        Ok(())
+    }
+
+    /// Lets go of a held block: it stays where the snapshot has it, as part of the scene.
+    pub fn release(&mut self) {
+        if let Some(h) = self.held.take() {
+            // Back at its snapshot pose: the pose at the snapshot's arm joints.
+            let pose = fk(&self.snapshot_q) * h.in_pinch;
+            write_pose(self.data.qpos_mut(), h.qpos, &pose);
+            self.rebuild_model();
+        }
+    }
+
+    /// The held block's scene index, if one is held.
+    pub fn held(&self) -> Option<usize> {
+        self.held.as_ref().map(|h| h.object)
+    }
+
+    /// The clearance margin, metres.
+    pub fn margin(&self) -> f64 {
+        self.margin
+    }
+
+    /// Sets the clearance margin, metres (0 to [`MAX_MARGIN`]).
+    ///
+    /// # Errors
+    /// A margin out of range (the old one stays).
+    pub fn set_margin(&mut self, margin: f64) -> Result<(), SimError> {
+        if !(margin.is_finite() && (0.0..=MAX_MARGIN).contains(&margin)) {
+            return Err(SimError::Scene(format!(
+                "collision margin {margin} m: use a value in [0, {MAX_MARGIN}] metres"
+            )));
+        }
+        if margin != self.margin {
+            self.margin = margin;
+            self.rebuild_model();
+        }
+        Ok(())
+    }
+
+    /// Poses the arm (and a held block) at `q` and runs MuJoCo's collision detection; the
+    /// number of contacts that count.
+    fn detect(&mut self, q: &[f64; 6]) -> usize {
+        let ids = self.scene.ids.arm_qpos;
+        {
+            let qpos = self.data.qpos_mut();
+            for (i, &a) in ids.iter().enumerate() {
+                qpos[a] = q[i];
+            }
+        }
+        if let Some(h) = &self.held {
+            let pose = fk(q) * h.in_pinch;
+            let at = h.qpos;
+            write_pose(self.data.qpos_mut(), at, &pose);
+        }
+        self.data.kinematics();
+        self.data.collision();
+        self.data
+            .contact()
+            .iter()
+            .filter(|c| c.dist < self.margin)
+            .count()
+    }
+}
+
+fn write_pose(qpos: &mut [f64], at: usize, pose: &Isometry3<f64>) {
+    let t = pose.translation.vector;
+    let r = pose.rotation.quaternion();
+    qpos[at..at + 7].copy_from_slice(&[t.x, t.y, t.z, r.w, r.i, r.j, r.k]);
+}
+
+impl CollisionChecker for SceneChecker {
+    fn is_free(&mut self, q: &[f64; 6]) -> bool {
+        if !q.iter().all(|v| v.is_finite()) {
+            return false;
+        }
+        self.detect(q) == 0
+    }
+
+    fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
+        if !q.iter().all(|v| v.is_finite()) {
+            return Vec::new();
+        }
+        self.detect(q);
+        let mut out: Vec<Collision> = Vec::new();
+        for c in self.data.contact() {
+            if c.dist >= self.margin {
+                continue;
+            }
+            let (g1, g2) = (c.geom[0] as usize, c.geom[1] as usize);
+            // The moving part first (the higher arm group: nearer the tool).
+            let (a, b) = if self.group_of(g1) >= self.group_of(g2) {
+                (g1, g2)
+            } else {
+                (g2, g1)
+            };
+            let (a, b) = (self.labels[a].clone(), self.labels[b].clone());
+            match out.iter_mut().find(|o| o.a == a && o.b == b) {
+                Some(o) => o.distance = o.distance.min(c.dist),
+                None => out.push(Collision {
+                    a,
+                    b,
+                    distance: c.dist,
+                }),
+            }
+        }
+        out.sort_by(|x, y| x.distance.total_cmp(&y.distance));
+        out
+    }
+}
+
+impl SceneChecker {
+    fn group_of(&self, g: usize) -> u8 {
+        match &self.held {
+            Some(h)
+                if (self.scene.objects[h.object].geoms[0]..self.scene.objects[h.object].geoms[1])
+                    .contains(&g) =>
+            {
+                WRIST_3 + 1
+            }
+            _ => self.group[g],
+        }
+    }
+
+    /// The block's pose the checker uses at `q` if it is held (world frame), for tests and logs.
+    pub fn held_pose(&self, q: &[f64; 6]) -> Option<Isometry3<f64>> {
+        self.held.as_ref().map(|h| fk(q) * h.in_pinch)
+    }
+}
