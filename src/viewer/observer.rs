@@ -63,8 +63,9 @@ pub struct ViewObserver {
     next_publish: f64,
     /// Wall-clock pacing: simulated seconds per wall second (1.0 = real time), if any.
     speed: Option<f64>,
-    /// Wall-clock origin of the pacing.
-    start: Instant,
+    /// Wall-clock origin of the pacing: set at the first tick, so the time spent building the
+    /// cell before the episode starts is not taken from the episode's pace.
+    start: Option<Instant>,
 }
 
 impl ViewObserver {
@@ -89,7 +90,7 @@ impl ViewObserver {
             recorder,
             next_publish: 0.0,
             speed,
-            start: Instant::now(),
+            start: None,
         }
     }
 
@@ -137,7 +138,11 @@ impl EpisodeObserver for ViewObserver {
         }
         if let Some(speed) = self.speed {
             let due = Duration::from_secs_f64(time / speed);
-            if let Some(wait) = due.checked_sub(self.start.elapsed()) {
+            let start = *self.start.get_or_insert_with(|| {
+                let now = Instant::now();
+                now.checked_sub(due).unwrap_or(now)
+            });
+            if let Some(wait) = due.checked_sub(start.elapsed()) {
                 std::thread::sleep(wait);
             }
         }
