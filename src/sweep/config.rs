@@ -77,10 +77,11 @@ impl SweepConfig {
         ScenarioIndices::new(self.scenarios, self.shard)
     }
 
-    /// Scenario `index` of this sweep on `scene`. A scene with `sampler: tutorial` (the built-in
-    /// `cube_bowl`) draws its cube and bowl with the documented task-region sampler
-    /// ([`sample_scenario`]), so its sweeps and reproduction commands (`--cube … --bowl …`) are
-    /// those of earlier releases; every other scene draws its own randomization
+    /// Scenario `index` of this sweep on `scene`, drawn by [`crate::episode::scenario::draw`]
+    /// (the draw the step-wise environment's resets use too). A scene with `sampler: tutorial`
+    /// (the built-in `cube_bowl`) draws its cube and bowl with the documented task-region sampler
+    /// ([`crate::sweep::sample_scenario`]), so its sweeps and reproduction commands (`--cube …
+    /// --bowl …`) are those of earlier releases; every other scene draws its own randomization
     /// ([`crate::scene::sample_placement`]).
     pub fn scene_scenario(&self, scene: &Scene, index: u64) -> Result<SceneScenario, PlacementError> {
         let draw = crate::episode::scenario::draw(scene, self.seed, index)?;
