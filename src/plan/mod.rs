@@ -103,36 +103,8 @@ pub struct LeafInfo {
 /// tag, where [`NodeInfo::kind`] is the YAML name shown to people.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
 pub enum NodeTag {
-    /// `sequence`.
-    Sequence,
-    /// `fallback`.
-    Fallback,
-    /// `reactive_sequence`.
-    ReactiveSequence,
-    /// `reactive_fallback`.
-    ReactiveFallback,
-    /// `parallel`.
-    Parallel,
-    /// `race`.
-    Race,
-    /// `guard`.
-    Guard,
-    /// `retry`.
-    Retry,
-    /// `repeat`.
-    Repeat,
-    /// `for_each`.
-    ForEach,
-    /// `timeout`.
-    Timeout,
-    /// `inverter`.
-    Inverter,
-    /// `force_success`.
-    ForceSuccess,
-    /// `force_failure`.
-    ForceFailure,
-    /// A subtree call.
-    Subtree,
+    /// A control node (composite, decorator or subtree call), by its kind.
+    Control(crate::kinds::ControlKind),
     /// A leaf: an action, a condition, `wait` or `select`.
     Leaf,
 }
@@ -140,25 +112,7 @@ pub enum NodeTag {
 impl NodeTag {
     /// The tag of a parsed node.
     pub fn of(kind: &crate::spec::NodeKind) -> NodeTag {
-        use crate::spec::NodeKind as K;
-        match kind {
-            K::Sequence(_) => NodeTag::Sequence,
-            K::Fallback(_) => NodeTag::Fallback,
-            K::ReactiveSequence(_) => NodeTag::ReactiveSequence,
-            K::ReactiveFallback(_) => NodeTag::ReactiveFallback,
-            K::Parallel(_) => NodeTag::Parallel,
-            K::Race(_) => NodeTag::Race,
-            K::Guard { .. } => NodeTag::Guard,
-            K::Retry { .. } => NodeTag::Retry,
-            K::Repeat { .. } => NodeTag::Repeat,
-            K::ForEach { .. } => NodeTag::ForEach,
-            K::Timeout { .. } => NodeTag::Timeout,
-            K::Inverter(_) => NodeTag::Inverter,
-            K::ForceSuccess(_) => NodeTag::ForceSuccess,
-            K::ForceFailure(_) => NodeTag::ForceFailure,
-            K::Subtree { .. } => NodeTag::Subtree,
-            K::Leaf(_) => NodeTag::Leaf,
-        }
+        kind.control_kind().map_or(NodeTag::Leaf, NodeTag::Control)
     }
 }
 

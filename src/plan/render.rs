@@ -1,12 +1,13 @@
 //! Diagrams of a plan with our node names and key parameters: Graphviz DOT and Mermaid.
 
+use crate::kinds::ControlKind;
 use std::fmt::Write as _;
 
 use super::{NodeTag, Plan};
 
 /// Visual family of a node: its category, with subtree calls on their own.
 fn family(n: &super::NodeInfo) -> &'static str {
-    if n.tag == NodeTag::Subtree {
+    if n.tag == NodeTag::Control(ControlKind::Subtree) {
         "subtree"
     } else {
         n.category.as_str()
@@ -45,7 +46,7 @@ pub fn to_dot(plan: &Plan) -> String {
     }
     for (i, n) in plan.nodes.iter().enumerate() {
         for (k, c) in n.children.iter().enumerate() {
-            if n.tag == NodeTag::Guard && k == 0 {
+            if n.tag == NodeTag::Control(ControlKind::Guard) && k == 0 {
                 let _ = writeln!(out, "  n{i} -> n{c} [label=\"while\", style=dashed];");
             } else {
                 let _ = writeln!(out, "  n{i} -> n{c};");
@@ -80,7 +81,7 @@ pub fn to_mermaid(plan: &Plan) -> String {
     }
     for (i, n) in plan.nodes.iter().enumerate() {
         for (k, c) in n.children.iter().enumerate() {
-            if n.tag == NodeTag::Guard && k == 0 {
+            if n.tag == NodeTag::Control(ControlKind::Guard) && k == 0 {
                 let _ = writeln!(out, "  n{i} -. while .-> n{c}");
             } else {
                 let _ = writeln!(out, "  n{i} --> n{c}");

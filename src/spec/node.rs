@@ -127,6 +127,29 @@ impl NodeKind {
         }
     }
 
+    /// The control kind of a composite, decorator or subtree call; `None` for a leaf.
+    pub fn control_kind(&self) -> Option<crate::kinds::ControlKind> {
+        use crate::kinds::ControlKind as C;
+        Some(match self {
+            NodeKind::Sequence(_) => C::Sequence,
+            NodeKind::Fallback(_) => C::Fallback,
+            NodeKind::ReactiveSequence(_) => C::ReactiveSequence,
+            NodeKind::ReactiveFallback(_) => C::ReactiveFallback,
+            NodeKind::Parallel(_) => C::Parallel,
+            NodeKind::Race(_) => C::Race,
+            NodeKind::Guard { .. } => C::Guard,
+            NodeKind::Retry { .. } => C::Retry,
+            NodeKind::Repeat { .. } => C::Repeat,
+            NodeKind::ForEach { .. } => C::ForEach,
+            NodeKind::Timeout { .. } => C::Timeout,
+            NodeKind::Inverter(_) => C::Inverter,
+            NodeKind::ForceSuccess(_) => C::ForceSuccess,
+            NodeKind::ForceFailure(_) => C::ForceFailure,
+            NodeKind::Subtree { .. } => C::Subtree,
+            NodeKind::Leaf(_) => return None,
+        })
+    }
+
     /// The children in tick order (a guard's condition comes first).
     pub fn children(&self) -> Vec<&Node> {
         match self {

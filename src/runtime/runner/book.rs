@@ -1,6 +1,7 @@
 //! The status book: every node's status, reason, attempt and counts, the transitions and
 //! the blackboard writes, as the runner records them.
 
+use crate::kinds::ControlKind;
 use tracing::Level;
 
 use super::{MAX_PENDING_TRANSITIONS, display_name};
@@ -81,13 +82,13 @@ impl RunState {
                 let mut a = ancestors[p].clone();
                 a.push(p);
                 ancestors[i] = a;
-                enclosing_retry[i] = if plan.nodes[p].tag == NodeTag::Retry {
+                enclosing_retry[i] = if plan.nodes[p].tag == NodeTag::Control(ControlKind::Retry) {
                     Some(p)
                 } else {
                     enclosing_retry[p]
                 };
             }
-            if plan.nodes[i].tag == NodeTag::Retry {
+            if plan.nodes[i].tag == NodeTag::Control(ControlKind::Retry) {
                 enclosing_retry[i] = Some(i);
             }
         }
@@ -139,11 +140,11 @@ impl RunState {
             || info.parent.is_none()
             || matches!(
                 info.tag,
-                NodeTag::Retry
-                    | NodeTag::Guard
-                    | NodeTag::Timeout
-                    | NodeTag::ReactiveSequence
-                    | NodeTag::ReactiveFallback
+                NodeTag::Control(ControlKind::Retry)
+                    | NodeTag::Control(ControlKind::Guard)
+                    | NodeTag::Control(ControlKind::Timeout)
+                    | NodeTag::Control(ControlKind::ReactiveSequence)
+                    | NodeTag::Control(ControlKind::ReactiveFallback)
             )
         {
             Level::INFO
@@ -277,7 +278,9 @@ impl RunState {
             if self.statuses[a] != NodeStatus::Running {
                 if matches!(
                     plan.nodes[a].tag,
-                    NodeTag::Retry | NodeTag::Repeat | NodeTag::ForEach
+                    NodeTag::Control(ControlKind::Retry)
+                        | NodeTag::Control(ControlKind::Repeat)
+                        | NodeTag::Control(ControlKind::ForEach)
                 ) {
                     self.attempts[a] = 1;
                 }
@@ -303,7 +306,7 @@ impl RunState {
                 .caused_by(last.clone())
         };
         match info.tag {
-            NodeTag::Timeout => {
+            NodeTag::Control(ControlKind::Timeout) => {
                 let child_failed = info.children.first().is_some_and(|&c| {
                     self.statuses[c] == NodeStatus::Failure && self.touched[c] == self.tick
                 });
@@ -313,17 +316,17 @@ impl RunState {
                     Failure::new(FailureKind::Timeout, format!("{} expired", info.label)).at(&info.path)
                 }
             }
-            NodeTag::Retry => wrap(format!(
+            NodeTag::Control(ControlKind::Retry) => wrap(format!(
                 "all {} attempts failed; last: {last}",
                 self.attempts[node].max(1)
             )),
-            NodeTag::Inverter => {
+            NodeTag::Control(ControlKind::Inverter) => {
                 Failure::new(FailureKind::Inverted, "inverter: child succeeded").at(&info.path)
             }
-            NodeTag::ForceFailure => {
+            NodeTag::Control(ControlKind::ForceFailure) => {
                 Failure::new(FailureKind::Forced, "force_failure: child succeeded").at(&info.path)
             }
-            NodeTag::Guard | NodeTag::ReactiveSequence => {
+            NodeTag::Control(ControlKind::Guard) | NodeTag::Control(ControlKind::ReactiveSequence) => {
                 let cond_failed = info
                     .children
                     .iter()

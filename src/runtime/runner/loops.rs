@@ -1,6 +1,7 @@
 //! Loops and decorators bonsai answers through internal leaves: retry attempts, repeats,
 //! `for_each` iterations, timeouts, guards.
 
+use crate::kinds::ControlKind;
 use bonsai_bt::Status;
 
 use super::book::RunState;
@@ -53,7 +54,7 @@ impl RunState {
                 let reset = self.reset_below(plan, node);
                 self.attempts[node] = iteration;
                 let info = &plan.nodes[node];
-                if info.tag == NodeTag::Retry {
+                if info.tag == NodeTag::Control(ControlKind::Retry) {
                     tracing::info!(
                         target: "macrotree::tree",
                         tick = self.tick,
