@@ -358,6 +358,7 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
         objects,
         goal: Goal::default(),
         sampler: Sampler::default(),
+        spots: Vec::new(),
     };
     let goal = match goal_v {
         Some(g) => read_goal(g, &scene, issues),

@@ -29,7 +29,7 @@ pub use load::{BUILTIN_CUBE_BOWL, SceneFileSchema, is_object_name, load_scene_fi
 pub use sample::{MAX_DRAWS, Placement, PlacementError, sample_placement};
 pub use types::{
     CONTAINER_FLOOR, CONTAINER_WALL, ObjectKind, ObjectSpec, Pose, ROBOT_BASE_RADIUS, RandomPlacement,
-    Sampler, SceneSpec, Shape, reach_limits,
+    Sampler, SceneSpec, Shape, Spot, reach_limits,
 };
 
 /// Prefix of every scene object's MuJoCo names (`obj/red`, `obj/bin/wall_px`), so that a user's

@@ -182,6 +182,20 @@ pub enum Sampler {
     Tutorial,
 }
 
+/// A named place on the table (the scene file's `spots:`): a point and a yaw, usable as a
+/// `carry`/`place` target, a goal point and a blackboard value.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Spot {
+    /// The spot's name (`[a-z][a-z0-9_]*`), unique among the scene's spots and objects.
+    pub name: String,
+    /// Centre x, metres.
+    pub x: f64,
+    /// Centre y, metres.
+    pub y: f64,
+    /// Yaw about world z, radians.
+    pub yaw: f64,
+}
+
 /// A loaded, validated scene.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SceneSpec {
@@ -195,6 +209,9 @@ pub struct SceneSpec {
     pub goal: Goal,
     /// How sweeps draw the starting layouts.
     pub sampler: Sampler,
+    /// Named places on the table, in file order.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub spots: Vec<Spot>,
 }
 
 impl SceneSpec {
@@ -206,6 +223,11 @@ impl SceneSpec {
     /// The object called `name`.
     pub fn object(&self, name: &str) -> Option<&ObjectSpec> {
         self.objects.iter().find(|o| o.name == name)
+    }
+
+    /// The spot called `name`.
+    pub fn spot(&self, name: &str) -> Option<&Spot> {
+        self.spots.iter().find(|s| s.name == name)
     }
 
     /// Indices of the objects of `kind`, in scene order.
