@@ -14,22 +14,39 @@ use macrotree::motion::{HOME_Q, Trajectory, down_pose, ik};
 use macrotree::scene::SceneSpec;
 use macrotree::sim::collision::{DEFAULT_MARGIN, SceneChecker};
 use macrotree::sim::{Scene, Sim};
-use nalgebra::Vector3;
+use nalgebra::{Isometry3, Unit, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-/// One query: a start, a goal pose (top-down pinch position and yaw), and the reason it must
-/// fail with, if it is infeasible by construction.
+/// One query: a start, a goal pose (top-down pinch position and yaw, or a horizontal approach),
+/// and the reason it must fail with, if it is infeasible by construction.
 struct Query {
     start: [f64; 6],
     goal: (Vector3<f64>, f64),
+    /// `Some(θ)`: the tool approaches horizontally along world direction θ (radians about z),
+    /// fingers closing horizontally; `None`: the tool points down.
+    side: Option<f64>,
     expect: Option<&'static str>,
 }
 
 struct Family {
     name: &'static str,
     scene: &'static str,
+    /// Obstacles moved after the scene is built: (scene object name, position of its bottom
+    /// centre, metres).
+    placed: &'static [(&'static str, [f64; 3])],
+    /// The collision-check budget of each query (`None`: the planner's default).
+    max_checks: Option<u64>,
     queries: fn(&mut ChaCha8Rng) -> Query,
+}
+
+/// The pinch at `position` with the tool horizontal along world direction `theta` (radians
+/// about z) and the fingers closing horizontally, across it.
+fn side_pose(position: &Vector3<f64>, theta: f64) -> Isometry3<f64> {
+    let down = down_pose(position, theta);
+    let axis = Unit::new_normalize(Vector3::new(theta.sin(), -theta.cos(), 0.0));
+    let turn = UnitQuaternion::from_axis_angle(&axis, std::f64::consts::FRAC_PI_2);
+    Isometry3::from_parts(down.translation, turn * down.rotation)
 }
 
 const OPEN: &str = "objects:
@@ -44,6 +61,16 @@ const BIN: &str = "objects:
 const POST: &str = "objects:
   cube: {block: {size: 0.044}, pose: [0.3, -0.35]}
   post: {obstacle: {size: [0.06, 0.06, 0.30]}, pose: [0.45, 0.0]}
+";
+
+/// A shelf opening in front of the arm: a bottom board 12 cm high and a top board whose bottom
+/// is at 30 cm (an 18 cm opening between the boards, 25 cm deep, 40 cm wide). The scene format
+/// stands every obstacle on the table and keeps them apart, so the top board is declared aside
+/// and moved into place in the simulation (`placed`).
+const SHELF: &str = "objects:
+  cube: {block: {size: 0.044}, pose: [0.3, -0.4]}
+  bottom: {obstacle: {size: [0.25, 0.40, 0.12]}, pose: [0.675, 0.0]}
+  top: {obstacle: {size: [0.25, 0.40, 0.02]}, pose: [0.3, 0.45]}
 ";
 
 const CLUTTER: &str = "objects:
@@ -73,6 +100,7 @@ fn open_table(r: &mut ChaCha8Rng) -> Query {
     Query {
         start,
         goal: (goal, r.random_range(-1.5..1.5)),
+        side: None,
         expect: None,
     }
 }
@@ -93,6 +121,7 @@ fn deep_bin(r: &mut ChaCha8Rng) -> Query {
     Query {
         start,
         goal: (goal, r.random_range(-0.3..0.3)),
+        side: None,
         expect: None,
     }
 }
@@ -112,6 +141,7 @@ fn tall_obstacle(r: &mut ChaCha8Rng) -> Query {
     Query {
         start,
         goal: (goal, r.random_range(-1.0..1.0)),
+        side: None,
         expect: None,
     }
 }
@@ -131,6 +161,7 @@ fn clutter(r: &mut ChaCha8Rng) -> Query {
     Query {
         start,
         goal: (goal, r.random_range(-1.0..1.0)),
+        side: None,
         expect: None,
     }
 }
@@ -142,7 +173,23 @@ fn infeasible(r: &mut ChaCha8Rng) -> Query {
         r.random_range(0.1..0.3),
         0.0,
     );
-    if r.random_bool(0.5) {
+    let pick = r.random_range(0..3u8);
+    if pick == 2 {
+        // The arm starts with its pinch inside the post.
+        let start = at(
+            0.45 + r.random_range(-0.01..0.01),
+            r.random_range(-0.01..0.01),
+            r.random_range(0.08..0.25),
+            r.random_range(-1.0..1.0),
+        );
+        return Query {
+            start,
+            goal: (Vector3::new(0.4, -0.25, 0.2), 0.0),
+            side: None,
+            expect: Some("start_in_collision"),
+        };
+    }
+    if pick == 0 {
         // Inside the post: every IK branch collides.
         let goal = Vector3::new(
             0.45 + r.random_range(-0.01..0.01),
@@ -152,6 +199,7 @@ fn infeasible(r: &mut ChaCha8Rng) -> Query {
         Query {
             start,
             goal: (goal, r.random_range(-1.5..1.5)),
+            side: None,
             expect: Some("goal_in_collision"),
         }
     } else {
@@ -164,8 +212,63 @@ fn infeasible(r: &mut ChaCha8Rng) -> Query {
         Query {
             start,
             goal: (goal, 0.0),
+            side: None,
             expect: Some("no_goal"),
         }
+    }
+}
+
+fn shelf(r: &mut ChaCha8Rng) -> Query {
+    let start = at(
+        r.random_range(0.3..0.5),
+        r.random_range(-0.4..-0.25),
+        r.random_range(0.1..0.3),
+        r.random_range(-1.0..1.0),
+    );
+    // Into the opening between the boards, approaching horizontally from the arm's side.
+    let goal = Vector3::new(
+        r.random_range(0.60..0.66),
+        r.random_range(-0.08..0.08),
+        r.random_range(0.19..0.23),
+    );
+    Query {
+        start,
+        goal: (goal, 0.0),
+        side: Some(r.random_range(-0.2..0.2)),
+        expect: None,
+    }
+}
+
+fn wrist_singular(r: &mut ChaCha8Rng) -> Query {
+    let start = at(
+        r.random_range(0.3..0.5),
+        r.random_range(-0.35..-0.15),
+        r.random_range(0.1..0.3),
+        r.random_range(-1.0..1.0),
+    );
+    // A horizontal approach across the arm's vertical plane (tangential): the wrist-3 axis lies
+    // along the wrist-1 axis there (sin q5 ≈ 0, the wrist singularity).
+    let goal: Vector3<f64> = Vector3::new(
+        r.random_range(0.35..0.5),
+        r.random_range(0.1..0.3),
+        r.random_range(0.15..0.3),
+    );
+    let tangential = goal.y.atan2(goal.x) + std::f64::consts::FRAC_PI_2;
+    Query {
+        start,
+        goal: (goal, 0.0),
+        side: Some(tangential + r.random_range(-0.05..0.05)),
+        expect: None,
+    }
+}
+
+/// A query across the post (tall_obstacle's) with a budget of 40 collision checks (the start,
+/// the goals and the first checks of the direct segments): no search fits, so a query whose
+/// direct segment is blocked must end with `search_exhausted`, naming the post.
+fn budget(r: &mut ChaCha8Rng) -> Query {
+    Query {
+        expect: Some("search_exhausted"),
+        ..tall_obstacle(r)
     }
 }
 
@@ -185,31 +288,63 @@ fn main() {
         .clamp(1, 10_000);
     // `coarse`: joint steps only (no displacement bound): faster, may graze between checks.
     let coarse = std::env::args().any(|a| a == "coarse");
+
     let families = [
         Family {
             name: "open_table",
             scene: OPEN,
+            placed: &[],
+            max_checks: None,
             queries: open_table,
         },
         Family {
             name: "deep_bin",
             scene: BIN,
+            placed: &[],
+            max_checks: None,
             queries: deep_bin,
         },
         Family {
             name: "tall_obstacle",
             scene: POST,
+            placed: &[],
+            max_checks: None,
             queries: tall_obstacle,
         },
         Family {
             name: "clutter",
             scene: CLUTTER,
+            placed: &[],
+            max_checks: None,
             queries: clutter,
+        },
+        Family {
+            name: "shelf",
+            scene: SHELF,
+            placed: &[("top", [0.675, 0.0, 0.30])],
+            max_checks: None,
+            queries: shelf,
+        },
+        Family {
+            name: "wrist_singular",
+            scene: POST,
+            placed: &[],
+            max_checks: None,
+            queries: wrist_singular,
         },
         Family {
             name: "infeasible",
             scene: POST,
+            placed: &[],
+            max_checks: None,
             queries: infeasible,
+        },
+        Family {
+            name: "budget",
+            scene: POST,
+            placed: &[],
+            max_checks: Some(40),
+            queries: budget,
         },
     ];
     println!(
@@ -239,7 +374,16 @@ fn main() {
     for f in &families {
         let spec = SceneSpec::from_str(f.scene, "bench.yaml").expect("valid scene");
         let scene = Scene::load_spec(&spec).expect("scene (run tools/bootstrap)");
-        let sim = Sim::new(&scene);
+        let mut sim = Sim::new(&scene);
+        for (name, at) in f.placed {
+            let i = spec
+                .objects
+                .iter()
+                .position(|o| o.name == *name)
+                .expect("placed object in the scene");
+            let m = scene.objects[i].mocap.expect("a mocap obstacle");
+            sim.data_mut().mocap_pos_mut()[m] = *at;
+        }
         let mut checker = SceneChecker::from_sim(&sim, DEFAULT_MARGIN).expect("checker");
         let mut exact = SceneChecker::from_sim(&sim, 0.0).expect("checker");
         let mut clean = 0;
@@ -249,21 +393,30 @@ fn main() {
         let (mut times, mut checks, mut lengths, mut durations) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let mut direct = 0;
+        let mut stages = [0u64; 4];
         let mut blocked_goal = 0;
         let mut failures: Vec<String> = Vec::new();
         for k in 0..n {
             // The arm never starts in collision: redraw until the start is free.
             let mut q = (f.queries)(&mut rng);
             for _ in 0..1000 {
-                if checker.is_free(&q.start) {
+                if q.expect == Some("start_in_collision") || checker.is_free(&q.start) {
                     break;
                 }
                 q = (f.queries)(&mut rng);
             }
-            let goals = GoalSet::down(&q.goal.0, q.goal.1, false, &q.start);
+            let goals = match q.side {
+                None => GoalSet::down(&q.goal.0, q.goal.1, false, &q.start),
+                Some(theta) => GoalSet::poses(
+                    &[side_pose(&q.goal.0, theta), side_pose(&q.goal.0, theta + std::f64::consts::PI)],
+                    &q.start,
+                ),
+            };
             let config = PlannerConfig {
                 seed: k as u64,
-                time_cap: Some(Duration::from_millis(250)),
+                max_checks: f.max_checks.unwrap_or(PlannerConfig::default().max_checks),
+                // A safety cap only: the deterministic check budget ends every search first.
+                time_cap: Some(Duration::from_secs(5)),
                 max_displacement: if coarse { f64::INFINITY } else { 0.01 },
                 ..PlannerConfig::default()
             };
@@ -273,6 +426,9 @@ fn main() {
                 Err(e) => (*e.stats).clone(),
             };
             times.push(stats.planning_time.as_secs_f64() * 1e3);
+            for (s, c) in stages.iter_mut().zip(stats.stage_checks) {
+                *s += c;
+            }
             checks.push(stats.collision_checks as f64);
             match (&out, q.expect) {
                 (Ok(m), None) => {
@@ -314,7 +470,22 @@ fn main() {
                 }
                 (Err(e), Some(want)) => {
                     infeasible += 1;
-                    right += usize::from(e.reason.name() == want);
+                    // The reason, and for an exhausted search the obstacle in the way named.
+                    let named = match &e.reason {
+                        PlanFailure::SearchExhausted { blocking, .. } => {
+                            blocking.iter().any(|(c, _)| c.b == "post")
+                        }
+                        _ => true,
+                    };
+                    if e.reason.name() == want && named {
+                        right += 1;
+                    } else {
+                        failures.push(format!("query {k}: expected {want}, got {e}"));
+                    }
+                }
+                (Ok(m), Some("search_exhausted")) if m.stats.direct => {
+                    // The direct segment was free: no search, the budget does not apply.
+                    direct += 1;
                 }
                 (Ok(_), Some(want)) => {
                     infeasible += 1;
@@ -354,6 +525,14 @@ fn main() {
             mean(&lengths),
             mean(&durations),
             reason
+        );
+        let total: u64 = stages.iter().sum::<u64>().max(1);
+        println!(
+            "    checks by stage (share): goals+direct {:.2}, search {:.2}, shortcut {:.2}, validation+blends {:.2}",
+            stages[0] as f64 / total as f64,
+            stages[1] as f64 / total as f64,
+            stages[2] as f64 / total as f64,
+            stages[3] as f64 / total as f64
         );
         if !worst.is_empty() {
             worst.sort_by(|a, b| a.distance.total_cmp(&b.distance));

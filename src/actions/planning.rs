@@ -235,6 +235,12 @@ pub(crate) fn describe(pairs: &[Collision]) -> String {
     s.join(", ")
 }
 
+/// Wall-clock safety cap of a plan under the leaves, seconds: the planner's deterministic
+/// collision-check budget ([`PlannerConfig::max_checks`], 0.1–0.2 s of checks) ends a search long
+/// before it, so the cap only fires on a machine stalled by 10× or more; it is the only
+/// outcome of a plan that depends on the machine (`no_path`, "planning stopped at its time cap").
+pub(crate) const LEAF_TIME_CAP: Duration = Duration::from_secs(2);
+
 /// Plans the arm from `start` to any of `goals` in the cell, the pairs touching at `start`
 /// allowed; logs the query; counts it in the tally. The cell's `n`-th plan of the episode is
 /// seeded with `n`, so an episode replays the same plans.
@@ -250,6 +256,7 @@ pub(crate) fn plan_motion(
     let t = Instant::now();
     let config = PlannerConfig {
         seed: 0x6d61_6372_6f74_7265 ^ u64::from(cell.planning().plans),
+        time_cap: Some(LEAF_TIME_CAP),
         ..PlannerConfig::default()
     };
     let sim_time = cell.sim().time();

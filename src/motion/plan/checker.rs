@@ -58,20 +58,36 @@ impl fmt::Display for Collision {
     }
 }
 
-/// A checker that counts the configurations it is asked about (the planner's statistics).
+/// A checker that counts the configurations it is asked about (the planner's statistics) and,
+/// while a budget is set, answers "blocked" without asking once the budget is used (a refusal
+/// never lets a collision through; it only ends the search).
 pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
     pub(crate) inner: &'a mut C,
     pub(crate) checks: u64,
+    /// Checks at most (`u64::MAX`: none).
+    pub(crate) budget: u64,
 }
 
 impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
     pub(crate) fn new(inner: &'a mut C) -> Self {
-        Self { inner, checks: 0 }
+        Self {
+            inner,
+            checks: 0,
+            budget: u64::MAX,
+        }
+    }
+
+    /// True when the budget is used.
+    pub(crate) fn spent(&self) -> bool {
+        self.checks >= self.budget
     }
 }
 
 impl<C: CollisionChecker + ?Sized> CollisionChecker for Counting<'_, C> {
     fn is_free(&mut self, q: &[f64; 6]) -> bool {
+        if self.spent() {
+            return false;
+        }
         self.checks += 1;
         self.inner.is_free(q)
     }

@@ -135,6 +135,8 @@ pub fn plan<C: CollisionChecker + ?Sized>(
     }
     // The direct segment to each free goal not much farther than the nearest, in the set's order.
     let mut found: Option<(Vec<[f64; 6]>, usize)> = None;
+    // Where the direct segments were blocked: named with the search's blocks if it fails.
+    let mut direct_hits: Vec<[f64; 6]> = Vec::new();
     let nearest = free
         .iter()
         .map(|&i| distance(start, &goals.configs[i]))
@@ -144,12 +146,16 @@ pub fn plan<C: CollisionChecker + ?Sized>(
         if distance(start, g) > DIRECT_SLACK * nearest {
             continue;
         }
-        if check_segment(&mut checker, start, g, &res).is_ok() {
-            found = Some((vec![*start, *g], i));
-            stats.direct = true;
-            break;
+        match check_segment(&mut checker, start, g, &res) {
+            Ok(()) => {
+                found = Some((vec![*start, *g], i));
+                stats.direct = true;
+                break;
+            }
+            Err(hit) => direct_hits.push(hit),
         }
     }
+    stats.stage_checks[0] = checker.checks;
     if found.is_none() {
         let free_configs: Vec<[f64; 6]> = free.iter().map(|&i| goals.configs[i]).collect();
         let (outcome, log) = rrt_connect(&mut checker, start, &free_configs, config, started);
@@ -158,10 +164,16 @@ pub fn plan<C: CollisionChecker + ?Sized>(
         match outcome {
             Search::Found { path, goal } => found = Some((path, free[goal])),
             Search::Exhausted => {
-                let named: Vec<_> = log.blocked.iter().map(|q| checker.collisions(q)).collect();
+                let named: Vec<_> = direct_hits
+                    .iter()
+                    .take(NAMED_GOALS)
+                    .chain(&log.blocked)
+                    .map(|q| checker.collisions(q))
+                    .collect();
                 let reason = PlanFailure::SearchExhausted {
                     iterations: log.iterations,
                     nodes: log.nodes,
+                    checks: checker.checks,
                     blocking: tally(named),
                 };
                 return fail(reason, stats, checker.checks);
@@ -175,6 +187,7 @@ pub fn plan<C: CollisionChecker + ?Sized>(
             }
         }
     }
+    stats.stage_checks[1] = checker.checks - stats.stage_checks[0];
     let (raw_path, goal) = found.expect("set above");
     stats.raw_length = path_length(&raw_path);
     let path = if raw_path.len() > 2 {
@@ -188,6 +201,7 @@ pub fn plan<C: CollisionChecker + ?Sized>(
     } else {
         raw_path.clone()
     };
+    stats.stage_checks[2] = checker.checks - stats.stage_checks[0] - stats.stage_checks[1];
     stats.length = path_length(&path);
     stats.waypoints = path.len();
     let smoothed = smooth(&mut checker, &path, config.blend_deviation, &res);
@@ -195,6 +209,7 @@ pub fn plan<C: CollisionChecker + ?Sized>(
     let trajectory = PathTrajectory::new(smoothed, path, &config.limits);
     stats.duration = crate::motion::trajectory::Trajectory::duration(&trajectory);
     stats.collision_checks = checker.checks;
+    stats.stage_checks[3] = checker.checks - stats.stage_checks[..3].iter().sum::<u64>();
     stats.planning_time = started.elapsed();
     debug_assert!(distance(&trajectory.start(), start) == 0.0);
     Ok(PlannedMotion {

@@ -36,17 +36,22 @@ pub enum PlanFailure {
         /// The colliding pairs, most frequent first, with how many goals each blocks.
         collisions: Vec<(Collision, usize)>,
     },
-    /// The search used its iteration or node cap without connecting start and goal.
+    /// The search used its iteration, node or collision-check budget without connecting start
+    /// and goal (deterministic: the same query always ends here).
     SearchExhausted {
         /// Iterations run.
         iterations: usize,
         /// Nodes in both trees.
         nodes: usize,
+        /// Collision checks of the whole query.
+        checks: u64,
         /// The pairs that blocked the search most (sampled from blocked extensions), most
         /// frequent first, with their counts.
         blocking: Vec<(Collision, usize)>,
     },
-    /// The optional wall-clock cap ended the search.
+    /// The wall-clock safety cap ended the search: the only outcome that depends on the
+    /// machine's speed (the budgets of [`PlanFailure::SearchExhausted`] normally end a search
+    /// first).
     TimeCap {
         /// The cap, seconds.
         cap_s: f64,
@@ -113,10 +118,11 @@ impl fmt::Display for PlanFailure {
             PlanFailure::SearchExhausted {
                 iterations,
                 nodes,
+                checks,
                 blocking,
             } => write!(
                 f,
-                "no collision-free path found in {iterations} iterations ({nodes} nodes); blocked most by {}",
+                "no collision-free path found in {iterations} iterations ({nodes} nodes, {checks} collision checks); blocked most by {}",
                 counted(blocking)
             ),
             PlanFailure::TimeCap { cap_s, iterations } => write!(

@@ -5,7 +5,7 @@
 
 use std::time::Instant;
 
-use super::checker::CollisionChecker;
+use super::checker::{CollisionChecker, Counting};
 use super::config::PlannerConfig;
 use super::edge::{Resolution, check_segment};
 use super::rng::Stream;
@@ -108,14 +108,19 @@ impl SearchLog {
     }
 }
 
-struct Grower<'a, C: CollisionChecker + ?Sized> {
-    checker: &'a mut C,
+struct Grower<'a, 'b, C: CollisionChecker + ?Sized> {
+    checker: &'a mut Counting<'b, C>,
     config: &'a PlannerConfig,
     res: Resolution,
     log: SearchLog,
 }
 
-impl<C: CollisionChecker + ?Sized> Grower<'_, C> {
+impl<C: CollisionChecker + ?Sized> Grower<'_, '_, C> {
+    /// True when the query has used its collision-check budget.
+    fn spent(&self) -> bool {
+        self.checker.spent()
+    }
+
     /// Grows `tree` one step (at most `range`) towards `target`.
     fn extend(&mut self, tree: &mut Tree, target: &[f64; 6]) -> Step {
         let near = tree.nearest(target);
@@ -136,11 +141,15 @@ impl<C: CollisionChecker + ?Sized> Grower<'_, C> {
             q
         };
         if !self.checker.is_free(&q) {
-            self.log.note_blocked(q);
+            if !self.spent() {
+                self.log.note_blocked(q);
+            }
             return Step::Trapped;
         }
         if let Err(hit) = check_segment(self.checker, &from, &q, &self.res) {
-            self.log.note_blocked(hit);
+            if !self.spent() {
+                self.log.note_blocked(hit);
+            }
             return Step::Trapped;
         }
         let root = tree.root[near as usize];
@@ -156,6 +165,9 @@ impl<C: CollisionChecker + ?Sized> Grower<'_, C> {
     fn connect(&mut self, tree: &mut Tree, target: &[f64; 6], nodes_left: usize) -> Step {
         let mut last = Step::Trapped;
         for _ in 0..nodes_left.max(1) {
+            if self.spent() {
+                return last;
+            }
             match self.extend(tree, target) {
                 Step::Advanced(i) => last = Step::Advanced(i),
                 other => {
@@ -171,10 +183,11 @@ impl<C: CollisionChecker + ?Sized> Grower<'_, C> {
 }
 
 /// Searches for a path from `start` to any of `goals` (all already known free and in bounds;
-/// at least one). `Found` paths run start → goal and contain only checked configurations and
+/// at least one), until it connects them or uses `config.max_iterations`, `config.max_nodes` or
+/// `config.max_checks` (collision checks of the whole query, counted by `checker`). `Found` paths run start → goal and contain only checked configurations and
 /// segments checked at the configured resolution.
 pub(crate) fn rrt_connect<C: CollisionChecker + ?Sized>(
-    checker: &mut C,
+    checker: &mut Counting<'_, C>,
     start: &[f64; 6],
     goals: &[[f64; 6]],
     config: &PlannerConfig,
@@ -187,6 +200,7 @@ pub(crate) fn rrt_connect<C: CollisionChecker + ?Sized>(
     for (i, g) in goals.iter().enumerate() {
         b.add(*g, ROOT, i as u32);
     }
+    checker.budget = config.max_checks;
     let mut grower = Grower {
         checker,
         config,
@@ -205,7 +219,7 @@ pub(crate) fn rrt_connect<C: CollisionChecker + ?Sized>(
             break Search::Exhausted;
         }
         let nodes = a.nodes.len() + b.nodes.len();
-        if nodes >= config.max_nodes {
+        if nodes >= config.max_nodes || grower.spent() {
             break Search::Exhausted;
         }
         if let Some(cap) = config.time_cap
@@ -241,5 +255,6 @@ pub(crate) fn rrt_connect<C: CollisionChecker + ?Sized>(
         a_is_start = !a_is_start;
     };
     grower.log.nodes = a.nodes.len() + b.nodes.len();
+    grower.checker.budget = u64::MAX;
     (outcome, grower.log)
 }

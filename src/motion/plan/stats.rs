@@ -17,6 +17,9 @@ pub struct PlanStats {
     pub nodes: usize,
     /// Configurations given to the collision checker, all stages together.
     pub collision_checks: u64,
+    /// Of those, per stage: start and goals with the direct segments, the search, the
+    /// shortcutting, and the final validation with the corner blends.
+    pub stage_checks: [u64; 4],
     /// Joint-space length of the path the search found, radians (Euclidean).
     pub raw_length: f64,
     /// Joint-space length after shortcutting, radians (Euclidean, corners not blended).
@@ -35,11 +38,12 @@ impl PlanStats {
     /// One line for logs: time, nodes, checks, lengths, duration.
     pub fn summary(&self) -> String {
         format!(
-            "{:.2} ms, {} iterations, {} nodes, {} checks, {}/{} goals free, length {:.3} rad ({:.3} found), {} waypoints, {} blends, {:.3} s{}",
+            "{:.2} ms, {} iterations, {} nodes, {} checks ({:?} by stage), {}/{} goals free, length {:.3} rad ({:.3} found), {} waypoints, {} blends, {:.3} s{}",
             self.planning_time.as_secs_f64() * 1e3,
             self.iterations,
             self.nodes,
             self.collision_checks,
+            self.stage_checks,
             self.free_goals,
             self.goals,
             self.length,

@@ -218,6 +218,7 @@ fn a_disconnected_goal_exhausts_the_search_and_names_what_blocked_it() {
     let mut c = JointBoxes::new(vec![wall("fence", (-0.2, 0.2), FULL)]);
     let config = PlannerConfig {
         max_iterations: 300,
+        max_checks: 10_000_000,
         ..PlannerConfig::default()
     };
     let e = plan(
@@ -232,6 +233,7 @@ fn a_disconnected_goal_exhausts_the_search_and_names_what_blocked_it() {
             iterations,
             nodes,
             blocking,
+            ..
         } => {
             assert_eq!(*iterations, 300);
             assert!(*nodes > 2);
@@ -264,8 +266,12 @@ fn the_node_cap_also_ends_the_search() {
 #[test]
 fn the_time_cap_ends_the_search_with_its_own_reason() {
     let mut c = JointBoxes::new(vec![wall("fence", (-0.2, 0.2), FULL)]);
+    // Budgets far beyond what 1 ms allows: the wall-clock cap ends the search.
     let config = PlannerConfig {
-        time_cap: Some(Duration::ZERO),
+        time_cap: Some(Duration::from_millis(1)),
+        max_iterations: 10_000_000,
+        max_nodes: 10_000_000,
+        max_checks: 10_000_000,
         ..PlannerConfig::default()
     };
     let e = plan(
@@ -276,11 +282,55 @@ fn the_time_cap_ends_the_search_with_its_own_reason() {
     )
     .unwrap_err();
     assert!(
-        matches!(e.reason, PlanFailure::TimeCap { iterations: 0, .. }),
+        matches!(e.reason, PlanFailure::TimeCap { .. }),
         "{}",
         e.reason
     );
     assert_eq!(e.reason.name(), "time_cap");
+    let zero = PlannerConfig {
+        time_cap: Some(Duration::ZERO),
+        ..PlannerConfig::default()
+    };
+    assert!(zero.check().unwrap_err().contains("time_cap"));
+}
+
+#[test]
+fn the_check_budget_ends_the_search_with_no_path_deterministically() {
+    let config = PlannerConfig {
+        max_checks: 3000,
+        max_iterations: 10_000_000,
+        max_nodes: 10_000_000,
+        ..PlannerConfig::default()
+    };
+    let run = || {
+        let mut c = JointBoxes::new(vec![wall("fence", (-0.2, 0.2), FULL)]);
+        plan(
+            &mut c,
+            &q(-1.0, 0.0),
+            &GoalSet::configs(vec![q(1.0, 0.0)]),
+            &config,
+        )
+        .unwrap_err()
+    };
+    let (e, again) = (run(), run());
+    match &e.reason {
+        PlanFailure::SearchExhausted {
+            checks, blocking, ..
+        } => {
+            // A hard cap: not one check past the budget (the names come after it).
+            assert_eq!(*checks, 3000);
+            assert_eq!(blocking[0].0.pair(), "arm–fence");
+        }
+        r => panic!("{r}"),
+    }
+    assert_eq!(e.reason, again.reason);
+    assert_eq!(e.stats.iterations, again.stats.iterations);
+    assert!(config.clone().check().is_ok());
+    let bad = PlannerConfig {
+        max_checks: 0,
+        ..PlannerConfig::default()
+    };
+    assert!(bad.check().unwrap_err().contains("max_checks"));
 }
 
 #[test]
