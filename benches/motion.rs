@@ -408,7 +408,10 @@ fn main() {
             let goals = match q.side {
                 None => GoalSet::down(&q.goal.0, q.goal.1, false, &q.start),
                 Some(theta) => GoalSet::poses(
-                    &[side_pose(&q.goal.0, theta), side_pose(&q.goal.0, theta + std::f64::consts::PI)],
+                    &[
+                        side_pose(&q.goal.0, theta),
+                        side_pose(&q.goal.0, theta + std::f64::consts::PI),
+                    ],
                     &q.start,
                 ),
             };

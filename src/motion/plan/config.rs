@@ -197,10 +197,7 @@ impl PlannerConfig {
             return Err(format!("max_nodes {}: use 2 to 10 000 000", self.max_nodes));
         }
         if self.max_checks == 0 || self.max_checks > 10_000_000 {
-            return Err(format!(
-                "max_checks {}: use 1 to 10 000 000",
-                self.max_checks
-            ));
+            return Err(format!("max_checks {}: use 1 to 10 000 000", self.max_checks));
         }
         if let Some(cap) = self.time_cap
             && !(Duration::from_millis(1)..=Duration::from_secs(60)).contains(&cap)

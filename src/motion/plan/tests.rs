@@ -281,11 +281,7 @@ fn the_time_cap_ends_the_search_with_its_own_reason() {
         &config,
     )
     .unwrap_err();
-    assert!(
-        matches!(e.reason, PlanFailure::TimeCap { .. }),
-        "{}",
-        e.reason
-    );
+    assert!(matches!(e.reason, PlanFailure::TimeCap { .. }), "{}", e.reason);
     assert_eq!(e.reason.name(), "time_cap");
     let zero = PlannerConfig {
         time_cap: Some(Duration::ZERO),
@@ -314,9 +310,7 @@ fn the_check_budget_ends_the_search_with_no_path_deterministically() {
     };
     let (e, again) = (run(), run());
     match &e.reason {
-        PlanFailure::SearchExhausted {
-            checks, blocking, ..
-        } => {
+        PlanFailure::SearchExhausted { checks, blocking, .. } => {
             // A hard cap: not one check past the budget (the names come after it).
             assert_eq!(*checks, 3000);
             assert_eq!(blocking[0].0.pair(), "arm–fence");
