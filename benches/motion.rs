@@ -288,6 +288,10 @@ fn main() {
         .clamp(1, 10_000);
     // `coarse`: joint steps only (no displacement bound): faster, may graze between checks.
     let coarse = std::env::args().any(|a| a == "coarse");
+    // `shortcuts=N`: random shortcut attempts per path (default: the planner's).
+    let shortcuts: usize = std::env::args()
+        .find_map(|a| a.strip_prefix("shortcuts=").and_then(|v| v.parse().ok()))
+        .unwrap_or(PlannerConfig::default().shortcut_attempts);
 
     let families = [
         Family {
@@ -418,6 +422,7 @@ fn main() {
             let config = PlannerConfig {
                 seed: k as u64,
                 max_checks: f.max_checks.unwrap_or(PlannerConfig::default().max_checks),
+                shortcut_attempts: shortcuts,
                 // A safety cap only: the deterministic check budget ends every search first.
                 time_cap: Some(Duration::from_secs(5)),
                 max_displacement: if coarse { f64::INFINITY } else { 0.01 },

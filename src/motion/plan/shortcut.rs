@@ -35,8 +35,29 @@ fn cumulative(path: &[[f64; 6]]) -> Vec<f64> {
     cum
 }
 
-/// Shortens `path` (start and end kept exactly) with `attempts` seeded random shortcuts and a
-/// final vertex-dropping sweep. Every segment of the result is free at `res`, given the
+/// Keeps, from each kept vertex, the farthest later vertex the straight segment reaches free
+/// (tried from the end backwards): a path whose segments are each checked once, before the
+/// random shortcuts refine its corners.
+fn greedy<C: CollisionChecker + ?Sized>(checker: &mut C, path: Vec<[f64; 6]>, res: &Resolution) -> Vec<[f64; 6]> {
+    let n = path.len();
+    if n < 3 {
+        return path;
+    }
+    let mut out = vec![path[0]];
+    let mut i = 0;
+    while i + 1 < n {
+        let mut j = n - 1;
+        while j > i + 1 && check_segment(checker, &path[i], &path[j], res).is_err() {
+            j -= 1;
+        }
+        out.push(path[j]);
+        i = j;
+    }
+    out
+}
+
+/// Shortens `path` (start and end kept exactly): a greedy pass over its vertices, then
+/// `attempts` seeded random shortcuts and a final vertex-dropping sweep. Every segment of the result is free at `res`, given the
 /// input's segments were.
 pub(crate) fn shortcut<C: CollisionChecker + ?Sized>(
     checker: &mut C,
@@ -45,7 +66,7 @@ pub(crate) fn shortcut<C: CollisionChecker + ?Sized>(
     res: &Resolution,
     seed: u64,
 ) -> Vec<[f64; 6]> {
-    let mut path = path;
+    let mut path = greedy(checker, path, res);
     let mut rng = Stream::new(seed, 2);
     for _ in 0..attempts {
         if path.len() < 3 {
