@@ -38,7 +38,11 @@ fn cumulative(path: &[[f64; 6]]) -> Vec<f64> {
 /// Keeps, from each kept vertex, the farthest later vertex the straight segment reaches free
 /// (tried from the end backwards): a path whose segments are each checked once, before the
 /// random shortcuts refine its corners.
-fn greedy<C: CollisionChecker + ?Sized>(checker: &mut C, path: Vec<[f64; 6]>, res: &Resolution) -> Vec<[f64; 6]> {
+fn greedy<C: CollisionChecker + ?Sized>(
+    checker: &mut C,
+    path: Vec<[f64; 6]>,
+    res: &Resolution,
+) -> Vec<[f64; 6]> {
     let n = path.len();
     if n < 3 {
         return path;
