@@ -200,6 +200,38 @@ fn the_planner_goes_around_the_post_and_every_configuration_on_the_way_is_free()
 }
 
 #[test]
+fn the_check_budget_is_a_hard_deterministic_cap_ending_in_no_path_naming_the_post() {
+    let scene = post_scene();
+    let mut c = checker(scene, DEFAULT_MARGIN);
+    let start = down(0.45, -0.2, 0.15);
+    let goals = GoalSet::down(&Vector3::new(0.45, 0.2, 0.15), 0.0, false, &start);
+    // The direct segments are blocked by the post (see above): a search is needed, and 120
+    // checks (the start, the goals and the direct segments' first checks) leave none for it.
+    let config = PlannerConfig {
+        max_checks: 120,
+        ..PlannerConfig::default()
+    };
+    let e = plan(&mut c, &start, &goals, &config).unwrap_err();
+    match &e.reason {
+        PlanFailure::SearchExhausted { checks, blocking, .. } => {
+            assert!(*checks <= 120, "{checks} checks past the budget");
+            assert!(blocking.iter().any(|(h, _)| h.b == "post"), "{e}");
+        }
+        r => panic!("expected search_exhausted, got {r}"),
+    }
+    assert!(e.stats.collision_checks <= 120);
+    // The same query ends the same way (no clock in the outcome).
+    let again = plan(&mut c, &start, &goals, &config).unwrap_err();
+    assert_eq!(again.reason, e.reason);
+    // Through the cell's planning entry point it is a typed `no_path` failure.
+    let f = macrotree::sim::planning::plan_in_cell(&mut c, &start, &goals, &config).unwrap_err();
+    assert_eq!(f.kind, macrotree::failure::FailureKind::NoPath);
+    assert!(f.message.contains("post"), "{}", f.message);
+    // With the default budget the same query plans.
+    assert!(plan(&mut c, &start, &goals, &PlannerConfig::default()).is_ok());
+}
+
+#[test]
 fn each_reason_on_the_real_cell() {
     let mut c = checker(post_scene(), DEFAULT_MARGIN);
     let config = PlannerConfig::default();

@@ -100,7 +100,8 @@ pub struct PlannerConfig {
     /// Collision checks at most for the start, the goals, the direct segments and the search
     /// together; when the search reaches it, the plan ends with
     /// [`PlanFailure::SearchExhausted`](super::PlanFailure::SearchExhausted). The deterministic
-    /// hard cap (not one check past it): at the MuJoCo checker's 6–10 µs per check the default
+    /// hard cap of the search (not one search check past it; the stages before it are bounded
+    /// by the goal set): at the MuJoCo checker's 6–10 µs per check the default
     /// 20 000 is 0.1–0.2 s. Shortcutting and blending a found path come after it and are bounded
     /// by `shortcut_attempts` and the path. 1 to 10 000 000.
     pub max_checks: u64,
