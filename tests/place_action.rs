@@ -160,33 +160,36 @@ fn closing_axis_after_pick(block_yaw_deg: f64) -> Vector2<f64> {
     (w.right_pad_pos - w.left_pad_pos).xy().normalize()
 }
 
-/// A neighbour whose footprint is 41 mm from the place, on the line through the place along
-/// `dir`; the place keeps the grasp's yaw.
-fn place_beside(name: &str, dir: Vector2<f64>) -> EpisodeReport {
+/// Blocks whose footprints are 41 mm from the place, on the lines through it along each of
+/// `dirs`, and `red` placed there keeping the grasp's yaw (modulo a quarter turn); the report and
+/// the fingers' closing axis at the end.
+fn place_beside(name: &str, dirs: &[Vector2<f64>]) -> (EpisodeReport, Vector2<f64>) {
     let target = Vector2::new(0.50, 0.05);
-    let n = target + dir * (0.041 + HALF);
-    let objects = format!(
-        "{}{}",
-        block("red", 0.45, -0.15, 0.0),
-        block("blue", n.x, n.y, 0.0)
-    );
+    let mut objects = block("red", 0.45, -0.15, 0.0);
+    for (i, d) in dirs.iter().enumerate() {
+        let n = target + d * (0.041 + HALF);
+        objects += &block(&format!("n{i}"), n.x, n.y, 0.0);
+    }
     let main = sequence(&format!(
         "{}      - place: {{point: [{}, {}], yaw: keep}}\n",
         pick("red"),
         target.x,
         target.y
     ));
-    run(name, &objects, &main).0
+    let (r, cell) = run(name, &objects, &main);
+    let w = cell.world();
+    (r, (w.right_pad_pos - w.left_pad_pos).xy().normalize())
 }
 
 #[test]
-fn place_is_refused_when_the_opened_fingers_would_hit_a_neighbour_along_their_closing_axis() {
+fn place_is_refused_when_the_opened_fingers_would_hit_a_neighbour_in_every_quarter_turn() {
     let closing = closing_axis_after_pick(0.0);
-    let r = place_beside("refused", closing);
+    let across = Vector2::new(-closing.y, closing.x);
+    let (r, _) = place_beside("refused", &[closing, across]);
     assert_eq!(r.failure_kind, Some(FailureKind::Blocked), "{:?}", r.failure_reason);
     let reason = r.failure_reason.unwrap_or_default();
     assert!(
-        reason.contains("no clear way down") && reason.contains("would hit blue"),
+        reason.contains("no clear way down") && reason.contains("would hit n"),
         "{reason}"
     );
     assert_eq!(r.failed_node.as_deref(), Some("main/sequence/place"));
@@ -196,8 +199,23 @@ fn place_is_refused_when_the_opened_fingers_would_hit_a_neighbour_along_their_cl
 fn place_is_accepted_with_the_same_neighbour_beside_the_fingers_open_side() {
     let closing = closing_axis_after_pick(0.0);
     let across = Vector2::new(-closing.y, closing.x);
-    let r = place_beside("accepted", across);
+    let (r, end) = place_beside("accepted", &[across]);
     assert_success(&r, "neighbour across the closing axis, 41 mm away");
+    assert!(end.dot(&across).abs() < 0.1, "the fingers still close across the neighbour's line");
+}
+
+/// With the neighbour on the fingers' closing axis the transfer is planned with the tool a
+/// quarter turn round (a cube looks the same), and the set-down is made with the neighbour
+/// beside the fingers' open side.
+#[test]
+fn a_neighbour_on_the_closing_axis_turns_the_fingers_a_quarter_turn() {
+    let closing = closing_axis_after_pick(0.0);
+    let (r, end) = place_beside("turned", &[closing]);
+    assert_success(&r, "neighbour along the closing axis, 41 mm away");
+    assert!(
+        end.dot(&closing).abs() < 0.1,
+        "the fingers turned: closing axis {end:?}, neighbour along {closing:?}"
+    );
 }
 
 /// The bug: in a 0.20 m bin `carry` chose a free spot that its own descent check then refused.
