@@ -117,7 +117,11 @@ fn place_at_a_point_with_a_yaw_lands_within_5_mm_and_3_degrees() {
     let e = yaw_error_deg(w, red, 30.0);
     assert!(e < 3.0, "yaw off by {e:.2}°");
     assert!(w.released(red), "the fingers let go");
-    assert!(w.gripper_width > 0.05, "opened to let go: {:.3} m", w.gripper_width);
+    assert!(
+        w.gripper_width > 0.05,
+        "opened to let go: {:.3} m",
+        w.gripper_width
+    );
 }
 
 #[test]
@@ -186,7 +190,12 @@ fn place_is_refused_when_the_opened_fingers_would_hit_a_neighbour_in_every_quart
     let closing = closing_axis_after_pick(0.0);
     let across = Vector2::new(-closing.y, closing.x);
     let (r, _) = place_beside("refused", &[closing, across]);
-    assert_eq!(r.failure_kind, Some(FailureKind::Blocked), "{:?}", r.failure_reason);
+    assert_eq!(
+        r.failure_kind,
+        Some(FailureKind::Blocked),
+        "{:?}",
+        r.failure_reason
+    );
     let reason = r.failure_reason.unwrap_or_default();
     assert!(
         reason.contains("no clear way down") && reason.contains("would hit n"),
@@ -201,7 +210,10 @@ fn place_is_accepted_with_the_same_neighbour_beside_the_fingers_open_side() {
     let across = Vector2::new(-closing.y, closing.x);
     let (r, end) = place_beside("accepted", &[across]);
     assert_success(&r, "neighbour across the closing axis, 41 mm away");
-    assert!(end.dot(&across).abs() < 0.1, "the fingers still close across the neighbour's line");
+    assert!(
+        end.dot(&across).abs() < 0.1,
+        "the fingers still close across the neighbour's line"
+    );
 }
 
 /// With the neighbour on the fingers' closing axis the transfer is planned with the tool a
@@ -239,7 +251,11 @@ fn carry_chose_a_free_spot_in_a_020_m_bin_that_its_own_descent_check_refused() {
     let w = cell.world();
     let bin = index(w, "bin");
     for b in ["a", "b", "c"] {
-        assert!(w.inside(index(w, b), bin), "{b} in the bin: {:?}", w.objects[index(w, b)].pos);
+        assert!(
+            w.inside(index(w, b), bin),
+            "{b} in the bin: {:?}",
+            w.objects[index(w, b)].pos
+        );
     }
 }
 

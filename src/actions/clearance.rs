@@ -73,7 +73,11 @@ pub struct SetDown {
 /// pinch frame's y axis for the 2F-85 mounted as the cell has it).
 pub fn closing_axis_in_pinch(w: &World) -> Vector3<f64> {
     let d = w.pinch_rot.transpose() * (w.right_pad_pos - w.left_pad_pos);
-    if d.norm() < 1e-9 { Vector3::y() } else { d.normalize() }
+    if d.norm() < 1e-9 {
+        Vector3::y()
+    } else {
+        d.normalize()
+    }
 }
 
 /// Height of the fingertips above the centre of the block they hold, from a snapshot, metres
@@ -86,7 +90,11 @@ pub fn tip_above_block(w: &World, block: usize) -> f64 {
 /// axis in the pinch frame ([`closing_axis_in_pinch`]); unit.
 pub fn closing_in_world(rotation: &UnitQuaternion<f64>, in_pinch: &Vector3<f64>) -> Vector2<f64> {
     let d = (rotation * in_pinch).xy();
-    if d.norm() < 1e-9 { Vector2::x() } else { d.normalize() }
+    if d.norm() < 1e-9 {
+        Vector2::x()
+    } else {
+        d.normalize()
+    }
 }
 
 /// An oriented rectangle in the table plane: centre, unit x axis, half extents, metres.
@@ -203,7 +211,9 @@ impl SetDown {
         for e in self.envelope(h) {
             for p in e.corners() {
                 let d = w.local_xy(c, &Vector3::new(p.x, p.y, 0.0));
-                least = least.min(inner_half[0] - d.x.abs()).min(inner_half[1] - d.y.abs());
+                least = least
+                    .min(inner_half[0] - d.x.abs())
+                    .min(inner_half[1] - d.y.abs());
             }
         }
         Some(least)
@@ -296,7 +306,10 @@ mod tests {
         let a = rect(0.0, 0.0, 0.0, 0.02, 0.02);
         let b = rect(0.06, 0.0, std::f64::consts::FRAC_PI_4, 0.02, 0.02);
         let g = gap(&a, &b);
-        assert!((g - (0.06 - 0.02 - 0.02 * std::f64::consts::SQRT_2)).abs() < 1e-12, "{g}");
+        assert!(
+            (g - (0.06 - 0.02 - 0.02 * std::f64::consts::SQRT_2)).abs() < 1e-12,
+            "{g}"
+        );
     }
 
     #[test]

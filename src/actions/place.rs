@@ -193,6 +193,9 @@ mod tests {
         let s = scene_with_spot();
         let e = place_target(&s, &spec(None, Some("kit_b"), None)).unwrap_err();
         assert_eq!(e.kind, crate::failure::FailureKind::Other);
-        assert!(e.message.contains("no spot `kit_b`") && e.message.contains("kit_a"), "{e}");
+        assert!(
+            e.message.contains("no spot `kit_b`") && e.message.contains("kit_a"),
+            "{e}"
+        );
     }
 }

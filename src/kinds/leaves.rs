@@ -750,10 +750,7 @@ impl Params for Place {
     fn validate_fields(&self) -> Result<(), ParamError> {
         match (&self.point, &self.spot) {
             (Some(_), Some(_)) => {
-                return Err(ParamError::at(
-                    "spot",
-                    "give `point` or `spot`, not both",
-                ));
+                return Err(ParamError::at("spot", "give `point` or `spot`, not both"));
             }
             (None, None) => {
                 return Err(ParamError::new(
