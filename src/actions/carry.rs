@@ -6,7 +6,9 @@
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
 use super::cell::Cell;
-use super::clearance::{SetDown, blocks_inside, closing_axis_in_pinch, closing_in_world, tip_above_block};
+use super::clearance::{
+    SetDown, blocks_inside, closing_axis_in_pinch, closing_in_world, release_opening, tip_above_block,
+};
 use super::macro_action::{Arrival, MacroAction, Progress};
 use super::planning::{check_motion, check_straight, describe};
 use super::targets::{resolve, segment_distance, target_object};
@@ -144,6 +146,7 @@ impl Carry {
             closing: closing_in_world(&self.turned(k).0, &self.closing),
             half: self.half,
             tip: self.tip,
+            opening: release_opening(self.half),
         }
     }
 
@@ -201,8 +204,9 @@ impl Carry {
     /// Where in container `c` to set the block down, its centre at height `z`: of a grid over
     /// the container's floor, the spots whose set-down the descent check accepts (the same
     /// [`SetDown::obstruction`] as [`Self::check_descent`], the fingers' closing axis as the tool
-    /// is now), the one with the most room beside the blocks already in it (the centre when it
-    /// is empty; ties go to the spot nearest the centre), world frame, metres. A container with
+    /// is now), the one with the most room: the largest of the least gaps to the blocks already
+    /// in it and to its walls with the fingers fully open (ties go to the spot nearest the
+    /// centre; the centre when it is empty), world frame, metres. A container with
     /// no such spot fails with `container_full`, before anything moves.
     fn free_spot(&self, w: &World, c: usize, z: f64) -> Result<Vector2<f64>, Failure> {
         let centre = w.objects[c].pos.xy();
@@ -230,7 +234,15 @@ impl Carry {
             if down.obstruction(w, self.held, Some(c)).is_some() {
                 continue;
             }
-            let room = down.room(w, &inside);
+            // Room: to the blocks in it, and to its walls with the fingers fully open (a
+            // `release` after the carry opens them fully by default).
+            let open = SetDown {
+                opening: crate::motion::gripper::width_for_ctrl(crate::motion::gripper::OPEN_CTRL),
+                ..down
+            };
+            let room = down
+                .room(w, &inside)
+                .min(open.wall_gap(w, c).unwrap_or(f64::INFINITY));
             if best.is_none_or(|(_, r)| room > r + 1e-9) {
                 best = Some((p, room));
             }
@@ -248,7 +260,7 @@ impl Carry {
                     "{} cannot take {}: no spot on its floor where the block and the fingers (opened to {:.0} mm) clear its walls and the blocks in it; {holding}",
                     w.name(c),
                     w.name(self.held),
-                    self.set_down(Vector3::zeros()).opening() * 1e3
+                    self.set_down(Vector3::zeros()).opening * 1e3
                 ),
             )
         })

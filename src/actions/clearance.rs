@@ -67,6 +67,9 @@ pub struct SetDown {
     pub half: f64,
     /// Height of the fingertips above the block's centre (negative: below it), metres.
     pub tip: f64,
+    /// Distance between the pad faces the fingers open to, metres (normally
+    /// [`release_opening`]).
+    pub opening: f64,
 }
 
 /// The fingers' closing axis in the pinch frame, from the pad centres of a snapshot (unit; the
@@ -138,11 +141,6 @@ fn gap(a: &Rect, b: &Rect) -> f64 {
 }
 
 impl SetDown {
-    /// The pad faces' distance when the fingers open to let the block go, metres.
-    pub fn opening(&self) -> f64 {
-        release_opening(self.half)
-    }
-
     /// The fingertips' height, or the block's bottom if lower, metres.
     fn bottom(&self) -> f64 {
         self.centre.z + self.tip.max(-self.half)
@@ -169,7 +167,7 @@ impl SetDown {
             Rect {
                 centre,
                 axis: self.closing,
-                half: [self.opening() / 2.0 + outside, across],
+                half: [self.opening / 2.0 + outside, across],
             },
         ]
     }
@@ -199,7 +197,7 @@ impl SetDown {
     /// How far the envelope stays inside container `c`'s inner walls, metres (negative: it
     /// crosses a wall), or `None` for an object that is not a container or a rim below the
     /// fingertips.
-    fn wall_gap(&self, w: &World, c: usize) -> Option<f64> {
+    pub fn wall_gap(&self, w: &World, c: usize) -> Option<f64> {
         let Shape::Container { inner_half, .. } = w.spec(c).shape else {
             return None;
         };
@@ -261,7 +259,7 @@ impl SetDown {
                 "no clear way down to ({:.3}, {:.3}): the fingers (opened to {:.0} mm along their closing axis at {:.0}°) would hit {what} ({:.0} mm clearance, {:.0} mm needed; its top at {:.3} m)",
                 self.centre.x,
                 self.centre.y,
-                self.opening() * 1e3,
+                self.opening * 1e3,
                 self.closing.y.atan2(self.closing.x).to_degrees(),
                 g * 1e3,
                 MARGIN * 1e3,
@@ -319,6 +317,7 @@ mod tests {
             closing: Vector2::x(),
             half: 0.022,
             tip: -0.019,
+            opening: release_opening(0.022),
         };
         let [block, fingers] = s.envelope(0.04);
         assert_eq!(block.half, [0.022, 0.022]);
