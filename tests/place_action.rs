@@ -298,3 +298,45 @@ fn carry_into_a_full_container_fails_before_moving() {
     );
     assert!(w.inside(index(w, "a"), index(w, "bin")));
 }
+
+/// `place` takes a point or a spot (not both, not neither) and an angle or `keep` for its yaw;
+/// each mistake is a located error that says what to write.
+#[test]
+fn place_parameters_are_checked_where_they_are_written() {
+    let cases = [
+        (
+            "main:\n  place: {point: [0.5, 0.1], spot: kit_a}\n",
+            "not both",
+            2,
+        ),
+        ("main:\n  place: {yaw: deg(30)}\n", "`place` needs where", 2),
+        (
+            "main:\n  place: {point: [0.5, 0.1], yaw: object}\n",
+            "not a place yaw",
+            2,
+        ),
+        ("main:\n  place: {spot: Kit-A}\n", "not a spot name", 2),
+        ("main:\n  place: {point: [0.5]}\n", "wrong number of items", 2),
+        (
+            "main:\n  place: {point: [0.5, 0.1], lift: -1}\n",
+            "must be ≥ 0",
+            2,
+        ),
+    ];
+    for (yaml, needle, line) in cases {
+        let Err(diags) = Loader::default().compile_str(yaml, "bad.yaml") else {
+            panic!("accepted:\n{yaml}");
+        };
+        let d = diags
+            .iter()
+            .find(|d| d.message.contains(needle))
+            .unwrap_or_else(|| panic!("no diagnostic with {needle:?} for {yaml}: {diags:?}"));
+        assert_eq!(d.line, line, "{d}");
+    }
+    Loader::default()
+        .compile_str(
+            "main:\n  place: {spot: kit_a, yaw: keep, retreat: 0.05}\n",
+            "ok.yaml",
+        )
+        .expect("a place at a spot, keeping the yaw, compiles");
+}
