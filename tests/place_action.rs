@@ -33,6 +33,16 @@ fn tempdir(name: &str) -> PathBuf {
 /// Runs `main` (the tree's body, YAML) on a scene whose `objects:` are `objects` (YAML), with
 /// the tree's own outcome as success; the report and the cell in its final state.
 fn run(name: &str, objects: &str, main: &str) -> (EpisodeReport, Cell) {
+    run_with_spots(name, objects, main, &[])
+}
+
+/// [`run`], with `spots` added to the scene (as the scene file's `spots:` will give them).
+fn run_with_spots(
+    name: &str,
+    objects: &str,
+    main: &str,
+    spots: &[macrotree::scene::Spot],
+) -> (EpisodeReport, Cell) {
     let dir = tempdir(name);
     std::fs::write(
         dir.join("cell.yaml"),
@@ -46,7 +56,9 @@ fn run(name: &str, objects: &str, main: &str) -> (EpisodeReport, Cell) {
             .load(&tree)
             .unwrap_or_else(|d| panic!("{}", d[0])),
     );
-    let scene = Scene::load_spec(&plan.scene).expect("scene compiles");
+    let mut spec = (*plan.scene).clone();
+    spec.spots.extend_from_slice(spots);
+    let scene = Scene::load_spec(&spec).expect("scene compiles");
     let mut cell = Cell::new(&scene, &Layout::default(), CONTROL_PERIOD);
     let config = EpisodeConfig {
         goal: Goal::Tree,
@@ -122,6 +134,26 @@ fn place_at_a_point_with_a_yaw_lands_within_5_mm_and_3_degrees() {
         "opened to let go: {:.3} m",
         w.gripper_width
     );
+}
+
+#[test]
+fn place_at_a_spot_takes_its_point_and_its_yaw() {
+    let spot = macrotree::scene::Spot {
+        name: "kit_a".into(),
+        x: 0.42,
+        y: 0.14,
+        yaw: (-20.0f64).to_radians(),
+    };
+    let objects = block("red", 0.45, -0.15, 10.0);
+    let main = sequence(&format!("{}      - place: {{spot: kit_a}}\n", pick("red")));
+    let (r, cell) = run_with_spots("spot", &objects, &main, &[spot]);
+    assert_success(&r, "place at a spot");
+    let w = cell.world();
+    let red = index(w, "red");
+    let off = (w.objects[red].pos.xy() - Vector2::new(0.42, 0.14)).norm();
+    assert!(off < 0.005, "{:.1} mm from the spot", off * 1e3);
+    let e = yaw_error_deg(w, red, -20.0);
+    assert!(e < 3.0, "yaw off by {e:.2}°");
 }
 
 #[test]
