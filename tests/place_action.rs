@@ -186,6 +186,53 @@ fn place_on_another_block_builds_a_tower() {
     assert!(w.released(red));
 }
 
+#[test]
+fn place_at_a_point_over_a_container_sets_the_block_on_its_floor() {
+    let objects = format!(
+        "{}  bin:\n    container: {{inner: [0.15, 0.15], wall_height: 0.05, color: gray}}\n    pose: [0.50, 0.10]\n",
+        block("red", 0.45, -0.15, 0.0)
+    );
+    let main = sequence(&format!(
+        "{}      - place: {{point: [0.51, 0.09]}}\n",
+        pick("red")
+    ));
+    let (r, cell) = run("into_bin", &objects, &main);
+    assert_success(&r, "place over a bin");
+    let w = cell.world();
+    let (red, bin) = (index(w, "red"), index(w, "bin"));
+    let p = w.objects[red].pos;
+    assert!(w.inside(red, bin), "in the bin: {p:?}");
+    assert!(
+        (p.z - (w.support_height(bin) + HALF)).abs() < 0.003,
+        "on its floor: z {:.4} m",
+        p.z
+    );
+    assert!((p.xy() - Vector2::new(0.51, 0.09)).norm() < 0.005, "{p:?}");
+}
+
+/// Halted during its transfer, `place` leaves the arm where it is and the block in the closed
+/// fingers (like `carry`).
+#[test]
+fn a_place_halted_mid_transfer_keeps_the_block_in_the_fingers() {
+    let objects = block("red", 0.45, -0.15, 0.0);
+    let main = sequence(&format!(
+        "{}      - force_success: {{child: {{timeout: {{seconds: 1.1, child: {{place: {{point: [0.50, 0.10]}}}}}}}}}}\n      - wait: {{seconds: 1.0}}\n",
+        pick("red")
+    ));
+    let (r, cell) = run("halted", &objects, &main);
+    assert_success(&r, "the halted place is forced to success");
+    let w = cell.world();
+    let red = index(w, "red");
+    assert!(w.holds(red, 0.03), "still held after the halt and 1 s of waiting");
+    let p = w.objects[red].pos;
+    assert!(p.z > HALF + 0.05, "still up in the air: {p:?}");
+    assert!(
+        (p.xy() - Vector2::new(0.50, 0.10)).norm() > 0.03
+            && (p.xy() - Vector2::new(0.45, -0.15)).norm() > 0.03,
+        "stopped on the way (the lift takes 0.75 s, then the transfer): {p:?}"
+    );
+}
+
 /// The fingers' closing axis, world table plane, with `block` grasped as `pick` grasps it (the
 /// tool's yaw follows the block's, so this is the axis a `place` with `yaw: keep` sets down with).
 fn closing_axis_after_pick(block_yaw_deg: f64) -> Vector2<f64> {
