@@ -7,7 +7,7 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
 use super::cell::Cell;
 use super::clearance::{
-    SetDown, blocks_inside, closing_axis_in_pinch, closing_in_world, release_opening, tip_above_block,
+    MARGIN, SetDown, blocks_inside, closing_axis_in_pinch, closing_in_world, release_opening, tip_above_block,
 };
 use super::macro_action::{Arrival, MacroAction, Progress};
 use super::planning::{check_motion, check_straight, describe};
@@ -204,9 +204,10 @@ impl Carry {
     /// Where in container `c` to set the block down, its centre at height `z`: of a grid over
     /// the container's floor, the spots whose set-down the descent check accepts (the same
     /// [`SetDown::obstruction`] as [`Self::check_descent`], the fingers' closing axis as the tool
-    /// is now), the one with the most room: the largest of the least gaps to the blocks already
-    /// in it and to its walls with the fingers fully open (ties go to the spot nearest the
-    /// centre; the centre when it is empty), world frame, metres. A container with
+    /// is now), preferring those where the fingers fully open (as a `release` opens them by
+    /// default) clear its walls by [`MARGIN`] (or come nearest to), and among them the one with
+    /// the most room to the blocks already in it (ties go to the spot nearest the centre; the
+    /// centre when it is empty), world frame, metres. A container with
     /// no such spot fails with `container_full`, before anything moves.
     fn free_spot(&self, w: &World, c: usize, z: f64) -> Result<Vector2<f64>, Failure> {
         let centre = w.objects[c].pos.xy();
@@ -228,23 +229,25 @@ impl Carry {
             }
         }
         candidates.sort_by(|a, b| (a - centre).norm().total_cmp(&(b - centre).norm()));
-        let mut best: Option<(Vector2<f64>, f64)> = None;
+        let mut best: Option<(Vector2<f64>, (f64, f64))> = None;
         for p in candidates {
             let down = self.set_down(Vector3::new(p.x, p.y, z));
             if down.obstruction(w, self.held, Some(c)).is_some() {
                 continue;
             }
-            // Room: to the blocks in it, and to its walls with the fingers fully open (a
-            // `release` after the carry opens them fully by default).
+            // First the walls: the fingers fully open (a `release` after the carry opens them
+            // fully by default) clear them by the margin where they can; then the most room to
+            // the blocks in it.
             let open = SetDown {
                 opening: crate::motion::gripper::width_for_ctrl(crate::motion::gripper::OPEN_CTRL),
                 ..down
             };
-            let room = down
-                .room(w, &inside)
-                .min(open.wall_gap(w, c).unwrap_or(f64::INFINITY));
-            if best.is_none_or(|(_, r)| room > r + 1e-9) {
-                best = Some((p, room));
+            let walls = open.wall_gap(w, c).unwrap_or(f64::INFINITY).min(MARGIN);
+            let room = down.room(w, &inside);
+            let better =
+                best.is_none_or(|(_, (bw, br))| walls > bw + 1e-9 || (walls > bw - 1e-9 && room > br + 1e-9));
+            if better {
+                best = Some((p, (walls, room)));
             }
         }
         best.map(|(p, _)| p).ok_or_else(|| {
