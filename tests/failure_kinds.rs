@@ -5,7 +5,7 @@
 //! substitution). Each asserts the kind; wording is checked only where it is the point.
 //!
 //! Kinds produced elsewhere: `max_iterations` in `tests/tree_loops.rs`, `substituted` through a
-//! whole sweep in `tests/scenario_suites.rs`.
+//! whole sweep in `tests/scenario_suites.rs`, `container_full` in `tests/place_action.rs`.
 
 use std::ops::ControlFlow;
 use std::sync::{Arc, OnceLock};
@@ -651,6 +651,7 @@ fn every_built_in_kind_is_tested() {
         "start_in_collision",
         "goal_in_collision",
         "no_path",
+        "container_full",
         "other",
     ];
     let all: Vec<&str> = FailureKind::BUILTIN.iter().map(|k| k.as_str()).collect();

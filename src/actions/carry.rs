@@ -1,9 +1,14 @@
 //! `carry`: lift the held block, move it above the goal at a height that clears everything under
 //! its path, lower it onto the goal (a container's floor, the top of another block, or a point).
+//! `place` runs the same controller ([`Carry::placing`]): to a point on whatever surface is under
+//! it, turned to a yaw, lowered by the block's own size.
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
 use super::cell::Cell;
+use super::clearance::{
+    MARGIN, SetDown, blocks_inside, closing_axis_in_pinch, closing_in_world, release_opening, tip_above_block,
+};
 use super::macro_action::{Arrival, MacroAction, Progress};
 use super::planning::{check_motion, check_straight, describe};
 use super::targets::{resolve, segment_distance, target_object};
@@ -31,9 +36,9 @@ pub const CLEARANCE: f64 = 0.03;
 /// 2F-85's fingertips are about 2 cm wide and the pads 8 mm thick).
 pub const FINGER_MARGIN: f64 = 0.025;
 
-/// Radius around a set-down block's centre that the fingers sweep when they open to release it
-/// (up to 6 cm apart, plus pads and fingertips), metres.
-pub const RELEASE_REACH: f64 = 0.05;
+/// Steps of the grid of candidate spots across a container's floor, each way (odd: the centre
+/// is one of them).
+const SPOT_GRID: i32 = 9;
 
 /// The carry's phases, in order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -75,6 +80,18 @@ pub struct Carry {
     goal_q: [f64; 6],
     arrival: Arrival,
     lost: u32,
+    /// The fingers' closing axis in the pinch frame (unit).
+    closing: Vector3<f64>,
+    /// Height of the fingertips above the held block's centre, metres.
+    tip: f64,
+    /// A point target is set down on whatever is under it (a block, an obstacle, a container's
+    /// floor, else the table), not at the point's own height (`place`).
+    surface: bool,
+    /// The yaw the block should have when set down, radians (`place`); `None`: as held.
+    turn_to: Option<f64>,
+    /// The spot chosen in the destination container, in the container's frame (kept for the
+    /// whole carry, so a container that moves carries the spot with it), metres.
+    spot_local: Option<Vector2<f64>>,
 }
 
 impl Carry {
@@ -92,12 +109,59 @@ impl Carry {
             goal_q: [0.0; 6],
             lost: 0,
             arrival: Arrival::default(),
+            closing: Vector3::y(),
+            tip: 0.0,
+            surface: false,
+            turn_to: None,
+            spot_local: None,
         }
     }
 
-    /// The object the carry goes to, if its target is one.
+    /// The controller `place` runs: `spec.to` is a point whose height is ignored, the block is
+    /// set down on the surface under it (`spec.place_height` above it), turned to `yaw`
+    /// (radians, modulo a quarter turn; `None`: as held).
+    pub fn placing(spec: CarrySpec, yaw: Option<f64>) -> Self {
+        Self {
+            surface: true,
+            turn_to: yaw,
+            ..Self::new(spec)
+        }
+    }
+
+    /// The held block (valid once started).
+    pub fn held(&self) -> usize {
+        self.held
+    }
+
+    /// The set-down at block centre `centre` with the tool as it is planned now.
+    fn set_down(&self, centre: Vector3<f64>) -> SetDown {
+        self.set_down_turned(centre, 0)
+    }
+
+    /// The set-down at `centre` with the tool turned `k` quarter turns from its planned
+    /// orientation.
+    fn set_down_turned(&self, centre: Vector3<f64>, k: usize) -> SetDown {
+        SetDown {
+            centre,
+            closing: closing_in_world(&self.turned(k).0, &self.closing),
+            half: self.half,
+            tip: self.tip,
+            opening: release_opening(self.half),
+        }
+    }
+
+    /// The object the carry goes to, if its target is one; for a `place` at a point, the
+    /// object the block would come down on (the one with the highest support under the point).
     fn destination(&self, w: &World) -> Option<usize> {
-        target_object(&self.spec.to, w)
+        match (&self.spec.to, self.surface) {
+            (crate::kinds::Target::Point(p), true) => {
+                let at = Vector3::new(p[0], p[1], 0.0);
+                (0..w.objects.len())
+                    .filter(|&j| j != self.held && w.from_footprint(j, &at).norm() == 0.0)
+                    .max_by(|&a, &b| w.support_height(a).total_cmp(&w.support_height(b)))
+            }
+            _ => target_object(&self.spec.to, w),
+        }
     }
 
     /// How far the held block's corners and the closed fingers reach from its centre in the table
@@ -108,67 +172,101 @@ impl Carry {
 
     /// Where the block's centre ends up when placed at the goal as it is now, metres: on a
     /// container's floor, on top of a block, or at a point, `place_height` above it.
-    fn place(&self, w: &World) -> Result<Vector3<f64>, Failure> {
+    fn place(&mut self, w: &World) -> Result<Vector3<f64>, Failure> {
         let goal = resolve(&self.spec.to, w)?;
         let dest = self.destination(w);
         let base = match dest {
             Some(d) if w.spec(d).kind() == ObjectKind::Block => w.top(d),
+            Some(d) if self.surface => w.support_height(d),
+            None if self.surface => 0.0,
             _ => goal.z,
         };
+        let z = base + self.spec.place_height + self.half;
         let spot = match dest {
-            Some(c) if w.spec(c).kind() == ObjectKind::Container => self.free_spot(w, c),
+            Some(c) if w.spec(c).kind() == ObjectKind::Container && !self.surface => {
+                let local = match self.spot_local {
+                    Some(l) => l,
+                    None => {
+                        let p = self.free_spot(w, c, z)?;
+                        let l = w.local_xy(c, &Vector3::new(p.x, p.y, 0.0));
+                        self.spot_local = Some(l);
+                        l
+                    }
+                };
+                let (s, co) = crate::world::snapshot::yaw_of(&w.objects[c].quat).sin_cos();
+                w.objects[c].pos.xy() + Vector2::new(co * local.x - s * local.y, s * local.x + co * local.y)
+            }
             _ => goal.xy(),
         };
-        Ok(Vector3::new(
-            spot.x,
-            spot.y,
-            base + self.spec.place_height + self.half,
-        ))
+        Ok(Vector3::new(spot.x, spot.y, z))
     }
 
-    /// Where in container `c` to set the block down: of a 5 × 5 grid over the part of its floor
-    /// the fingers can reach, the point farthest from the blocks already in it (the centre when
-    /// it is empty; ties go to the point nearest the centre), world frame, metres.
-    fn free_spot(&self, w: &World, c: usize) -> Vector2<f64> {
+    /// Where in container `c` to set the block down, its centre at height `z`: of a grid over
+    /// the container's floor, the spots whose set-down the descent check accepts (the same
+    /// [`SetDown::obstruction`] as [`Self::check_descent`], the fingers' closing axis as the tool
+    /// is now), preferring those where the fingers fully open (as a `release` opens them by
+    /// default) clear its walls by [`MARGIN`] (or come nearest to), and among them the one with
+    /// the most room to the blocks already in it (ties go to the spot nearest the centre; the
+    /// centre when it is empty), world frame, metres. A container with
+    /// no such spot fails with `container_full`, before anything moves.
+    fn free_spot(&self, w: &World, c: usize, z: f64) -> Result<Vector2<f64>, Failure> {
         let centre = w.objects[c].pos.xy();
         let crate::scene::Shape::Container { inner_half, .. } = w.spec(c).shape else {
-            return centre;
+            return Ok(centre);
         };
-        let inside: Vec<Vector2<f64>> = (0..w.objects.len())
-            .filter(|&j| j != self.held && w.spec(j).kind() == ObjectKind::Block && w.inside(j, c))
-            .map(|j| w.objects[j].pos.xy())
-            .collect();
-        if inside.is_empty() {
-            return centre;
-        }
-        // The opening fingers may point any way: keep their whole sweep inside the walls.
-        let reach = (self.half * std::f64::consts::SQRT_2).max(RELEASE_REACH) + 0.005;
-        let usable = inner_half.map(|h| (h - reach).max(0.0));
+        let inside = blocks_inside(w, c, self.held);
+        let usable = inner_half.map(|h| (h - self.half).max(0.0));
         let (s, co) = crate::world::snapshot::yaw_of(&w.objects[c].quat).sin_cos();
-        let mut candidates: Vec<Vector2<f64>> = Vec::with_capacity(25);
-        for i in -2..=2 {
-            for k in -2..=2 {
-                let (lx, ly) = (usable[0] * i as f64 / 2.0, usable[1] * k as f64 / 2.0);
+        let n = SPOT_GRID / 2;
+        let mut candidates: Vec<Vector2<f64>> = Vec::with_capacity((SPOT_GRID * SPOT_GRID) as usize);
+        for i in -n..=n {
+            for k in -n..=n {
+                let (lx, ly) = (
+                    usable[0] * f64::from(i) / f64::from(n),
+                    usable[1] * f64::from(k) / f64::from(n),
+                );
                 candidates.push(centre + Vector2::new(co * lx - s * ly, s * lx + co * ly));
             }
         }
         candidates.sort_by(|a, b| (a - centre).norm().total_cmp(&(b - centre).norm()));
-        let clearance = |p: &Vector2<f64>| {
-            inside
-                .iter()
-                .map(|q| (p - q).norm())
-                .fold(f64::INFINITY, f64::min)
-        };
-        let mut best = candidates[0];
-        let mut best_clearance = clearance(&best);
-        for p in &candidates[1..] {
-            let d = clearance(p);
-            if d > best_clearance + 1e-9 {
-                best = *p;
-                best_clearance = d;
+        let mut best: Option<(Vector2<f64>, (f64, f64))> = None;
+        for p in candidates {
+            let down = self.set_down(Vector3::new(p.x, p.y, z));
+            if down.obstruction(w, self.held, Some(c)).is_some() {
+                continue;
+            }
+            // First the walls: the fingers fully open (a `release` after the carry opens them
+            // fully by default) clear them by the margin where they can; then the most room to
+            // the blocks in it.
+            let open = SetDown {
+                opening: crate::motion::gripper::width_for_ctrl(crate::motion::gripper::OPEN_CTRL),
+                ..down
+            };
+            let walls = open.wall_gap(w, c).unwrap_or(f64::INFINITY).min(MARGIN);
+            let room = down.room(w, &inside);
+            let better =
+                best.is_none_or(|(_, (bw, br))| walls > bw + 1e-9 || (walls > bw - 1e-9 && room > br + 1e-9));
+            if better {
+                best = Some((p, (walls, room)));
             }
         }
-        best
+        best.map(|(p, _)| p).ok_or_else(|| {
+            let names: Vec<&str> = inside.iter().map(|&j| w.name(j)).collect();
+            let holding = if names.is_empty() {
+                "it is empty, but too small for the block and the opened fingers".to_string()
+            } else {
+                format!("it holds {}", names.join(", "))
+            };
+            Failure::new(
+                FailureKind::ContainerFull,
+                format!(
+                    "{} cannot take {}: no spot on its floor where the block and the fingers (opened to {:.0} mm) clear its walls and the blocks in it; {holding}",
+                    w.name(c),
+                    w.name(self.held),
+                    self.set_down(Vector3::zeros()).opening * 1e3
+                ),
+            )
+        })
     }
 
     /// Height of the block's centre for a transfer from `from` to `to` (table plane), metres:
@@ -190,32 +288,10 @@ impl Carry {
         z
     }
 
-    /// Checks that the fingers can come down to `place` (block centre): no object other than the
-    /// goal stands within the fingers' reach of it higher than the block's bottom will be.
+    /// Checks that the block and the fingers (opened to let go, along their closing axis) can
+    /// come down to `place` (block centre): [`SetDown::check`].
     fn check_descent(&self, w: &World, place: &Vector3<f64>) -> Result<(), Failure> {
-        let dest = self.destination(w);
-        let bottom = place.z - self.half;
-        let reach = self.finger_reach();
-        for j in 0..w.objects.len() {
-            if j == self.held || Some(j) == dest {
-                continue;
-            }
-            let gap = w.from_footprint(j, place).norm();
-            if gap < reach && w.top(j) > bottom {
-                return Err(Failure::new(
-                    FailureKind::Blocked,
-                    format!(
-                        "no clear way down to ({:.3}, {:.3}): the fingers would hit {} ({:.0} mm away, its top at {:.3} m)",
-                        place.x,
-                        place.y,
-                        w.name(j),
-                        gap * 1e3,
-                        w.top(j)
-                    ),
-                ));
-            }
-        }
-        Ok(())
+        self.set_down(*place).check(w, self.held, self.destination(w))
     }
 
     /// Moves the block centre to `end` in a straight line: the phase `phase` starts.
@@ -346,6 +422,20 @@ impl Carry {
             }
         }
         all.sort_by(|a, b| a.0.total_cmp(&b.0));
+        // Quarter turns whose fingers the descent check refuses at the place are left out
+        // (unless every turn is refused: the check then says why when the set-down starts).
+        let w = cell.world();
+        let dest = self.destination(w);
+        let clear: Vec<bool> = (0..4)
+            .map(|k| {
+                self.set_down_turned(*place, k)
+                    .obstruction(w, self.held, dest)
+                    .is_none()
+            })
+            .collect();
+        if clear.iter().any(|&c| c) {
+            all.retain(|(_, k, _)| clear[*k]);
+        }
         let mut free: Vec<[f64; 6]> = Vec::new();
         for (_, k, q) in &all {
             if !self.set_down_hits(cell, q, place, *k) {
@@ -356,6 +446,7 @@ impl Carry {
             // Every pre-place configuration's set-down touches: plan to any (the goal's own
             // reasons, if any, name why) and let the set-down run as the leaf asks.
             let poses: Vec<Isometry3<f64>> = (0..4)
+                .filter(|&k| clear[k] || !clear.iter().any(|&c| c))
                 .map(|k| {
                     let (rotation, offset) = self.turned(k);
                     Isometry3::from_parts(Translation3::from(end + offset), rotation)
@@ -378,6 +469,21 @@ impl Carry {
         Ok(motion)
     }
 
+    /// Turns the planned tool orientation (and the block's offset from the pinch with it) about
+    /// the vertical through the block's centre so the block ends at the yaw `place` asks for,
+    /// by the smallest turn modulo a quarter turn (a cube looks the same).
+    fn turn(&mut self, w: &World) {
+        let Some(yaw) = self.turn_to else {
+            return;
+        };
+        let now = w.yaw(self.held);
+        let by = crate::world::snapshot::fold_quarter_turn(yaw - now);
+        let r = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), by);
+        self.rotation = r * self.rotation;
+        self.pinch_from_block = r * self.pinch_from_block;
+        self.turn_to = None;
+    }
+
     /// The current phase's motion has ended: start the next one (or re-plan the transfer).
     fn next_phase(&mut self, cell: &mut Cell) -> Result<(), Failure> {
         let w = cell.world();
@@ -386,7 +492,12 @@ impl Carry {
         let above_z = self.transfer_z(w, from, place.xy()).max(place.z);
         let above = Vector3::new(place.x, place.y, above_z);
         match self.phase {
-            Phase::Lift => self.start_phase(cell, Phase::Transfer, above),
+            Phase::Lift => {
+                self.turn(w);
+                let place = self.place(w)?;
+                let above = Vector3::new(place.x, place.y, above_z.max(place.z));
+                self.start_phase(cell, Phase::Transfer, above)
+            }
             Phase::Transfer if (above.xy() - self.phase_end.xy()).norm() > GOAL_MOVED => {
                 self.replans += 1;
                 if self.replans > MAX_REPLANS {
@@ -422,6 +533,9 @@ impl MacroAction for Carry {
         // Keep the pinch where it holds the block: move the pinch by as much as the block should move.
         self.pinch_from_block = w.pinch_pos - pos;
         self.rotation = UnitQuaternion::from_matrix(&w.pinch_rot);
+        self.closing = closing_axis_in_pinch(w);
+        self.tip = tip_above_block(w, held);
+        self.spot_local = None;
         let place = self.place(w)?;
         let lift_z = self.transfer_z(w, pos.xy(), place.xy()).max(pos.z);
         let lift = Vector3::new(pos.x, pos.y, lift_z);

@@ -1,5 +1,5 @@
 //! The macro-action controllers on the simulated cell: `reach`, `move_joints`, `home`, `grasp`,
-//! `carry`, `release`. `crate::factory` binds them to their node kinds, and the episode's leaf
+//! `carry`, `place`, `release`. `crate::factory` binds them to their node kinds, and the episode's leaf
 //! driver starts them when the tree runs.
 //!
 //! Each action is a small controller ([`MacroAction`]) in its own file: planned on its first
@@ -9,9 +9,11 @@
 mod carry;
 mod cell;
 mod checks;
+mod clearance;
 mod grasp;
 mod joints;
 mod macro_action;
+mod place;
 mod planning;
 mod reach;
 mod release;
@@ -23,6 +25,7 @@ pub use checks::{Checks, ChecksRecorder, pad_block_distance};
 pub(crate) use grasp::Grasp as GraspAction;
 pub(crate) use joints::MoveJoints as MoveJointsAction;
 pub use macro_action::{Arrival, MacroAction, Progress};
+pub(crate) use place::Place as PlaceAction;
 pub(crate) use reach::Reach as ReachAction;
 pub(crate) use release::Release as ReleaseAction;
 pub use targets::{object_index, object_point, resolve, target_block, target_object, tool_yaw};

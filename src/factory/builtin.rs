@@ -1,10 +1,12 @@
 //! The built-in leaves' controllers and checks.
 
 use super::{BindError, Factory};
-use crate::actions::{CarryAction, GraspAction, MoveJointsAction, ReachAction, ReleaseAction, object_index};
+use crate::actions::{
+    CarryAction, GraspAction, MoveJointsAction, PlaceAction, ReachAction, ReleaseAction, object_index,
+};
 use crate::kinds::{
     At, AtHome, Carry, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, GoalMet, Grasp, Grasped,
-    GripperOpen, Home, In, Lifted, MoveJoints, ObjectRef, On, OnTable, Reach, Release,
+    GripperOpen, Home, In, Lifted, MoveJoints, ObjectRef, On, OnTable, Place, Reach, Release,
 };
 use crate::world::conditions as cond;
 use crate::world::{World, goal};
@@ -30,6 +32,7 @@ fn bind(f: &mut Factory) -> Result<(), BindError> {
     f.bind_action("grasp", |p: &Grasp| Box::new(GraspAction::new(p.clone())))?;
     f.bind_action("carry", |p: &Carry| Box::new(CarryAction::new(p.clone())))?;
     f.bind_action("release", |p: &Release| Box::new(ReleaseAction::new(p.clone())))?;
+    f.bind_action("place", |p: &Place| Box::new(PlaceAction::new(p.clone())))?;
 
     // Conditions: pure functions of the world snapshot.
     f.bind_condition("grasped", |w, p: &Grasped| {

@@ -15,7 +15,7 @@ use super::control::{
 };
 use super::leaves::{
     At, AtHome, Carry, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, GoalMet, Grasp, Grasped,
-    GripperOpen, Home, In, Lifted, MoveJoints, On, OnTable, Reach, Release,
+    GripperOpen, Home, In, Lifted, MoveJoints, On, OnTable, Place, Reach, Release,
 };
 use super::registry::{Category, ControlImp, Imp, Registry};
 use super::role::ActionRole;
@@ -81,6 +81,7 @@ fn register(r: &mut Registry) -> Result<(), crate::error::Error> {
     r.declare_action_as::<Grasp>("grasp", doc!("grasp"), ActionRole::Grasp)?;
     r.declare_action_as::<Carry>("carry", doc!("carry"), ActionRole::Carry)?;
     r.declare_action_as::<Release>("release", doc!("release"), ActionRole::Release)?;
+    r.declare_action_as::<Place>("place", doc!("place"), ActionRole::Carry)?;
 
     // Leaves the runtime handles itself.
     r.add("wait", Runtime, doc!("wait"), Imp::Wait)?;

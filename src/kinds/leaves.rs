@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 use schemars::JsonSchema;
 
 use super::objects::{ObjectRef, ObjectRole, opt_var_name, var_name};
+use super::param_error::ParamError;
 use super::targets::{PathKind, Target, Yaw};
 pub use crate::kinds::{LeafCall, Params};
 use crate::world::conditions::Tolerances;
@@ -178,6 +179,54 @@ pub struct Carry {
     pub speed: f64,
     /// Give up after this many simulated seconds (> 0). Default 10.
     #[serde(default = "d_10", deserialize_with = "units::time_limit")]
+    #[schemars(range(min = 0.0))]
+    pub timeout: f64,
+}
+
+fn d_15() -> f64 {
+    15.0
+}
+
+/// `point: [x, y]` for an optional field (range-checked like any point on the table).
+fn opt_point<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>, D::Error> {
+    units::vec2(d).map(Some)
+}
+
+#[doc = include_str!("../../docs/nodes/place.md")]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Place {
+    /// Where the block's centre goes, `[x, y]` on the table, world metres (give `point` or
+    /// `spot`). It is set down on whatever is under the point: the table, the top of a block or
+    /// an obstacle, a container's floor.
+    #[serde(
+        default,
+        deserialize_with = "opt_point",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub point: Option<[f64; 2]>,
+    /// A named spot of the scene (`spots:`), instead of `point`; its yaw is the default `yaw`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(regex(pattern = r"^[a-z][a-z0-9_]*$"))]
+    pub spot: Option<String>,
+    /// The block's yaw when set down: an angle (radians or `deg(..)`, modulo 90°) or `keep`.
+    /// Default: the spot's yaw for a `spot`, `keep` for a `point`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub yaw: Option<Yaw>,
+    /// Height of the block's bottom above the table during the transfer, metres (≥ 0). Default 0.20.
+    #[serde(default = "d_lift", deserialize_with = "units::distance")]
+    #[schemars(range(min = 0.0, max = units::MAX_REACH))]
+    pub lift: f64,
+    /// Vertical retreat after the fingers open, metres (≥ 0). Default 0.10.
+    #[serde(default = "d_retreat", deserialize_with = "units::distance")]
+    #[schemars(range(min = 0.0, max = units::MAX_REACH))]
+    pub retreat: f64,
+    /// Tool speed, m/s (> 0). Default 0.5.
+    #[serde(default = "d_speed", deserialize_with = "units::speed")]
+    #[schemars(range(min = 0.0))]
+    pub speed: f64,
+    /// Give up after this many simulated seconds (> 0). Default 15.
+    #[serde(default = "d_15", deserialize_with = "units::time_limit")]
     #[schemars(range(min = 0.0))]
     pub timeout: f64,
 }
@@ -678,6 +727,57 @@ impl Params for Carry {
     }
     fn timeout(&self) -> Option<f64> {
         Some(self.timeout)
+    }
+}
+
+impl Params for Place {
+    fn label(&self, _: &str) -> Option<String> {
+        let mut s = match (&self.point, &self.spot) {
+            (Some(p), _) => format!("place at {}", fmt_vec(p)),
+            (None, Some(spot)) => format!("place at {spot}"),
+            (None, None) => "place".to_string(),
+        };
+        match self.yaw {
+            Some(Yaw::Angle(a)) => s.push_str(&format!(" yaw={}°", fmt_num(a.to_degrees()))),
+            Some(Yaw::Keep) => s.push_str(" yaw=keep"),
+            _ => {}
+        }
+        Some(s)
+    }
+    fn timeout(&self) -> Option<f64> {
+        Some(self.timeout)
+    }
+    fn validate_fields(&self) -> Result<(), ParamError> {
+        match (&self.point, &self.spot) {
+            (Some(_), Some(_)) => {
+                return Err(ParamError::at("spot", "give `point` or `spot`, not both"));
+            }
+            (None, None) => {
+                return Err(ParamError::new(
+                    "`place` needs where: `point: [x, y]` (metres) or `spot: NAME` (a spot of the scene)",
+                ));
+            }
+            _ => {}
+        }
+        if let Some(spot) = &self.spot {
+            let ok = spot.starts_with(|c: char| c.is_ascii_lowercase())
+                && spot
+                    .chars()
+                    .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
+            if !ok {
+                return Err(ParamError::at(
+                    "spot",
+                    format!("`{spot}` is not a spot name: a-z, 0-9 and _, starting with a letter"),
+                ));
+            }
+        }
+        if self.yaw == Some(Yaw::Object) {
+            return Err(ParamError::at(
+                "yaw",
+                "`object` is not a place yaw: give an angle (`deg(90)`) or `keep`",
+            ));
+        }
+        Ok(())
     }
 }
 

@@ -1,0 +1,201 @@
+//! `place`: set the held block down at a point or a named spot, turned to a yaw, on whatever
+//! surface is under it, then open the fingers just enough to let go and retreat straight up.
+//!
+//! The transfer and the set-down are `carry`'s ([`Carry::placing`]: the same lift, planned
+//! transfer, clearance check and straight set-down); the letting go is `release`'s, opened to
+//! the width the clearance check was made for.
+
+use super::carry::Carry;
+use super::cell::Cell;
+use super::clearance::release_opening;
+use super::macro_action::{MacroAction, Progress};
+use super::release::Release;
+use crate::failure::Failure;
+use crate::kinds::{Carry as CarrySpec, Place as PlaceSpec, Release as ReleaseSpec, Target, Yaw};
+use crate::scene::SceneSpec;
+
+/// Gap left under the block when the set-down ends, metres: the block drops this much when the
+/// fingers open (a set-down aimed exactly at the surface would press the arm into it).
+pub const DROP: f64 = 0.002;
+
+/// Time the fingers get to open and the arm to retreat after the set-down, seconds.
+const RELEASE_TIME: f64 = 3.0;
+
+/// Where a `place` goes: the point `[x, y]` (world metres) and the block's yaw there
+/// (radians; `None`: as held). A spot the scene does not have is a failure of kind `other`
+/// that lists the spots it has.
+pub fn place_target(scene: &SceneSpec, spec: &PlaceSpec) -> Result<([f64; 2], Option<f64>), Failure> {
+    let explicit = match spec.yaw {
+        Some(Yaw::Angle(a)) => Some(Some(a)),
+        Some(Yaw::Keep) | Some(Yaw::Object) => Some(None),
+        None => None,
+    };
+    if let Some(p) = spec.point {
+        return Ok((p, explicit.flatten()));
+    }
+    let name = spec.spot.as_deref().unwrap_or_default();
+    let Some(spot) = scene.spot(name) else {
+        let names: Vec<&str> = scene.spots.iter().map(|s| s.name.as_str()).collect();
+        let has = if names.is_empty() {
+            "it has none".to_string()
+        } else {
+            format!("its spots: {}", names.join(", "))
+        };
+        return Err(Failure::other(format!(
+            "scene `{}` has no spot `{name}` ({has})",
+            scene.name
+        )));
+    };
+    Ok(([spot.x, spot.y], explicit.unwrap_or(Some(spot.yaw))))
+}
+
+/// Executes a [`PlaceSpec`]: a carry to the place, then a release to the checked opening.
+pub struct Place {
+    spec: PlaceSpec,
+    carry: Option<Carry>,
+    release: Option<Release>,
+}
+
+impl Place {
+    /// A place controller for `spec`.
+    pub fn new(spec: PlaceSpec) -> Self {
+        Self {
+            spec,
+            carry: None,
+            release: None,
+        }
+    }
+
+    /// The set-down has ended: open to the width the clearance check allowed for, and retreat.
+    fn let_go(&mut self, cell: &mut Cell) -> Result<(), Failure> {
+        let half = self.carry.as_ref().map_or(0.0, |c| cell.world().half(c.held()));
+        let mut release = Release::new(ReleaseSpec {
+            width: Some(release_opening(half)),
+            retreat: self.spec.retreat,
+            timeout: RELEASE_TIME,
+        });
+        release.start(cell)?;
+        self.release = Some(release);
+        Ok(())
+    }
+}
+
+impl MacroAction for Place {
+    fn start(&mut self, cell: &mut Cell) -> Result<(), Failure> {
+        let ([x, y], yaw) = place_target(&cell.world().scene, &self.spec)?;
+        let spec = CarrySpec {
+            to: Target::Point([x, y, 0.0]),
+            lift: self.spec.lift,
+            place_height: DROP,
+            speed: self.spec.speed,
+            timeout: self.spec.timeout,
+        };
+        let mut carry = Carry::placing(spec, yaw);
+        self.release = None;
+        let started = carry.start(cell);
+        self.carry = Some(carry);
+        started
+    }
+
+    fn update(&mut self, cell: &mut Cell) -> Progress {
+        if let Some(release) = &mut self.release {
+            return release.update(cell);
+        }
+        let Some(carry) = &mut self.carry else {
+            return Progress::Failed(Failure::other("place updated before it started"));
+        };
+        match carry.update(cell) {
+            Progress::Done => match self.let_go(cell) {
+                Ok(()) => Progress::Running,
+                Err(e) => Progress::Failed(e),
+            },
+            other => other,
+        }
+    }
+
+    fn halt(&mut self, cell: &mut Cell) {
+        match (&mut self.release, &mut self.carry) {
+            (Some(r), _) => r.halt(cell),
+            (None, Some(c)) => c.halt(cell),
+            (None, None) => {}
+        }
+    }
+
+    fn waiting_for(&self, cell: &Cell) -> String {
+        match (&self.release, &self.carry) {
+            (Some(r), _) => format!("letting go: {}", r.waiting_for(cell)),
+            (None, Some(c)) => c.waiting_for(cell),
+            (None, None) => "not started".to_string(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Spot;
+
+    fn spec(point: Option<[f64; 2]>, spot: Option<&str>, yaw: Option<Yaw>) -> PlaceSpec {
+        PlaceSpec {
+            point,
+            spot: spot.map(str::to_string),
+            yaw,
+            lift: 0.2,
+            retreat: 0.1,
+            speed: 0.5,
+            timeout: 15.0,
+        }
+    }
+
+    fn scene_with_spot() -> SceneSpec {
+        let mut s = SceneSpec::builtin();
+        s.spots.push(Spot {
+            name: "kit_a".into(),
+            x: 0.45,
+            y: -0.1,
+            yaw: 0.3,
+        });
+        s
+    }
+
+    #[test]
+    fn a_spot_gives_its_point_and_its_yaw_unless_the_node_says_otherwise() {
+        let s = scene_with_spot();
+        assert_eq!(
+            place_target(&s, &spec(None, Some("kit_a"), None)).unwrap(),
+            ([0.45, -0.1], Some(0.3))
+        );
+        assert_eq!(
+            place_target(&s, &spec(None, Some("kit_a"), Some(Yaw::Keep))).unwrap(),
+            ([0.45, -0.1], None)
+        );
+        assert_eq!(
+            place_target(&s, &spec(None, Some("kit_a"), Some(Yaw::Angle(1.0)))).unwrap(),
+            ([0.45, -0.1], Some(1.0))
+        );
+    }
+
+    #[test]
+    fn a_point_keeps_the_yaw_unless_given() {
+        let s = scene_with_spot();
+        assert_eq!(
+            place_target(&s, &spec(Some([0.5, 0.1]), None, None)).unwrap(),
+            ([0.5, 0.1], None)
+        );
+        assert_eq!(
+            place_target(&s, &spec(Some([0.5, 0.1]), None, Some(Yaw::Angle(-0.2)))).unwrap(),
+            ([0.5, 0.1], Some(-0.2))
+        );
+    }
+
+    #[test]
+    fn an_unknown_spot_names_the_spots_the_scene_has() {
+        let s = scene_with_spot();
+        let e = place_target(&s, &spec(None, Some("kit_b"), None)).unwrap_err();
+        assert_eq!(e.kind, crate::failure::FailureKind::Other);
+        assert!(
+            e.message.contains("no spot `kit_b`") && e.message.contains("kit_a"),
+            "{e}"
+        );
+    }
+}
