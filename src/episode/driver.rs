@@ -207,7 +207,7 @@ impl LeafDriver for MacroDriver<'_> {
         let w = self.cell.world();
         Ok(query::select(w, query).map(|i| Selection {
             object: w.name(i).to_string(),
-            destination: goal::destination(w, i).map(|d| w.name(d).to_string()),
+            destination: goal::destination_name(w, i),
         }))
     }
 

@@ -37,9 +37,13 @@ pub fn lifted(w: &World, i: usize, min_height: f64) -> bool {
     w.bottom(i) >= min_height
 }
 
-/// Block `i` rests on the table ([`on_table`] with [`Tolerances::ON_TABLE_HEIGHT`]) with its centre
-/// within `tolerance` metres of `point` = (x, y) in the table plane and, when `yaw` is given, its
-/// side faces within `yaw_tolerance` radians of `yaw` modulo a quarter turn (the `at` condition).
+/// Block `i` rests at `point` = (x, y), metres (the `at` condition and the scene goal's `at`):
+/// released (no pad touches it), at rest (speed below `rest_speed`, m/s), its bottom within
+/// [`Tolerances::ON_TABLE_HEIGHT`] of the surface under it — the table outside every container
+/// ([`on_table`]), or the floor of the container it is inside (a kitting tray) —, its centre within
+/// `tolerance` metres of the point in the table plane and, when `yaw` is given, its side faces
+/// within `yaw_tolerance` radians of `yaw` modulo a quarter turn (a cube looks the same every
+/// quarter turn).
 pub fn at(
     w: &World,
     i: usize,
@@ -53,18 +57,28 @@ pub fn at(
     let near = (pos.x - point[0]).hypot(pos.y - point[1]) <= tolerance;
     let turned =
         yaw.is_none_or(|target| super::snapshot::fold_quarter_turn(w.yaw(i) - target).abs() <= yaw_tolerance);
-    on_table(w, i, Tolerances::ON_TABLE_HEIGHT, rest_speed) && near && turned
+    let resting = match w.container_of(i) {
+        Some(c) => {
+            w.bottom(i) - w.support_height(c) <= Tolerances::ON_TABLE_HEIGHT
+                && w.released(i)
+                && w.at_rest(i, rest_speed)
+        }
+        None => on_table(w, i, Tolerances::ON_TABLE_HEIGHT, rest_speed),
+    };
+    resting && near && turned
 }
 
 /// Block `i` rests on the table: its bottom within `max_height` metres of the table top, not over
-/// any container's footprint (1 cm margin), at rest (speed below `rest_speed`, m/s).
+/// any container's footprint (1 cm margin), released (no pad touches it) and at rest (speed below
+/// `rest_speed`, m/s). A block still in the gripper, even one pressed onto the table, is not on
+/// the table.
 pub fn on_table(w: &World, i: usize, max_height: f64, rest_speed: f64) -> bool {
     let p = w.objects[i].pos;
     let over_container = w
         .scene
         .of_kind(crate::scene::ObjectKind::Container)
         .any(|c| w.from_footprint(c, &p).norm() < 0.01);
-    w.bottom(i) <= max_height && !over_container && w.at_rest(i, rest_speed)
+    w.bottom(i) <= max_height && !over_container && w.released(i) && w.at_rest(i, rest_speed)
 }
 
 /// The gripper is open at least `min_width` metres.
