@@ -84,6 +84,9 @@ pub enum FailureKind {
     /// `no_path`: the goal configurations are free but the motion planner found no
     /// collision-free path to any within its budget; the message names what blocked it most.
     NoPath,
+    /// `collision`: a contact that should not happen (`--collisions fail`): the arm, the fingers
+    /// or the held block touched a container, an obstacle or another block; at the leaf running.
+    Collision,
     /// `other`: a failure of no more specific kind (an unknown object, an unresolved variable,
     /// a leaf the driver cannot run, …).
     Other,
@@ -94,7 +97,7 @@ pub enum FailureKind {
 
 impl FailureKind {
     /// Every built-in kind (all but [`Custom`](Self::Custom)).
-    pub const BUILTIN: [FailureKind; 23] = [
+    pub const BUILTIN: [FailureKind; 24] = [
         FailureKind::TimeLimit,
         FailureKind::Unstable,
         FailureKind::GoalNotMet,
@@ -117,6 +120,7 @@ impl FailureKind {
         FailureKind::StartInCollision,
         FailureKind::GoalInCollision,
         FailureKind::NoPath,
+        FailureKind::Collision,
         FailureKind::Other,
     ];
 
@@ -145,6 +149,7 @@ impl FailureKind {
             FailureKind::StartInCollision => "start_in_collision",
             FailureKind::GoalInCollision => "goal_in_collision",
             FailureKind::NoPath => "no_path",
+            FailureKind::Collision => "collision",
             FailureKind::Other => "other",
             FailureKind::Custom(name) => name,
         }

@@ -254,6 +254,9 @@ impl ScenarioResult {
         for sub in &config.substitutions {
             cmd += &format!(" --substitute {}", shell_quote(&sub.to_string()));
         }
+        if config.collisions != crate::episode::CollisionPolicy::Count {
+            cmd += &format!(" --collisions {}", config.collisions.name());
+        }
         cmd
     }
 }
