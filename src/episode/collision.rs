@@ -150,6 +150,11 @@ pub enum CollisionPolicy {
 }
 
 impl CollisionPolicy {
+    /// True for the default, [`CollisionPolicy::Count`].
+    pub fn is_count(&self) -> bool {
+        *self == CollisionPolicy::Count
+    }
+
     /// `count` or `fail`.
     pub fn name(self) -> &'static str {
         match self {
@@ -248,6 +253,45 @@ mod tests {
             object: "bin".into(),
             node: None,
         }
+    }
+
+    use crate::world::conditions::tests_support::{held, resting};
+    use crate::world::{Part, Piece};
+
+    fn obj(index: usize, piece: Piece) -> Part {
+        Part::Object { index, piece }
+    }
+
+    #[test]
+    fn contacts_are_typed_by_who_and_what() {
+        // The built-in scene: object 0 the cube, 1 the bowl.
+        let mut w = resting();
+        w.touches = vec![
+            (Part::Fingers, obj(1, Piece::Wall)),
+            (obj(1, Piece::Floor), Part::Robot),
+            (Part::Fingers, obj(0, Piece::Whole)),
+            (Part::Table, obj(0, Piece::Whole)),
+        ];
+        let c = classify(&w);
+        let labels: Vec<String> = c.iter().map(Collision::label).collect();
+        assert_eq!(labels, ["fingers-container", "arm-container", "fingers-block"]);
+        assert_eq!(c[0].what, "the fingers hit bowl wall");
+        assert_eq!(c[1].object, "bowl");
+        assert_eq!(c[2].what, "the fingers hit cube");
+    }
+
+    #[test]
+    fn the_held_block_counts_on_walls_but_not_on_the_floor_and_the_pads_on_it_do_not_count() {
+        let mut w = held();
+        w.touches = vec![
+            (Part::Fingers, obj(0, Piece::Whole)),
+            (obj(0, Piece::Whole), obj(1, Piece::Floor)),
+            (obj(0, Piece::Whole), obj(1, Piece::Wall)),
+        ];
+        let c = classify(&w);
+        assert_eq!(c.len(), 1, "{c:?}");
+        assert_eq!((c[0].who, c[0].kind), (Hitter::HeldBlock, HitKind::Container));
+        assert_eq!(c[0].what, "the carried cube hit bowl wall");
     }
 
     #[test]

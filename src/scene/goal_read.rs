@@ -517,3 +517,73 @@ fn read_place(
         yaw_tolerance: raw.yaw_tolerance,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Spot;
+    use crate::yaml::diag::Sources;
+    use crate::yaml::value::parse_yaml;
+
+    /// The goal `yaml` of the built-in scene with spots `slot_a` (0.40, −0.10, 90°) and
+    /// `slot_b`: the atoms, or the issues' messages and helps.
+    fn read(yaml: &str) -> Result<Goal, Vec<(String, Option<String>)>> {
+        let mut scene = SceneSpec::builtin();
+        scene.spots = vec![
+            Spot {
+                name: "slot_a".into(),
+                x: 0.40,
+                y: -0.10,
+                yaw: std::f64::consts::FRAC_PI_2,
+            },
+            Spot {
+                name: "slot_b".into(),
+                x: 0.40,
+                y: 0.10,
+                yaw: 0.0,
+            },
+        ];
+        let mut sources = Sources::new();
+        let id = sources.add("t.yaml", yaml);
+        let v = parse_yaml(yaml, id).unwrap();
+        let mut issues = Vec::new();
+        let goal = read_goal(&v, &scene, &mut issues);
+        if issues.is_empty() {
+            Ok(goal)
+        } else {
+            Err(issues.into_iter().map(|i| (i.message, i.help)).collect())
+        }
+    }
+
+    #[test]
+    fn a_spot_gives_the_point_and_names_the_destination() {
+        let g = read("- at: {object: cube, spot: slot_a}\n").unwrap();
+        let place = g.atoms[0].place().unwrap();
+        assert_eq!(place.point, [0.40, -0.10]);
+        assert_eq!(
+            place.yaw, None,
+            "the spot's yaw is checked only when `yaw` is written"
+        );
+        assert_eq!(g.atoms[0].destination(), Some("slot_a"));
+        assert_eq!(g.atoms[0].to_string(), "cube at slot_a (0.400, -0.100)");
+        let g = read("- at: {object: cube, spot: slot_b, yaw: deg(30)}\n").unwrap();
+        assert!((g.atoms[0].place().unwrap().yaw.unwrap() - 30f64.to_radians()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn an_unknown_spot_suggests_the_nearest_name() {
+        let e = read("- at: {object: cube, spot: slot_c}\n").unwrap_err();
+        assert_eq!(e[0].0, "unknown spot `slot_c`");
+        assert!(
+            e[0].1.as_deref().unwrap().contains("slot_a") || e[0].1.as_deref().unwrap().contains("slot_b"),
+            "{e:?}"
+        );
+        let e = read("- at: {object: cube, spot: bowl}\n").unwrap_err();
+        assert!(
+            e[0].1.as_deref().unwrap().contains("is an object, not a spot"),
+            "{e:?}"
+        );
+        let e = read("- in: {object: slot_a, container: bowl}\n").unwrap_err();
+        assert!(e[0].1.as_deref().unwrap().contains("is a spot"), "{e:?}");
+    }
+}

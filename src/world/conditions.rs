@@ -268,6 +268,82 @@ mod tests {
         assert!(!at(&w, 0, [p.x, p.y], 0.01, Some(turned + 0.03), 0.02, v));
     }
 
+    /// The held cube pressed onto the table: on the table by height and at rest, but the pads
+    /// touch it.
+    fn held_on_the_table() -> World {
+        let mut w = held();
+        w.objects[0].pos.z = HALF;
+        w
+    }
+
+    #[test]
+    fn on_table_and_at_need_the_block_released() {
+        let w = held_on_the_table();
+        let p = w.objects[0].pos;
+        let v = Tolerances::REST_SPEED;
+        assert!(w.bottom(0) < 1e-9 && w.at_rest(0, v), "pressed flat and still");
+        assert!(!on_table(&w, 0, 0.01, v), "held, not on the table");
+        assert!(!at(&w, 0, [p.x, p.y], 0.01, None, 0.05, v), "held, not placed");
+        let mut one_pad = w.clone();
+        one_pad.objects[0].right_pad_contact = false;
+        assert!(!on_table(&one_pad, 0, 0.01, v), "one pad still touching");
+        let mut let_go = w.clone();
+        let_go.objects[0].left_pad_contact = false;
+        let_go.objects[0].right_pad_contact = false;
+        assert!(on_table(&let_go, 0, 0.01, v) && at(&let_go, 0, [p.x, p.y], 0.01, None, 0.05, v));
+    }
+
+    #[test]
+    fn at_accepts_a_block_resting_on_a_container_floor_at_the_point() {
+        // The bowl's floor top is at z = 0.01: a cube on it, 2 cm from the bowl's centre.
+        let mut w = resting();
+        w.objects[0].pos = Vector3::new(0.47, 0.08, 0.01 + HALF);
+        let v = Tolerances::REST_SPEED;
+        assert!(
+            at(&w, 0, [0.47, 0.08], 0.01, None, 0.05, v),
+            "on the tray's floor at the point"
+        );
+        assert!(!on_table(&w, 0, 0.01, v), "but not on the table");
+        let mut floating = w.clone();
+        floating.objects[0].pos.z += 0.02;
+        assert!(
+            !at(&floating, 0, [0.47, 0.08], 0.01, None, 0.05, v),
+            "2 cm above the floor"
+        );
+        let mut gripped = w.clone();
+        gripped.objects[0].left_pad_contact = true;
+        assert!(
+            !at(&gripped, 0, [0.47, 0.08], 0.01, None, 0.05, v),
+            "a pad touches it"
+        );
+    }
+
+    #[test]
+    fn at_compares_the_yaw_modulo_a_quarter_turn() {
+        let mut w = resting();
+        let p = w.objects[0].pos;
+        w.objects[0].quat = UnitQuaternion::from_euler_angles(0.0, 0.0, 88f64.to_radians());
+        let v = Tolerances::REST_SPEED;
+        let tol = 3f64.to_radians();
+        assert!(
+            at(&w, 0, [p.x, p.y], 0.01, Some(-2f64.to_radians()), tol, v),
+            "88° is −2°"
+        );
+        assert!(at(
+            &w,
+            0,
+            [p.x, p.y],
+            0.01,
+            Some(std::f64::consts::FRAC_PI_2),
+            tol,
+            v
+        ));
+        assert!(
+            !at(&w, 0, [p.x, p.y], 0.01, Some(5f64.to_radians()), tol, v),
+            "7° off"
+        );
+    }
+
     #[test]
     fn gripper_open_and_at_home_compare_against_their_tolerances() {
         assert!(gripper_open(&resting(), 0.08));

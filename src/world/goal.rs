@@ -163,3 +163,95 @@ pub fn destination_name(w: &World, i: usize) -> Option<String> {
         .and_then(|a| a.destination())
         .map(str::to_string)
 }
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use nalgebra::Vector3;
+
+    use super::*;
+    use crate::scene::{AT_TOLERANCE, AT_YAW_TOLERANCE, SceneSpec};
+    use crate::world::conditions::tests_support::{HALF, held, resting};
+    use crate::world::query::{Filter, KindFilter, Order, Query, matches};
+
+    /// Two blocks `a` (at (0.40, −0.10)) and `b` (at (0.40, 0.10)), resting, with `goal`.
+    fn two_blocks(goal: &str) -> World {
+        let mut w = resting();
+        w.scene = Arc::new(
+            SceneSpec::from_str(
+                &format!(
+                    "objects:\n  a: {{block: {{size: 0.044}}, pose: [0.40, -0.10]}}\n  b: {{block: {{size: 0.044}}, pose: [0.40, 0.10]}}\ngoal:\n{goal}"
+                ),
+                "two.yaml",
+            )
+            .unwrap(),
+        );
+        w.objects[0].pos = Vector3::new(0.40, -0.10, HALF);
+        w.objects[1].pos = Vector3::new(0.40, 0.10, HALF);
+        w
+    }
+
+    #[test]
+    fn a_swap_is_pending_only_once_the_other_block_left_the_place() {
+        let mut w = two_blocks(
+            "  - at: {object: a, point: [0.40, 0.10]}\n  - at: {object: b, point: [0.40, -0.10]}\n",
+        );
+        assert!(
+            !pending(&w, 0) && !pending(&w, 1),
+            "each place is taken by the other block"
+        );
+        assert!(!done(&w, 0) && !goal_holds(&w));
+        // b moved to a buffer: a can go to b's place, b cannot yet go to a's.
+        w.objects[1].pos = Vector3::new(0.30, 0.25, HALF);
+        assert!(pending(&w, 0) && !pending(&w, 1));
+        w.objects[0].pos = Vector3::new(0.40, 0.10, HALF);
+        assert!(done(&w, 0) && !pending(&w, 0) && pending(&w, 1));
+        w.objects[1].pos = Vector3::new(0.40, -0.10, HALF);
+        assert!(goal_holds(&w));
+        assert_eq!(evaluate(&w).iter().filter(|g| g.holds).count(), 2);
+        // Placed but still in the gripper: not done, and `done` does not select it.
+        w.objects[1].left_pad_contact = true;
+        w.objects[1].right_pad_contact = true;
+        assert!(!done(&w, 1) && !goal_holds(&w));
+        let q = Query {
+            kind: KindFilter::default(),
+            color: None,
+            filters: vec![Filter::Done],
+            order: Order::Scene,
+        };
+        assert_eq!(matches(&w, &q), vec![0]);
+        let q = Query {
+            filters: vec![Filter::OnTable],
+            ..q
+        };
+        assert_eq!(matches(&w, &q), vec![0], "a held block is not `on_table`");
+    }
+
+    #[test]
+    fn a_stack_on_a_base_at_a_point_waits_for_the_base() {
+        let mut w = two_blocks("  - stack: {blocks: [a, b], base_at: {point: [0.50, 0.0]}}\n");
+        assert!(pending(&w, 1), "the base goes first");
+        assert!(!pending(&w, 0), "the top waits for its base");
+        w.objects[1].pos = Vector3::new(0.50, 0.0, HALF);
+        assert!(done(&w, 1) && pending(&w, 0));
+        assert_eq!(destination(&w, 0), Some(1));
+        assert_eq!(destination(&w, 1), None, "a place is not an object");
+        assert_eq!(destination_name(&w, 0).as_deref(), Some("b"));
+    }
+
+    #[test]
+    fn rests_at_is_the_at_condition_on_the_goal_place() {
+        let w = resting();
+        let p = w.objects[0].pos;
+        let place = GoalPlace {
+            spot: None,
+            point: [p.x + 0.005, p.y],
+            yaw: Some(0.0),
+            tolerance: AT_TOLERANCE,
+            yaw_tolerance: AT_YAW_TOLERANCE,
+        };
+        assert!(rests_at(&w, 0, &place, Tolerances::REST_SPEED));
+        assert!(!rests_at(&held(), 0, &place, Tolerances::REST_SPEED));
+    }
+}
