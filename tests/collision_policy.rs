@@ -9,7 +9,9 @@ mod cli;
 use cli::{macrotree, s, scratch};
 
 /// Opens the gripper, goes above the bowl's +x wall (the built-in `cube_bowl` scene: bowl at
-/// (0.45, 0.08), 0.15 m inside, walls 0.06 m high) and lowers the tool straight onto it.
+/// (0.45, 0.08), 0.15 m inside, walls 0.06 m high) with the pads apart along the wall (tool yaw
+/// 90°: at yaw 0 the open fingers would straddle the thin wall), and lowers the tool straight
+/// onto it.
 const INTO_THE_WALL: &str = "\
 description: lowers the open gripper onto the bowl's wall
 main:
@@ -17,14 +19,26 @@ main:
     name: into the wall
     children:
       - release: {name: open, width: 0.085, retreat: 0}
-      - reach: {name: above the wall, target: [0.53, 0.08, 0.20]}
-      - reach: {name: onto the wall, target: [0.53, 0.08, 0.03], path: cartesian, speed: 0.1}
+      - reach: {name: above the wall, target: [0.53, 0.08, 0.20], yaw: deg(90)}
+      - reach: {name: onto the wall, target: [0.53, 0.08, 0.03], yaw: deg(90), path: cartesian, speed: 0.1}
 ";
 
-fn write_tree(dir: &std::path::Path) -> std::path::PathBuf {
+/// The built-in cell with the bowl fixed where the tree goes (sweeps draw only the cube).
+const CELL: &str = "\
+objects:
+  cube: {block: {size: 0.044}, pose: [0.45, -0.18], random: {x: [0.40, 0.50], y: [-0.25, -0.15]}}
+  bowl: {container: {inner: [0.15, 0.15], wall_height: 0.06}, pose: [0.45, 0.08]}
+goal:
+  - in: {object: cube, container: bowl}
+";
+
+/// The tree and the scene, in `dir`.
+fn write_tree(dir: &std::path::Path) -> (std::path::PathBuf, std::path::PathBuf) {
     let tree = dir.join("into_the_wall.yaml");
     std::fs::write(&tree, INTO_THE_WALL).unwrap();
-    tree
+    let scene = dir.join("cell.yaml");
+    std::fs::write(&scene, CELL).unwrap();
+    (tree, scene)
 }
 
 fn json(out: &std::process::Output) -> serde_json::Value {
@@ -40,9 +54,9 @@ fn json(out: &std::process::Output) -> serde_json::Value {
 #[test]
 fn collisions_fail_ends_the_episode_with_kind_collision_at_the_leaf_running() {
     let dir = scratch("collision-fail");
-    let tree = write_tree(&dir);
+    let (tree, scene) = write_tree(&dir);
     // Counted (the default): the episode goes on; the report lists the contact, typed.
-    let out = macrotree(&["run", s(&tree), "--goal", "tree", "--json"]);
+    let out = macrotree(&["run", s(&tree), "--scene", s(&scene), "--goal", "tree", "--json"]);
     let counted = json(&out);
     let collisions = counted["collisions"].as_array().expect("collisions");
     assert!(!collisions.is_empty(), "the fingers land on the wall: {counted}");
@@ -90,11 +104,13 @@ fn collisions_fail_ends_the_episode_with_kind_collision_at_the_leaf_running() {
 #[test]
 fn sweep_summaries_count_collisions_by_kind_and_the_reproduction_keeps_the_policy() {
     let dir = scratch("collision-sweep");
-    let tree = write_tree(&dir);
+    let (tree, scene) = write_tree(&dir);
     let jsonl = dir.join("out.jsonl");
     let out = macrotree(&[
         "sweep",
         s(&tree),
+        "--scene",
+        s(&scene),
         "--scenarios",
         "2",
         "--jobs",
@@ -121,15 +137,20 @@ fn sweep_summaries_count_collisions_by_kind_and_the_reproduction_keeps_the_polic
         f["reproduce"].as_str().unwrap().ends_with("--collisions fail"),
         "{f}"
     );
-    // The JSONL lines carry the typed entries, and a resume reads them back.
+    // The JSONL lines carry the typed entries and the policy, and a resume reads them back.
     let text = std::fs::read_to_string(&jsonl).unwrap();
-    let line: serde_json::Value = serde_json::from_str(text.lines().next().unwrap()).unwrap();
+    let first = text.lines().next().unwrap();
+    let line: serde_json::Value = serde_json::from_str(first).unwrap();
     assert_eq!(line["collisions"][0]["kind"], "container");
+    assert_eq!(line["collision_policy"], "fail");
+    std::fs::write(&jsonl, format!("{first}\n")).unwrap();
     let out = macrotree(&[
         "sweep",
         s(&tree),
+        "--scene",
+        s(&scene),
         "--scenarios",
-        "3",
+        "2",
         "--jobs",
         "1",
         "--goal",
@@ -144,11 +165,16 @@ fn sweep_summaries_count_collisions_by_kind_and_the_reproduction_keeps_the_polic
     let resumed = json(&out);
     assert_eq!(
         resumed["scenarios"],
-        3,
+        2,
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    assert_eq!(resumed["collisions"]["episodes"], 3);
+    assert_eq!(resumed["collisions"]["episodes"], 2);
+    assert_eq!(
+        std::fs::read_to_string(&jsonl).unwrap(),
+        text,
+        "the resumed file is the same"
+    );
 }
 
 #[test]
@@ -159,7 +185,9 @@ fn max_collisions_in_a_scenario_file_passes_and_fails() {
         let p = dir.join(name);
         std::fs::write(
             &p,
-            format!("tree: into_the_wall.yaml\ncount: 1\ngoal: tree\nexpect:\n  max_collisions: {max}\n"),
+            format!(
+                "tree: into_the_wall.yaml\nscene: cell.yaml\ncount: 1\ngoal: tree\nexpect:\n  min_success_rate: 0\n  max_collisions: {max}\n"
+            ),
         )
         .unwrap();
         p

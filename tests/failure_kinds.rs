@@ -4,7 +4,8 @@
 //! and on scripted leaves where it is the tree's own logic (a timeout node, an inverter, a
 //! substitution). Each asserts the kind; wording is checked only where it is the point.
 //!
-//! Kinds produced elsewhere: `max_iterations` in `tests/tree_loops.rs`, `substituted` through a
+//! Kinds produced elsewhere: `collision` in `tests/collision_policy.rs`, `max_iterations` in
+//! `tests/tree_loops.rs`, `substituted` through a
 //! whole sweep in `tests/scenario_suites.rs`.
 
 use std::ops::ControlFlow;
@@ -651,6 +652,7 @@ fn every_built_in_kind_is_tested() {
         "start_in_collision",
         "goal_in_collision",
         "no_path",
+        "collision",
         "other",
     ];
     let all: Vec<&str> = FailureKind::BUILTIN.iter().map(|k| k.as_str()).collect();

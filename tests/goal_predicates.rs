@@ -77,7 +77,7 @@ fn a_stack_can_say_where_its_bottom_block_rests_and_the_list_form_still_reads() 
 fn placement_goal_mistakes_are_located_and_explained() {
     let d = errors("  - at: {object: rde, point: [0.4, 0.1]}\n");
     let e = find(&d, "unknown object `rde`");
-    assert_eq!((e.line, e.column), (7, 19));
+    assert_eq!((e.line, e.column), (7, 18));
     assert_eq!(e.help.as_deref(), Some("did you mean `red`?"));
 
     let d = errors("  - at: {object: red, pointt: [0.4, 0.1]}\n");
@@ -93,12 +93,12 @@ fn placement_goal_mistakes_are_located_and_explained() {
 
     let d = errors("  - at: {object: red, spot: slot_a}\n");
     let e = find(&d, "unknown spot `slot_a`");
-    assert_eq!((e.line, e.column), (7, 30));
+    assert_eq!((e.line, e.column), (7, 29));
     assert!(e.help.as_deref().unwrap().contains("declares no spots"), "{e}");
 
     let d = errors("  - at: {object: red, point: [0.9, 0.1]}\n");
     let e = find(&d, "outside the reach");
-    assert_eq!((e.line, e.column), (7, 31));
+    assert_eq!((e.line, e.column), (7, 30));
 
     let d = errors("  - at: {object: red, point: [0.4, 0.1], tolerance: 0}\n");
     find(&d, "`tolerance` must be > 0");
@@ -125,7 +125,7 @@ fn placement_goal_mistakes_are_located_and_explained() {
     find(&d, "at least two blocks");
     let d = errors("  - stack: {blocks: [red, blu]}\n");
     let e = find(&d, "unknown object `blu`");
-    assert_eq!((e.line, e.column), (7, 28));
+    assert_eq!((e.line, e.column), (7, 27));
 }
 
 /// The built-in cell with an `at` goal: the cube square at (0.32, −0.30), where
