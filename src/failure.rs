@@ -87,6 +87,9 @@ pub enum FailureKind {
     /// `container_full`: a `carry` into a container found no spot on its floor where the block
     /// and the opened fingers clear its walls and the blocks already in it (said before moving).
     ContainerFull,
+    /// `collision`: a contact that should not happen (`--collisions fail`): the arm, the fingers
+    /// or the held block touched a container, an obstacle or another block; at the leaf running.
+    Collision,
     /// `other`: a failure of no more specific kind (an unknown object, an unresolved variable,
     /// a leaf the driver cannot run, …).
     Other,
@@ -121,6 +124,7 @@ impl FailureKind {
         FailureKind::GoalInCollision,
         FailureKind::NoPath,
         FailureKind::ContainerFull,
+        FailureKind::Collision,
         FailureKind::Other,
     ];
 
@@ -150,6 +154,7 @@ impl FailureKind {
             FailureKind::GoalInCollision => "goal_in_collision",
             FailureKind::NoPath => "no_path",
             FailureKind::ContainerFull => "container_full",
+            FailureKind::Collision => "collision",
             FailureKind::Other => "other",
             FailureKind::Custom(name) => name,
         }

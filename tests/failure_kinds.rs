@@ -4,8 +4,9 @@
 //! and on scripted leaves where it is the tree's own logic (a timeout node, an inverter, a
 //! substitution). Each asserts the kind; wording is checked only where it is the point.
 //!
-//! Kinds produced elsewhere: `max_iterations` in `tests/tree_loops.rs`, `substituted` through a
-//! whole sweep in `tests/scenario_suites.rs`, `container_full` in `tests/place_action.rs`.
+//! Kinds produced elsewhere: `collision` in `tests/collision_policy.rs`, `max_iterations` in
+//! `tests/tree_loops.rs`, `substituted` through a whole sweep in `tests/scenario_suites.rs`,
+//! `container_full` in `tests/place_action.rs`.
 
 use std::ops::ControlFlow;
 use std::sync::{Arc, OnceLock};
@@ -652,6 +653,7 @@ fn every_built_in_kind_is_tested() {
         "goal_in_collision",
         "no_path",
         "container_full",
+        "collision",
         "other",
     ];
     let all: Vec<&str> = FailureKind::BUILTIN.iter().map(|k| k.as_str()).collect();

@@ -32,6 +32,13 @@ pub fn goal() -> impl clap::builder::TypedValueParser<Value = crate::episode::Go
         .try_map(|s| s.parse::<crate::episode::Goal>())
 }
 
+/// `--collisions POLICY`: `count` or `fail`.
+pub fn collisions() -> impl clap::builder::TypedValueParser<Value = crate::episode::CollisionPolicy> {
+    use clap::builder::TypedValueParser as _;
+    clap::builder::PossibleValuesParser::new(["count", "fail"])
+        .try_map(|s| s.parse::<crate::episode::CollisionPolicy>())
+}
+
 /// `s` as a number accepted by `ok`, or an error that gives the `range`.
 fn number_in(s: &str, ok: impl Fn(f64) -> bool, range: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {

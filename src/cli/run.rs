@@ -101,6 +101,11 @@ pub struct EpisodeArgs {
     /// conditions check the task).
     #[arg(long, value_parser = super::limits::goal(), default_value = "scene")]
     pub goal: Goal,
+    /// Contacts that should not happen (the arm, the fingers or the held block on a container,
+    /// an obstacle or another block): `count` them (default), or `fail` the episode at the first
+    /// one (failure kind `collision`).
+    #[arg(long, value_parser = super::limits::collisions(), default_value = "count")]
+    pub collisions: crate::episode::CollisionPolicy,
     /// Replace the leaves whose path matches PATTERN (`main/**/grasp`) with a scripted outcome:
     /// success, failure, running:N or fail_first:N (repeatable; see docs/testing_trees.md).
     #[arg(long = "substitute", value_name = "PATTERN=OUTCOME")]
@@ -124,6 +129,7 @@ impl EpisodeArgs {
             fault: self.fault,
             goal: self.goal,
             substitutions: self.substitute.clone(),
+            collisions: self.collisions,
             ..EpisodeConfig::default()
         })
     }
@@ -199,6 +205,13 @@ pub(super) fn check_goal(goal: Goal, scene: &Scene) -> Result<(), CliError> {
             spec.of_kind(crate::scene::ObjectKind::Block).count(),
             spec.of_kind(crate::scene::ObjectKind::Container).count()
         )));
+    }
+    if goal == Goal::Scene && spec.goal.is_empty() {
+        tracing::warn!(target: "macrotree::cli", scene = %spec.name, "--goal scene on a scene without a goal");
+        eprintln!(
+            "warning: --goal scene, but scene `{}` declares no goal: success means only that the tree succeeded\n  help: add a `goal:` to the scene (see docs/scenes.md), or pass --goal tree to say so",
+            spec.name
+        );
     }
     Ok(())
 }
@@ -447,8 +460,9 @@ fn print_summary(r: &crate::episode::EpisodeReport, goal: Goal, json: bool) {
             if g.holds { "holds" } else { "does NOT hold" }
         );
     }
+    say!(json, "  success judged by {}", r.goal_checked);
     for c in &r.collisions {
-        say!(json, "  collision at {:.2} s: {}", c.time, c.what);
+        say!(json, "  collision at {:.2} s ({}): {}", c.time, c.label(), c.what);
     }
     // The cube and bowl lines only for a scene that has them (see `World::cube`).
     let xyz = |p: [f64; 3]| format!("({:.3}, {:.3}, {:.3}) m", p[0], p[1], p[2]);

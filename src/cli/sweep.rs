@@ -40,6 +40,11 @@ pub struct SweepArgs {
     /// succeeded and the cube rests in the bowl; `tree` = the tree succeeded.
     #[arg(long, value_parser = super::limits::goal(), default_value = "scene")]
     pub goal: Goal,
+    /// Contacts that should not happen (the arm, the fingers or the held block on a container,
+    /// an obstacle or another block): `count` them (default), or `fail` the episode at the first
+    /// one (failure kind `collision`).
+    #[arg(long, value_parser = super::limits::collisions(), default_value = "count")]
+    pub collisions: crate::episode::CollisionPolicy,
     /// Write one JSON line per scenario here, in scenario order (a regular file or a new path).
     #[arg(long, value_name = "FILE.jsonl")]
     pub out: Option<PathBuf>,
@@ -122,6 +127,7 @@ pub fn sweep(app: &crate::App, args: SweepArgs) -> Result<(), CliError> {
         resolved: Some(resolved),
         suite: None,
         tree_digest: Some(super::outputs::inputs_digest(&inputs)),
+        collisions: args.collisions,
         program: super::program_name(),
     };
     let total = config.indices().len() as u64;

@@ -43,6 +43,11 @@ pub struct TestArgs {
     /// Write one JSON line per scenario here (the sweep's lines, each naming its `suite`).
     #[arg(long, value_name = "FILE.jsonl")]
     pub out: Option<PathBuf>,
+    /// In every scenario file: contacts that should not happen (the arm, the fingers or the held block on a container,
+    /// an obstacle or another block): `count` them (default), or `fail` the episode at the first
+    /// one (failure kind `collision`).
+    #[arg(long, value_parser = super::limits::collisions(), default_value = "count")]
+    pub collisions: crate::episode::CollisionPolicy,
     /// Print the outcome as one JSON object on stdout (the only thing on stdout; the text for people goes to stderr).
     #[arg(long)]
     pub json: bool,
@@ -107,6 +112,7 @@ pub fn test(app: &crate::App, args: TestArgs) -> Result<(), CliError> {
         s.sweep.shard = shard;
         s.sweep.jobs = args.jobs.map_or(0, |j| j as usize);
         s.sweep.program = super::program_name();
+        s.sweep.collisions = args.collisions;
         let read = super::outputs::suite_inputs(s, &plan);
         s.sweep.tree_digest = Some(super::outputs::inputs_digest(&read));
         inputs.extend(read);
@@ -211,6 +217,7 @@ pub(super) fn finish(
         for g in &sm.failure_groups {
             say!(json, "  failures: {} × {} at {}", g.count, g.kind, g.node);
         }
+        say!(json, "  collisions: {}", sm.collisions.line());
         let cmds = offending_commands(&file.expect, results, &file.sweep);
         if !o.passed && !cmds.is_empty() {
             details += "reproduce:\n";

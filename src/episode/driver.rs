@@ -9,10 +9,10 @@ use crate::failure::{Failure, FailureKind};
 use crate::kinds::{ActionRole, Leaf, LeafCall};
 use crate::plan::LeafId;
 use crate::runtime::{LeafDriver, LeafOutcome, Selection};
-use crate::scene::ObjectKind;
-use crate::world::conditions as cond;
+use crate::world::goal;
 use crate::world::query::{self, Query};
-use crate::world::{Part, Piece, goal};
+
+use super::collision::{Collision, CollisionPolicy};
 
 /// A running macro action and when it must be done by.
 struct Active {
@@ -45,15 +45,15 @@ pub struct MacroDriver<'a> {
     pub last_failure: Option<Failure>,
     /// Contacts that should not happen, by name, in the order first seen.
     pub collisions: Vec<Collision>,
-}
-
-/// A contact that should not happen (the fingers on a wall, the carried block on an obstacle).
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Collision {
-    /// Simulated time it was first seen, seconds.
-    pub time: f64,
-    /// What hit what, e.g. `the fingers hit bowl wall`.
-    pub what: String,
+    /// What a collision does ([`CollisionPolicy::Fail`]: [`Self::collision_failure`]).
+    pub collision_policy: CollisionPolicy,
+    /// With [`CollisionPolicy::Fail`], the failure (kind `collision`, at the running leaf) of the
+    /// first collision; the episode ends on it.
+    pub collision_failure: Option<Failure>,
+    /// The plan's leaf paths, by leaf index (names the leaf running when a collision is seen).
+    leaf_paths: Vec<String>,
+    /// The action leaf ticked last that is still running.
+    current: Option<LeafId>,
 }
 
 impl<'a> MacroDriver<'a> {
@@ -67,7 +67,17 @@ impl<'a> MacroDriver<'a> {
             counters: LeafCounters::default(),
             last_failure: None,
             collisions: Vec::new(),
+            collision_policy: CollisionPolicy::Count,
+            collision_failure: None,
+            leaf_paths: Vec::new(),
+            current: None,
         }
+    }
+
+    /// Names collisions by the running leaf's path: `paths[i]` is leaf `i`'s (the plan's
+    /// [`crate::plan::LeafInfo::path`]s).
+    pub fn set_leaf_paths(&mut self, paths: Vec<String>) {
+        self.leaf_paths = paths;
     }
 
     /// The cell.
@@ -96,43 +106,44 @@ impl<'a> MacroDriver<'a> {
         self.factory.start(action)
     }
 
-    /// Notes contacts that should not happen: the fingers on a container or an obstacle, and the
-    /// held block on a wall or an obstacle. Each is logged and recorded once, by name.
+    /// Notes contacts that should not happen (see [`super::collision::classify`]), each logged and
+    /// recorded once, by name, with the running leaf's path; with [`CollisionPolicy::Fail`] the
+    /// first one becomes [`Self::collision_failure`].
     fn watch_contacts(&mut self) {
         let w = self.cell.world();
         if w.touches.is_empty() {
             return;
         }
-        let held = w.held_block(cond::Tolerances::GRASP_OFF_AXIS);
-        for &(a, b) in &w.touches {
-            for (me, other) in [(a, b), (b, a)] {
-                let Part::Object { index, piece } = other else {
-                    continue;
-                };
-                let kind = w.spec(index).kind();
-                let fingers = matches!(me, Part::Fingers | Part::Robot) && kind != ObjectKind::Block;
-                let carried = matches!(me, Part::Object { index: h, .. } if Some(h) == held && h != index)
-                    && (piece == Piece::Wall || kind == ObjectKind::Obstacle);
-                if !(fingers || carried) {
-                    continue;
-                }
-                let who = match me {
-                    Part::Object { index: h, .. } => format!("the carried {}", w.name(h)),
-                    Part::Robot => "the arm".to_string(),
-                    _ => "the fingers".to_string(),
-                };
-                let what = format!("{who} hit {}", w.describe(other));
-                if !self.collisions.iter().any(|c| c.what == what) {
-                    tracing::info!(target: "macrotree::actions", sim_time = w.time, "collision: {what}");
-                    self.collisions.push(Collision { time: w.time, what });
-                }
+        let node = self
+            .current
+            .filter(|id| !id.is_internal())
+            .and_then(|id| self.leaf_paths.get(id.0 as usize).cloned());
+        for mut c in super::collision::classify(w) {
+            if self.collisions.iter().any(|seen| seen.what == c.what) {
+                continue;
             }
+            c.node = node.clone();
+            tracing::info!(target: "macrotree::actions", sim_time = w.time, node = node.as_deref(), "collision: {}", c.what);
+            if self.collision_policy == CollisionPolicy::Fail && self.collision_failure.is_none() {
+                let f = Failure::new(
+                    FailureKind::Collision,
+                    format!("collision ({}): {} at {:.2} s", c.label(), c.what, c.time),
+                );
+                self.collision_failure = Some(match &node {
+                    Some(n) => f.at(n.clone()),
+                    None => f,
+                });
+            }
+            self.collisions.push(c);
         }
     }
 
     fn finish(&mut self, id: LeafId, leaf: &Leaf, progress: Progress) -> LeafOutcome {
         if !matches!(progress, Progress::Running) {
             self.active.remove(&id);
+            if self.current == Some(id) {
+                self.current = None;
+            }
             if matches!(leaf, Leaf::Action(a) if a.role() == ActionRole::Grasp) {
                 self.checks.after_grasp(self.cell.world());
             }
@@ -161,7 +172,10 @@ impl LeafDriver for MacroDriver<'_> {
                     }
                 };
             }
-            Leaf::Action(a) => a,
+            Leaf::Action(a) => {
+                self.current = Some(id);
+                a
+            }
             Leaf::Wait(_) | Leaf::Select(_) => {
                 return LeafOutcome::Failure(Failure::other(format!(
                     "`{}` is handled by the runtime, not the driver",
@@ -207,11 +221,14 @@ impl LeafDriver for MacroDriver<'_> {
         let w = self.cell.world();
         Ok(query::select(w, query).map(|i| Selection {
             object: w.name(i).to_string(),
-            destination: goal::destination(w, i).map(|d| w.name(d).to_string()),
+            destination: goal::destination_name(w, i),
         }))
     }
 
     fn halt(&mut self, id: LeafId, _leaf: &Leaf) {
+        if self.current == Some(id) {
+            self.current = None;
+        }
         if let Some(mut active) = self.active.remove(&id) {
             active.action.halt(self.cell);
             self.counters.halts += 1;

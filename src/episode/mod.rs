@@ -2,6 +2,7 @@
 //! layout to a report. This is where tree logic ([`crate::runtime`]) meets physics
 //! ([`crate::actions`], [`crate::sim`]).
 
+pub mod collision;
 mod driver;
 pub mod replay;
 mod report;
@@ -11,7 +12,8 @@ pub mod vectors;
 use std::sync::Arc;
 use std::time::Instant;
 
-pub use driver::{Collision, LeafCounters, MacroDriver};
+pub use collision::{Collision, CollisionCounts, CollisionPolicy, HitKind, Hitter};
+pub use driver::{LeafCounters, MacroDriver};
 pub use report::{EpisodeReport, LayoutJson, NodeReport, ObjectReport};
 
 use crate::actions::Cell;
@@ -55,6 +57,9 @@ pub struct EpisodeConfig {
     /// every episode reuses them. `None` (or a resolution of another plan, with another number
     /// of leaves): the episode resolves `substitutions` itself.
     pub resolved: Option<Arc<crate::runtime::substitute::Resolved>>,
+    /// What a contact that should not happen does: counted (default), or an episode failure of
+    /// kind `collision` (`--collisions fail`).
+    pub collisions: CollisionPolicy,
 }
 
 /// What counts as a successful episode (`run --goal`, `sweep --goal`).
@@ -86,6 +91,26 @@ impl Goal {
     }
 }
 
+impl Goal {
+    /// What this goal checks on a scene with `scene_goal`, for reports: `the tree's result and
+    /// the scene's goal (2 predicates)`, or `the tree's result only (the scene declares no goal)`
+    /// when `--goal scene` meets a scene without one.
+    pub fn checked(self, scene_goal: &crate::scene::Goal) -> String {
+        match self {
+            Goal::Scene if scene_goal.is_empty() => {
+                "the tree's result only (the scene declares no goal)".into()
+            }
+            Goal::Scene => format!(
+                "the tree's result and the scene's goal ({} predicate{})",
+                scene_goal.atoms.len(),
+                if scene_goal.atoms.len() == 1 { "" } else { "s" }
+            ),
+            Goal::Bowl => "the tree's result and the cube at rest in the bowl".into(),
+            Goal::Tree => "the tree's result".into(),
+        }
+    }
+}
+
 impl std::str::FromStr for Goal {
     type Err = String;
 
@@ -109,6 +134,7 @@ impl Default for EpisodeConfig {
             goal: Goal::Scene,
             substitutions: Vec::new(),
             resolved: None,
+            collisions: CollisionPolicy::Count,
         }
     }
 }
@@ -170,6 +196,8 @@ pub fn run_in_cell(
     };
     let mut runner = TreeRunner::with_substitutions(plan, subs);
     let mut driver = MacroDriver::new(cell, factory);
+    driver.collision_policy = config.collisions;
+    driver.set_leaf_paths(runner.plan().leaves.iter().map(|l| l.path.clone()).collect());
     let mut status = if bad_subs.is_some() {
         TreeStatus::Failure
     } else {
@@ -177,6 +205,7 @@ pub fn run_in_cell(
     };
     let mut timed_out = false;
     let mut unstable = None;
+    let mut collided = None;
     while status == TreeStatus::Running {
         let now = driver.cell().world().time;
         if now >= config.max_sim_time {
@@ -192,8 +221,14 @@ pub fn run_in_cell(
             unstable = Some(Failure::new(FailureKind::Unstable, why));
             break;
         }
+        // `--collisions fail`: the first contact that should not happen ends the episode.
+        if let Some(f) = driver.collision_failure.take() {
+            tracing::info!(target: "macrotree::episode", "{}", f.message);
+            collided = Some(f);
+            break;
+        }
     }
-    if timed_out || unstable.is_some() {
+    if timed_out || unstable.is_some() || collided.is_some() {
         runner.halt_all(&mut driver);
     }
     let checks = driver.checks.clone();
@@ -226,6 +261,11 @@ pub fn run_in_cell(
     report.planning = cell.planning().clone();
     if !report.success {
         report.failed_node = runner.last_failed_path();
+    }
+    if let Some(f) = collided {
+        report.success = false;
+        report.failed_node = f.node.clone();
+        report.set_failure(f);
     }
     report
 }

@@ -53,6 +53,9 @@ pub struct EpisodeReport {
     pub goal: Vec<GoalValue>,
     /// Contacts that should not happen (the fingers on a wall, …), in the order first seen.
     pub collisions: Vec<Collision>,
+    /// What success was judged by ([`Goal::checked`]), e.g. `the tree's result only (the scene
+    /// declares no goal)`.
+    pub goal_checked: String,
     /// The path of the last leaf (or check) that failed, when the episode failed: the leaf where
     /// the failure started, not the composite or decorator that passed it up (that is the root).
     pub failed_node: Option<String>,
@@ -215,6 +218,7 @@ impl EpisodeReport {
             seed: config.seed,
             scene: world.scene.name.clone(),
             objects: Vec::new(),
+            goal_checked: config.goal.checked(&world.scene.goal),
             goal,
             collisions: Vec::new(),
             failed_node: None,

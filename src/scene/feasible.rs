@@ -1,6 +1,6 @@
 //! Scenes whose task can never be done are refused at load, located: a scene without a block
 //! (nothing to pick), goals that stack blocks in a cycle (`a on b`, `b on a`), and a block
-//! wider than the inside of the container it must end in.
+//! wider than the inside of the container it must end in, two blocks whose `at` goals overlap.
 
 use std::collections::BTreeMap;
 
@@ -81,6 +81,36 @@ pub(super) fn check_goal_feasible(scene: &SceneSpec, atoms: &[(GoalAtom, Loc)], 
                     )
                     .label("this goal can never hold")
                     .help("make the block smaller or the container wider (see docs/scenes.md)"),
+                );
+            }
+        }
+    }
+    // Two `at` goals whose places overlap whatever the blocks' yaws, even at the tolerances'
+    // ends: the blocks' inscribed circles would meet.
+    let places: Vec<(&str, &super::GoalPlace, Loc)> = atoms
+        .iter()
+        .filter_map(|(a, loc)| a.place().map(|p| (a.object(), p, *loc)))
+        .collect();
+    let half = |name: &str| match scene.object(name).map(|o| &o.shape) {
+        Some(Shape::Block { half, .. }) => *half,
+        _ => 0.0,
+    };
+    for (k, (a, pa, _)) in places.iter().enumerate() {
+        for (b, pb, loc) in &places[k + 1..] {
+            let d = (pa.point[0] - pb.point[0]).hypot(pa.point[1] - pb.point[1]);
+            if d + pa.tolerance + pb.tolerance < half(a) + half(b) {
+                issues.push(
+                    Issue::new(
+                        *loc,
+                        format!(
+                            "blocks `{a}` and `{b}` cannot both be there: their places are {:.0} mm apart and the blocks {:.0} mm and {:.0} mm wide",
+                            d * 1e3,
+                            2e3 * half(a),
+                            2e3 * half(b)
+                        ),
+                    )
+                    .label("these `at` goals can never hold together")
+                    .help("move the points apart by at least the blocks' half widths added"),
                 );
             }
         }

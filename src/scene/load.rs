@@ -8,14 +8,15 @@ use schemars::JsonSchema;
 use serde::Deserialize;
 
 use super::color::Color;
-use super::goal::{Goal, GoalAtom};
+use super::goal::Goal;
+use super::goal_read::{GoalRaw, read_goal};
 use super::sample::{Placement, sample_placement};
-use super::types::{ObjectKind, ObjectSpec, Pose, RandomPlacement, Sampler, SceneSpec, Shape};
+use super::types::{ObjectSpec, Pose, RandomPlacement, Sampler, SceneSpec, Shape};
 use crate::yaml::de::from_value;
 use crate::yaml::diag::{Diagnostic, Issue, Loc, Sources};
 use crate::yaml::suggest::did_you_mean;
 use crate::yaml::units::Angle;
-use crate::yaml::value::{Value, ValueKind, decode_utf8, parse_yaml};
+use crate::yaml::value::{Value, decode_utf8, parse_yaml};
 
 /// The built-in scene `cube_bowl` (the reference tutorial's cell), used when a tree names no
 /// scene. The same text as `scenes/cube_bowl.yaml`.
@@ -127,55 +128,6 @@ pub struct ObjectRaw {
     random: Option<RandomRaw>,
 }
 
-/// `in:` goal.
-#[derive(Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct InRaw {
-    /// A block.
-    object: String,
-    /// A container.
-    container: String,
-}
-
-/// `on:` goal.
-#[derive(Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct OnRaw {
-    /// The block on top.
-    object: String,
-    /// The block under it.
-    support: String,
-}
-
-/// `all_in:` goal.
-#[derive(Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct AllInRaw {
-    /// The container every block must end in.
-    container: String,
-}
-
-/// `sorted_by_color:` goal (no parameters).
-#[derive(Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct NoParams {}
-
-/// One goal predicate (see `docs/scenes.md`).
-#[derive(Deserialize, JsonSchema)]
-#[serde(rename_all = "snake_case", deny_unknown_fields)]
-pub enum GoalRaw {
-    /// The block rests in the container.
-    In(InRaw),
-    /// The block rests on the other block.
-    On(OnRaw),
-    /// Every block rests in the container.
-    AllIn(AllInRaw),
-    /// `[top, …, bottom]`: each block rests on the next; the last stays on the table.
-    Stack(Vec<String>),
-    /// Every block rests in the container of its colour.
-    SortedByColor(NoParams),
-}
-
 /// The whole scene file, for the JSON Schema (`macrotree schema --scene`).
 #[derive(Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -274,7 +226,7 @@ pub fn is_object_name(s: &str) -> bool {
 }
 
 /// The location of the value at `path` under `v` (or `v`'s own when absent).
-fn loc_at(v: &Value, path: &[&str]) -> Loc {
+pub(super) fn loc_at(v: &Value, path: &[&str]) -> Loc {
     let mut cur = v;
     for k in path {
         match cur.get(k) {
@@ -708,183 +660,5 @@ fn check_fixed_poses(scene: &SceneSpec, objects_v: &Value, issues: &mut Vec<Issu
             Issue::new(at, e.to_string())
                 .help("move the objects apart, onto the table and within the arm's reach"),
         );
-    }
-}
-
-fn read_goal(v: &Value, scene: &SceneSpec, issues: &mut Vec<Issue>) -> Goal {
-    let Some(items) = v.as_seq() else {
-        issues.push(
-            Issue::new(
-                v.loc,
-                format!("`goal` must be a list of predicates, found {}", v.describe()),
-            )
-            .label("expected e.g. `- in: {object: red, container: red_bin}`"),
-        );
-        return Goal::default();
-    };
-    let mut atoms: Vec<(GoalAtom, Loc)> = Vec::new();
-    for item in items {
-        let raw: GoalRaw =
-            match from_value(item) {
-                Ok(r) => r,
-                Err(e) => {
-                    issues.push(e.into_issue(item.loc, |l| format!("{l:?}")).help_or(
-                        "a goal predicate is one of `in`, `on`, `all_in`, `stack`, `sorted_by_color`",
-                    ));
-                    continue;
-                }
-            };
-        let body = match &item.kind {
-            ValueKind::Map(e) if e.len() == 1 => &e[0].1,
-            _ => item,
-        };
-        let mut want = |name: &str, key: &str, kinds: &[ObjectKind]| -> bool {
-            let at = if key.is_empty() {
-                body.loc
-            } else {
-                loc_at(body, &[key])
-            };
-            match scene.object(name) {
-                Some(o) if kinds.contains(&o.kind()) => true,
-                Some(o) => {
-                    let expect: Vec<&str> = kinds.iter().map(|k| k.name()).collect();
-                    issues.push(
-                        Issue::new(
-                            at,
-                            format!("`{name}` is a {}, not a {}", o.kind(), expect.join(" or ")),
-                        )
-                        .label(format!("expected a {}", expect.join(" or "))),
-                    );
-                    false
-                }
-                None => {
-                    issues.push(
-                        Issue::new(at, format!("unknown object `{name}`"))
-                            .label("expected one of the scene's objects")
-                            .maybe_help(did_you_mean(name, scene.objects.iter().map(|o| o.name.as_str()))),
-                    );
-                    false
-                }
-            }
-        };
-        match raw {
-            GoalRaw::In(r) => {
-                if want(&r.object, "object", &[ObjectKind::Block])
-                    & want(&r.container, "container", &[ObjectKind::Container])
-                {
-                    atoms.push((
-                        GoalAtom::In {
-                            object: r.object,
-                            container: r.container,
-                        },
-                        item.loc,
-                    ));
-                }
-            }
-            GoalRaw::On(r) => {
-                if want(&r.object, "object", &[ObjectKind::Block])
-                    & want(&r.support, "support", &[ObjectKind::Block])
-                {
-                    atoms.push((
-                        GoalAtom::On {
-                            object: r.object,
-                            support: r.support,
-                        },
-                        item.loc,
-                    ));
-                }
-            }
-            GoalRaw::AllIn(r) => {
-                if want(&r.container, "container", &[ObjectKind::Container]) {
-                    for b in scene.of_kind(ObjectKind::Block) {
-                        let object = scene.objects[b].name.clone();
-                        atoms.push((
-                            GoalAtom::In {
-                                object,
-                                container: r.container.clone(),
-                            },
-                            item.loc,
-                        ));
-                    }
-                }
-            }
-            GoalRaw::Stack(names) => {
-                if names.len() < 2 {
-                    issues.push(
-                        Issue::new(body.loc, "a stack names at least two blocks, top first")
-                            .label("expected e.g. `[red, green, blue]` (red on green on blue)"),
-                    );
-                    continue;
-                }
-                // Every name is checked (and reported), not only up to the first bad one.
-                let checked: Vec<bool> = names.iter().map(|n| want(n, "", &[ObjectKind::Block])).collect();
-                let ok = checked.iter().all(|&b| b);
-                if ok {
-                    for pair in names.windows(2) {
-                        atoms.push((
-                            GoalAtom::On {
-                                object: pair[0].clone(),
-                                support: pair[1].clone(),
-                            },
-                            item.loc,
-                        ));
-                    }
-                }
-            }
-            GoalRaw::SortedByColor(NoParams {}) => {
-                for b in scene.of_kind(ObjectKind::Block) {
-                    let block = &scene.objects[b];
-                    let matching: Vec<&ObjectSpec> = scene
-                        .objects
-                        .iter()
-                        .filter(|o| {
-                            o.kind() == ObjectKind::Container
-                                && o.color.name.is_some()
-                                && o.color.name == block.color.name
-                        })
-                        .collect();
-                    if matching.len() == 1 {
-                        atoms.push((
-                            GoalAtom::In {
-                                object: block.name.clone(),
-                                container: matching[0].name.clone(),
-                            },
-                            item.loc,
-                        ));
-                    } else {
-                        issues.push(Issue::new(
-                            item.loc,
-                            format!(
-                                "`sorted_by_color` needs exactly one container of block `{}`'s colour ({}), found {}",
-                                block.name,
-                                block.color,
-                                matching.len()
-                            ),
-                        ));
-                    }
-                }
-            }
-        }
-    }
-    // At most one predicate per block, and no block stacked on itself.
-    let mut seen: BTreeMap<String, Loc> = BTreeMap::new();
-    for (a, loc) in &atoms {
-        if a.object() == a.destination() {
-            issues.push(Issue::new(
-                *loc,
-                format!("`{}` cannot rest on itself", a.object()),
-            ));
-        }
-        if let Some(first) = seen.insert(a.object().to_string(), *loc) {
-            issues.push(
-                Issue::new(*loc, format!("block `{}` has two goals", a.object()))
-                    .note(format!("the first is at line {}", first.line))
-                    .help("give each block one destination"),
-            );
-        }
-    }
-    super::feasible::check_goal_feasible(scene, &atoms, issues);
-    Goal {
-        atoms: atoms.into_iter().map(|(a, _)| a).collect(),
     }
 }

@@ -19,12 +19,15 @@
 mod color;
 mod feasible;
 mod goal;
+mod goal_read;
 mod load;
 mod sample;
 mod types;
 
 pub use color::{COLOR_NAMES, Color};
-pub use goal::{Goal, GoalAtom};
+pub use goal::{
+    AT_MAX_TOLERANCE, AT_MAX_YAW_TOLERANCE, AT_TOLERANCE, AT_YAW_TOLERANCE, Goal, GoalAtom, GoalPlace,
+};
 pub use load::{BUILTIN_CUBE_BOWL, SceneFileSchema, is_object_name, load_scene_file};
 pub use sample::{MAX_DRAWS, Placement, PlacementError, sample_placement};
 pub use types::{

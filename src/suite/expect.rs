@@ -42,6 +42,11 @@ pub struct Expect {
     #[serde(default)]
     #[schemars(range(min = 0.0, max = crate::episode::MAX_SIM_TIME_S))]
     pub max_sim_time: Option<f64>,
+    /// At most this many contacts that should not happen over the suite (each counted once per
+    /// scenario, see `docs/sweep.md`); `0`: none at all.
+    #[serde(default)]
+    #[schemars(range(min = 0, max = 1_000_000_000))]
+    pub max_collisions: Option<u64>,
     /// Node path globs of which some node ran (was activated) at least once over the suite.
     #[serde(default)]
     pub ran: Vec<String>,
@@ -176,6 +181,14 @@ pub fn check(expect: &Expect, results: &[ScenarioResult], summary: &Summary) -> 
             measured: format!("longest {worst:.2} s"),
         });
     }
+    if let Some(max) = expect.max_collisions {
+        let c = &summary.collisions;
+        out.push(Checked {
+            expectation: format!("at most {max} collision(s)"),
+            ok: c.total <= max,
+            measured: c.line(),
+        });
+    }
     let sum = |p: &str, f: fn(&crate::sweep::NodeTotals) -> u64| -> u64 {
         summary
             .nodes
@@ -253,6 +266,9 @@ pub fn offending_commands(expect: &Expect, results: &[ScenarioResult], config: &
         .iter()
         .filter(|r| {
             expect.counts.iter().any(|c| c.broken_by(r))
+                || expect
+                    .max_collisions
+                    .is_some_and(|max| !r.collisions.is_empty() && too_many_collisions(max, results))
                 || match expect.outcome {
                     Outcome::Success => !r.success,
                     Outcome::Failure => {
@@ -270,4 +286,9 @@ pub fn offending_commands(expect: &Expect, results: &[ScenarioResult], config: &
         })
         .map(|r| r.reproduce(&config.tree, config))
         .collect()
+}
+
+/// More than `max` collisions over `results`.
+fn too_many_collisions(max: u64, results: &[ScenarioResult]) -> bool {
+    results.iter().map(|r| r.collisions.len() as u64).sum::<u64>() > max
 }

@@ -226,6 +226,7 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>, custom_kinds: &[&str]) 
             "failure_kind",
             "failed_node",
             "max_sim_time",
+            "max_collisions",
             "ran",
             "ran_in_every",
             "failed",

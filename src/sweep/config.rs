@@ -45,6 +45,8 @@ pub struct SweepConfig {
     /// The digest of the tree file, its includes and the scene file ([`files_digest`](crate::sweep::digest::files_digest)),
     /// written to every result line: `--resume` refuses lines of other contents.
     pub tree_digest: Option<String>,
+    /// What a contact that should not happen does (`--collisions`).
+    pub collisions: crate::episode::CollisionPolicy,
     /// How reproduction commands name the program (`macrotree` when it is on `PATH`, else the
     /// path of the binary that ran, e.g. `target/release/macrotree`), shell-quoted.
     pub program: String,
@@ -66,6 +68,7 @@ impl Default for SweepConfig {
             resolved: None,
             suite: None,
             tree_digest: None,
+            collisions: Default::default(),
             program: "macrotree".to_string(),
         }
     }
@@ -105,6 +108,7 @@ impl SweepConfig {
             goal: self.goal,
             substitutions: self.substitutions.clone(),
             resolved: self.resolved.clone(),
+            collisions: self.collisions,
         }
     }
 
@@ -121,6 +125,7 @@ impl SweepConfig {
             goal: self.goal,
             substitutions: self.substitutions.clone(),
             resolved: self.resolved.clone(),
+            collisions: self.collisions,
         }
     }
 }

@@ -33,6 +33,10 @@ pub struct ScenarioResult {
     /// Substitutions applied in every scenario (`PATTERN=OUTCOME`).
     #[serde(skip_serializing_if = "Vec::is_empty", serialize_with = "as_rules")]
     pub substitutions: Vec<Substitution>,
+    /// `--collisions`: written only when not the default `count` (so the lines of a default sweep
+    /// are what they were).
+    #[serde(skip_serializing_if = "crate::episode::CollisionPolicy::is_count")]
+    pub collision_policy: crate::episode::CollisionPolicy,
     /// Scenario index k.
     pub index: u64,
     /// Sweep seed S.
@@ -124,6 +128,7 @@ impl ScenarioResult {
             sweep_goal: config.goal,
             max_sim_time: config.max_sim_time,
             substitutions: config.substitutions.clone(),
+            collision_policy: config.collisions,
             index,
             sweep_seed: config.seed,
             seed,
@@ -170,6 +175,7 @@ impl ScenarioResult {
             sweep_goal: config.goal,
             max_sim_time: config.max_sim_time,
             substitutions: config.substitutions.clone(),
+            collision_policy: config.collisions,
             index,
             sweep_seed: config.seed,
             seed,
@@ -253,6 +259,9 @@ impl ScenarioResult {
         }
         for sub in &config.substitutions {
             cmd += &format!(" --substitute {}", shell_quote(&sub.to_string()));
+        }
+        if config.collisions != crate::episode::CollisionPolicy::Count {
+            cmd += &format!(" --collisions {}", config.collisions.name());
         }
         cmd
     }

@@ -14,7 +14,7 @@
 //! - its `sweep_seed`, `fault`, episode `seed` and `layout` are those of that scenario of this
 //!   sweep seed ([`super::sample_scenario`]): the seed matches;
 //! - its `success` agrees with its `tree_status` and `checks.in_bowl` under this `--goal`;
-//! - its `tree`, `scenarios`, `sweep_goal`, `max_sim_time`, `scene_file`, `substitutions` (and `suite`
+//! - its `tree`, `scenarios`, `sweep_goal`, `max_sim_time`, `scene_file`, `substitutions`, `collision_policy` (and `suite`
 //!   for `macrotree test`) are this sweep's;
 //! - it is exactly what this version writes for the result it holds (no unknown or reordered
 //!   fields);
@@ -225,6 +225,13 @@ fn check_result(
     if r.scenarios != config.scenarios {
         return Err(format!("{} scenarios, not {}", r.scenarios, config.scenarios));
     }
+    if r.collision_policy != config.collisions {
+        return Err(format!(
+            "--collisions {}, not {}",
+            r.collision_policy.name(),
+            config.collisions.name()
+        ));
+    }
     if r.substitutions != config.substitutions {
         return Err("its --substitute rules differ".into());
     }
@@ -356,6 +363,13 @@ pub fn parse_line(line: &str) -> Result<ScenarioResult, String> {
             .ok_or("unknown `sweep_goal`")?,
         max_sim_time: float(field("max_sim_time")?, "max_sim_time")?,
         substitutions,
+        collision_policy: match v.get("collision_policy") {
+            None => crate::episode::CollisionPolicy::Count,
+            Some(p) => p
+                .as_str()
+                .and_then(|p| p.parse().ok())
+                .ok_or("`collision_policy` is not `count` or `fail`")?,
+        },
         index: u64_of("index")?,
         sweep_seed: u64_of("sweep_seed")?,
         seed: u64_of("seed")?,

@@ -96,6 +96,11 @@ pub struct Summary {
     pub physics_share: Option<f64>,
     /// Motions checked and planned over the sweep.
     pub planning: PlanningTotals,
+    /// Contacts that should not happen over the sweep, by kind (`fingers-container`, …).
+    pub collisions: crate::episode::CollisionCounts,
+    /// What success was judged by, e.g. `the tree's result only (the scene declares no goal)`
+    /// for `--goal scene` on a scene without a goal.
+    pub goal_checked: String,
     /// Wall-clock time the workers spent checking and planning motions, summed over workers,
     /// seconds (`None` until [`Summary::with_physics`] sets it).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -318,6 +323,10 @@ impl Summary {
                 p.wall_time_s, p.motions_checked, p.plans, p.plan_failures, p.scenarios_planned
             );
         }
+        if self.goal_checked.contains("no goal") {
+            let _ = writeln!(s, "  success judged by {}", self.goal_checked);
+        }
+        let _ = writeln!(s, "  collisions: {}", self.collisions.line());
         if !self.failure_groups.is_empty() {
             let _ = writeln!(s, "  failures by node and kind:");
             for g in &self.failure_groups {

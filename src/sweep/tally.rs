@@ -40,6 +40,9 @@ pub struct Tally {
     nodes: Vec<NodeTotals>,
     node_at: HashMap<String, usize>,
     planning: PlanningTotals,
+    collisions: crate::episode::CollisionCounts,
+    /// Some result had scene goal predicates.
+    scene_goal_seen: bool,
 }
 
 /// A key that orders like [`f64::total_cmp`].
@@ -68,6 +71,8 @@ impl Tally {
             nodes: Vec::new(),
             node_at: HashMap::new(),
             planning: PlanningTotals::default(),
+            collisions: Default::default(),
+            scene_goal_seen: false,
         }
     }
 
@@ -86,6 +91,8 @@ impl Tally {
         self.n += 1;
         self.successes += u64::from(r.success);
         self.planning.add(r);
+        self.collisions.add(&r.collisions);
+        self.scene_goal_seen |= !r.goal.is_empty();
         *self.attempts.entry(r.grasp_attempts).or_insert(0) += 1;
         *self.times.entry(order_key(r.sim_time_s)).or_insert(0) += 1;
         for node in &r.nodes {
@@ -222,6 +229,16 @@ impl Tally {
             process_wall_time_s: None,
             physics_share: None,
             planning: self.planning,
+            collisions: self.collisions,
+            goal_checked: if self.config.goal == crate::episode::Goal::Scene && n > 0 && !self.scene_goal_seen
+            {
+                crate::episode::Goal::Scene.checked(&Default::default())
+            } else {
+                match self.config.goal {
+                    crate::episode::Goal::Scene => "the tree's result and the scene's goal".into(),
+                    g => g.checked(&Default::default()),
+                }
+            },
             planning_time_s: None,
             planning_share: None,
         }

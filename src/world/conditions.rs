@@ -37,9 +37,13 @@ pub fn lifted(w: &World, i: usize, min_height: f64) -> bool {
     w.bottom(i) >= min_height
 }
 
-/// Block `i` rests on the table ([`on_table`] with [`Tolerances::ON_TABLE_HEIGHT`]) with its centre
-/// within `tolerance` metres of `point` = (x, y) in the table plane and, when `yaw` is given, its
-/// side faces within `yaw_tolerance` radians of `yaw` modulo a quarter turn (the `at` condition).
+/// Block `i` rests at `point` = (x, y), metres (the `at` condition and the scene goal's `at`):
+/// released (no pad touches it), at rest (speed below `rest_speed`, m/s), its bottom within
+/// [`Tolerances::ON_TABLE_HEIGHT`] of the surface under it — the table outside every container
+/// ([`on_table`]), or the floor of the container it is inside (a kitting tray) —, its centre within
+/// `tolerance` metres of the point in the table plane and, when `yaw` is given, its side faces
+/// within `yaw_tolerance` radians of `yaw` modulo a quarter turn (a cube looks the same every
+/// quarter turn).
 pub fn at(
     w: &World,
     i: usize,
@@ -53,18 +57,28 @@ pub fn at(
     let near = (pos.x - point[0]).hypot(pos.y - point[1]) <= tolerance;
     let turned =
         yaw.is_none_or(|target| super::snapshot::fold_quarter_turn(w.yaw(i) - target).abs() <= yaw_tolerance);
-    on_table(w, i, Tolerances::ON_TABLE_HEIGHT, rest_speed) && near && turned
+    let resting = match w.container_of(i) {
+        Some(c) => {
+            w.bottom(i) - w.support_height(c) <= Tolerances::ON_TABLE_HEIGHT
+                && w.released(i)
+                && w.at_rest(i, rest_speed)
+        }
+        None => on_table(w, i, Tolerances::ON_TABLE_HEIGHT, rest_speed),
+    };
+    resting && near && turned
 }
 
 /// Block `i` rests on the table: its bottom within `max_height` metres of the table top, not over
-/// any container's footprint (1 cm margin), at rest (speed below `rest_speed`, m/s).
+/// any container's footprint (1 cm margin), released (no pad touches it) and at rest (speed below
+/// `rest_speed`, m/s). A block still in the gripper, even one pressed onto the table, is not on
+/// the table.
 pub fn on_table(w: &World, i: usize, max_height: f64, rest_speed: f64) -> bool {
     let p = w.objects[i].pos;
     let over_container = w
         .scene
         .of_kind(crate::scene::ObjectKind::Container)
         .any(|c| w.from_footprint(c, &p).norm() < 0.01);
-    w.bottom(i) <= max_height && !over_container && w.at_rest(i, rest_speed)
+    w.bottom(i) <= max_height && !over_container && w.released(i) && w.at_rest(i, rest_speed)
 }
 
 /// The gripper is open at least `min_width` metres.
@@ -252,6 +266,82 @@ mod tests {
         w.objects[0].quat = UnitQuaternion::from_euler_angles(0.0, 0.0, turned);
         assert!(at(&w, 0, [p.x, p.y], 0.01, Some(turned + 0.01), 0.02, v));
         assert!(!at(&w, 0, [p.x, p.y], 0.01, Some(turned + 0.03), 0.02, v));
+    }
+
+    /// The held cube pressed onto the table: on the table by height and at rest, but the pads
+    /// touch it.
+    fn held_on_the_table() -> World {
+        let mut w = held();
+        w.objects[0].pos.z = HALF;
+        w
+    }
+
+    #[test]
+    fn on_table_and_at_need_the_block_released() {
+        let w = held_on_the_table();
+        let p = w.objects[0].pos;
+        let v = Tolerances::REST_SPEED;
+        assert!(w.bottom(0) < 1e-9 && w.at_rest(0, v), "pressed flat and still");
+        assert!(!on_table(&w, 0, 0.01, v), "held, not on the table");
+        assert!(!at(&w, 0, [p.x, p.y], 0.01, None, 0.05, v), "held, not placed");
+        let mut one_pad = w.clone();
+        one_pad.objects[0].right_pad_contact = false;
+        assert!(!on_table(&one_pad, 0, 0.01, v), "one pad still touching");
+        let mut let_go = w.clone();
+        let_go.objects[0].left_pad_contact = false;
+        let_go.objects[0].right_pad_contact = false;
+        assert!(on_table(&let_go, 0, 0.01, v) && at(&let_go, 0, [p.x, p.y], 0.01, None, 0.05, v));
+    }
+
+    #[test]
+    fn at_accepts_a_block_resting_on_a_container_floor_at_the_point() {
+        // The bowl's floor top is at z = 0.01: a cube on it, 2 cm from the bowl's centre.
+        let mut w = resting();
+        w.objects[0].pos = Vector3::new(0.47, 0.08, 0.01 + HALF);
+        let v = Tolerances::REST_SPEED;
+        assert!(
+            at(&w, 0, [0.47, 0.08], 0.01, None, 0.05, v),
+            "on the tray's floor at the point"
+        );
+        assert!(!on_table(&w, 0, 0.01, v), "but not on the table");
+        let mut floating = w.clone();
+        floating.objects[0].pos.z += 0.02;
+        assert!(
+            !at(&floating, 0, [0.47, 0.08], 0.01, None, 0.05, v),
+            "2 cm above the floor"
+        );
+        let mut gripped = w.clone();
+        gripped.objects[0].left_pad_contact = true;
+        assert!(
+            !at(&gripped, 0, [0.47, 0.08], 0.01, None, 0.05, v),
+            "a pad touches it"
+        );
+    }
+
+    #[test]
+    fn at_compares_the_yaw_modulo_a_quarter_turn() {
+        let mut w = resting();
+        let p = w.objects[0].pos;
+        w.objects[0].quat = UnitQuaternion::from_euler_angles(0.0, 0.0, 88f64.to_radians());
+        let v = Tolerances::REST_SPEED;
+        let tol = 3f64.to_radians();
+        assert!(
+            at(&w, 0, [p.x, p.y], 0.01, Some(-2f64.to_radians()), tol, v),
+            "88° is −2°"
+        );
+        assert!(at(
+            &w,
+            0,
+            [p.x, p.y],
+            0.01,
+            Some(std::f64::consts::FRAC_PI_2),
+            tol,
+            v
+        ));
+        assert!(
+            !at(&w, 0, [p.x, p.y], 0.01, Some(5f64.to_radians()), tol, v),
+            "7° off"
+        );
     }
 
     #[test]

@@ -5,7 +5,7 @@ use serde::Serialize;
 
 use super::World;
 use super::conditions::Tolerances;
-use crate::scene::{GoalAtom, ObjectKind, Shape};
+use crate::scene::{GoalAtom, GoalPlace, ObjectKind, Shape};
 
 /// Largest horizontal offset of a stacked block from the one under it beyond half its edge,
 /// metres (ManiSkill StackCube's criterion).
@@ -34,14 +34,35 @@ pub fn rests_on(w: &World, i: usize, s: usize, rest_speed: f64) -> bool {
         && w.at_rest(i, rest_speed)
 }
 
+/// Block `i` rests at `place` ([`super::conditions::at`] with the place's point, yaw and
+/// tolerances): released, at rest, on the table or a container's floor.
+pub fn rests_at(w: &World, i: usize, place: &GoalPlace, rest_speed: f64) -> bool {
+    super::conditions::at(
+        w,
+        i,
+        place.point,
+        place.tolerance,
+        place.yaw,
+        place.yaw_tolerance,
+        rest_speed,
+    )
+}
+
 /// Whether one goal predicate holds.
 pub fn atom_holds(w: &World, atom: &GoalAtom) -> bool {
-    let (Some(i), Some(d)) = (w.index_of(atom.object()), w.index_of(atom.destination())) else {
+    let Some(i) = w.index_of(atom.object()) else {
+        return false;
+    };
+    if let GoalAtom::At { place, .. } = atom {
+        return rests_at(w, i, place, Tolerances::REST_SPEED);
+    }
+    let Some(d) = atom.destination_object().and_then(|d| w.index_of(d)) else {
         return false;
     };
     match atom {
         GoalAtom::In { .. } => rests_in(w, i, d, Tolerances::REST_SPEED),
         GoalAtom::On { .. } => rests_on(w, i, d, Tolerances::REST_SPEED),
+        GoalAtom::At { .. } => unreachable!("handled above"),
     }
 }
 
@@ -84,9 +105,20 @@ pub fn covered(w: &World, i: usize) -> bool {
         .any(|j| j != i && w.resting_on(j) == Some(i))
 }
 
+/// Another block occupies `place` for block `i`: some block other than `i` has its centre within
+/// the two half edges of the place's point in the table plane, so the two would overlap there
+/// whatever their yaws (the inscribed circles meet).
+pub fn place_taken(w: &World, i: usize, place: &GoalPlace) -> bool {
+    let p = nalgebra::Vector2::new(place.point[0], place.point[1]);
+    w.scene
+        .of_kind(ObjectKind::Block)
+        .any(|j| j != i && (w.objects[j].pos.xy() - p).norm() < w.half(i) + w.half(j))
+}
+
 /// Block `i` has a goal that does not hold yet and that can be worked on now: it is not covered
-/// by another block, and when it goes on top of another block, that block is finished (its own
-/// goal holds, or it has none and rests on the table) and uncovered.
+/// by another block; when it goes on top of another block, that block is finished (its own goal
+/// holds, or it has none and rests, released, on the table) and uncovered; when it goes to a
+/// place (`at`), no other block occupies that place (a swap needs a buffer).
 pub fn pending(w: &World, i: usize) -> bool {
     if !matches!(w.spec(i).shape, Shape::Block { .. }) || covered(w, i) {
         return false;
@@ -99,20 +131,127 @@ pub fn pending(w: &World, i: usize) -> bool {
     }
     match atom {
         GoalAtom::In { .. } => true,
+        GoalAtom::At { place, .. } => !place_taken(w, i, place),
         GoalAtom::On { support, .. } => w.index_of(support).is_some_and(|s| {
             let settled = match w.scene.goal.of(support) {
                 Some(a) => atom_holds(w, a),
-                None => w.bottom(s) < Tolerances::ON_TABLE_HEIGHT && w.container_of(s).is_none(),
+                None => {
+                    w.bottom(s) < Tolerances::ON_TABLE_HEIGHT && w.container_of(s).is_none() && w.released(s)
+                }
             };
             settled && !covered(w, s)
         }),
     }
 }
 
-/// Where block `i`'s goal sends it (a container or the supporting block), if it has a goal.
+/// The object block `i`'s goal sends it to (a container or the supporting block), if it has an
+/// `in` or `on` goal.
 pub fn destination(w: &World, i: usize) -> Option<usize> {
     w.scene
         .goal
         .of(w.name(i))
-        .and_then(|a| w.index_of(a.destination()))
+        .and_then(|a| a.destination_object())
+        .and_then(|d| w.index_of(d))
+}
+
+/// The name `select … goal_as` writes for block `i`: its goal's container, supporting block or
+/// spot ([`GoalAtom::destination`]); `None` without a goal or for an `at` goal at a bare point.
+pub fn destination_name(w: &World, i: usize) -> Option<String> {
+    w.scene
+        .goal
+        .of(w.name(i))
+        .and_then(|a| a.destination())
+        .map(str::to_string)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use nalgebra::Vector3;
+
+    use super::*;
+    use crate::scene::{AT_TOLERANCE, AT_YAW_TOLERANCE, SceneSpec};
+    use crate::world::conditions::tests_support::{HALF, held, resting};
+    use crate::world::query::{Filter, KindFilter, Order, Query, matches};
+
+    /// Two blocks `a` (at (0.40, −0.10)) and `b` (at (0.40, 0.10)), resting, with `goal`.
+    fn two_blocks(goal: &str) -> World {
+        let mut w = resting();
+        w.scene = Arc::new(
+            SceneSpec::from_str(
+                &format!(
+                    "objects:\n  a: {{block: {{size: 0.044}}, pose: [0.40, -0.10]}}\n  b: {{block: {{size: 0.044}}, pose: [0.40, 0.10]}}\ngoal:\n{goal}"
+                ),
+                "two.yaml",
+            )
+            .unwrap(),
+        );
+        w.objects[0].pos = Vector3::new(0.40, -0.10, HALF);
+        w.objects[1].pos = Vector3::new(0.40, 0.10, HALF);
+        w
+    }
+
+    #[test]
+    fn a_swap_is_pending_only_once_the_other_block_left_the_place() {
+        let mut w = two_blocks(
+            "  - at: {object: a, point: [0.40, 0.10]}\n  - at: {object: b, point: [0.40, -0.10]}\n",
+        );
+        assert!(
+            !pending(&w, 0) && !pending(&w, 1),
+            "each place is taken by the other block"
+        );
+        assert!(!done(&w, 0) && !goal_holds(&w));
+        // b moved to a buffer: a can go to b's place, b cannot yet go to a's.
+        w.objects[1].pos = Vector3::new(0.30, 0.25, HALF);
+        assert!(pending(&w, 0) && !pending(&w, 1));
+        w.objects[0].pos = Vector3::new(0.40, 0.10, HALF);
+        assert!(done(&w, 0) && !pending(&w, 0) && pending(&w, 1));
+        w.objects[1].pos = Vector3::new(0.40, -0.10, HALF);
+        assert!(goal_holds(&w));
+        assert_eq!(evaluate(&w).iter().filter(|g| g.holds).count(), 2);
+        // Placed but still in the gripper: not done, and `done` does not select it.
+        w.objects[1].left_pad_contact = true;
+        w.objects[1].right_pad_contact = true;
+        assert!(!done(&w, 1) && !goal_holds(&w));
+        let q = Query {
+            kind: KindFilter::default(),
+            color: None,
+            filters: vec![Filter::Done],
+            order: Order::Scene,
+        };
+        assert_eq!(matches(&w, &q), vec![0]);
+        let q = Query {
+            filters: vec![Filter::OnTable],
+            ..q
+        };
+        assert_eq!(matches(&w, &q), vec![0], "a held block is not `on_table`");
+    }
+
+    #[test]
+    fn a_stack_on_a_base_at_a_point_waits_for_the_base() {
+        let mut w = two_blocks("  - stack: {blocks: [a, b], base_at: {point: [0.50, 0.0]}}\n");
+        assert!(pending(&w, 1), "the base goes first");
+        assert!(!pending(&w, 0), "the top waits for its base");
+        w.objects[1].pos = Vector3::new(0.50, 0.0, HALF);
+        assert!(done(&w, 1) && pending(&w, 0));
+        assert_eq!(destination(&w, 0), Some(1));
+        assert_eq!(destination(&w, 1), None, "a place is not an object");
+        assert_eq!(destination_name(&w, 0).as_deref(), Some("b"));
+    }
+
+    #[test]
+    fn rests_at_is_the_at_condition_on_the_goal_place() {
+        let w = resting();
+        let p = w.objects[0].pos;
+        let place = GoalPlace {
+            spot: None,
+            point: [p.x + 0.005, p.y],
+            yaw: Some(0.0),
+            tolerance: AT_TOLERANCE,
+            yaw_tolerance: AT_YAW_TOLERANCE,
+        };
+        assert!(rests_at(&w, 0, &place, Tolerances::REST_SPEED));
+        assert!(!rests_at(&held(), 0, &place, Tolerances::REST_SPEED));
+    }
 }

@@ -41,7 +41,8 @@ pub enum Filter {
     Pending,
     /// A block whose goal holds.
     Done,
-    /// A block resting on the table (bottom within 1 cm of it, not in a container), at rest.
+    /// A block resting on the table (bottom within 1 cm of it, not in a container), released (no
+    /// pad touches it) and at rest.
     OnTable,
     /// A block no pad touches.
     Free,
@@ -115,6 +116,7 @@ fn passes(w: &World, i: usize, f: Filter) -> bool {
         Filter::OnTable => {
             w.bottom(i) <= Tolerances::ON_TABLE_HEIGHT
                 && w.container_of(i).is_none()
+                && w.released(i)
                 && w.at_rest(i, Tolerances::REST_SPEED)
         }
         Filter::Free => w.released(i),
