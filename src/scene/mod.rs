@@ -18,18 +18,22 @@
 
 mod color;
 mod feasible;
+mod footprint;
 mod goal;
+mod layout_keys;
 mod load;
+mod placement_error;
 mod sample;
 mod types;
 
 pub use color::{COLOR_NAMES, Color};
 pub use goal::{Goal, GoalAtom};
 pub use load::{BUILTIN_CUBE_BOWL, SceneFileSchema, is_object_name, load_scene_file};
-pub use sample::{MAX_DRAWS, Placement, PlacementError, sample_placement};
+pub use footprint::Rect;
+pub use sample::{MAX_DRAWS, Placement, PlacementError, placement_order, sample_placement, support_of};
 pub use types::{
     CONTAINER_FLOOR, CONTAINER_WALL, ObjectKind, ObjectSpec, Pose, ROBOT_BASE_RADIUS, RandomPlacement,
-    Sampler, SceneSpec, Shape, Spot, reach_limits,
+    Region, RegionRole, Sampler, SceneSpec, Shape, Spot, reach_limits,
 };
 
 /// Prefix of every scene object's MuJoCo names (`obj/red`, `obj/bin/wall_px`), so that a user's
