@@ -86,7 +86,7 @@ pub struct ContainerRaw {
 #[derive(Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ObstacleRaw {
-    /// Size `[x, y, z]`, metres (x, y: 0.01 … 0.5; z: 0.01 … 0.3).
+    /// Size `[x, y, z]`, metres (x, y: 0.01 … 0.5; z: 0.01 … 1.0, a post or a fixture).
     size: [f64; 3],
     /// Colour name or `[r, g, b, a]`. Default gray.
     #[serde(default = "d_gray")]
@@ -636,7 +636,7 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
     } else {
         let o = raw.obstacle.expect("one kind is set");
         for (i, x) in o.size.iter().enumerate() {
-            let hi = if i == 2 { 0.3 } else { 0.5 };
+            let hi = if i == 2 { 1.0 } else { 0.5 };
             check_range(
                 body,
                 &["obstacle", "size"],
@@ -844,13 +844,7 @@ fn check_fixed_poses(scene: &SceneSpec, objects_v: &Value, issues: &mut Vec<Issu
         }
         return;
     }
-    let placement = Placement {
-        poses: scene
-            .objects
-            .iter()
-            .map(|o| o.pose.expect("fully posed"))
-            .collect(),
-    };
+    let placement = Placement::fixed(scene).expect("fully posed");
     if let Err(e) = placement.check(scene) {
         let at = e
             .object()
