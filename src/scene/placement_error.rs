@@ -189,7 +189,12 @@ impl std::fmt::Display for PlacementError {
                 if *distance <= 0.0 {
                     write!(
                         f,
-                        "`{a}` and `{b}` overlap: their footprints are 0 m apart (footprints) at the same height; at least {min:.3} m is needed"
+                        "`{a}` and `{b}` overlap: their footprints meet at heights where both stand{}",
+                        if *min > 0.0 {
+                            format!(" (at least {min:.3} m is needed between them)")
+                        } else {
+                            String::new()
+                        }
                     )
                 } else {
                     write!(
