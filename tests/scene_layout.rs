@@ -70,7 +70,10 @@ fn blocks_drawn_in_a_randomized_bin_lie_on_its_floor_inside_the_walls_for_every_
                 [q.x + r * a.cos() - b.x, q.y + r * a.sin() - b.y]
             });
             for [dx, dy] in corners {
-                assert!(dx.abs() <= 0.08 + 1e-9 && dy.abs() <= 0.08 + 1e-9, "scenario {k}: {name} corner at ({dx}, {dy})");
+                assert!(
+                    dx.abs() <= 0.08 + 1e-9 && dy.abs() <= 0.08 + 1e-9,
+                    "scenario {k}: {name} corner at ({dx}, {dy})"
+                );
             }
         }
         let (r, g) = (pose(&s, &p, "red"), pose(&s, &p, "green"));
@@ -78,7 +81,10 @@ fn blocks_drawn_in_a_randomized_bin_lie_on_its_floor_inside_the_walls_for_every_
         assert_eq!(pose(&s, &p, "blue").z, 0.0);
     }
     // The draw is a pure function of (seed, scenario).
-    assert_eq!(sample_placement(&s, 7, 11).unwrap(), sample_placement(&s, 7, 11).unwrap());
+    assert_eq!(
+        sample_placement(&s, 7, 11).unwrap(),
+        sample_placement(&s, 7, 11).unwrap()
+    );
 }
 
 #[test]
@@ -93,7 +99,10 @@ fn random_in_a_bin_failed_after_100000_draws_with_a_wrong_hint() {
     assert!(e.message.contains("`red` and `bin`"), "{e}");
     assert!(e.message.contains("100 %"), "every draw failed on that pair: {e}");
     let help = e.help.as_deref().unwrap();
-    assert!(help.contains("random: {in: bin}") && !help.contains("widen"), "{help}");
+    assert!(
+        help.contains("random: {in: bin}") && !help.contains("widen"),
+        "{help}"
+    );
     assert_eq!(e.line, 5, "located at red's `random:`: {e}");
     // The new way works.
     let s = scene(
@@ -138,7 +147,10 @@ fn an_unmeetable_randomization_names_the_constraint_most_draws_broke() {
         "objects:\n  bin: {container: {inner: [0.08, 0.08]}, pose: [0.45, 0.0]}\n  a: {block: {size: 0.04}, random: {in: bin, clearance: 0.005}}\n  b: {block: {size: 0.04}, random: {in: bin, clearance: 0.005}}\n",
     );
     let e = find(&d, "the randomization cannot be met");
-    assert!(e.message.contains("`a` and `b`") || e.message.contains("`b` and `a`"), "{e}");
+    assert!(
+        e.message.contains("`a` and `b`") || e.message.contains("`b` and `a`"),
+        "{e}"
+    );
     assert!(e.help.as_deref().unwrap().contains("clearance"), "{e}");
 }
 
@@ -161,11 +173,17 @@ fn a_thin_wall_is_an_oriented_footprint_not_a_disc() {
     let mut closest = f64::INFINITY;
     for k in 0..500 {
         let (_, p) = sample_placement(&s, 3, k).unwrap();
-        let gap = s.objects[w].shape.footprint(&p.poses[w]).gap(&s.objects[c].shape.footprint(&p.poses[c]));
+        let gap = s.objects[w]
+            .shape
+            .footprint(&p.poses[w])
+            .gap(&s.objects[c].shape.footprint(&p.poses[c]));
         assert!(gap >= 0.03 - 1e-9, "scenario {k}: {gap}");
         closest = closest.min(gap);
     }
-    assert!(closest < 0.06, "blocks are drawn near the wall (closest {closest}), inside its old 0.15 m disc");
+    assert!(
+        closest < 0.06,
+        "blocks are drawn near the wall (closest {closest}), inside its old 0.15 m disc"
+    );
 }
 
 #[test]
@@ -187,7 +205,11 @@ regions:
     for k in 0..400 {
         let (_, p) = sample_placement(&s, 1, k).unwrap();
         for (i, o) in s.objects.iter().enumerate() {
-            assert!(!middle.overlaps(&o.shape.footprint(&p.poses[i])), "scenario {k}: {} in middle", o.name);
+            assert!(
+                !middle.overlaps(&o.shape.footprint(&p.poses[i])),
+                "scenario {k}: {} in middle",
+                o.name
+            );
         }
         assert!(left.margin_inside(&s.objects[1].shape.footprint(&p.poses[1])) >= -1e-9);
         let fc = s.objects[2].shape.footprint(&p.poses[2]);
@@ -206,8 +228,14 @@ fn blocks_on_a_shelf_board_start_on_its_top() {
             let i = s.index_of(name).unwrap();
             assert_eq!(support_of(&s, i), Some(low));
             assert!((p.poses[i].z - 0.12).abs() < 1e-12, "{name} at {}", p.poses[i].z);
-            let m = s.objects[low].shape.footprint(&p.poses[low]).margin_inside(&s.objects[i].shape.footprint(&p.poses[i]));
-            assert!(m >= -1e-9, "scenario {k}: {name} hangs over the board's edge by {m}");
+            let m = s.objects[low]
+                .shape
+                .footprint(&p.poses[low])
+                .margin_inside(&s.objects[i].shape.footprint(&p.poses[i]));
+            assert!(
+                m >= -1e-9,
+                "scenario {k}: {name} hangs over the board's edge by {m}"
+            );
         }
         assert!((pose(&s, &p, "top_a").z - 0.24).abs() < 1e-12);
         assert!((p.poses[top].z - 0.22).abs() < 1e-12);
@@ -216,71 +244,125 @@ fn blocks_on_a_shelf_board_start_on_its_top() {
     // The lower board's blocks are under the upper board: a top-down grasp is blocked.
     let p = Placement::fixed(&s).unwrap();
     let a = pose(&s, &p, "low_a");
-    assert!(s.objects[top].shape.footprint(&p.poses[top]).distance_to_point([a.x, a.y]) == 0.0);
-    assert!(p.poses[top].z - (a.z + 0.04) < 0.1, "less than 10 cm above the block's top");
+    assert!(
+        s.objects[top]
+            .shape
+            .footprint(&p.poses[top])
+            .distance_to_point([a.x, a.y])
+            == 0.0
+    );
+    assert!(
+        p.poses[top].z - (a.z + 0.04) < 0.1,
+        "less than 10 cm above the block's top"
+    );
 }
 
 #[test]
 fn every_new_key_has_a_located_error() {
     // `z:` on a block, out of range on an obstacle.
-    let e = find(&scene_errors("objects:\n  red: {block: {size: 0.04}, pose: [0.45, 0], z: 0.1}\n"), "takes no `z");
+    let e = find(
+        &scene_errors("objects:\n  red: {block: {size: 0.04}, pose: [0.45, 0], z: 0.1}\n"),
+        "takes no `z",
+    );
     assert_eq!((e.line, e.column), (2, 50));
     let e = find(
-        &scene_errors("objects:\n  red: {block: {size: 0.04}, pose: [0.45, 0.2]}\n  board: {obstacle: {size: [0.1, 0.1, 0.02]}, pose: [0.45, 0], z: 0.9}\n"),
+        &scene_errors(
+            "objects:\n  red: {block: {size: 0.04}, pose: [0.45, 0.2]}\n  board: {obstacle: {size: [0.1, 0.1, 0.02]}, pose: [0.45, 0], z: 0.9}\n",
+        ),
         "height of a base",
     );
     assert_eq!(e.line, 3);
     // `on:` an unknown object, on a container, on itself, in a cycle.
     let e = find(
-        &scene_errors("objects:\n  red: {block: {size: 0.04}, pose: [0.45, 0], on: shelff}\n  shelf: {obstacle: {size: [0.1, 0.1, 0.02]}, pose: [0.45, 0.2]}\n"),
+        &scene_errors(
+            "objects:\n  red: {block: {size: 0.04}, pose: [0.45, 0], on: shelff}\n  shelf: {obstacle: {size: [0.1, 0.1, 0.02]}, pose: [0.45, 0.2]}\n",
+        ),
         "unknown object `shelff`",
     );
     assert_eq!(e.help.as_deref(), Some("did you mean `shelf`?"));
     find(
-        &scene_errors("objects:\n  red: {block: {size: 0.04}, pose: [0.45, 0.2]}\n  bin: {container: {inner: [0.1, 0.1]}, pose: [0.45, 0], on: red}\n"),
+        &scene_errors(
+            "objects:\n  red: {block: {size: 0.04}, pose: [0.45, 0.2]}\n  bin: {container: {inner: [0.1, 0.1]}, pose: [0.45, 0], on: red}\n",
+        ),
         "only blocks take `on:`",
     );
-    find(&scene_errors("objects:\n  red: {block: {size: 0.04}, pose: [0.45, 0], on: red}\n"), "cannot rest on itself");
     find(
-        &scene_errors("objects:\n  a: {block: {size: 0.04}, pose: [0.45, 0], on: b}\n  b: {block: {size: 0.04}, pose: [0.45, 0], on: a}\n"),
+        &scene_errors("objects:\n  red: {block: {size: 0.04}, pose: [0.45, 0], on: red}\n"),
+        "cannot rest on itself",
+    );
+    find(
+        &scene_errors(
+            "objects:\n  a: {block: {size: 0.04}, pose: [0.45, 0], on: b}\n  b: {block: {size: 0.04}, pose: [0.45, 0], on: a}\n",
+        ),
         "through others, on itself",
     );
     // `random: {in: ..}` with x/y, both in and on, a fixed block on a randomized bin.
     let e = find(
-        &scene_errors("objects:\n  bin: {container: {inner: [0.2, 0.2]}, pose: [0.45, 0]}\n  red: {block: {size: 0.04}, random: {in: bin, x: [0.4, 0.5]}}\n"),
+        &scene_errors(
+            "objects:\n  bin: {container: {inner: [0.2, 0.2]}, pose: [0.45, 0]}\n  red: {block: {size: 0.04}, random: {in: bin, x: [0.4, 0.5]}}\n",
+        ),
         "drawn over `bin`",
     );
     assert_eq!(e.line, 3);
     find(
-        &scene_errors("objects:\n  bin: {container: {inner: [0.2, 0.2]}, pose: [0.45, 0]}\n  red: {block: {size: 0.04}, random: {in: bin, on: bin}}\n"),
+        &scene_errors(
+            "objects:\n  bin: {container: {inner: [0.2, 0.2]}, pose: [0.45, 0]}\n  red: {block: {size: 0.04}, random: {in: bin, on: bin}}\n",
+        ),
         "not both",
     );
     find(
-        &scene_errors("objects:\n  bin: {container: {inner: [0.2, 0.2]}, random: {x: [0.4, 0.5], y: [0, 0.1]}}\n  red: {block: {size: 0.04}, pose: [0.45, 0.05], on: bin}\n"),
+        &scene_errors(
+            "objects:\n  bin: {container: {inner: [0.2, 0.2]}, random: {x: [0.4, 0.5], y: [0, 0.1]}}\n  red: {block: {size: 0.04}, pose: [0.45, 0.05], on: bin}\n",
+        ),
         "which sweeps place at random",
     );
-    find(&scene_errors("objects:\n  red: {block: {size: 0.04}, random: {x: [0.4, 0.5]}}\n"), "has no `y:` range");
+    find(
+        &scene_errors("objects:\n  red: {block: {size: 0.04}, random: {x: [0.4, 0.5]}}\n"),
+        "has no `y:` range",
+    );
     // Spots: out of reach, bad shape, a name taken by an object.
     let base = "objects:\n  red: {block: {size: 0.04}, pose: [0.45, 0]}\n";
-    let e = find(&scene_errors(&format!("{base}spots:\n  far: [0.9, 0.0]\n")), "spot `far`");
+    let e = find(
+        &scene_errors(&format!("{base}spots:\n  far: [0.9, 0.0]\n")),
+        "spot `far`",
+    );
     assert_eq!(e.line, 4);
-    find(&scene_errors(&format!("{base}spots:\n  p: [0.4]\n")), "2 or 3 numbers");
-    find(&scene_errors(&format!("{base}spots:\n  red: [0.4, 0.1]\n")), "already used");
-    // Regions: bad range, unknown role, unknown or keep-out region named by a random.
-    let e = find(&scene_errors(&format!("{base}regions:\n  r: {{x: [0.5, 0.4], y: [0, 0.1], role: keep_out}}\n")), "lo < hi");
-    assert_eq!(e.line, 4);
-    scene_errors(&format!("{base}regions:\n  r: {{x: [0.4, 0.5], y: [0, 0.1], role: keepout}}\n"));
     find(
-        &scene_errors("objects:\n  red: {block: {size: 0.04}, random: {region: lft}}\nregions:\n  left: {x: [0.3, 0.5], y: [0.1, 0.3], role: allowed}\n"),
+        &scene_errors(&format!("{base}spots:\n  p: [0.4]\n")),
+        "2 or 3 numbers",
+    );
+    find(
+        &scene_errors(&format!("{base}spots:\n  red: [0.4, 0.1]\n")),
+        "already used",
+    );
+    // Regions: bad range, unknown role, unknown or keep-out region named by a random.
+    let e = find(
+        &scene_errors(&format!(
+            "{base}regions:\n  r: {{x: [0.5, 0.4], y: [0, 0.1], role: keep_out}}\n"
+        )),
+        "lo < hi",
+    );
+    assert_eq!(e.line, 4);
+    scene_errors(&format!(
+        "{base}regions:\n  r: {{x: [0.4, 0.5], y: [0, 0.1], role: keepout}}\n"
+    ));
+    find(
+        &scene_errors(
+            "objects:\n  red: {block: {size: 0.04}, random: {region: lft}}\nregions:\n  left: {x: [0.3, 0.5], y: [0.1, 0.3], role: allowed}\n",
+        ),
         "unknown region `lft`",
     );
     find(
-        &scene_errors("objects:\n  red: {block: {size: 0.04}, random: {region: no}}\nregions:\n  no: {x: [0.3, 0.5], y: [0.1, 0.3], role: keep_out}\n"),
+        &scene_errors(
+            "objects:\n  red: {block: {size: 0.04}, random: {region: no}}\nregions:\n  no: {x: [0.3, 0.5], y: [0.1, 0.3], role: keep_out}\n",
+        ),
         "keep-out region, not an allowed one",
     );
     // A keep-out region that covers the whole random range: the region is named.
     let e = find(
-        &scene_errors("objects:\n  red: {block: {size: 0.04}, random: {x: [0.4, 0.5], y: [0.0, 0.1]}}\nregions:\n  no: {x: [0.3, 0.6], y: [-0.1, 0.2], role: keep_out}\n"),
+        &scene_errors(
+            "objects:\n  red: {block: {size: 0.04}, random: {x: [0.4, 0.5], y: [0.0, 0.1]}}\nregions:\n  no: {x: [0.3, 0.6], y: [-0.1, 0.2], role: keep_out}\n",
+        ),
         "keep-out region `no`",
     );
     assert!(e.help.as_deref().unwrap().contains("`no`"));
@@ -298,7 +380,15 @@ fn spots_load_in_file_order_with_their_yaw() {
 
 #[test]
 fn every_layout_scene_loads_and_draws_200_valid_placements() {
-    for name in ["shelf.yaml", "go_around.yaml", "bin_to_bin.yaml", "kitting.yaml", "swap.yaml", "tower_four.yaml", "wall_cell.yaml"] {
+    for name in [
+        "shelf.yaml",
+        "go_around.yaml",
+        "bin_to_bin.yaml",
+        "kitting.yaml",
+        "swap.yaml",
+        "tower_four.yaml",
+        "wall_cell.yaml",
+    ] {
         let s = shipped(name);
         Placement::fixed(&s).map(|p| p.check(&s).unwrap());
         if !s.randomized() {
@@ -330,7 +420,8 @@ fn raised_objects_and_blocks_on_a_shelf_start_where_declared_and_stay_at_rest_on
     );
     spec.objects.retain(|o| o.name != "table_a");
     spec.objects.extend(extra.objects);
-    let spec = SceneSpec::from_str(&serde_yaml_text(&spec), "shelf_plus.yaml").unwrap_or_else(|d| panic!("{}", d[0]));
+    let spec = SceneSpec::from_str(&serde_yaml_text(&spec), "shelf_plus.yaml")
+        .unwrap_or_else(|d| panic!("{}", d[0]));
     let scene = Scene::load_spec(&spec).expect("compiles");
     let mut sim = Sim::new(&scene);
     let placement = Placement::fixed(&spec).unwrap();
@@ -345,12 +436,23 @@ fn raised_objects_and_blocks_on_a_shelf_start_where_declared_and_stay_at_rest_on
         };
         [p.x, p.y, p.z + dz]
     };
-    let names = ["shelf_low", "shelf_top", "high_bin", "low_a", "low_b", "top_a", "in_high"];
+    let names = [
+        "shelf_low",
+        "shelf_top",
+        "high_bin",
+        "low_a",
+        "low_b",
+        "top_a",
+        "in_high",
+    ];
     for n in names {
         let got = body_pos(&sim, n);
         let want = expect(n);
         for k in 0..3 {
-            assert!((got[k] - want[k]).abs() < 1e-9, "{n} starts at {got:?}, declared {want:?}");
+            assert!(
+                (got[k] - want[k]).abs() < 1e-9,
+                "{n} starts at {got:?}, declared {want:?}"
+            );
         }
     }
     assert!((expect("in_high")[2] - (0.08 + 0.01 + 0.015)).abs() < 1e-12);
@@ -361,8 +463,12 @@ fn raised_objects_and_blocks_on_a_shelf_start_where_declared_and_stay_at_rest_on
     for n in ["low_a", "low_b", "top_a", "in_high"] {
         let got = body_pos(&sim, n);
         let want = expect(n);
-        let moved = ((got[0] - want[0]).powi(2) + (got[1] - want[1]).powi(2) + (got[2] - want[2]).powi(2)).sqrt();
-        assert!(moved < 0.002, "{n} moved {moved} m in 2 s: from {want:?} to {got:?}");
+        let moved =
+            ((got[0] - want[0]).powi(2) + (got[1] - want[1]).powi(2) + (got[2] - want[2]).powi(2)).sqrt();
+        assert!(
+            moved < 0.002,
+            "{n} moved {moved} m in 2 s: from {want:?} to {got:?}"
+        );
     }
     let w = sim.observe();
     let (b, c) = (w.index_of("in_high").unwrap(), w.index_of("high_bin").unwrap());
@@ -377,12 +483,20 @@ fn serde_yaml_text(spec: &SceneSpec) -> String {
     for o in &spec.objects {
         let kind = match &o.shape {
             Shape::Block { half, .. } => format!("block: {{size: {}}}", 2.0 * half),
-            Shape::Container { inner_half, wall_height } => format!(
+            Shape::Container {
+                inner_half,
+                wall_height,
+            } => format!(
                 "container: {{inner: [{}, {}], wall_height: {wall_height}}}",
                 2.0 * inner_half[0],
                 2.0 * inner_half[1]
             ),
-            Shape::Obstacle { half } => format!("obstacle: {{size: [{}, {}, {}]}}", 2.0 * half[0], 2.0 * half[1], 2.0 * half[2]),
+            Shape::Obstacle { half } => format!(
+                "obstacle: {{size: [{}, {}, {}]}}",
+                2.0 * half[0],
+                2.0 * half[1],
+                2.0 * half[2]
+            ),
         };
         let p = o.pose.unwrap();
         t += &format!("  {}: {{{kind}, pose: [{}, {}, {}]", o.name, p.x, p.y, p.yaw);

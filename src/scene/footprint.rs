@@ -25,7 +25,12 @@ impl Rect {
         let [ax, ay] = self.axes();
         let [hx, hy] = self.half;
         let [cx, cy] = self.centre;
-        let at = |sx: f64, sy: f64| [cx + sx * hx * ax[0] + sy * hy * ay[0], cy + sx * hx * ax[1] + sy * hy * ay[1]];
+        let at = |sx: f64, sy: f64| {
+            [
+                cx + sx * hx * ax[0] + sy * hy * ay[0],
+                cy + sx * hx * ax[1] + sy * hy * ay[1],
+            ]
+        };
         [at(1.0, 1.0), at(-1.0, 1.0), at(-1.0, -1.0), at(1.0, -1.0)]
     }
 
@@ -47,7 +52,8 @@ impl Rect {
     /// Half the extent of the rectangle along the world-frame unit direction `n`, metres.
     fn extent_along(&self, n: [f64; 2]) -> f64 {
         let [ax, ay] = self.axes();
-        self.half[0] * (ax[0] * n[0] + ax[1] * n[1]).abs() + self.half[1] * (ay[0] * n[0] + ay[1] * n[1]).abs()
+        self.half[0] * (ax[0] * n[0] + ax[1] * n[1]).abs()
+            + self.half[1] * (ay[0] * n[0] + ay[1] * n[1]).abs()
     }
 
     /// The two rectangles' interiors overlap (separating-axis test on the four edge normals;
@@ -109,7 +115,10 @@ mod tests {
         assert!((g - (0.1f64).hypot(0.1)).abs() < 1e-12, "{g}");
         assert_eq!(a.gap(&rect(0.15, 0.0, 0.1, 0.1, 0.0)), 0.0);
         assert!(a.overlaps(&rect(0.15, 0.0, 0.1, 0.1, 0.0)));
-        assert!(!a.overlaps(&rect(0.2, 0.0, 0.1, 0.1, 0.0)), "touching is not overlapping");
+        assert!(
+            !a.overlaps(&rect(0.2, 0.0, 0.1, 0.1, 0.0)),
+            "touching is not overlapping"
+        );
     }
 
     #[test]

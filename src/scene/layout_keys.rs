@@ -55,8 +55,11 @@ fn taken(scene: &SceneSpec) -> BTreeSet<&str> {
 fn name_of<'a>(k: &'a Value, what: &str, scene: &SceneSpec, issues: &mut Vec<Issue>) -> Option<&'a str> {
     let Some(name) = k.as_str().filter(|n| is_object_name(n)) else {
         issues.push(
-            Issue::new(k.loc, format!("`{}` is not a valid {what} name", k.as_str().unwrap_or("?")))
-                .label("expected lower-case letters, digits and `_`, starting with a letter (at most 32)"),
+            Issue::new(
+                k.loc,
+                format!("`{}` is not a valid {what} name", k.as_str().unwrap_or("?")),
+            )
+            .label("expected lower-case letters, digits and `_`, starting with a letter (at most 32)"),
         );
         return None;
     };
@@ -75,15 +78,24 @@ fn name_of<'a>(k: &'a Value, what: &str, scene: &SceneSpec, issues: &mut Vec<Iss
 pub(super) fn read_spots(v: &Value, scene: &mut SceneSpec, issues: &mut Vec<Issue>) {
     let Some(entries) = v.as_map() else {
         issues.push(
-            Issue::new(v.loc, format!("`spots` must be a mapping of names to points, found {}", v.describe()))
-                .label("expected e.g. `spots: {buffer: [0.40, 0.25, deg(90)]}`"),
+            Issue::new(
+                v.loc,
+                format!(
+                    "`spots` must be a mapping of names to points, found {}",
+                    v.describe()
+                ),
+            )
+            .label("expected e.g. `spots: {buffer: [0.40, 0.25, deg(90)]}`"),
         );
         return;
     };
     if entries.len() > MAX_SPOTS {
         issues.push(Issue::new(
             v.loc,
-            format!("a scene has at most {MAX_SPOTS} spots, this one has {}", entries.len()),
+            format!(
+                "a scene has at most {MAX_SPOTS} spots, this one has {}",
+                entries.len()
+            ),
         ));
         return;
     }
@@ -95,10 +107,10 @@ pub(super) fn read_spots(v: &Value, scene: &mut SceneSpec, issues: &mut Vec<Issu
         let p: Vec<Angle> = match from_value(body) {
             Ok(p) => p,
             Err(e) => {
-                issues.push(
-                    e.into_issue(body.loc, |l| format!("{l:?}"))
-                        .help_or("a spot is `[x, y]` or `[x, y, yaw]` (metres; yaw in radians or `deg(..)`)"),
-                );
+                issues
+                    .push(e.into_issue(body.loc, |l| format!("{l:?}")).help_or(
+                        "a spot is `[x, y]` or `[x, y, yaw]` (metres; yaw in radians or `deg(..)`)",
+                    ));
                 continue;
             }
         };
@@ -134,15 +146,24 @@ pub(super) fn read_spots(v: &Value, scene: &mut SceneSpec, issues: &mut Vec<Issu
 pub(super) fn read_regions(v: &Value, scene: &mut SceneSpec, issues: &mut Vec<Issue>) {
     let Some(entries) = v.as_map() else {
         issues.push(
-            Issue::new(v.loc, format!("`regions` must be a mapping of names to boxes, found {}", v.describe()))
-                .label("expected e.g. `regions: {no_go: {x: [0.3, 0.4], y: [-0.1, 0.1], role: keep_out}}`"),
+            Issue::new(
+                v.loc,
+                format!(
+                    "`regions` must be a mapping of names to boxes, found {}",
+                    v.describe()
+                ),
+            )
+            .label("expected e.g. `regions: {no_go: {x: [0.3, 0.4], y: [-0.1, 0.1], role: keep_out}}`"),
         );
         return;
     };
     if entries.len() > MAX_SPOTS {
         issues.push(Issue::new(
             v.loc,
-            format!("a scene has at most {MAX_SPOTS} regions, this one has {}", entries.len()),
+            format!(
+                "a scene has at most {MAX_SPOTS} regions, this one has {}",
+                entries.len()
+            ),
         ));
         return;
     }
@@ -207,7 +228,8 @@ fn at(objects_v: &Value, name: &str, path: &[&str]) -> Loc {
 /// around its allowed regions.
 pub(super) fn resolve_layout(scene: &mut SceneSpec, objects_v: &Value, issues: &mut Vec<Issue>) {
     let names: Vec<String> = scene.objects.iter().map(|o| o.name.clone()).collect();
-    let kinds: BTreeMap<String, ObjectKind> = scene.objects.iter().map(|o| (o.name.clone(), o.kind())).collect();
+    let kinds: BTreeMap<String, ObjectKind> =
+        scene.objects.iter().map(|o| (o.name.clone(), o.kind())).collect();
     let regions = scene.regions.clone();
     for o in scene.objects.iter_mut() {
         resolve_regions(o, &regions, objects_v, issues);
@@ -225,7 +247,10 @@ pub(super) fn resolve_layout(scene: &mut SceneSpec, objects_v: &Value, issues: &
                 issues.push(
                     Issue::new(loc, format!("`{}` rests on unknown object `{s}`", o.name))
                         .label("expected one of the scene's containers, obstacles or blocks")
-                        .maybe_help(crate::yaml::suggest::did_you_mean(&s, names.iter().map(String::as_str))),
+                        .maybe_help(crate::yaml::suggest::did_you_mean(
+                            &s,
+                            names.iter().map(String::as_str),
+                        )),
                 );
                 o.on = None;
             }
@@ -268,13 +293,23 @@ pub(super) fn resolve_layout(scene: &mut SceneSpec, objects_v: &Value, issues: &
             issues.push(
                 Issue::new(
                     at(objects_v, &o.name, &["on"]),
-                    format!("`{}` has a fixed pose on `{}`, which sweeps place at random", o.name, sup.name),
+                    format!(
+                        "`{}` has a fixed pose on `{}`, which sweeps place at random",
+                        o.name, sup.name
+                    ),
                 )
-                .label(format!("this block would be left where `{}` no longer is", sup.name))
+                .label(format!(
+                    "this block would be left where `{}` no longer is",
+                    sup.name
+                ))
                 .help(format!(
                     "give `{}` a `random: {{{}: {}}}` too, or give `{}` only a fixed pose",
                     o.name,
-                    if sup.kind() == ObjectKind::Container { "in" } else { "on" },
+                    if sup.kind() == ObjectKind::Container {
+                        "in"
+                    } else {
+                        "on"
+                    },
                     sup.name,
                     sup.name
                 )),
@@ -338,9 +373,15 @@ fn resolve_regions(o: &mut ObjectSpec, regions: &[Region], objects_v: &Value, is
                 .help("keep-out regions apply to every randomized object without being named"),
             ),
             None => issues.push(
-                Issue::new(at(objects_v, &o.name, &["random", "region"]), format!("unknown region `{n}`"))
-                    .label("expected one of the scene's `regions:`")
-                    .maybe_help(crate::yaml::suggest::did_you_mean(n, regions.iter().map(|g| g.name.as_str()))),
+                Issue::new(
+                    at(objects_v, &o.name, &["random", "region"]),
+                    format!("unknown region `{n}`"),
+                )
+                .label("expected one of the scene's `regions:`")
+                .maybe_help(crate::yaml::suggest::did_you_mean(
+                    n,
+                    regions.iter().map(|g| g.name.as_str()),
+                )),
             ),
         }
     }

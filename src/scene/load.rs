@@ -688,7 +688,15 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
             0.0
         }
         Some(z) => {
-            check_range(body, &["z"], z, 0.0, MAX_Z, "the height of a base above the table (m)", issues);
+            check_range(
+                body,
+                &["z"],
+                z,
+                0.0,
+                MAX_Z,
+                "the height of a base above the table (m)",
+                issues,
+            );
             z
         }
     };
@@ -698,7 +706,9 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
                 loc_at(body, &["on"]),
                 format!("{kind} `{name}` cannot rest on another object: only blocks take `on:`"),
             )
-            .label(format!("expected `z:` (the height of the {kind}'s base above the table, metres)"))
+            .label(format!(
+                "expected `z:` (the height of the {kind}'s base above the table, metres)"
+            ))
             .help("raise containers and obstacles with `z:`, e.g. a shelf board on posts"),
         );
     }
@@ -707,8 +717,11 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
         let support = match (r.in_, r.on) {
             (Some(a), Some(b)) => {
                 issues.push(
-                    Issue::new(loc_at(body, &["random"]), "`random:` takes `in:` or `on:`, not both")
-                        .label("expected `in: CONTAINER` or `on: OBSTACLE_OR_BLOCK`"),
+                    Issue::new(
+                        loc_at(body, &["random"]),
+                        "`random:` takes `in:` or `on:`, not both",
+                    )
+                    .label("expected `in: CONTAINER` or `on: OBSTACLE_OR_BLOCK`"),
                 );
                 Some(a).or(Some(b))
             }
@@ -763,7 +776,9 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
                         issues.push(
                             Issue::new(
                                 loc_at(body, &["random", key]),
-                                format!("`{key}` must be a range [lo, hi] with lo ≤ hi, within ±1 m of the robot"),
+                                format!(
+                                    "`{key}` must be a range [lo, hi] with lo ≤ hi, within ±1 m of the robot"
+                                ),
                             )
                             .label("expected e.g. [0.30, 0.60] (metres)"),
                         );
@@ -773,8 +788,13 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
                 None => {
                     if need {
                         issues.push(
-                            Issue::new(loc_at(body, &["random"]), format!("`random:` of `{name}` has no `{key}:` range"))
-                                .label(format!("expected `{key}: [lo, hi]` (metres), or `in:`, `on:` or `region:`")),
+                            Issue::new(
+                                loc_at(body, &["random"]),
+                                format!("`random:` of `{name}` has no `{key}:` range"),
+                            )
+                            .label(format!(
+                                "expected `{key}: [lo, hi]` (metres), or `in:`, `on:` or `region:`"
+                            )),
                         );
                     }
                     [unset, unset]

@@ -27,9 +27,9 @@ mod sample;
 mod types;
 
 pub use color::{COLOR_NAMES, Color};
+pub use footprint::Rect;
 pub use goal::{Goal, GoalAtom};
 pub use load::{BUILTIN_CUBE_BOWL, SceneFileSchema, is_object_name, load_scene_file};
-pub use footprint::Rect;
 pub use sample::{MAX_DRAWS, Placement, PlacementError, placement_order, sample_placement, support_of};
 pub use types::{
     CONTAINER_FLOOR, CONTAINER_WALL, ObjectKind, ObjectSpec, Pose, ROBOT_BASE_RADIUS, RandomPlacement,

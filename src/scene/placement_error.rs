@@ -134,7 +134,9 @@ impl PlacementError {
             }
             PlacementError::OutOfReach { object, .. } => {
                 let [lo, hi] = reach_limits();
-                format!("keep block `{object}` {lo} … {hi} m from the base (its `pose:` or `random:` x and y)")
+                format!(
+                    "keep block `{object}` {lo} … {hi} m from the base (its `pose:` or `random:` x and y)"
+                )
             }
             PlacementError::TooClose { a, b, on_b: true, .. } => format!(
                 "to start `{a}` on or inside `{b}`, declare it: `on: {b}` with a fixed pose, or `random: {{in: {b}}}` (`{{on: {b}}}` for a top)"
@@ -152,7 +154,9 @@ impl PlacementError {
                 "make `{object}`'s `random:` x and y ranges lie inside its regions, or widen the regions"
             ),
             PlacementError::Unsatisfiable { most_common, .. } => most_common.hint(),
-            PlacementError::WrongCount { .. } => "give one pose per object of the scene, in scene order".into(),
+            PlacementError::WrongCount { .. } => {
+                "give one pose per object of the scene, in scene order".into()
+            }
         }
     }
 }
@@ -185,7 +189,9 @@ impl std::fmt::Display for PlacementError {
                 f,
                 "`{a}` and `{b}` are {distance:.3} m apart (centres); at least {min:.3} m is needed so they do not overlap"
             ),
-            PlacementError::TooClose { a, b, distance, min, .. } => {
+            PlacementError::TooClose {
+                a, b, distance, min, ..
+            } => {
                 if *distance <= 0.0 {
                     write!(
                         f,

@@ -173,7 +173,8 @@ impl Placement {
             return Ok(());
         };
         let (o, sup) = (&scene.objects[i], &scene.objects[s]);
-        let margin = support_rect(&sup.shape, &self.poses[s]).margin_inside(&o.shape.footprint(&self.poses[i]));
+        let margin =
+            support_rect(&sup.shape, &self.poses[s]).margin_inside(&o.shape.footprint(&self.poses[i]));
         let min = if sup.kind() == ObjectKind::Container {
             clearance(scene, i)
         } else {
