@@ -390,7 +390,9 @@ fn every_layout_scene_loads_and_draws_200_valid_placements() {
         "wall_cell.yaml",
     ] {
         let s = shipped(name);
-        Placement::fixed(&s).map(|p| p.check(&s).unwrap());
+        if let Some(p) = Placement::fixed(&s) {
+            p.check(&s).unwrap();
+        }
         if !s.randomized() {
             continue;
         }

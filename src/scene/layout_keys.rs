@@ -123,7 +123,7 @@ pub(super) fn read_spots(v: &Value, scene: &mut SceneSpec, issues: &mut Vec<Issu
         }
         let (x, y) = (p[0].0, p[1].0);
         let r = x.hypot(y);
-        if !(x.is_finite() && y.is_finite()) || !(rmin..=rmax).contains(&r) {
+        if !(x.is_finite() && y.is_finite() && (rmin..=rmax).contains(&r)) {
             issues.push(
                 Issue::new(
                     body.loc,
