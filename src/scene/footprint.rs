@@ -126,7 +126,7 @@ mod tests {
         // A 0.30 × 0.02 m wall along y; a 0.04 m block 0.05 m beside it: 0.04 m gap, though the
         // block's centre is inside the wall's 0.15 m circle.
         let wall = rect(0.5, 0.0, 0.01, 0.15, 0.0);
-        let block = rect(0.57, 0.05, 0.02, 0.02, 0.0);
+        let block = rect(0.57, 0.0, 0.02, 0.02, 0.0);
         assert!((wall.gap(&block) - 0.04).abs() < 1e-12);
         // Turned 90°, the wall runs along x through the block.
         let turned = rect(0.5, 0.0, 0.01, 0.15, std::f64::consts::FRAC_PI_2);
