@@ -185,9 +185,11 @@ pub struct RandomPlacement {
     /// What a block is drawn on (`random: {in: bin}` or `{on: shelf}`): x and y are then drawn
     /// over the support's top (a container's floor inside its walls), in the support's frame.
     /// `None`: the table.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub support: Option<String>,
     /// The `allowed` regions (by name) the object's footprint must lie within, one of them
     /// (`random: {region: left}`). Empty: anywhere.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
     pub regions: Vec<String>,
 }
 
@@ -206,9 +208,11 @@ pub struct ObjectSpec {
     pub random: Option<RandomPlacement>,
     /// Height of a container's or obstacle's base above the table (`z:`), metres; 0 for blocks
     /// (their height comes from what they rest on).
+    #[serde(skip_serializing_if = "is_zero")]
     pub z: f64,
     /// What a block with a fixed `pose:` rests on (`on: NAME`): a container's floor, an
     /// obstacle's or another block's top. `None`: the table.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub on: Option<String>,
 }
 
