@@ -100,7 +100,7 @@ pub enum FailureKind {
 
 impl FailureKind {
     /// Every built-in kind (all but [`Custom`](Self::Custom)).
-    pub const BUILTIN: [FailureKind; 24] = [
+    pub const BUILTIN: [FailureKind; 25] = [
         FailureKind::TimeLimit,
         FailureKind::Unstable,
         FailureKind::GoalNotMet,

@@ -266,6 +266,8 @@ fn load_spec_panicked_in_default_placement_on_an_unsatisfiable_random_placement(
             y: [0.2, 0.2],
             yaw: None,
             clearance: 0.01,
+            support: None,
+            regions: Vec::new(),
         });
     }
     match Scene::load_spec(&spec) {

@@ -73,7 +73,7 @@ pub fn reset_of(
             let [x, y, yaw]: [f64; 3] = xyz
                 .try_into()
                 .map_err(|_| value(format!("placement of `{name}` is [x, y, yaw] (metres, radians)")))?;
-            poses[i] = Pose { x, y, yaw };
+            poses[i] = Pose { x, y, yaw, z: 0.0 };
         }
         return Ok(Reset::Placement(Placement { poses }));
     }

@@ -68,6 +68,8 @@ pub(super) fn resolve(scene: &Scene, how: &Reset) -> Result<(Placement, Option<u
                         .join(", ")
                 )));
             }
+            let mut p = p.clone();
+            p.settle(&scene.spec); // heights come from the scene (`z:`, what each block rests on)
             p.check(&scene.spec).map_err(|e| {
                 invalid(format!(
                     "reset placement is not allowed: {e}; objects stand on the table (|x|, |y| ≤ 1 m), clear of the robot's base (within {} m of the origin) and of each other; blocks {:.2} … {:.2} m from the base",
@@ -76,7 +78,7 @@ pub(super) fn resolve(scene: &Scene, how: &Reset) -> Result<(Placement, Option<u
                     crate::scene::reach_limits()[1]
                 ))
             })?;
-            Ok((p.clone(), None))
+            Ok((p, None))
         }
     }
 }

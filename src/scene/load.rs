@@ -26,7 +26,10 @@ pub const BUILTIN_CUBE_BOWL: &str = include_str!("../../scenes/cube_bowl.yaml");
 pub const MAX_OBJECTS: usize = 16;
 
 /// Keys allowed at the top level of a scene file.
-const TOP_LEVEL_KEYS: &[&str] = &["description", "objects", "goal", "sampler"];
+const TOP_LEVEL_KEYS: &[&str] = &["description", "objects", "goal", "sampler", "spots", "regions"];
+
+/// Highest base of a container or an obstacle above the table (`z:`), metres.
+pub const MAX_Z: f64 = 0.6;
 
 fn d_mass() -> f64 {
     0.05
@@ -84,7 +87,7 @@ pub struct ContainerRaw {
 #[derive(Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ObstacleRaw {
-    /// Size `[x, y, z]`, metres (x, y: 0.01 … 0.5; z: 0.01 … 0.3).
+    /// Size `[x, y, z]`, metres (x, y: 0.01 … 0.5; z: 0.01 … 1.0, a post or a fixture).
     size: [f64; 3],
     /// Colour name or `[r, g, b, a]`. Default gray.
     #[serde(default = "d_gray")]
@@ -95,15 +98,34 @@ pub struct ObstacleRaw {
 #[derive(Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RandomRaw {
-    /// Range of the centre x `[lo, hi]`, metres.
-    x: [f64; 2],
-    /// Range of the centre y `[lo, hi]`, metres.
-    y: [f64; 2],
+    /// Range of the centre x `[lo, hi]`, metres. Required unless `in`, `on` or `region` is given.
+    x: Option<[f64; 2]>,
+    /// Range of the centre y `[lo, hi]`, metres. Required unless `in`, `on` or `region` is given.
+    y: Option<[f64; 2]>,
     /// Range of the yaw `[lo, hi]` (radians, or `deg(..)`). Absent: no yaw is drawn.
     yaw: Option<[Angle; 2]>,
-    /// Smallest gap to every other object's footprint circle, metres (≥ 0). Default 0.01.
+    /// Smallest gap to every other object's footprint (and to the walls of the container a
+    /// block is drawn in), metres (0 … 0.5). Default 0.01.
     #[serde(default = "d_clearance")]
     clearance: f64,
+    /// A block only: draw it on the floor of this container, inside the walls (no `x`/`y`).
+    #[serde(rename = "in")]
+    in_: Option<String>,
+    /// A block only: draw it on the top of this obstacle or block (no `x`/`y`).
+    on: Option<String>,
+    /// The `allowed` region(s) the footprint must lie within (one of them); `x`/`y` default to
+    /// the box around them.
+    region: Option<OneOrMany>,
+}
+
+/// One name or a list of names.
+#[derive(Deserialize, JsonSchema)]
+#[serde(untagged)]
+pub enum OneOrMany {
+    /// One name.
+    One(String),
+    /// Several names.
+    Many(Vec<String>),
 }
 
 fn d_clearance() -> f64 {
@@ -126,6 +148,12 @@ pub struct ObjectRaw {
     pose: Option<Vec<Angle>>,
     /// Randomization, used by sweeps.
     random: Option<RandomRaw>,
+    /// A container or obstacle only: height of its base above the table, metres (0 … 0.6).
+    /// Default 0 (standing on the table).
+    z: Option<f64>,
+    /// A block only: what it rests on — a container (on its floor), an obstacle or another
+    /// block (on its top). Its height follows; its `pose:` stays in world coordinates.
+    on: Option<String>,
 }
 
 /// The whole scene file, for the JSON Schema (`macrotree schema --scene`).
@@ -144,6 +172,13 @@ pub struct SceneFileSchema {
     /// container).
     #[serde(default)]
     pub sampler: SamplerRaw,
+    /// Named points on the table: `NAME: [x, y]` or `[x, y, yaw]` (metres; yaw in radians or
+    /// `deg(..)`), each 0.22 … 0.72 m from the robot's base.
+    #[serde(default)]
+    pub spots: BTreeMap<String, Vec<Angle>>,
+    /// Named boxes on the table: `NAME: {x: [lo, hi], y: [lo, hi], role: keep_out | allowed}`.
+    #[serde(default)]
+    pub regions: BTreeMap<String, super::layout_keys::RegionRaw>,
 }
 
 /// `sampler:` values.
@@ -270,6 +305,8 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
     let mut objects_v = None;
     let mut goal_v = None;
     let mut sampler_v = None;
+    let mut spots_v = None;
+    let mut regions_v = None;
     for (k, val) in entries {
         match k.as_str() {
             Some("description") => match val.as_str() {
@@ -285,11 +322,13 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
             Some("objects") => objects_v = Some((k.loc, val)),
             Some("goal") => goal_v = Some(val),
             Some("sampler") => sampler_v = Some(val),
+            Some("spots") => spots_v = Some(val),
+            Some("regions") => regions_v = Some(val),
             other => {
                 let other = other.unwrap_or("?");
                 issues.push(
                     Issue::new(k.loc, format!("unknown top-level key `{other}` in a scene file"))
-                        .label("expected `description`, `objects`, `goal` or `sampler`")
+                        .label("expected `description`, `objects`, `goal`, `sampler`, `spots` or `regions`")
                         .maybe_help(did_you_mean(other, TOP_LEVEL_KEYS.iter().copied())),
                 )
             }
@@ -304,14 +343,24 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
         return None;
     };
     let objects = read_objects(objects_v, issues);
-    let scene = SceneSpec {
+    let mut scene = SceneSpec {
         name,
         description,
         objects,
         goal: Goal::default(),
         sampler: Sampler::default(),
         spots: Vec::new(),
+        regions: Vec::new(),
     };
+    if let Some(v) = spots_v {
+        super::layout_keys::read_spots(v, &mut scene, issues);
+    }
+    if let Some(v) = regions_v {
+        super::layout_keys::read_regions(v, &mut scene, issues);
+    }
+    if issues.is_empty() {
+        super::layout_keys::resolve_layout(&mut scene, objects_v, issues);
+    }
     let goal = match goal_v {
         Some(g) => read_goal(g, &scene, issues),
         None => Goal::default(),
@@ -332,10 +381,10 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
         && scene.randomized()
         && let Err(e) = sample_placement(&scene, 0, 0)
     {
-        issues.push(
-            Issue::new(objects_key, format!("the randomization cannot be met: {e}"))
-                .help("widen the `random:` regions or lower the clearances"),
-        );
+        let at = e
+            .object()
+            .map_or(objects_key, |n| loc_at(objects_v, &[n, "random"]));
+        issues.push(Issue::new(at, format!("the randomization cannot be met: {e}")).help(e.hint()));
     }
     if issues.is_empty() || !scene.objects.is_empty() {
         super::feasible::check_has_block(&scene, objects_key, issues);
@@ -539,7 +588,7 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
     } else {
         let o = raw.obstacle.expect("one kind is set");
         for (i, x) in o.size.iter().enumerate() {
-            let hi = if i == 2 { 0.3 } else { 0.5 };
+            let hi = if i == 2 { 1.0 } else { 0.5 };
             check_range(
                 body,
                 &["obstacle", "size"],
@@ -557,12 +606,14 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
             o.color,
         )
     };
+    let kind = shape.kind();
     let pose = match raw.pose {
         None => None,
         Some(p) if p.len() == 2 || p.len() == 3 => Some(Pose {
             x: p[0].0,
             y: p[1].0,
             yaw: p.get(2).map_or(0.0, |a| a.0),
+            z: 0.0,
         }),
         Some(p) => {
             issues.push(
@@ -575,19 +626,135 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
             None
         }
     };
+    let z = match raw.z {
+        None => 0.0,
+        Some(z) if kind == ObjectKind::Block => {
+            issues.push(
+                Issue::new(
+                    loc_at(body, &["z"]),
+                    format!("block `{name}` takes no `z: {z}`: a block's height comes from what it rests on"),
+                )
+                .label("expected no `z:` on a block")
+                .help("write `on: NAME` (a container, an obstacle or a block) to start it on something"),
+            );
+            0.0
+        }
+        Some(z) => {
+            check_range(
+                body,
+                &["z"],
+                z,
+                0.0,
+                MAX_Z,
+                "the height of a base above the table (m)",
+                issues,
+            );
+            z
+        }
+    };
+    if raw.on.is_some() && kind != ObjectKind::Block {
+        issues.push(
+            Issue::new(
+                loc_at(body, &["on"]),
+                format!("{kind} `{name}` cannot rest on another object: only blocks take `on:`"),
+            )
+            .label(format!(
+                "expected `z:` (the height of the {kind}'s base above the table, metres)"
+            ))
+            .help("raise containers and obstacles with `z:`, e.g. a shelf board on posts"),
+        );
+    }
+    let mut on = raw.on.clone();
     let random = raw.random.map(|r| {
-        for (key, range) in [("x", r.x), ("y", r.y)] {
-            let ok = range.iter().all(|x| x.is_finite() && x.abs() <= 1.0) && range[0] <= range[1];
-            if !ok {
+        let support = match (r.in_, r.on) {
+            (Some(a), Some(b)) => {
                 issues.push(
                     Issue::new(
-                        loc_at(body, &["random", key]),
-                        format!("`{key}` must be a range [lo, hi] with lo ≤ hi, within ±1 m of the robot"),
+                        loc_at(body, &["random"]),
+                        "`random:` takes `in:` or `on:`, not both",
                     )
-                    .label("expected e.g. [0.30, 0.60] (metres)"),
+                    .label("expected `in: CONTAINER` or `on: OBSTACLE_OR_BLOCK`"),
+                );
+                Some(a).or(Some(b))
+            }
+            (a, b) => a.or(b),
+        };
+        if let Some(s) = &support {
+            if kind != ObjectKind::Block {
+                issues.push(
+                    Issue::new(
+                        loc_at(body, &["random"]),
+                        format!("{kind} `{name}` cannot be drawn in or on another object: only blocks can"),
+                    )
+                    .label("expected `x:` and `y:` ranges")
+                    .help("raise containers and obstacles with `z:`"),
+                );
+            } else if r.x.is_some() || r.y.is_some() {
+                issues.push(
+                    Issue::new(
+                        loc_at(body, &["random", if r.x.is_some() { "x" } else { "y" }]),
+                        format!("`{name}` is drawn over `{s}`: its x and y come from `{s}`'s top"),
+                    )
+                    .label("expected no `x:`/`y:` beside `in:`/`on:`")
+                    .help("remove `x:` and `y:`, or remove `in:`/`on:` to draw on the table"),
                 );
             }
+            match &on {
+                Some(o) if o != s => issues.push(
+                    Issue::new(
+                        loc_at(body, &["on"]),
+                        format!("`{name}` rests on `{o}` but is drawn over `{s}`"),
+                    )
+                    .label("a block rests on one thing")
+                    .help(format!("remove `on: {o}`, or draw over `{o}`")),
+                ),
+                _ => on = Some(s.clone()),
+            }
         }
+        let regions = match r.region {
+            None => Vec::new(),
+            Some(OneOrMany::One(n)) => vec![n],
+            Some(OneOrMany::Many(v)) => v,
+        };
+        // Absent ranges: over a support they are unused; with regions they become the box
+        // around the regions (resolved once the regions are read: NaN until then).
+        let unset = if support.is_some() { 0.0 } else { f64::NAN };
+        let need = support.is_none() && regions.is_empty();
+        let mut range = |key: &str, v: Option<[f64; 2]>| -> [f64; 2] {
+            match v {
+                Some(range) => {
+                    let ok = range.iter().all(|x| x.is_finite() && x.abs() <= 1.0) && range[0] <= range[1];
+                    if !ok {
+                        issues.push(
+                            Issue::new(
+                                loc_at(body, &["random", key]),
+                                format!(
+                                    "`{key}` must be a range [lo, hi] with lo ≤ hi, within ±1 m of the robot"
+                                ),
+                            )
+                            .label("expected e.g. [0.30, 0.60] (metres)"),
+                        );
+                    }
+                    range
+                }
+                None => {
+                    if need {
+                        issues.push(
+                            Issue::new(
+                                loc_at(body, &["random"]),
+                                format!("`random:` of `{name}` has no `{key}:` range"),
+                            )
+                            .label(format!(
+                                "expected `{key}: [lo, hi]` (metres), or `in:`, `on:` or `region:`"
+                            )),
+                        );
+                    }
+                    [unset, unset]
+                }
+            }
+        };
+        let x = range("x", r.x);
+        let y = range("y", r.y);
         if let Some([lo, hi]) = r.yaw
             && !(lo.0 <= hi.0 && hi.0 - lo.0 <= std::f64::consts::TAU)
         {
@@ -609,10 +776,12 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
             issues,
         );
         RandomPlacement {
-            x: r.x,
-            y: r.y,
+            x,
+            y,
             yaw: r.yaw.map(|[a, b]| [a.0, b.0]),
             clearance: r.clearance,
+            support,
+            regions,
         }
     });
     if pose.is_none() && random.is_none() && issues.len() == before {
@@ -630,6 +799,8 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
         color,
         pose,
         random,
+        z,
+        on,
     })
 }
 
@@ -640,25 +811,16 @@ fn check_fixed_poses(scene: &SceneSpec, objects_v: &Value, issues: &mut Vec<Issu
             if let Some(p) = o.pose
                 && let Err(e) = Placement::check_one(scene, i, &p)
             {
-                issues.push(Issue::new(loc_at(objects_v, &[&o.name, "pose"]), e.to_string()));
+                issues.push(Issue::new(loc_at(objects_v, &[&o.name, "pose"]), e.to_string()).help(e.hint()));
             }
         }
         return;
     }
-    let placement = Placement {
-        poses: scene
-            .objects
-            .iter()
-            .map(|o| o.pose.expect("fully posed"))
-            .collect(),
-    };
+    let placement = Placement::fixed(scene).expect("fully posed");
     if let Err(e) = placement.check(scene) {
         let at = e
             .object()
             .map_or(objects_v.loc, |n| loc_at(objects_v, &[n, "pose"]));
-        issues.push(
-            Issue::new(at, e.to_string())
-                .help("move the objects apart, onto the table and within the arm's reach"),
-        );
+        issues.push(Issue::new(at, e.to_string()).help(e.hint()));
     }
 }

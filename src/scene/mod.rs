@@ -18,21 +18,25 @@
 
 mod color;
 mod feasible;
+mod footprint;
 mod goal;
 mod goal_read;
+mod layout_keys;
 mod load;
+mod placement_error;
 mod sample;
 mod types;
 
 pub use color::{COLOR_NAMES, Color};
+pub use footprint::Rect;
 pub use goal::{
     AT_MAX_TOLERANCE, AT_MAX_YAW_TOLERANCE, AT_TOLERANCE, AT_YAW_TOLERANCE, Goal, GoalAtom, GoalPlace,
 };
 pub use load::{BUILTIN_CUBE_BOWL, SceneFileSchema, is_object_name, load_scene_file};
-pub use sample::{MAX_DRAWS, Placement, PlacementError, sample_placement};
+pub use sample::{MAX_DRAWS, Placement, PlacementError, placement_order, sample_placement, support_of};
 pub use types::{
     CONTAINER_FLOOR, CONTAINER_WALL, ObjectKind, ObjectSpec, Pose, ROBOT_BASE_RADIUS, RandomPlacement,
-    Sampler, SceneSpec, Shape, Spot, reach_limits,
+    Region, RegionRole, Sampler, SceneSpec, Shape, Spot, reach_limits,
 };
 
 /// Prefix of every scene object's MuJoCo names (`obj/red`, `obj/bin/wall_px`), so that a user's

@@ -98,6 +98,33 @@ impl Shape {
         }
     }
 
+    /// The footprint at `pose`: a rectangle turned by the pose's yaw.
+    pub fn footprint(&self, pose: &Pose) -> super::footprint::Rect {
+        super::footprint::Rect {
+            centre: [pose.x, pose.y],
+            half: self.footprint_half(),
+            yaw: pose.yaw,
+        }
+    }
+
+    /// Height above its base of the surface a block set on this object rests on, metres: a
+    /// container's floor top, a block's or an obstacle's top.
+    pub fn support_surface(&self) -> f64 {
+        match self {
+            Shape::Container { .. } => CONTAINER_FLOOR,
+            other => other.height(),
+        }
+    }
+
+    /// Half extents of the area a block set on this object can rest on, in the object's frame,
+    /// metres: inside a container's walls, a block's or an obstacle's top.
+    pub fn support_half(&self) -> [f64; 2] {
+        match self {
+            Shape::Container { inner_half, .. } => *inner_half,
+            other => other.footprint_half(),
+        }
+    }
+
     /// Radius of the circle around the footprint (any yaw), metres.
     pub fn footprint_radius(&self) -> f64 {
         let [a, b] = self.footprint_half();
@@ -114,7 +141,8 @@ impl Shape {
     }
 }
 
-/// A pose on the table: centre x, y (metres) and yaw about the vertical (radians).
+/// A pose in the cell: centre x, y (metres), yaw about the vertical (radians) and the height
+/// of the object's base above the table (metres; 0 for an object standing on the table).
 #[derive(Copy, Clone, Debug, PartialEq, Serialize, Default)]
 pub struct Pose {
     /// Centre x, metres.
@@ -123,6 +151,15 @@ pub struct Pose {
     pub y: f64,
     /// Yaw about world z, radians.
     pub yaw: f64,
+    /// Height of the object's base (a block's bottom face, a container's floor underside, an
+    /// obstacle's bottom face) above the table, metres. Placements fill it in from the object's
+    /// `z:` or from what it rests on ([`super::Placement::settle`]).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub z: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 impl Pose {
@@ -142,8 +179,18 @@ pub struct RandomPlacement {
     /// Range of the yaw, radians (`[lo, hi)`); `None` keeps the fixed pose's yaw (or 0) and
     /// draws nothing.
     pub yaw: Option<[f64; 2]>,
-    /// Smallest gap between this object's footprint circle and any other object's, metres.
+    /// Smallest gap between this object's footprint and any other object's (and, for a block
+    /// drawn on a support, the support's walls or edges), metres.
     pub clearance: f64,
+    /// What a block is drawn on (`random: {in: bin}` or `{on: shelf}`): x and y are then drawn
+    /// over the support's top (a container's floor inside its walls), in the support's frame.
+    /// `None`: the table.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub support: Option<String>,
+    /// The `allowed` regions (by name) the object's footprint must lie within, one of them
+    /// (`random: {region: left}`). Empty: anywhere.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub regions: Vec<String>,
 }
 
 /// One object of the scene.
@@ -159,6 +206,14 @@ pub struct ObjectSpec {
     pub pose: Option<Pose>,
     /// The randomization sweeps draw from.
     pub random: Option<RandomPlacement>,
+    /// Height of a container's or obstacle's base above the table (`z:`), metres; 0 for blocks
+    /// (their height comes from what they rest on).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub z: f64,
+    /// What a block with a fixed `pose:` rests on (`on: NAME`): a container's floor, an
+    /// obstacle's or another block's top. `None`: the table.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub on: Option<String>,
 }
 
 impl ObjectSpec {
@@ -212,6 +267,45 @@ pub struct SceneSpec {
     /// Named places on the table, in file order.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub spots: Vec<Spot>,
+    /// Named boxes on the table that random placement keeps out of or draws within, in file
+    /// order.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub regions: Vec<Region>,
+}
+
+/// What a [`Region`] is for.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RegionRole {
+    /// No randomized object's footprint may enter it.
+    KeepOut,
+    /// Objects whose `random:` names it must keep their footprint within it.
+    Allowed,
+}
+
+/// A named axis-aligned box on the table (the scene file's `regions:`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Region {
+    /// The region's name (`[a-z][a-z0-9_]*`), unique among the scene's regions, spots and
+    /// objects.
+    pub name: String,
+    /// Range of x, metres (`lo < hi`).
+    pub x: [f64; 2],
+    /// Range of y, metres (`lo < hi`).
+    pub y: [f64; 2],
+    /// What it is for.
+    pub role: RegionRole,
+}
+
+impl Region {
+    /// The region as a footprint rectangle.
+    pub fn rect(&self) -> super::footprint::Rect {
+        super::footprint::Rect {
+            centre: [(self.x[0] + self.x[1]) / 2.0, (self.y[0] + self.y[1]) / 2.0],
+            half: [(self.x[1] - self.x[0]) / 2.0, (self.y[1] - self.y[0]) / 2.0],
+            yaw: 0.0,
+        }
+    }
 }
 
 impl SceneSpec {
@@ -228,6 +322,11 @@ impl SceneSpec {
     /// The spot called `name`.
     pub fn spot(&self, name: &str) -> Option<&Spot> {
         self.spots.iter().find(|s| s.name == name)
+    }
+
+    /// The region called `name`.
+    pub fn region(&self, name: &str) -> Option<&Region> {
+        self.regions.iter().find(|r| r.name == name)
     }
 
     /// Indices of the objects of `kind`, in scene order.

@@ -33,7 +33,8 @@ impl std::fmt::Display for SimError {
             SimError::Scene(msg) => write!(f, "scene: {msg}"),
             SimError::Placement { scene, reason } => write!(
                 f,
-                "scene `{scene}`: its default placement cannot be drawn: {reason}; widen the objects' `random:` ranges or lower their `clearance`"
+                "scene `{scene}`: its default placement cannot be drawn: {reason}; {}",
+                reason.hint()
             ),
         }
     }

@@ -9,7 +9,8 @@
 //! | obstacle `o` | mocap body `obj/o` with a box geom `obj/o` |
 //!
 //! Containers and obstacles are mocap bodies: a layout moves them through `mocap_pos`/`mocap_quat`
-//! without recompiling, and they never move by physics.
+//! without recompiling, and they never move by physics. A body's origin is the centre of the
+//! object's base, at the object's height `z:` above the table (a shelf board, a raised bin).
 //!
 //! A block's contact parameters are the ones measured for the reference cube: `priority="2"`
 //! makes them win over the 2F-85 pads (priority 1), so the unmodified Menagerie pads hold it with
@@ -79,9 +80,10 @@ pub fn objects_mjcf(scene: &SceneSpec) -> String {
                 let (t, f, h) = (CONTAINER_WALL, CONTAINER_FLOOR, *wall_height);
                 let _ = writeln!(
                     out,
-                    r#"    <body name="{name}" mocap="true" pos="{} {} 0">"#,
+                    r#"    <body name="{name}" mocap="true" pos="{} {} {}">"#,
                     n(pose.x),
-                    n(pose.y)
+                    n(pose.y),
+                    n(o.z)
                 );
                 boxgeom(
                     &mut out,
@@ -130,9 +132,10 @@ pub fn objects_mjcf(scene: &SceneSpec) -> String {
             Shape::Obstacle { half } => {
                 let _ = writeln!(
                     out,
-                    r#"    <body name="{name}" mocap="true" pos="{} {} 0">"#,
+                    r#"    <body name="{name}" mocap="true" pos="{} {} {}">"#,
                     n(pose.x),
-                    n(pose.y)
+                    n(pose.y),
+                    n(o.z)
                 );
                 boxgeom(&mut out, &name, *half, [0.0, 0.0, half[2]], &color);
                 let _ = writeln!(out, "    </body>");

@@ -341,12 +341,14 @@ impl Scene {
                 x: layout.cube_xy[0],
                 y: layout.cube_xy[1],
                 yaw: layout.cube_yaw,
+                z: 0.0,
             };
         }
         if let Some(b) = self.spec.legacy_bowl() {
             p.poses[b].x = layout.bowl_xy[0];
             p.poses[b].y = layout.bowl_xy[1];
         }
+        p.settle(&self.spec);
         p
     }
 }

@@ -57,8 +57,9 @@ impl Sim {
     }
 
     /// Puts the arm at home with its servos holding home, the gripper open, every block resting
-    /// on the table and every container and obstacle at its pose in `placement` (one pose per
-    /// object, scene order); time, step count and MuJoCo's warning counters go to zero.
+    /// at its pose in `placement` (its bottom at the pose's height `z`: the table, a container's
+    /// floor, a shelf board) and every container and obstacle at its pose (base at `z`), one
+    /// pose per object, scene order; time, step count and MuJoCo's warning counters go to zero.
     pub fn reset_placement(&mut self, placement: &Placement) {
         self.data.reset();
         let scene = self.scene.clone();
@@ -76,14 +77,14 @@ impl Sim {
             {
                 if let (Shape::Block { half, .. }, Some(c)) = (&o.shape, ids.qpos) {
                     let h = p.yaw / 2.0;
-                    qpos[c..c + 7].copy_from_slice(&[p.x, p.y, *half, h.cos(), 0.0, 0.0, h.sin()]);
+                    qpos[c..c + 7].copy_from_slice(&[p.x, p.y, p.z + *half, h.cos(), 0.0, 0.0, h.sin()]);
                 }
             }
         }
         for (ids, p) in scene.objects.iter().zip(&placement.poses) {
             if let Some(m) = ids.mocap {
                 let h = p.yaw / 2.0;
-                self.data.mocap_pos_mut()[m] = [p.x, p.y, 0.0];
+                self.data.mocap_pos_mut()[m] = [p.x, p.y, p.z];
                 self.data.mocap_quat_mut()[m] = [h.cos(), 0.0, 0.0, h.sin()];
             }
         }

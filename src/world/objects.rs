@@ -10,7 +10,8 @@ use super::snapshot::{fold_quarter_turn, yaw_of};
 use crate::scene::{CONTAINER_FLOOR, ObjectKind, ObjectSpec, Shape};
 
 /// One object's state. For a block, `pos` is its centre; for a container or an obstacle, the
-/// centre of its footprint on the table.
+/// centre of its base (on the table, or at the object's height `z:` for a shelf board or a
+/// raised bin).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ObjectState {
     /// Position, world frame, metres.
@@ -177,9 +178,10 @@ impl World {
             .find(|&i| self.holds(i, off_axis))
     }
 
-    /// Block `i` lies inside container `c`'s walls, below its rim: its centre at most (inner
-    /// half-width − its half-size) from the container's centre along each of the container's
-    /// axes, so the whole block fits between the walls.
+    /// Block `i` lies inside container `c`'s walls, below its rim and above its base: its centre
+    /// at most (inner half-width − its half-size) from the container's centre along each of the
+    /// container's axes, so the whole block fits between the walls. (A block under a raised
+    /// container is not in it.)
     pub fn inside(&self, i: usize, c: usize) -> bool {
         let Shape::Container {
             inner_half,
@@ -193,6 +195,7 @@ impl World {
         d.x.abs() <= inner_half[0] - half
             && d.y.abs() <= inner_half[1] - half
             && self.objects[i].pos.z < self.objects[c].pos.z + wall_height
+            && self.objects[i].pos.z > self.objects[c].pos.z
     }
 
     /// The container block `i` is inside, if any.
