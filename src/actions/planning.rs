@@ -253,11 +253,28 @@ pub(crate) fn plan_motion(
     start: &[f64; 6],
     goals: &GoalSet,
 ) -> Result<PlannedMotion, Failure> {
+    plan_motion_within(cell, what, start, goals, None)
+}
+
+/// [`plan_motion`] with the planner's collision-check budget set to `max_checks` (the leaf's
+/// `max_checks` parameter, range-checked by the tree reader; `None`: the planner's default).
+///
+/// # Errors
+/// The planner's typed failure ([`crate::sim::planning::plan_failure`]).
+pub(crate) fn plan_motion_within(
+    cell: &mut Cell,
+    what: &str,
+    start: &[f64; 6],
+    goals: &GoalSet,
+    max_checks: Option<u64>,
+) -> Result<PlannedMotion, Failure> {
     let t = Instant::now();
+    let defaults = PlannerConfig::default();
     let config = PlannerConfig {
         seed: 0x6d61_6372_6f74_7265 ^ u64::from(cell.planning().plans),
         time_cap: Some(LEAF_TIME_CAP),
-        ..PlannerConfig::default()
+        max_checks: max_checks.unwrap_or(defaults.max_checks),
+        ..defaults
     };
     let sim_time = cell.sim().time();
     let Some(checker) = cell.checker() else {
