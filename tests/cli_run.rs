@@ -103,7 +103,8 @@ fn run_refuses_layouts_outside_the_cell_with_exit_2() {
     // The cube on top of the bowl overlaps it.
     let out = macrotree(&["run", "trees/cube_to_bowl.yaml", "--cube", "0.45,0.08", "--json"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("apart"));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("`cube` and `bowl` overlap"), "{stderr}");
 }
 
 #[test]

@@ -11,7 +11,7 @@ use super::color::Color;
 use super::goal::Goal;
 use super::goal_read::{GoalRaw, read_goal};
 use super::sample::{Placement, sample_placement};
-use super::types::{ObjectSpec, Pose, RandomPlacement, Sampler, SceneSpec, Shape};
+use super::types::{ObjectKind, ObjectSpec, Pose, RandomPlacement, Sampler, SceneSpec, Shape};
 use crate::yaml::de::from_value;
 use crate::yaml::diag::{Diagnostic, Issue, Loc, Sources};
 use crate::yaml::suggest::did_you_mean;
