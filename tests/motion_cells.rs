@@ -114,6 +114,9 @@ fn swing_tree(extra: &str) -> (Scene, Arc<Plan>) {
     let cell = scene(
         "
 objects:
+  cube:
+    block: {size: 0.044}
+    pose: [0.25, -0.50]
   fixture:
     obstacle: {size: [0.08, 0.08, 0.80]}
     pose: [0.45, 0.0]
@@ -140,7 +143,7 @@ fn no_path_through_a_tree_when_the_check_budget_runs_out_names_the_fixture() {
         "{:?}",
         r.failure_reason
     );
-    assert_eq!(r.failed_node.as_deref(), Some("main/sequence/swing"));
+    assert_eq!(r.failed_node.as_deref(), Some("main/sequence/move_joints[swing]"));
     let why = r.failure_reason.unwrap_or_default();
     assert!(why.contains("fixture"), "{why}");
     assert_eq!(r.planning.plan_failures, 1, "{:?}", r.planning);
@@ -170,11 +173,13 @@ fn max_checks_out_of_range_is_a_located_tree_error() {
 
 #[test]
 fn goal_in_collision_through_a_tree_names_the_fixture_and_the_node() {
-    // A reach whose pinch target lies inside the fixture: every IK branch puts the gripper in it.
+    // Joints that put the gripper inside the fixture.
     let (cell, _) = swing_tree("");
-    let plan = tree(
-        "main:\n  sequence:\n    children:\n      - home: {}\n      - reach: {name: into fixture, target: [0.45, 0.0, 0.30]}\n",
-    );
+    let inside = down(0.45, 0.0, 0.30, &HOME_Q);
+    let plan = tree(&format!(
+        "main:\n  sequence:\n    children:\n      - home: {{}}\n      - move_joints: {{name: into fixture, joints: [{}]}}\n",
+        joints(&inside)
+    ));
     let r = run(&cell, plan);
     assert_eq!(
         r.failure_kind,
@@ -182,7 +187,10 @@ fn goal_in_collision_through_a_tree_names_the_fixture_and_the_node() {
         "{:?}",
         r.failure_reason
     );
-    assert_eq!(r.failed_node.as_deref(), Some("main/sequence/into fixture"));
+    assert_eq!(
+        r.failed_node.as_deref(),
+        Some("main/sequence/move_joints[into fixture]")
+    );
     let why = r.failure_reason.unwrap_or_default();
     assert!(why.contains("fixture"), "{why}");
     assert!(r.collisions.is_empty(), "{:?}", r.collisions);
@@ -200,6 +208,6 @@ fn unreachable_through_a_tree_names_the_node_and_why() {
         "{:?}",
         r.failure_reason
     );
-    assert_eq!(r.failed_node.as_deref(), Some("main/sequence/too far"));
+    assert_eq!(r.failed_node.as_deref(), Some("main/sequence/reach[too far]"));
     assert!(r.failure_reason.unwrap_or_default().contains("beyond"));
 }
