@@ -210,6 +210,16 @@ pub(crate) fn check_motion(
     hit
 }
 
+/// True when the straight segment `mv`, a look-ahead at a motion the tree will ask for next (a
+/// descent from a planned pre-grasp pose), would really touch something but the `intended`
+/// objects. Its checks count in the tally's `collision_checks`, not as a motion checked.
+pub(crate) fn look_ahead_hits(cell: &mut Cell, mv: &dyn Trajectory, intended: &[String]) -> bool {
+    let before = cell.planning().motions_checked;
+    let hit = check_motion(cell, &[mv], intended, true).is_some();
+    cell.planning_mut().motions_checked = before;
+    hit
+}
+
 /// Checks a straight segment (`what`: "descent", "lift", "set-down") along its length, only
 /// real contact counting and contact with `intended` objects allowed; a hit is logged and
 /// counted in the tally, and the segment runs anyway (the leaf asked for a straight line, and
