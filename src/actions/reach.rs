@@ -170,7 +170,9 @@ impl MacroAction for Reach {
                     tracing::debug!(target: "macrotree::actions", "reach: the {} would touch {}; planning", if legs.len() == 1 { "direct joint move" } else { "detour" }, describe(&pairs));
                     let goals = GoalSet::down(&position, yaw, quarter, &from);
                     let mut motion = plan_motion(cell, "reach", &from, &goals)?;
-                    if let Some(free) = self.descent_free_goals(cell, &goals, &motion.trajectory.end(), offset) {
+                    if let Some(free) =
+                        self.descent_free_goals(cell, &goals, &motion.trajectory.end(), offset)
+                    {
                         // The straight descent a pick runs next from the pose reached would touch
                         // (the forearm on the table): plan again to the branches whose descent is free.
                         tracing::debug!(target: "macrotree::actions", "reach: the descent from the planned pose would touch; planning to the {} goal(s) whose descent is free", free.configs.len());
