@@ -47,8 +47,6 @@ impl Reach {
     }
 }
 
-/// The first object (other than `skip`) the pinch passes over lower than [`PATH_CLEARANCE`]
-/// above its top on the joint-space line from `from` to `to`, with the pinch there.
 impl Reach {
     /// When this reach goes to an approach pose above its target object (`offset` up) and the
     /// straight descent to the object from `reached` would touch something, the goals of `goals`
@@ -85,6 +83,10 @@ impl Reach {
     }
 }
 
+/// The first object (other than `skip`) the pinch passes over lower than [`PATH_CLEARANCE`]
+/// above its top on the joint-space line from `from` to `to`, with the pinch there.
+/// Objects taller than [`super::carry::MAX_LIFT_OVER`] are not detoured over (the check of the
+/// joint move sees them and the planner goes around).
 fn joint_path_conflict(w: &World, from: &[f64; 6], to: &[f64; 6], skip: Option<usize>) -> Option<usize> {
     (1..PATH_SAMPLES).find_map(|k| {
         let t = k as f64 / PATH_SAMPLES as f64;
@@ -92,6 +94,7 @@ fn joint_path_conflict(w: &World, from: &[f64; 6], to: &[f64; 6], skip: Option<u
         let p = fk(&q).translation.vector;
         (0..w.objects.len()).find(|&j| {
             Some(j) != skip
+                && w.top(j) <= super::carry::MAX_LIFT_OVER
                 && w.from_footprint(j, &p).norm() < FINGER_REACH
                 && p.z < w.top(j) + PATH_CLEARANCE
         })
