@@ -625,7 +625,10 @@ fn a_planned_motion_past_a_post_out_of_its_check_budget_is_no_path() {
     };
     let f = planned(&post, &start, &GoalSet::configs(vec![goal]), &config);
     assert_eq!(f.kind, FailureKind::NoPath);
-    assert!(f.message.contains("40 collision checks") && f.message.contains("post"), "{f}");
+    assert!(
+        f.message.contains("40 collision checks") && f.message.contains("post"),
+        "{f}"
+    );
 }
 
 #[test]

@@ -32,6 +32,11 @@ const MAX_REPLANS: u32 = 3;
 /// Gap kept between the carried block's bottom and the top of anything it passes over, metres.
 pub const CLEARANCE: f64 = 0.03;
 
+/// Tallest object top the carry lifts over, metres above the table: a taller fixture (a column
+/// 0.80 m high) would need a transfer height the arm cannot reach with the tool pointing down, so
+/// the transfer stays at its own height and the planner takes the held block around it.
+pub const MAX_LIFT_OVER: f64 = 0.40;
+
 /// Reach of the closed fingers beyond the held block's faces, in the table plane, metres (the
 /// 2F-85's fingertips are about 2 cm wide and the pads 8 mm thick).
 pub const FINGER_MARGIN: f64 = 0.025;
@@ -271,7 +276,9 @@ impl Carry {
 
     /// Height of the block's centre for a transfer from `from` to `to` (table plane), metres:
     /// `lift` above the table, or higher when something under the path (any object but the held
-    /// block, the goal's own walls included) needs it to clear its top by [`CLEARANCE`].
+    /// block, the goal's own walls included) needs it to clear its top by [`CLEARANCE`]; an
+    /// object taller than [`MAX_LIFT_OVER`] is not lifted over (the transfer's check sees it
+    /// and the planner goes around it).
     fn transfer_z(&self, w: &World, from: Vector2<f64>, to: Vector2<f64>) -> f64 {
         let mut z = self.spec.lift + self.half;
         let reach = self.finger_reach();
@@ -281,7 +288,7 @@ impl Carry {
             }
             let c = w.objects[j].pos.xy();
             let near = segment_distance(c, from, to) <= w.spec(j).shape.footprint_radius() + reach;
-            if near {
+            if near && w.top(j) <= MAX_LIFT_OVER {
                 z = z.max(w.top(j) + CLEARANCE + self.half);
             }
         }

@@ -2,13 +2,14 @@
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
-use super::planning::{check_motion, describe, plan_motion};
+use super::planning::{check_motion, describe, plan_motion_within};
 use crate::motion::plan::GoalSet;
 use crate::motion::{JointMove, MotionLimits};
 
 /// Moves the arm in joint space to fixed joint angles (radians).
 pub struct MoveJoints {
     goal_q: [f64; 6],
+    max_checks: Option<u64>,
     arrival: Arrival,
 }
 
@@ -17,8 +18,16 @@ impl MoveJoints {
     pub fn new(goal_q: [f64; 6]) -> Self {
         Self {
             goal_q,
+            max_checks: None,
             arrival: Arrival::default(),
         }
+    }
+
+    /// The planner, when the direct move collides, may spend at most `max_checks` collision
+    /// checks (`None`: its default budget); past them the move fails with `no_path`.
+    pub fn with_max_checks(mut self, max_checks: Option<u64>) -> Self {
+        self.max_checks = max_checks;
+        self
     }
 
     /// A joint move to the UR5e home configuration.
@@ -36,7 +45,7 @@ impl MacroAction for MoveJoints {
             // exactly these joint angles.
             tracing::debug!(target: "macrotree::actions", "move_joints: the direct joint move would touch {}; planning", describe(&pairs));
             let goals = GoalSet::configs(vec![self.goal_q]);
-            let motion = plan_motion(cell, "move_joints", &from, &goals)?;
+            let motion = plan_motion_within(cell, "move_joints", &from, &goals, self.max_checks)?;
             cell.track(Box::new(motion.trajectory));
             return Ok(());
         }

@@ -210,6 +210,16 @@ pub(crate) fn check_motion(
     hit
 }
 
+/// True when the straight segment `mv`, a look-ahead at a motion the tree will ask for next (a
+/// descent from a planned pre-grasp pose), would really touch something but the `intended`
+/// objects. Its checks count in the tally's `collision_checks`, not as a motion checked.
+pub(crate) fn look_ahead_hits(cell: &mut Cell, mv: &dyn Trajectory, intended: &[String]) -> bool {
+    let before = cell.planning().motions_checked;
+    let hit = check_motion(cell, &[mv], intended, true).is_some();
+    cell.planning_mut().motions_checked = before;
+    hit
+}
+
 /// Checks a straight segment (`what`: "descent", "lift", "set-down") along its length, only
 /// real contact counting and contact with `intended` objects allowed; a hit is logged and
 /// counted in the tally, and the segment runs anyway (the leaf asked for a straight line, and
@@ -253,11 +263,28 @@ pub(crate) fn plan_motion(
     start: &[f64; 6],
     goals: &GoalSet,
 ) -> Result<PlannedMotion, Failure> {
+    plan_motion_within(cell, what, start, goals, None)
+}
+
+/// [`plan_motion`] with the planner's collision-check budget set to `max_checks` (the leaf's
+/// `max_checks` parameter, range-checked by the tree reader; `None`: the planner's default).
+///
+/// # Errors
+/// The planner's typed failure ([`crate::sim::planning::plan_failure`]).
+pub(crate) fn plan_motion_within(
+    cell: &mut Cell,
+    what: &str,
+    start: &[f64; 6],
+    goals: &GoalSet,
+    max_checks: Option<u64>,
+) -> Result<PlannedMotion, Failure> {
     let t = Instant::now();
+    let defaults = PlannerConfig::default();
     let config = PlannerConfig {
         seed: 0x6d61_6372_6f74_7265 ^ u64::from(cell.planning().plans),
         time_cap: Some(LEAF_TIME_CAP),
-        ..PlannerConfig::default()
+        max_checks: max_checks.unwrap_or(defaults.max_checks),
+        ..defaults
     };
     let sim_time = cell.sim().time();
     let Some(checker) = cell.checker() else {

@@ -4,7 +4,7 @@ use nalgebra::{Isometry3, Translation3, Vector3};
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
-use super::planning::{check_motion, check_straight, describe, plan_motion};
+use super::planning::{check_motion, check_straight, describe, look_ahead_hits, plan_motion};
 use super::targets::{resolve, segment_distance, target_block, target_object, tool_yaw};
 use crate::failure::{Failure, FailureKind};
 use crate::kinds::{PathKind, Reach as ReachSpec, Yaw};
@@ -47,8 +47,46 @@ impl Reach {
     }
 }
 
+impl Reach {
+    /// When this reach goes to an approach pose above its target object (`offset` up) and the
+    /// straight descent to the object from `reached` would touch something, the goals of `goals`
+    /// whose descent is free (`None` when the descent from `reached` is free, when the target is
+    /// not an object, or when no goal's descent is free).
+    fn descent_free_goals(
+        &self,
+        cell: &mut Cell,
+        goals: &GoalSet,
+        reached: &[f64; 6],
+        offset: Vector3<f64>,
+    ) -> Option<GoalSet> {
+        if offset.z <= 0.0 {
+            return None;
+        }
+        let w = cell.world();
+        let target = target_object(&self.spec.target, w)?;
+        let intended = vec![w.name(target).to_string()];
+        let limits = MotionLimits::default();
+        let drop = Vector3::new(0.0, 0.0, offset.z);
+        let hits = |cell: &mut Cell, q: &[f64; 6]| {
+            let top = fk(q);
+            let down = Isometry3::from_parts(Translation3::from(top.translation.vector - drop), top.rotation);
+            match CartesianMove::new(*q, down, &limits) {
+                Ok(mv) => look_ahead_hits(cell, &mv, &intended),
+                Err(_) => true,
+            }
+        };
+        if !hits(cell, reached) {
+            return None;
+        }
+        let free: Vec<[f64; 6]> = goals.configs.iter().filter(|q| !hits(cell, q)).copied().collect();
+        (!free.is_empty()).then(|| GoalSet::configs(free))
+    }
+}
+
 /// The first object (other than `skip`) the pinch passes over lower than [`PATH_CLEARANCE`]
 /// above its top on the joint-space line from `from` to `to`, with the pinch there.
+/// Objects taller than [`super::carry::MAX_LIFT_OVER`] are not detoured over (the check of the
+/// joint move sees them and the planner goes around).
 fn joint_path_conflict(w: &World, from: &[f64; 6], to: &[f64; 6], skip: Option<usize>) -> Option<usize> {
     (1..PATH_SAMPLES).find_map(|k| {
         let t = k as f64 / PATH_SAMPLES as f64;
@@ -56,6 +94,7 @@ fn joint_path_conflict(w: &World, from: &[f64; 6], to: &[f64; 6], skip: Option<u
         let p = fk(&q).translation.vector;
         (0..w.objects.len()).find(|&j| {
             Some(j) != skip
+                && w.top(j) <= super::carry::MAX_LIFT_OVER
                 && w.from_footprint(j, &p).norm() < FINGER_REACH
                 && p.z < w.top(j) + PATH_CLEARANCE
         })
@@ -133,7 +172,15 @@ impl MacroAction for Reach {
                     // equivalent grasp yaw) around whatever is in the way.
                     tracing::debug!(target: "macrotree::actions", "reach: the {} would touch {}; planning", if legs.len() == 1 { "direct joint move" } else { "detour" }, describe(&pairs));
                     let goals = GoalSet::down(&position, yaw, quarter, &from);
-                    let motion = plan_motion(cell, "reach", &from, &goals)?;
+                    let mut motion = plan_motion(cell, "reach", &from, &goals)?;
+                    if let Some(free) =
+                        self.descent_free_goals(cell, &goals, &motion.trajectory.end(), offset)
+                    {
+                        // The straight descent a pick runs next from the pose reached would touch
+                        // (the forearm on the table): plan again to the branches whose descent is free.
+                        tracing::debug!(target: "macrotree::actions", "reach: the descent from the planned pose would touch; planning to the {} goal(s) whose descent is free", free.configs.len());
+                        motion = plan_motion(cell, "reach", &from, &free)?;
+                    }
                     self.goal_q = motion.trajectory.end();
                     cell.track(Box::new(motion.trajectory));
                     return Ok(());

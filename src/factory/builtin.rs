@@ -26,7 +26,7 @@ fn bind(f: &mut Factory) -> Result<(), BindError> {
     // Actions.
     f.bind_action("reach", |p: &Reach| Box::new(ReachAction::new(p.clone())))?;
     f.bind_action("move_joints", |p: &MoveJoints| {
-        Box::new(MoveJointsAction::new(p.joints))
+        Box::new(MoveJointsAction::new(p.joints).with_max_checks(p.max_checks))
     })?;
     f.bind_action("home", |_: &Home| Box::new(MoveJointsAction::home()))?;
     f.bind_action("grasp", |p: &Grasp| Box::new(GraspAction::new(p.clone())))?;

@@ -112,6 +112,12 @@ pub struct MoveJoints {
     #[serde(default = "d_6", deserialize_with = "units::time_limit")]
     #[schemars(range(min = 0.0))]
     pub timeout: f64,
+    /// Collision checks the planner may spend when the direct move would collide (1 to
+    /// 10 000 000); a search that uses them up fails with `no_path`. Default: the planner's
+    /// own budget (20 000).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(range(min = 1, max = 10_000_000))]
+    pub max_checks: Option<u64>,
 }
 
 #[doc = include_str!("../../docs/nodes/home.md")]
@@ -691,6 +697,15 @@ impl Params for MoveJoints {
     }
     fn timeout(&self) -> Option<f64> {
         Some(self.timeout)
+    }
+    fn validate_fields(&self) -> Result<(), ParamError> {
+        match self.max_checks {
+            Some(n) if !(1..=10_000_000).contains(&n) => Err(ParamError::at(
+                "max_checks",
+                format!("`max_checks` must be between 1 and 10000000 collision checks, found {n}"),
+            )),
+            _ => Ok(()),
+        }
     }
 }
 

@@ -1,0 +1,213 @@
+//! Motion in cells with tall fixtures, on real MuJoCo: a held block carried past a wall taller
+//! than the carry's lift, and the planner's failure reasons reaching a YAML tree's result (kind,
+//! node path, and the objects named in the message).
+
+use std::path::Path;
+use std::sync::Arc;
+
+use macrotree::episode::{EpisodeConfig, EpisodeReport, Hitter, NoObserver, run_episode};
+use macrotree::factory::Factory;
+use macrotree::failure::FailureKind;
+use macrotree::motion::{HOME_Q, ik_down};
+use macrotree::plan::{Loader, Plan};
+use macrotree::scene::SceneSpec;
+use macrotree::sim::Scene;
+use nalgebra::Vector3;
+
+const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+
+fn scene(yaml: &str) -> Scene {
+    let spec = SceneSpec::from_str(yaml, "cell.yaml").expect("valid scene");
+    Scene::load_spec(&spec).expect("scene (run tools/bootstrap)")
+}
+
+fn tree(text: &str) -> Arc<Plan> {
+    Arc::new(
+        Loader::default()
+            .compile_str(text, "tree.yaml")
+            .unwrap_or_else(|d| panic!("{}", d[0])),
+    )
+}
+
+fn flagship() -> Arc<Plan> {
+    Arc::new(
+        Loader::default()
+            .load(&Path::new(ROOT).join("trees/cube_to_bowl.yaml"))
+            .unwrap_or_else(|d| panic!("{}", d[0])),
+    )
+}
+
+fn run(scene: &Scene, plan: Arc<Plan>) -> EpisodeReport {
+    run_episode(
+        scene,
+        plan,
+        &Factory::builtin(),
+        &EpisodeConfig::default(),
+        &mut NoObserver,
+    )
+}
+
+/// The flagship cell with a wall `height` metres tall (4 cm thick, 20 cm wide) standing across
+/// the straight route between the cube and the bowl.
+fn wall_between(height: f64) -> Scene {
+    scene(&format!(
+        "
+objects:
+  cube:
+    block: {{size: 0.044, mass: 0.05, friction: 1.0}}
+    pose: [0.45, -0.22, 0]
+  bowl:
+    container: {{inner: [0.15, 0.15], wall_height: 0.06}}
+    pose: [0.45, 0.22]
+  wall:
+    obstacle: {{size: [0.20, 0.04, {height}]}}
+    pose: [0.45, 0.0]
+goal:
+  - in: {{object: cube, container: bowl}}
+"
+    ))
+}
+
+#[test]
+fn a_held_block_is_carried_past_a_wall_taller_than_the_lift_without_touching_it() {
+    // The carry lifts 15 cm; the wall is 30 cm: the straight transfer would sweep the held
+    // block and the fingers through it, so the carry plans around (over) it.
+    let scene = wall_between(0.30);
+    let r = run(&scene, flagship());
+    assert!(r.success, "{:?} {:?}", r.failure_reason, r.collisions);
+    assert!(r.planning.plans >= 1, "{:?}", r.planning);
+    assert_eq!(r.planning.plan_failures, 0, "{:?}", r.planning);
+    let bad: Vec<_> = r
+        .collisions
+        .iter()
+        .filter(|c| matches!(c.who, Hitter::HeldBlock | Hitter::Fingers))
+        .collect();
+    assert!(bad.is_empty(), "{bad:?}");
+    assert!(
+        !r.collisions.iter().any(|c| c.object == "wall"),
+        "{:?}",
+        r.collisions
+    );
+}
+
+#[test]
+fn a_low_wall_needs_no_plan_and_a_tall_one_does() {
+    // The contrast that makes the test above mean something: a 5 cm wall is cleared by the
+    // carry's own 15 cm lift, the 30 cm one is not.
+    let low = run(&wall_between(0.05), flagship());
+    assert!(low.success, "{:?}", low.failure_reason);
+    assert_eq!(low.planning.plans, 0, "{:?}", low.planning);
+}
+
+/// Joints putting the pinch at (x, y, z) metres, pointing down, yaw 0, nearest `seed`.
+fn down(x: f64, y: f64, z: f64, seed: &[f64; 6]) -> [f64; 6] {
+    ik_down(&Vector3::new(x, y, z), 0.0, false, seed).expect("reachable")
+}
+
+fn joints(q: &[f64; 6]) -> String {
+    q.map(|j| format!("{j}")).join(", ")
+}
+
+/// The go-around cell's 0.80 m fixture between two free arm poses on either side of it; the
+/// second `move_joints` is named `swing` and carries `extra` parameters.
+fn swing_tree(extra: &str) -> (Scene, Arc<Plan>) {
+    let cell = scene(
+        "
+objects:
+  cube:
+    block: {size: 0.044}
+    pose: [0.25, -0.50]
+  fixture:
+    obstacle: {size: [0.08, 0.08, 0.80]}
+    pose: [0.45, 0.0]
+",
+    );
+    let a = down(0.45, -0.25, 0.25, &HOME_Q);
+    let b = down(0.45, 0.25, 0.25, &a);
+    let text = format!(
+        "main:\n  sequence:\n    children:\n      - move_joints: {{name: one side, joints: [{}]}}\n      - move_joints: {{name: swing, joints: [{}]{extra}}}\n",
+        joints(&a),
+        joints(&b)
+    );
+    (cell, tree(&text))
+}
+
+#[test]
+fn no_path_through_a_tree_when_the_check_budget_runs_out_names_the_fixture() {
+    let (cell, plan) = swing_tree(", max_checks: 40");
+    let r = run(&cell, plan);
+    assert!(!r.success);
+    assert_eq!(
+        r.failure_kind,
+        Some(FailureKind::NoPath),
+        "{:?}",
+        r.failure_reason
+    );
+    assert_eq!(r.failed_node.as_deref(), Some("main/sequence/move_joints[swing]"));
+    let why = r.failure_reason.unwrap_or_default();
+    assert!(why.contains("fixture"), "{why}");
+    assert_eq!(r.planning.plan_failures, 1, "{:?}", r.planning);
+    // Failed before swinging: nothing was hit.
+    assert!(r.collisions.is_empty(), "{:?}", r.collisions);
+}
+
+#[test]
+fn the_same_swing_with_the_default_budget_goes_around_the_fixture() {
+    let (cell, plan) = swing_tree("");
+    let r = run(&cell, plan);
+    assert!(r.success, "{:?}", r.failure_reason);
+    assert!(r.planning.plans >= 1, "{:?}", r.planning);
+    assert!(r.collisions.is_empty(), "{:?}", r.collisions);
+}
+
+#[test]
+fn max_checks_out_of_range_is_a_located_tree_error() {
+    let text = "main:\n  move_joints: {joints: [0, -1.57, 1.57, -1.57, -1.57, 0], max_checks: 0}\n";
+    let errs = Loader::default()
+        .compile_str(text, "budget.yaml")
+        .expect_err("max_checks 0 is rejected");
+    let msg = errs[0].to_string();
+    assert!(msg.contains("budget.yaml:2:"), "{msg}");
+    assert!(msg.contains("max_checks"), "{msg}");
+}
+
+#[test]
+fn goal_in_collision_through_a_tree_names_the_fixture_and_the_node() {
+    // Joints that put the gripper inside the fixture.
+    let (cell, _) = swing_tree("");
+    let inside = down(0.45, 0.0, 0.30, &HOME_Q);
+    let plan = tree(&format!(
+        "main:\n  sequence:\n    children:\n      - home: {{}}\n      - move_joints: {{name: into fixture, joints: [{}]}}\n",
+        joints(&inside)
+    ));
+    let r = run(&cell, plan);
+    assert_eq!(
+        r.failure_kind,
+        Some(FailureKind::GoalInCollision),
+        "{:?}",
+        r.failure_reason
+    );
+    assert_eq!(
+        r.failed_node.as_deref(),
+        Some("main/sequence/move_joints[into fixture]")
+    );
+    let why = r.failure_reason.unwrap_or_default();
+    assert!(why.contains("fixture"), "{why}");
+    assert!(r.collisions.is_empty(), "{:?}", r.collisions);
+}
+
+#[test]
+fn unreachable_through_a_tree_names_the_node_and_why() {
+    let cell = Scene::load().expect("scene");
+    let plan =
+        tree("main:\n  sequence:\n    children:\n      - reach: {name: too far, target: [0.95, 0.0, 0.2]}\n");
+    let r = run(&cell, plan);
+    assert_eq!(
+        r.failure_kind,
+        Some(FailureKind::Unreachable),
+        "{:?}",
+        r.failure_reason
+    );
+    assert_eq!(r.failed_node.as_deref(), Some("main/sequence/reach[too far]"));
+    assert!(r.failure_reason.unwrap_or_default().contains("beyond"));
+}
