@@ -114,14 +114,16 @@ impl<'a> MacroDriver<'a> {
         if w.touches.is_empty() {
             return;
         }
-        let node = self
-            .current
-            .filter(|id| !id.is_internal())
-            .and_then(|id| self.leaf_paths.get(id.0 as usize).cloned());
         for mut c in super::collision::classify(w) {
             if self.collisions.iter().any(|seen| seen.what == c.what) {
                 continue;
             }
+            // The running leaf's path, looked up only for a contact not seen before (the pads on
+            // a held block touch it every step).
+            let node = self
+                .current
+                .filter(|id| !id.is_internal())
+                .and_then(|id| self.leaf_paths.get(id.0 as usize).cloned());
             c.node = node.clone();
             tracing::info!(target: "macrotree::actions", sim_time = w.time, node = node.as_deref(), "collision: {}", c.what);
             if self.collision_policy == CollisionPolicy::Fail && self.collision_failure.is_none() {
