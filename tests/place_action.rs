@@ -36,7 +36,7 @@ fn run(name: &str, objects: &str, main: &str) -> (EpisodeReport, Cell) {
     run_with_spots(name, objects, main, &[])
 }
 
-/// [`run`], with `spots` added to the scene (as the scene file's `spots:` will give them).
+/// [`run`], with `spots` written into the scene file's `spots:`.
 fn run_with_spots(
     name: &str,
     objects: &str,
@@ -44,9 +44,18 @@ fn run_with_spots(
     spots: &[macrotree::scene::Spot],
 ) -> (EpisodeReport, Cell) {
     let dir = tempdir(name);
+    let spots: String = spots
+        .iter()
+        .map(|s| format!("  {}: [{}, {}, {}]\n", s.name, s.x, s.y, s.yaw))
+        .collect();
+    let spots = if spots.is_empty() {
+        spots
+    } else {
+        format!("spots:\n{spots}")
+    };
     std::fs::write(
         dir.join("cell.yaml"),
-        format!("description: {name}\nobjects:\n{objects}"),
+        format!("description: {name}\nobjects:\n{objects}{spots}"),
     )
     .unwrap();
     let tree = dir.join("tree.yaml");
@@ -56,9 +65,7 @@ fn run_with_spots(
             .load(&tree)
             .unwrap_or_else(|d| panic!("{}", d[0])),
     );
-    let mut spec = (*plan.scene).clone();
-    spec.spots.extend_from_slice(spots);
-    let scene = Scene::load_spec(&spec).expect("scene compiles");
+    let scene = Scene::load_spec(&plan.scene).expect("scene compiles");
     let mut cell = Cell::new(&scene, &Layout::default(), CONTROL_PERIOD);
     let config = EpisodeConfig {
         goal: Goal::Tree,
@@ -394,7 +401,11 @@ fn place_parameters_are_checked_where_they_are_written() {
             "not a place yaw",
             2,
         ),
-        ("main:\n  place: {spot: Kit-A}\n", "not a spot name", 2),
+        (
+            "main:\n  place: {spot: Kit-A}\n",
+            "not a name of an object or a spot",
+            2,
+        ),
         ("main:\n  place: {point: [0.5]}\n", "wrong number of items", 2),
         (
             "main:\n  place: {point: [0.5, 0.1], lift: -1}\n",
@@ -412,10 +423,22 @@ fn place_parameters_are_checked_where_they_are_written() {
             .unwrap_or_else(|| panic!("no diagnostic with {needle:?} for {yaml}: {diags:?}"));
         assert_eq!(d.line, line, "{d}");
     }
+    let dir = tempdir("params_ok");
+    std::fs::write(
+        dir.join("cell.yaml"),
+        format!(
+            "objects:\n{}spots:\n  kit_a: [0.45, 0.1]\n",
+            block("red", 0.45, -0.15, 0.0)
+        ),
+    )
+    .unwrap();
+    let tree = dir.join("ok.yaml");
+    std::fs::write(
+        &tree,
+        "scene: cell.yaml\nmain:\n  place: {spot: kit_a, yaw: keep, retreat: 0.05}\n",
+    )
+    .unwrap();
     Loader::default()
-        .compile_str(
-            "main:\n  place: {spot: kit_a, yaw: keep, retreat: 0.05}\n",
-            "ok.yaml",
-        )
+        .load(&tree)
         .expect("a place at a spot, keeping the yaw, compiles");
 }

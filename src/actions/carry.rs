@@ -11,7 +11,7 @@ use super::clearance::{
 };
 use super::macro_action::{Arrival, MacroAction, Progress};
 use super::planning::{check_motion, check_straight, describe};
-use super::targets::{resolve, segment_distance, target_object};
+use super::targets::{resolve, segment_distance, target_object, target_spot};
 use crate::failure::{Failure, FailureKind};
 use crate::kinds::Carry as CarrySpec;
 use crate::motion::{CartesianMove, JointMove, MotionLimits, Trajectory};
@@ -528,6 +528,13 @@ impl Carry {
 impl MacroAction for Carry {
     fn start(&mut self, cell: &mut Cell) -> Result<(), Failure> {
         let w = cell.world();
+        // A spot is a place on the table: the block is set down there as `place` would, on
+        // whatever is under the spot, turned to the spot's yaw.
+        if let Some(spot) = target_spot(&self.spec.to, &w.scene) {
+            self.spec.to = crate::kinds::Target::Point([spot.x, spot.y, 0.0]);
+            self.surface = true;
+            self.turn_to = Some(spot.yaw);
+        }
         let Some(held) = w.held_block(Tolerances::GRASP_OFF_AXIS) else {
             return Err(Failure::new(
                 FailureKind::NotHeld,

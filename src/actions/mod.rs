@@ -28,4 +28,6 @@ pub use macro_action::{Arrival, MacroAction, Progress};
 pub(crate) use place::Place as PlaceAction;
 pub(crate) use reach::Reach as ReachAction;
 pub(crate) use release::Release as ReleaseAction;
-pub use targets::{object_index, object_point, resolve, target_block, target_object, tool_yaw};
+pub use targets::{
+    object_index, object_point, resolve, spot, target_block, target_object, target_spot, tool_yaw,
+};

@@ -33,19 +33,10 @@ pub fn place_target(scene: &SceneSpec, spec: &PlaceSpec) -> Result<([f64; 2], Op
     if let Some(p) = spec.point {
         return Ok((p, explicit.flatten()));
     }
-    let name = spec.spot.as_deref().unwrap_or_default();
-    let Some(spot) = scene.spot(name) else {
-        let names: Vec<&str> = scene.spots.iter().map(|s| s.name.as_str()).collect();
-        let has = if names.is_empty() {
-            "it has none".to_string()
-        } else {
-            format!("its spots: {}", names.join(", "))
-        };
-        return Err(Failure::other(format!(
-            "scene `{}` has no spot `{name}` ({has})",
-            scene.name
-        )));
+    let Some(named) = &spec.spot else {
+        return Err(Failure::other("`place` has neither a point nor a spot"));
     };
+    let spot = super::targets::spot(named, scene)?;
     Ok(([spot.x, spot.y], explicit.unwrap_or(Some(spot.yaw))))
 }
 
@@ -138,7 +129,7 @@ mod tests {
     fn spec(point: Option<[f64; 2]>, spot: Option<&str>, yaw: Option<Yaw>) -> PlaceSpec {
         PlaceSpec {
             point,
-            spot: spot.map(str::to_string),
+            spot: spot.map(|n| crate::kinds::ObjectRef::name(n).unwrap()),
             yaw,
             lift: 0.2,
             retreat: 0.1,
@@ -197,5 +188,14 @@ mod tests {
             e.message.contains("no spot `kit_b`") && e.message.contains("kit_a"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn a_spot_variable_left_unresolved_is_a_failure_not_a_panic() {
+        let s = scene_with_spot();
+        let mut p = spec(None, None, None);
+        p.spot = Some(crate::kinds::ObjectRef::parse("{where}").unwrap());
+        let e = place_target(&s, &p).unwrap_err();
+        assert!(e.message.contains("`{where}` was not resolved"), "{e}");
     }
 }

@@ -2,7 +2,7 @@
 
 use super::{BindError, Factory};
 use crate::actions::{
-    CarryAction, GraspAction, MoveJointsAction, PlaceAction, ReachAction, ReleaseAction, object_index,
+    CarryAction, GraspAction, MoveJointsAction, PlaceAction, ReachAction, ReleaseAction, object_index, spot,
 };
 use crate::kinds::{
     At, AtHome, Carry, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, GoalMet, Grasp, Grasped,
@@ -61,10 +61,22 @@ fn bind(f: &mut Factory) -> Result<(), BindError> {
         Ok(cond::on_table(w, obj(w, &p.object)?, p.tolerance, p.rest_speed))
     })?;
     f.bind_condition("at", |w, p: &At| {
+        let point = match (&p.point, &p.spot) {
+            (Some(point), _) => *point,
+            (None, Some(s)) => {
+                let s = spot(s, &w.scene)?;
+                [s.x, s.y]
+            }
+            (None, None) => {
+                return Err(crate::failure::Failure::other(
+                    "`at` has neither a point nor a spot",
+                ));
+            }
+        };
         Ok(cond::at(
             w,
             obj(w, &p.object)?,
-            p.point,
+            point,
             p.tolerance,
             p.yaw.map(|a| a.0),
             p.yaw_tolerance,

@@ -211,10 +211,10 @@ pub struct Place {
         skip_serializing_if = "Option::is_none"
     )]
     pub point: Option<[f64; 2]>,
-    /// A named spot of the scene (`spots:`), instead of `point`; its yaw is the default `yaw`.
+    /// A named spot of the scene (`spots:`) or a variable holding one (`{where}`, e.g. written
+    /// by `select … goal_as` for an `at` goal), instead of `point`; its yaw is the default `yaw`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schemars(regex(pattern = r"^[a-z][a-z0-9_]*$"))]
-    pub spot: Option<String>,
+    pub spot: Option<ObjectRef>,
     /// The block's yaw when set down: an angle (radians or `deg(..)`, modulo 90°) or `keep`.
     /// Default: the spot's yaw for a `spot`, `keep` for a `point`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -483,14 +483,24 @@ pub struct OnTable {
 pub struct At {
     /// The block (a name or `{var}`).
     pub object: ObjectRef,
-    /// Where its centre should rest, `[x, y]` on the table, world metres.
-    #[serde(deserialize_with = "units::vec2")]
-    pub point: [f64; 2],
-    /// Largest horizontal distance of its centre from `point`, metres (≥ 0). Default 0.01.
+    /// Where its centre should rest, `[x, y]` on the table, world metres (give `point` or
+    /// `spot`).
+    #[serde(
+        default,
+        deserialize_with = "opt_point",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub point: Option<[f64; 2]>,
+    /// A named spot of the scene (`spots:`) or a variable holding one (`{where}`), instead of
+    /// `point`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spot: Option<ObjectRef>,
+    /// Largest horizontal distance of its centre from the point, metres (≥ 0). Default 0.01.
     #[serde(default = "d_point_tol", deserialize_with = "units::distance")]
     #[schemars(range(min = 0.0, max = units::MAX_REACH))]
     pub tolerance: f64,
-    /// The yaw its faces should have (radians or `deg(..)`, compared modulo 90°). Absent: any.
+    /// The yaw its faces should have (radians or `deg(..)`, compared modulo 90°). Absent: any
+    /// (also for a `spot`: its yaw is checked only when `yaw` is given, as in the scene goal).
     #[serde(default)]
     pub yaw: Option<Angle>,
     /// Largest yaw error when `yaw` is given, radians (or `deg(..)`). Default 3°.
@@ -746,6 +756,10 @@ impl Params for Carry {
 }
 
 impl Params for Place {
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("spot", ObjectRole::Spot)];
+    fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
+        self.spot.iter_mut().collect()
+    }
     fn label(&self, _: &str) -> Option<String> {
         let mut s = match (&self.point, &self.spot) {
             (Some(p), _) => format!("place at {}", fmt_vec(p)),
@@ -773,18 +787,6 @@ impl Params for Place {
                 ));
             }
             _ => {}
-        }
-        if let Some(spot) = &self.spot {
-            let ok = spot.starts_with(|c: char| c.is_ascii_lowercase())
-                && spot
-                    .chars()
-                    .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
-            if !ok {
-                return Err(ParamError::at(
-                    "spot",
-                    format!("`{spot}` is not a spot name: a-z, 0-9 and _, starting with a letter"),
-                ));
-            }
         }
         if self.yaw == Some(Yaw::Object) {
             return Err(ParamError::at(
@@ -873,9 +875,21 @@ impl Params for OnTable {
 }
 
 impl Params for At {
-    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("object", ObjectRole::Block)];
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] =
+        &[("object", ObjectRole::Block), ("spot", ObjectRole::Spot)];
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {
-        vec![&mut self.object]
+        let mut refs = vec![&mut self.object];
+        refs.extend(self.spot.iter_mut());
+        refs
+    }
+    fn validate_fields(&self) -> Result<(), ParamError> {
+        match (&self.point, &self.spot) {
+            (Some(_), Some(_)) => Err(ParamError::at("spot", "give `point` or `spot`, not both")),
+            (None, None) => Err(ParamError::new(
+                "`at` needs where: `point: [x, y]` (metres) or `spot: NAME` (a spot of the scene)",
+            )),
+            _ => Ok(()),
+        }
     }
 }
 

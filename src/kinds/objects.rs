@@ -97,7 +97,7 @@ impl ObjectRef {
             ))
         } else {
             Err(format!(
-                "`{s}` is not an object name: names are lower-case letters, digits and `_` (or `{{var}}` for a blackboard variable)"
+                "`{s}` is not a name of an object or a spot: names are lower-case letters, digits and `_` (or `{{var}}` for a blackboard variable)"
             ))
         }
     }
@@ -199,8 +199,10 @@ pub enum ObjectRole {
     Block,
     /// A container (e.g. `container:`).
     Container,
-    /// Any object (e.g. `target:`, `to:`).
+    /// Any object or a spot of the scene (e.g. `target:`, `to:`).
     Any,
+    /// A spot of the scene (`spots:` in the scene file; e.g. `place`'s `spot:`).
+    Spot,
 }
 
 impl ObjectRole {
@@ -210,15 +212,22 @@ impl ObjectRole {
             ObjectRole::Block => kind == ObjectKind::Block,
             ObjectRole::Container => kind == ObjectKind::Container,
             ObjectRole::Any => true,
+            ObjectRole::Spot => false,
         }
     }
 
-    /// How messages name what fits (`a block`, `a container`, `an object`).
+    /// Whether a spot of the scene fits (a motion's target, `place`'s spot).
+    pub fn accepts_spot(self) -> bool {
+        matches!(self, ObjectRole::Any | ObjectRole::Spot)
+    }
+
+    /// How messages name what fits (`a block`, `a container`, `an object or a spot`, `a spot`).
     pub fn name(self) -> &'static str {
         match self {
             ObjectRole::Block => "a block",
             ObjectRole::Container => "a container",
-            ObjectRole::Any => "an object",
+            ObjectRole::Any => "an object or a spot",
+            ObjectRole::Spot => "a spot",
         }
     }
 }

@@ -42,7 +42,7 @@ pub struct ObjectUse {
 pub enum VarType {
     /// Objects of this kind.
     Kind(ObjectKind),
-    /// A goal's destination: a container or a block.
+    /// A goal's destination: a container, a block, or the spot of an `at` goal.
     Destination,
 }
 
@@ -51,6 +51,8 @@ impl VarType {
         match (self, role) {
             (_, ObjectRole::Any) => true,
             (VarType::Kind(k), r) => r.accepts(k),
+            // An `at` goal's destination is its spot.
+            (VarType::Destination, ObjectRole::Spot) => true,
             (VarType::Destination, _) => false,
         }
     }
@@ -60,7 +62,7 @@ impl VarType {
             VarType::Kind(ObjectKind::Block) => "a block",
             VarType::Kind(ObjectKind::Container) => "a container",
             VarType::Kind(ObjectKind::Obstacle) => "an obstacle",
-            VarType::Destination => "a goal destination (a container or a block)",
+            VarType::Destination => "a goal destination (a container, a block or a spot)",
         }
     }
 }
@@ -146,37 +148,16 @@ pub fn check_vars(uses: &[ObjectUse], defs: &[VarDef], describe: impl Fn(Loc) ->
     issues
 }
 
-/// Checks every object a tree names against `scene`: the name exists, it is the right kind of
-/// object, and the legacy names `cube`/`bowl` stand for exactly one object.
+/// Checks every object and spot a tree names against `scene`: the name exists, it is the right
+/// kind of object (or a spot where a spot fits), and the legacy names `cube`/`bowl` stand for
+/// exactly one object.
 pub fn check_scene(uses: &[ObjectUse], scene: &SceneSpec, describe: impl Fn(Loc) -> String) -> Vec<Issue> {
-    let names: Vec<&str> = scene.objects.iter().map(|o| o.name.as_str()).collect();
     let mut issues = Vec::new();
     for u in uses {
         let issue = match &u.reference {
             Named::Ref(ObjectRef::Var(_)) => continue,
-            Named::Ref(ObjectRef::Name(n)) => match scene.object(n.as_str()) {
-                None => {
-                    let what = if u.role == ObjectRole::Any {
-                        "target"
-                    } else {
-                        "object"
-                    };
-                    let hint = did_you_mean(n.as_str(), names.iter().copied())
-                        .map_or(String::new(), |h| format!(" ({h})"));
-                    Issue::new(u.loc, format!("unknown {what} `{n}` in `{}`{hint}", u.leaf))
-                        .label(format!(
-                            "expected an object of scene `{}` ({}), a variable `{{name}}`{}",
-                            scene.name,
-                            names.join(", "),
-                            if u.role == ObjectRole::Any {
-                                " or `[x, y, z]`"
-                            } else {
-                                ""
-                            }
-                        ))
-                        .help("name an object of the scene, or run the tree on another scene with `--scene FILE`")
-                }
-                Some(o) if !u.role.accepts(o.kind()) => Issue::new(
+            Named::Ref(ObjectRef::Name(n)) => match (scene.object(n.as_str()), scene.spot(n.as_str())) {
+                (Some(o), _) if !u.role.accepts(o.kind()) => Issue::new(
                     u.loc,
                     format!(
                         "`{n}` is a {}, but `{}` needs {} here",
@@ -185,7 +166,13 @@ pub fn check_scene(uses: &[ObjectUse], scene: &SceneSpec, describe: impl Fn(Loc)
                         u.role.name()
                     ),
                 ),
-                Some(_) => continue,
+                (Some(_), _) => continue,
+                (None, Some(_)) if !u.role.accepts_spot() => Issue::new(
+                    u.loc,
+                    format!("`{n}` is a spot, but `{}` needs {} here", u.leaf, u.role.name()),
+                ),
+                (None, Some(_)) => continue,
+                (None, None) => unknown_name(u, n.as_str(), scene),
             },
             Named::LegacyCube if scene.legacy_cube().is_none() => {
                 legacy_issue(u, scene, "cube", ObjectKind::Block)
@@ -205,6 +192,39 @@ pub fn check_scene(uses: &[ObjectUse], scene: &SceneSpec, describe: impl Fn(Loc)
         issues.push(issue);
     }
     issues
+}
+
+/// A name that is neither an object nor a spot of `scene`: what was expected there, with a
+/// did-you-mean among the names that would fit.
+fn unknown_name(u: &ObjectUse, n: &str, scene: &SceneSpec) -> Issue {
+    let objects = scene.objects.iter().map(|o| o.name.as_str());
+    let spots = scene.spots.iter().map(|s| s.name.as_str());
+    let (what, fitting): (&str, Vec<&str>) = match u.role {
+        ObjectRole::Spot => ("spot", spots.collect()),
+        ObjectRole::Any => ("target", objects.chain(spots).collect()),
+        _ => ("object", objects.collect()),
+    };
+    let hint = did_you_mean(n, fitting.iter().copied()).map_or(String::new(), |h| format!(" ({h})"));
+    let listed = if fitting.is_empty() {
+        format!("scene `{}` has none", scene.name)
+    } else {
+        format!("scene `{}` has {}", scene.name, fitting.join(", "))
+    };
+    let expected = match u.role {
+        ObjectRole::Spot => format!("expected a spot ({listed}) or a variable `{{name}}`"),
+        ObjectRole::Any => {
+            format!("expected an object or a spot ({listed}), a variable `{{name}}` or `[x, y, z]`")
+        }
+        _ => format!("expected an object ({listed}) or a variable `{{name}}`"),
+    };
+    let help = if u.role == ObjectRole::Spot {
+        "name a spot of the scene (its `spots:`), or run the tree on another scene with `--scene FILE`"
+    } else {
+        "name an object of the scene, or run the tree on another scene with `--scene FILE`"
+    };
+    Issue::new(u.loc, format!("unknown {what} `{n}` in `{}`{hint}", u.leaf))
+        .label(expected)
+        .help(help)
 }
 
 fn legacy_issue(u: &ObjectUse, scene: &SceneSpec, legacy: &str, kind: ObjectKind) -> Issue {
