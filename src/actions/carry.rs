@@ -555,7 +555,17 @@ impl MacroAction for Carry {
         let lift = Vector3::new(pos.x, pos.y, lift_z);
         self.replans = 0;
         self.lost = 0;
-        self.start_phase(cell, Phase::Lift, lift)
+        let base_z = (self.spec.lift + self.half).max(pos.z);
+        match self.start_phase(cell, Phase::Lift, lift) {
+            // High over a tall post, far out, the straight line up can cross a branch flip: lift
+            // to the carry's own height, and the transfer (checked, planned when it would touch)
+            // takes the block on from there.
+            Err(e) if e.kind == FailureKind::Unreachable && lift_z > base_z => {
+                tracing::debug!(target: "macrotree::actions", "carry: the lift to {lift_z:.3} m is impossible ({}); lifting to {base_z:.3} m", e.message);
+                self.start_phase(cell, Phase::Lift, Vector3::new(pos.x, pos.y, base_z))
+            }
+            started => started,
+        }
     }
 
     fn waiting_for(&self, cell: &Cell) -> String {

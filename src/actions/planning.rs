@@ -214,8 +214,18 @@ pub(crate) fn check_motion(
 /// descent from a planned pre-grasp pose), would really touch something but the `intended`
 /// objects. Its checks count in the tally's `collision_checks`, not as a motion checked.
 pub(crate) fn look_ahead_hits(cell: &mut Cell, mv: &dyn Trajectory, intended: &[String]) -> bool {
+    look_ahead_pairs(cell, mv, intended).is_some()
+}
+
+/// The pairs the straight segment `mv` (a look-ahead, as in [`look_ahead_hits`]) would really
+/// touch, but the `intended` objects; `None` when it is free.
+pub(crate) fn look_ahead_pairs(
+    cell: &mut Cell,
+    mv: &dyn Trajectory,
+    intended: &[String],
+) -> Option<Vec<Collision>> {
     let before = cell.planning().motions_checked;
-    let hit = check_motion(cell, &[mv], intended, true).is_some();
+    let hit = check_motion(cell, &[mv], intended, true).map(|(_, pairs)| pairs);
     cell.planning_mut().motions_checked = before;
     hit
 }

@@ -4,7 +4,9 @@ use nalgebra::{Isometry3, Translation3, Vector3};
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
-use super::planning::{check_motion, check_straight, describe, look_ahead_hits, plan_motion};
+use super::planning::{
+    check_motion, check_straight, describe, look_ahead_hits, look_ahead_pairs, plan_motion,
+};
 use super::targets::{resolve, segment_distance, target_block, target_object, tool_yaw};
 use crate::failure::{Failure, FailureKind};
 use crate::kinds::{PathKind, Reach as ReachSpec, Yaw};
@@ -50,36 +52,56 @@ impl Reach {
 impl Reach {
     /// When this reach goes to an approach pose above its target object (`offset` up) and the
     /// straight descent to the object from `reached` would touch something, the goals of `goals`
-    /// whose descent is free (`None` when the descent from `reached` is free, when the target is
-    /// not an object, or when no goal's descent is free).
+    /// whose descent is free. `Ok(None)` when the descent from `reached` is free or the target is
+    /// not an object; a failure of kind `blocked`, naming what the descent would touch, when no
+    /// goal's descent is free (the pick could only run the arm into it).
     fn descent_free_goals(
         &self,
         cell: &mut Cell,
         goals: &GoalSet,
         reached: &[f64; 6],
         offset: Vector3<f64>,
-    ) -> Option<GoalSet> {
+    ) -> Result<Option<GoalSet>, Failure> {
         if offset.z <= 0.0 {
-            return None;
+            return Ok(None);
         }
         let w = cell.world();
-        let target = target_object(&self.spec.target, w)?;
-        let intended = vec![w.name(target).to_string()];
+        let Some(target) = target_object(&self.spec.target, w) else {
+            return Ok(None);
+        };
+        let name = w.name(target).to_string();
+        let intended = vec![name.clone()];
         let limits = MotionLimits::default();
         let drop = Vector3::new(0.0, 0.0, offset.z);
-        let hits = |cell: &mut Cell, q: &[f64; 6]| {
+        let descent = |q: &[f64; 6]| {
             let top = fk(q);
             let down = Isometry3::from_parts(Translation3::from(top.translation.vector - drop), top.rotation);
-            match CartesianMove::new(*q, down, &limits) {
-                Ok(mv) => look_ahead_hits(cell, &mv, &intended),
-                Err(_) => true,
-            }
+            CartesianMove::new(*q, down, &limits).ok()
+        };
+        let hits = |cell: &mut Cell, q: &[f64; 6]| match descent(q) {
+            Some(mv) => look_ahead_hits(cell, &mv, &intended),
+            None => true,
         };
         if !hits(cell, reached) {
-            return None;
+            return Ok(None);
         }
         let free: Vec<[f64; 6]> = goals.configs.iter().filter(|q| !hits(cell, q)).copied().collect();
-        (!free.is_empty()).then(|| GoalSet::configs(free))
+        if !free.is_empty() {
+            return Ok(Some(GoalSet::configs(free)));
+        }
+        let what = descent(reached)
+            .and_then(|mv| look_ahead_pairs(cell, &mv, &intended))
+            .map_or_else(
+                || "the arm's joint limits or a singularity".to_string(),
+                |pairs| describe(&pairs),
+            );
+        Err(Failure::new(
+            FailureKind::Blocked,
+            format!(
+                "the straight descent onto `{name}` would touch {what} from every arm configuration above it ({} checked); the pick cannot be made from above",
+                goals.configs.len()
+            ),
+        ))
     }
 }
 
@@ -174,13 +196,24 @@ impl MacroAction for Reach {
                     let goals = GoalSet::down(&position, yaw, quarter, &from);
                     let mut motion = plan_motion(cell, "reach", &from, &goals)?;
                     if let Some(free) =
-                        self.descent_free_goals(cell, &goals, &motion.trajectory.end(), offset)
+                        self.descent_free_goals(cell, &goals, &motion.trajectory.end(), offset)?
                     {
                         // The straight descent a pick runs next from the pose reached would touch
                         // (the forearm on the table): plan again to the branches whose descent is free.
                         tracing::debug!(target: "macrotree::actions", "reach: the descent from the planned pose would touch; planning to the {} goal(s) whose descent is free", free.configs.len());
                         motion = plan_motion(cell, "reach", &from, &free)?;
                     }
+                    self.goal_q = motion.trajectory.end();
+                    cell.track(Box::new(motion.trajectory));
+                    return Ok(());
+                }
+                // The direct motion is free; the straight descent a pick runs next from where it
+                // ends may not be (the forearm on a post beside the block): then plan to the
+                // branches whose descent is free.
+                let goals = GoalSet::down(&position, yaw, quarter, &from);
+                if let Some(free) = self.descent_free_goals(cell, &goals, &goal_q, offset)? {
+                    tracing::debug!(target: "macrotree::actions", "reach: the descent from the direct move's end would touch; planning to the {} goal(s) whose descent is free", free.configs.len());
+                    let motion = plan_motion(cell, "reach", &from, &free)?;
                     self.goal_q = motion.trajectory.end();
                     cell.track(Box::new(motion.trajectory));
                     return Ok(());
