@@ -345,6 +345,37 @@ fn carry_chose_a_free_spot_in_a_020_m_bin_that_its_own_descent_check_refused() {
     }
 }
 
+/// The bug: a deep bin (0.12 m walls, the scene format's maximum) holding one block "could not
+/// take" a second one held at 40° to it: the opened hand, diagonal across the bin, reached a wall
+/// or the first block from every spot. Set down square to the bin, both fit.
+#[test]
+fn a_deep_bin_could_not_take_a_second_block_held_diagonally() {
+    let objects = format!(
+        "{}{}  bin:\n    container: {{inner: [0.22, 0.22], wall_height: 0.12, color: gray}}\n    pose: [0.50, 0.14]\n",
+        block("a", 0.40, -0.20, 0.0),
+        block("b", 0.55, -0.20, 40.0),
+    );
+    let mut steps = String::new();
+    for b in ["a", "b"] {
+        steps += &pick(b);
+        steps += "      - carry: {to: bin, lift: 0.20}\n      - release: {width: 0.08, retreat: 0.15}\n";
+    }
+    let (r, cell) = run("deep_bin_square", &objects, &sequence(&steps));
+    assert_success(&r, "two blocks into a deep 0.22 m bin");
+    assert!(r.collisions.is_empty(), "{:?}", r.collisions);
+    let w = cell.world();
+    let bin = index(w, "bin");
+    for b in ["a", "b"] {
+        assert!(
+            w.inside(index(w, b), bin),
+            "{b} in the bin: {:?}",
+            w.objects[index(w, b)].pos
+        );
+    }
+    let e = yaw_error_deg(w, index(w, "b"), 0.0);
+    assert!(e < 5.0, "b set down square to the bin: {e:.1}° off");
+}
+
 /// A 0.12 m bin with one block in it cannot take another with the fingers opened beside it:
 /// the carry says so before the block leaves the table, naming the bin and what is in it.
 #[test]

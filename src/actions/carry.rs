@@ -97,6 +97,9 @@ pub struct Carry {
     /// The spot chosen in the destination container, in the container's frame (kept for the
     /// whole carry, so a container that moves carries the spot with it), metres.
     spot_local: Option<Vector2<f64>>,
+    /// The spot chosen in the container takes the tool turned by this much about the vertical
+    /// through the block (radians): turned when the lift ends.
+    spot_turn: f64,
 }
 
 impl Carry {
@@ -119,6 +122,7 @@ impl Carry {
             surface: false,
             turn_to: None,
             spot_local: None,
+            spot_turn: 0.0,
         }
     }
 
@@ -192,7 +196,8 @@ impl Carry {
                 let local = match self.spot_local {
                     Some(l) => l,
                     None => {
-                        let p = self.free_spot(w, c, z)?;
+                        let (p, turn) = self.free_spot(w, c, z)?;
+                        self.spot_turn = turn;
                         let l = w.local_xy(c, &Vector3::new(p.x, p.y, 0.0));
                         self.spot_local = Some(l);
                         l
@@ -212,12 +217,13 @@ impl Carry {
     /// is now), preferring those where the fingers fully open (as a `release` opens them by
     /// default) clear its walls by [`MARGIN`] (or come nearest to), and among them the one with
     /// the most room to the blocks already in it (ties go to the spot nearest the centre; the
-    /// centre when it is empty), world frame, metres. A container with
-    /// no such spot fails with `container_full`, before anything moves.
-    fn free_spot(&self, w: &World, c: usize, z: f64) -> Result<Vector2<f64>, Failure> {
+    /// centre when it is empty), world frame, metres; with the tool as held, else turned about
+    /// the vertical by the angle returned (radians). A container with no such spot any way
+    /// fails with `container_full`, before anything moves.
+    fn free_spot(&self, w: &World, c: usize, z: f64) -> Result<(Vector2<f64>, f64), Failure> {
         let centre = w.objects[c].pos.xy();
         let crate::scene::Shape::Container { inner_half, .. } = w.spec(c).shape else {
-            return Ok(centre);
+            return Ok((centre, 0.0));
         };
         let inside = blocks_inside(w, c, self.held);
         let usable = inner_half.map(|h| (h - self.half).max(0.0));
@@ -234,9 +240,55 @@ impl Carry {
             }
         }
         candidates.sort_by(|a, b| (a - centre).norm().total_cmp(&(b - centre).norm()));
+        // The tool as held first. Only when no spot takes it so (a deep bin, where the opened
+        // hand reaches far along its closing axis), the block goes square to the container, its
+        // fingers along one of the container's axes, then the other, then a quarter turn from
+        // the hold.
+        let closing = self.set_down(Vector3::zeros()).closing;
+        let bin_x = crate::world::snapshot::yaw_of(&w.objects[c].quat);
+        let square = crate::world::snapshot::fold_quarter_turn(bin_x - closing.y.atan2(closing.x));
+        let quarter = std::f64::consts::FRAC_PI_2;
+        for turn in [0.0, square, square + quarter, quarter] {
+            if let Some(p) = self.best_spot(w, c, z, &candidates, &inside, turn) {
+                return Ok((p, turn));
+            }
+        }
+        let names: Vec<&str> = inside.iter().map(|&j| w.name(j)).collect();
+        let holding = if names.is_empty() {
+            "it is empty, but too small for the block and the opened fingers".to_string()
+        } else {
+            format!("it holds {}", names.join(", "))
+        };
+        Err(Failure::new(
+            FailureKind::ContainerFull,
+            format!(
+                "{} cannot take {}: no spot on its floor where the block and the fingers (opened to {:.0} mm, turned any way) clear its walls and the blocks in it; {holding}",
+                w.name(c),
+                w.name(self.held),
+                self.set_down(Vector3::zeros()).opening * 1e3
+            ),
+        ))
+    }
+
+    /// Of `candidates` in container `c` (block centre at height `z`), the spot [`Self::free_spot`]
+    /// prefers with the tool turned by `turn` radians about the vertical; `None` when the
+    /// descent check refuses all.
+    fn best_spot(
+        &self,
+        w: &World,
+        c: usize,
+        z: f64,
+        candidates: &[Vector2<f64>],
+        inside: &[usize],
+        turn: f64,
+    ) -> Option<Vector2<f64>> {
+        let r = nalgebra::Rotation2::new(turn);
         let mut best: Option<(Vector2<f64>, (f64, f64))> = None;
-        for p in candidates {
-            let down = self.set_down(Vector3::new(p.x, p.y, z));
+        for &p in candidates {
+            let down = SetDown {
+                closing: r * self.set_down(Vector3::zeros()).closing,
+                ..self.set_down(Vector3::new(p.x, p.y, z))
+            };
             if down.obstruction(w, self.held, Some(c)).is_some() {
                 continue;
             }
@@ -248,30 +300,14 @@ impl Carry {
                 ..down
             };
             let walls = open.wall_gap(w, c).unwrap_or(f64::INFINITY).min(MARGIN);
-            let room = down.room(w, &inside);
+            let room = down.room(w, inside);
             let better =
                 best.is_none_or(|(_, (bw, br))| walls > bw + 1e-9 || (walls > bw - 1e-9 && room > br + 1e-9));
             if better {
                 best = Some((p, (walls, room)));
             }
         }
-        best.map(|(p, _)| p).ok_or_else(|| {
-            let names: Vec<&str> = inside.iter().map(|&j| w.name(j)).collect();
-            let holding = if names.is_empty() {
-                "it is empty, but too small for the block and the opened fingers".to_string()
-            } else {
-                format!("it holds {}", names.join(", "))
-            };
-            Failure::new(
-                FailureKind::ContainerFull,
-                format!(
-                    "{} cannot take {}: no spot on its floor where the block and the fingers (opened to {:.0} mm) clear its walls and the blocks in it; {holding}",
-                    w.name(c),
-                    w.name(self.held),
-                    self.set_down(Vector3::zeros()).opening * 1e3
-                ),
-            )
-        })
+        best.map(|(p, _)| p)
     }
 
     /// Height of the block's centre for a transfer from `from` to `to` (table plane), metres:
@@ -501,6 +537,12 @@ impl Carry {
         match self.phase {
             Phase::Lift => {
                 self.turn(w);
+                let turn = std::mem::take(&mut self.spot_turn);
+                if turn != 0.0 {
+                    let r = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), turn);
+                    self.rotation = r * self.rotation;
+                    self.pinch_from_block = r * self.pinch_from_block;
+                }
                 let place = self.place(w)?;
                 let above = Vector3::new(place.x, place.y, above_z.max(place.z));
                 self.start_phase(cell, Phase::Transfer, above)
@@ -550,6 +592,7 @@ impl MacroAction for Carry {
         self.closing = closing_axis_in_pinch(w);
         self.tip = tip_above_block(w, held);
         self.spot_local = None;
+        self.spot_turn = 0.0;
         let place = self.place(w)?;
         let lift_z = self.transfer_z(w, pos.xy(), place.xy()).max(pos.z);
         let lift = Vector3::new(pos.x, pos.y, lift_z);
