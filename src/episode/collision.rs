@@ -179,6 +179,13 @@ impl std::str::FromStr for CollisionPolicy {
     }
 }
 
+/// True when held block `h` rests on obstacle `o`'s top (a shelf board it is picked from or set
+/// down on): its bottom no more than [`SET_ON_SLACK`] below the obstacle's top and its centre over
+/// the obstacle's footprint. Touching an obstacle any other way counts.
+fn rests_on(w: &World, h: usize, o: usize) -> bool {
+    w.bottom(h) + SET_ON_SLACK >= w.top(o) && w.from_footprint(o, &w.objects[h].pos).norm() == 0.0
+}
+
 /// The contacts of `w` that should not happen, in the order of [`World::touches`] (times set,
 /// node unset, possibly repeated):
 ///
@@ -186,7 +193,7 @@ impl std::str::FromStr for CollisionPolicy {
 /// |---|---|
 /// | the arm (links, gripper base) | a container, an obstacle, a block no pad touches |
 /// | the fingers | a container, an obstacle, a block no pad touches |
-/// | the held block ([`World::held_block`]) | a container's wall, an obstacle, a block beside it (not one it is set down on) |
+/// | the held block ([`World::held_block`]) | a container's wall, an obstacle (not one whose top it rests on), a block beside it (not one it is set down on) |
 ///
 /// A container's floor under the held block, the block between the pads and the table are
 /// intended contacts.
@@ -213,7 +220,7 @@ pub fn classify(w: &World) -> Vec<Collision> {
                 (Hitter::Arm | Hitter::Fingers, HitKind::Block) => w.released(index) && Some(index) != held,
                 (Hitter::Arm | Hitter::Fingers, _) => true,
                 (Hitter::HeldBlock, HitKind::Container) => piece == Piece::Wall,
-                (Hitter::HeldBlock, HitKind::Obstacle) => true,
+                (Hitter::HeldBlock, HitKind::Obstacle) => !rests_on(w, held.expect("a held block"), index),
                 (Hitter::HeldBlock, HitKind::Block) => {
                     let h = held.expect("a held block");
                     w.bottom(h) + SET_ON_SLACK < w.top(index)
