@@ -264,6 +264,7 @@ mod tests {
 
     use crate::world::conditions::tests_support::{held, resting};
     use crate::world::{Part, Piece};
+    use nalgebra::Vector3;
 
     fn obj(index: usize, piece: Piece) -> Part {
         Part::Object { index, piece }
@@ -299,6 +300,42 @@ mod tests {
         assert_eq!(c.len(), 1, "{c:?}");
         assert_eq!((c[0].who, c[0].kind), (Hitter::HeldBlock, HitKind::Container));
         assert_eq!(c[0].what, "the carried cube hit bowl wall");
+    }
+
+    #[test]
+    fn the_held_block_resting_on_a_board_does_not_count_but_hitting_its_side_does() {
+        // The held cube of `held()` (bottom 0.10 m) over a board whose top is 0.10 m high.
+        let mut w = held();
+        let scene = crate::scene::SceneSpec::from_str(
+            "objects:\n  cube: {block: {size: 0.044}, pose: [0.45, -0.18]}\n  board: {obstacle: {size: [0.10, 0.10, 0.02]}, pose: [0.45, -0.18], z: 0.08}\n",
+            "board.yaml",
+        )
+        .expect("a valid scene");
+        w.scene = std::sync::Arc::new(scene);
+        w.objects[1].pos = Vector3::new(0.45, -0.18, 0.08);
+        w.touches = vec![(obj(0, Piece::Whole), obj(1, Piece::Whole))];
+        assert!(classify(&w).is_empty(), "resting on the board's top");
+        // 1 cm lower: the block is in the board, it hit it.
+        let mut low = w.clone();
+        for p in [
+            &mut low.objects[0].pos,
+            &mut low.left_pad_pos,
+            &mut low.right_pad_pos,
+        ] {
+            p.z -= 0.01;
+        }
+        assert_eq!(classify(&low).len(), 1);
+        // Beside the board at its top's height: its centre is not over the board.
+        let mut beside = w.clone();
+        for p in [
+            &mut beside.objects[0].pos,
+            &mut beside.left_pad_pos,
+            &mut beside.right_pad_pos,
+        ] {
+            p.x += 0.08;
+        }
+        let c = classify(&beside);
+        assert_eq!((c.len(), c[0].kind), (1, HitKind::Obstacle), "{c:?}");
     }
 
     #[test]
