@@ -4,9 +4,9 @@
 //!
 //! The faces are tried in a fixed order (the one facing the robot's base most first; ties by
 //! face index), and the first whose pre-grasp configurations and straight approach are free
-//! (the cell's collision checker: the pre-grasp with the planner's margin, the approach counting
-//! only real contact, the block itself intended) is taken; the arm then moves there directly when
-//! that joint move is free, else by the planner to those pre-grasp configurations.
+//! (the cell's collision checker: the pre-grasp with the planner's margin, the approach keeping
+//! [`APPROACH_CLEARANCE`], the block itself intended) is taken; the arm then moves there directly
+//! when that joint move is free, else by the planner to those pre-grasp configurations.
 //!
 //! `offset` is read in the approach frame of the face: z is the stand-off back out along the
 //! face's normal, y is up (world z), x = y × z runs along the face. A Cartesian side reach (the
@@ -86,9 +86,35 @@ fn intended(w: &World, b: usize) -> Vec<String> {
     vec![w.name(b).to_string()]
 }
 
+/// Each of `configs` with the pairs that count there by the planner's margin (those touching at
+/// `start` and contact with the `intended` objects allowed); none when the cell has no checker.
+/// The checks are counted in the tally.
+fn blocking(
+    cell: &mut Cell,
+    start: &[f64; 6],
+    intended: &[String],
+    configs: Vec<[f64; 6]>,
+) -> Vec<([f64; 6], Vec<crate::motion::plan::Collision>)> {
+    let Some(checker) = cell.checker() else {
+        return configs.into_iter().map(|q| (q, Vec::new())).collect();
+    };
+    let mut allow = super::planning::Allowing::new(checker, start, intended, false);
+    let out = configs
+        .into_iter()
+        .map(|q| {
+            let pairs = allow.blocking(&q);
+            (q, pairs)
+        })
+        .collect();
+    let checks = allow.checks;
+    cell.planning_mut().collision_checks += checks;
+    out
+}
+
 /// The pre-grasp configurations (pinch at `pre`, tool along −`n`) whose configuration is free
 /// (the planner's margin, the block intended) and whose straight approach to the grasp (pinch
-/// at `grasp`) touches nothing but the block; nearest to `from` first.
+/// at `grasp`) keeps [`APPROACH_CLEARANCE`] from everything but the block; nearest to `from`
+/// first. With none, why (the counts, and the pairs of the pre-grasp nearest to free).
 fn free_pregrasps(
     cell: &mut Cell,
     b: usize,
@@ -118,17 +144,7 @@ fn free_pregrasps(
     // count of those whose straight approach is blocked.
     let mut nearest: Option<(f64, String)> = None;
     let mut approach_blocked = 0;
-    for q in goals.configs {
-        let blocked = match cell.checker() {
-            Some(checker) => {
-                let mut allow = super::planning::Allowing::new(checker, &start, &intended, false);
-                let pairs = allow.blocking(&q);
-                let checks = allow.checks;
-                cell.planning_mut().collision_checks += checks;
-                pairs
-            }
-            None => Vec::new(),
-        };
+    for (q, blocked) in blocking(cell, &start, &intended, goals.configs) {
         if !blocked.is_empty() {
             let deepest = blocked.iter().map(|c| c.distance).fold(f64::INFINITY, f64::min);
             if nearest.as_ref().is_none_or(|(d, _)| deepest > *d) {
@@ -176,18 +192,8 @@ pub(crate) fn top_free_goals(cell: &mut Cell, b: usize, standoff: f64, from: &[f
     let start = cell.arm_setpoint();
     let limits = MotionLimits::default();
     let mut out = Vec::new();
-    for q in goals.configs {
-        let free = match cell.checker() {
-            Some(checker) => {
-                let mut allow = super::planning::Allowing::new(checker, &start, &intended, false);
-                let free = allow.blocking(&q).is_empty();
-                let checks = allow.checks;
-                cell.planning_mut().collision_checks += checks;
-                free
-            }
-            None => true,
-        };
-        if !free {
+    for (q, blocked) in blocking(cell, &start, &intended, goals.configs) {
+        if !blocked.is_empty() {
             continue;
         }
         if standoff > 1e-6 {
