@@ -17,6 +17,7 @@ mod place;
 mod planning;
 mod reach;
 mod release;
+mod side;
 mod targets;
 
 pub(crate) use carry::Carry as CarryAction;

@@ -137,6 +137,12 @@ fn detour_height(w: &World, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
 
 impl MacroAction for Reach {
     fn start(&mut self, cell: &mut Cell) -> Result<(), Failure> {
+        // `approach: side | auto`: docs/motion.md "Side grasps"; `top` goes on below.
+        if let Some(goal_q) = super::side::start(cell, &self.spec)? {
+            self.pending.clear();
+            self.goal_q = goal_q;
+            return Ok(());
+        }
         let w = cell.world();
         let offset = Vector3::from(self.spec.offset);
         let position = resolve(&self.spec.target, w)? + offset;
@@ -277,7 +283,7 @@ const NEAR_CLEARANCE: f64 = 0.08;
 /// wrist); within [`NEAR_CLEARANCE`] of one (a container's wall, an obstacle, another block), the
 /// one whose fingers point most across the direction to the nearest is taken, so the open
 /// fingertips do not land on it.
-fn block_grasp_yaw(w: &crate::world::World, b: usize) -> (f64, bool) {
+pub(super) fn block_grasp_yaw(w: &crate::world::World, b: usize) -> (f64, bool) {
     let yaw = w.yaw(b);
     let p = w.objects[b].pos;
     let nearest = (0..w.objects.len())

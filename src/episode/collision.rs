@@ -179,6 +179,13 @@ impl std::str::FromStr for CollisionPolicy {
     }
 }
 
+/// True when held block `h` rests on obstacle `o`'s top (a shelf board it is picked from or set
+/// down on): its bottom no more than [`SET_ON_SLACK`] below the obstacle's top and its centre over
+/// the obstacle's footprint. Touching an obstacle any other way counts.
+fn rests_on(w: &World, h: usize, o: usize) -> bool {
+    w.bottom(h) + SET_ON_SLACK >= w.top(o) && w.from_footprint(o, &w.objects[h].pos).norm() == 0.0
+}
+
 /// The contacts of `w` that should not happen, in the order of [`World::touches`] (times set,
 /// node unset, possibly repeated):
 ///
@@ -186,7 +193,7 @@ impl std::str::FromStr for CollisionPolicy {
 /// |---|---|
 /// | the arm (links, gripper base) | a container, an obstacle, a block no pad touches |
 /// | the fingers | a container, an obstacle, a block no pad touches |
-/// | the held block ([`World::held_block`]) | a container's wall, an obstacle, a block beside it (not one it is set down on) |
+/// | the held block ([`World::held_block`]) | a container's wall, an obstacle (not one whose top it rests on), a block beside it (not one it is set down on) |
 ///
 /// A container's floor under the held block, the block between the pads and the table are
 /// intended contacts.
@@ -213,7 +220,7 @@ pub fn classify(w: &World) -> Vec<Collision> {
                 (Hitter::Arm | Hitter::Fingers, HitKind::Block) => w.released(index) && Some(index) != held,
                 (Hitter::Arm | Hitter::Fingers, _) => true,
                 (Hitter::HeldBlock, HitKind::Container) => piece == Piece::Wall,
-                (Hitter::HeldBlock, HitKind::Obstacle) => true,
+                (Hitter::HeldBlock, HitKind::Obstacle) => !rests_on(w, held.expect("a held block"), index),
                 (Hitter::HeldBlock, HitKind::Block) => {
                     let h = held.expect("a held block");
                     w.bottom(h) + SET_ON_SLACK < w.top(index)
@@ -257,6 +264,7 @@ mod tests {
 
     use crate::world::conditions::tests_support::{held, resting};
     use crate::world::{Part, Piece};
+    use nalgebra::Vector3;
 
     fn obj(index: usize, piece: Piece) -> Part {
         Part::Object { index, piece }
@@ -292,6 +300,42 @@ mod tests {
         assert_eq!(c.len(), 1, "{c:?}");
         assert_eq!((c[0].who, c[0].kind), (Hitter::HeldBlock, HitKind::Container));
         assert_eq!(c[0].what, "the carried cube hit bowl wall");
+    }
+
+    #[test]
+    fn the_held_block_resting_on_a_board_does_not_count_but_hitting_its_side_does() {
+        // The held cube of `held()` (bottom 0.10 m) over a board whose top is 0.10 m high.
+        let mut w = held();
+        let scene = crate::scene::SceneSpec::from_str(
+            "objects:\n  cube: {block: {size: 0.044}, pose: [0.45, -0.18]}\n  board: {obstacle: {size: [0.10, 0.10, 0.02]}, pose: [0.45, -0.18], z: 0.08}\n",
+            "board.yaml",
+        )
+        .expect("a valid scene");
+        w.scene = std::sync::Arc::new(scene);
+        w.objects[1].pos = Vector3::new(0.45, -0.18, 0.08);
+        w.touches = vec![(obj(0, Piece::Whole), obj(1, Piece::Whole))];
+        assert!(classify(&w).is_empty(), "resting on the board's top");
+        // 1 cm lower: the block is in the board, it hit it.
+        let mut low = w.clone();
+        for p in [
+            &mut low.objects[0].pos,
+            &mut low.left_pad_pos,
+            &mut low.right_pad_pos,
+        ] {
+            p.z -= 0.01;
+        }
+        assert_eq!(classify(&low).len(), 1);
+        // Beside the board at its top's height: its centre is not over the board.
+        let mut beside = w.clone();
+        for p in [
+            &mut beside.objects[0].pos,
+            &mut beside.left_pad_pos,
+            &mut beside.right_pad_pos,
+        ] {
+            p.x += 0.08;
+        }
+        let c = classify(&beside);
+        assert_eq!((c.len(), c[0].kind), (1, HitKind::Obstacle), "{c:?}");
     }
 
     #[test]

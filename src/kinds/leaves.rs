@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use schemars::JsonSchema;
 
+use super::approach::Approach;
 use super::objects::{ObjectRef, ObjectRole, opt_var_name, var_name};
 use super::param_error::ParamError;
 use super::targets::{PathKind, Target, Yaw};
@@ -90,6 +91,11 @@ pub struct Reach {
     /// `joint` (default, joint-space interpolation) or `cartesian` (straight tool path).
     #[serde(default)]
     pub path: PathKind,
+    /// `top` (default: tool pointing down), `side` (tool horizontal along a face normal of the
+    /// target block, `offset` in that approach's frame) or `auto` (`top` when its pre-grasp and
+    /// descent are free, else `side`); see docs/motion.md "Side grasps".
+    #[serde(default, skip_serializing_if = "Approach::is_top")]
+    pub approach: Approach,
     /// Tool speed, m/s (> 0). Default 0.5.
     #[serde(default = "d_speed", deserialize_with = "units::speed")]
     #[schemars(range(min = 0.0))]
@@ -689,6 +695,9 @@ impl Params for Reach {
         if self.path == PathKind::Cartesian {
             s.push_str(" cartesian");
         }
+        if !self.approach.is_top() {
+            s.push_str(&format!(" from {}", self.approach.name()));
+        }
         match self.yaw {
             Yaw::Object => {}
             Yaw::Keep => s.push_str(" yaw=keep"),
@@ -698,6 +707,9 @@ impl Params for Reach {
     }
     fn timeout(&self) -> Option<f64> {
         Some(self.timeout)
+    }
+    fn validate_fields(&self) -> Result<(), ParamError> {
+        super::approach::check_reach(self.approach, &self.target, &self.offset, &self.yaw)
     }
 }
 

@@ -14,6 +14,7 @@
 //! YAML body of the node is read into it with located errors, its doc comments become the
 //! parameter documentation, and the schema is generated from it.
 
+mod approach;
 mod builtin;
 pub mod catalog;
 mod control;
@@ -26,6 +27,7 @@ mod registry;
 mod role;
 mod targets;
 
+pub use approach::Approach;
 pub use catalog::{NodeDoc, ParamDoc};
 pub use control::{
     Arguments, ChildParams, CompositeParams, ConditionValue, Control, ControlKind, ForEachParams,
