@@ -18,6 +18,15 @@ pub trait CollisionChecker {
     fn collisions(&mut self, _q: &[f64; 6]) -> Vec<Collision> {
         Vec::new()
     }
+
+    /// A conservative screen, asked before [`is_free`](Self::is_free): true only when `q`
+    /// (radians) is certainly free, e.g. when a fast model that bounds every part of the robot
+    /// and the scene keeps the margin; false when it cannot tell (the default: no screen). The
+    /// planner searches with "screen, else `is_free`" and re-checks every configuration of the
+    /// final path with `is_free` alone, so a screen that errs only costs time, never a collision.
+    fn certainly_free(&mut self, _q: &[f64; 6]) -> bool {
+        false
+    }
 }
 
 impl<C: CollisionChecker + ?Sized> CollisionChecker for &mut C {
@@ -26,6 +35,9 @@ impl<C: CollisionChecker + ?Sized> CollisionChecker for &mut C {
     }
     fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
         (**self).collisions(q)
+    }
+    fn certainly_free(&mut self, q: &[f64; 6]) -> bool {
+        (**self).certainly_free(q)
     }
 }
 
@@ -60,12 +72,18 @@ impl fmt::Display for Collision {
 
 /// A checker that counts the configurations it is asked about (the planner's statistics) and,
 /// while a budget is set, answers "blocked" without asking once the budget is used (a refusal
-/// never lets a collision through; it only ends the search).
+/// never lets a collision through; it only ends the search). While `screen` is on, a
+/// configuration the inner checker's [`certainly_free`](CollisionChecker::certainly_free)
+/// vouches for is free without `is_free`; each check counts once either way.
 pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
     pub(crate) inner: &'a mut C,
     pub(crate) checks: u64,
     /// Checks at most (`u64::MAX`: none).
     pub(crate) budget: u64,
+    /// Ask the inner checker's screen first.
+    pub(crate) screen: bool,
+    /// Checks the screen answered (free without `is_free`).
+    pub(crate) screened: u64,
 }
 
 impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
@@ -74,6 +92,8 @@ impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
             inner,
             checks: 0,
             budget: u64::MAX,
+            screen: true,
+            screened: 0,
         }
     }
 
@@ -89,6 +109,10 @@ impl<C: CollisionChecker + ?Sized> CollisionChecker for Counting<'_, C> {
             return false;
         }
         self.checks += 1;
+        if self.screen && self.inner.certainly_free(q) {
+            self.screened += 1;
+            return true;
+        }
         self.inner.is_free(q)
     }
     fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {

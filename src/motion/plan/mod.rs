@@ -24,6 +24,7 @@
 //! | [`stats`] | [`PlanStats`] and joint-space distances |
 //! | [`planner`] | [`plan`]: one query, stage by stage |
 //! | [`boxes`] | [`JointBoxes`]: obstacles as boxes in joint space, for tests and benchmarks |
+//! | [`shapes`] | capsules, boxes, half-spaces and conservative nearness tests (the screen's geometry) |
 
 pub mod blend;
 pub mod boxes;
@@ -35,6 +36,7 @@ pub mod planner;
 pub mod reason;
 mod rng;
 pub mod rrt;
+pub mod shapes;
 pub mod shortcut;
 pub mod stats;
 pub mod timing;

@@ -62,18 +62,69 @@ pub fn plan<C: CollisionChecker + ?Sized>(
     config: &PlannerConfig,
 ) -> Result<PlannedMotion, PlanError> {
     let started = Instant::now();
+    match attempt(checker, start, goals, config, true, started) {
+        Attempt::Done(result) => result,
+        Attempt::ScreenWrong { checks, screened } => {
+            tracing::warn!(target: "macrotree::plan", "the collision screen passed a configuration of the final path that the exact check finds blocked: planning again with exact checks only");
+            let Attempt::Done(mut result) = attempt(checker, start, goals, config, false, started) else {
+                unreachable!("an attempt without the screen is never re-checked")
+            };
+            let stats = match &mut result {
+                Ok(m) => &mut m.stats,
+                Err(e) => &mut *e.stats,
+            };
+            stats.collision_checks += checks;
+            stats.screened += screened;
+            stats.screen_fallback = true;
+            result
+        }
+    }
+}
+
+/// How one attempt ended.
+enum Attempt {
+    /// A motion or a reason.
+    Done(Result<PlannedMotion, PlanError>),
+    /// The exact re-check of the final path found a configuration the screen had passed blocked
+    /// (the checks spent, and how many of them the screen answered).
+    ScreenWrong { checks: u64, screened: u64 },
+}
+
+/// True when every vertex of `path` and every segment between them is free at `res`, checked
+/// by `checker` (its screen off).
+fn revalidate<C: CollisionChecker + ?Sized>(
+    checker: &mut Counting<'_, C>,
+    path: &[[f64; 6]],
+    res: &super::edge::Resolution,
+) -> bool {
+    path.iter().all(|q| checker.is_free(q))
+        && path
+            .windows(2)
+            .all(|w| check_segment(checker, &w[0], &w[1], res).is_ok())
+}
+
+/// One planning attempt, with the checker's screen asked first (`screen`) or not.
+fn attempt<C: CollisionChecker + ?Sized>(
+    checker: &mut C,
+    start: &[f64; 6],
+    goals: &GoalSet,
+    config: &PlannerConfig,
+    screen: bool,
+    started: Instant,
+) -> Attempt {
     let mut stats = PlanStats {
         goals: goals.len(),
         ..PlanStats::default()
     };
     let mut checker = Counting::new(checker);
+    checker.screen = screen;
     let fail = |reason: PlanFailure, mut stats: PlanStats, checks: u64| {
         stats.collision_checks = checks;
         stats.planning_time = started.elapsed();
-        Err(PlanError {
+        Attempt::Done(Err(PlanError {
             reason,
             stats: Box::new(stats),
-        })
+        }))
     };
     if let Err(e) = config.check() {
         return fail(PlanFailure::InvalidQuery { reason: e }, stats, 0);
@@ -176,6 +227,7 @@ pub fn plan<C: CollisionChecker + ?Sized>(
                     checks: checker.checks,
                     blocking: tally(named),
                 };
+                stats.screened = checker.screened;
                 return fail(reason, stats, checker.checks);
             }
             Search::TimeCap => {
@@ -204,18 +256,28 @@ pub fn plan<C: CollisionChecker + ?Sized>(
     stats.stage_checks[2] = checker.checks - stats.stage_checks[0] - stats.stage_checks[1];
     stats.length = path_length(&path);
     stats.waypoints = path.len();
+    // From here on every check is exact: the path the screen passed is re-checked, and the
+    // corner arcs are checked, with the checker's exact test alone.
+    checker.screen = false;
+    if checker.screened > 0 && !revalidate(&mut checker, &path, &res) {
+        return Attempt::ScreenWrong {
+            checks: checker.checks,
+            screened: checker.screened,
+        };
+    }
     let smoothed = smooth(&mut checker, &path, config.blend_deviation, &res);
     stats.blends = smoothed.blends;
     let trajectory = PathTrajectory::new(smoothed, path, &config.limits);
     stats.duration = crate::motion::trajectory::Trajectory::duration(&trajectory);
     stats.collision_checks = checker.checks;
     stats.stage_checks[3] = checker.checks - stats.stage_checks[..3].iter().sum::<u64>();
+    stats.screened = checker.screened;
     stats.planning_time = started.elapsed();
     debug_assert!(distance(&trajectory.start(), start) == 0.0);
-    Ok(PlannedMotion {
+    Attempt::Done(Ok(PlannedMotion {
         goal,
         raw_path,
         trajectory,
         stats,
-    })
+    }))
 }
