@@ -144,12 +144,12 @@ impl CollisionChecker for Allowing<'_> {
         all
     }
 
-    /// The inner checker's screen: what keeps the margin from everything is free whatever is
-    /// allowed. Counted as a check like `is_free`.
-    fn certainly_free(&mut self, q: &[f64; 6]) -> bool {
-        let free = self.inner.certainly_free(q);
+    /// The inner checker's "certainly free" (what keeps the margin from everything is free
+    /// whatever is allowed; its "blocked" may be an allowed pair). Counted as a check.
+    fn screen(&mut self, q: &[f64; 6]) -> Option<bool> {
+        let free = self.inner.screen(q) == Some(true);
         self.checks += u64::from(free);
-        free
+        free.then_some(true)
     }
 }
 

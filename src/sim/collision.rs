@@ -74,7 +74,7 @@ pub struct SceneChecker {
     /// The conservative fast model of the current snapshot ([`Screen`]), built on first use
     /// after a change; `None` inside when the cell has geometry it cannot bound.
     screen: Option<Option<Screen>>,
-    /// Whether [`CollisionChecker::certainly_free`] asks the screen (default true).
+    /// Whether [`CollisionChecker::screen`] asks the screen (default true).
     screen_on: bool,
     /// Body and joint ids of the six arm links.
     arm_links: ([usize; 6], [usize; 6]),
@@ -444,17 +444,13 @@ impl CollisionChecker for SceneChecker {
         self.detect(q) == 0
     }
 
-    /// The [`Screen`]'s verdict: true only when its bounding primitives keep every pair's margin
-    /// (plus [`PAD`](super::screen::PAD)); false when the screen is off or the cell has
-    /// geometry it cannot bound.
-    fn certainly_free(&mut self, q: &[f64; 6]) -> bool {
+    /// The [`Screen`]'s verdict ([`Screen::classify`]); `None` when the screen is off or the
+    /// cell has geometry it cannot bound.
+    fn screen(&mut self, q: &[f64; 6]) -> Option<bool> {
         if !self.screen_on || !q.iter().all(|v| v.is_finite()) {
-            return false;
+            return None;
         }
-        match self.screen() {
-            Some(s) => s.free(q),
-            None => false,
-        }
+        self.screen_model()?.classify(q)
     }
 
     fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
@@ -498,7 +494,7 @@ impl SceneChecker {
 
     /// The screen of the current snapshot, built if needed; `None` when the cell has geometry it
     /// cannot bound.
-    pub fn screen(&mut self) -> Option<&mut Screen> {
+    pub fn screen_model(&mut self) -> Option<&mut Screen> {
         if self.screen.is_none() {
             // Pose the private data at the snapshot's joints (a held block from the pinch).
             let q = self.snapshot_q;

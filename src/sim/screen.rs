@@ -20,7 +20,7 @@ use std::sync::Arc;
 use mujoco_rs::prelude::*;
 use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, Unit, UnitQuaternion, Vector3};
 
-use crate::motion::plan::shapes::{Shape, V3, near};
+use crate::motion::plan::shapes::{Shape, V3, near, within};
 
 /// Extra distance every pair must keep beyond its margin for the screen to vouch, metres: room
 /// for MuJoCo's own tolerances (its convex-hull distances converge to about 1e-6 m).
@@ -78,13 +78,17 @@ struct Link {
     qpos0: f64,
 }
 
-/// One pair to test: two shape indices (moving shapes first, then fixed ones) and the distance
-/// they must keep, metres.
+/// One pair to test: two shape indices (moving shapes first, then fixed ones), the distance
+/// they must keep for "free" (the pair's margin plus [`PAD`], metres), and the distance below
+/// which exact shapes are "blocked": [`PAD`] of penetration (MuJoCo reports every
+/// penetration, but not every pair closer than a margin: its plane–box and capsule–box
+/// contacts within a margin were found missing in `tests/motion_screen.rs`).
 #[derive(Clone, Copy, Debug)]
 struct Pair {
     a: u16,
     b: u16,
     gap: f64,
+    block: f64,
 }
 
 /// The conservative model of one snapshot of the cell (see the module docs).
@@ -93,14 +97,20 @@ pub struct Screen {
     /// World pose of the first arm link's parent body.
     base: Isometry3<f64>,
     links: [Link; 6],
-    /// Shapes moved by the arm: (link index 0..6, shape in the link's frame).
-    moving: Vec<(usize, Local)>,
-    /// Fixed shapes, world frame, with their bounding spheres.
-    fixed: Vec<(Shape, Option<(V3, f64)>)>,
+    /// Shapes moved by the arm: (link index 0..6, shape in the link's frame, whether the
+    /// shape is the geom itself rather than a bound of it).
+    moving: Vec<(usize, Local, bool)>,
+    /// Fixed shapes, world frame, with their bounding spheres and exactness.
+    fixed: Vec<Posed>,
     pairs: Vec<Pair>,
-    /// Scratch: the moving shapes posed, with bounding spheres.
-    posed: Vec<(Shape, Option<(V3, f64)>)>,
+    /// Geom id of each shape (moving ones, then fixed ones).
+    geoms: Vec<usize>,
+    /// Scratch: the moving shapes posed.
+    posed: Vec<Posed>,
 }
+
+/// A shape in the world, its bounding sphere, and whether it is the geom itself.
+type Posed = (Shape, Option<(V3, f64)>, bool);
 
 /// Rotation matrix of MuJoCo's row-major `xmat`.
 fn mat(x: &[f64; 9]) -> Matrix3<f64> {
@@ -141,6 +151,18 @@ fn geom_local(m: &MjModel, g: usize) -> Option<GeomShape> {
 enum GeomShape {
     Plane,
     Solid(Local),
+}
+
+/// True when the screen's shape of the geom is the geom itself (a sphere, capsule, box or
+/// plane), not a bound of it.
+fn exact(m: &MjModel, g: usize) -> bool {
+    matches!(
+        m.geom_type()[g],
+        MjtGeomBase::mjGEOM_PLANE
+            | MjtGeomBase::mjGEOM_SPHERE
+            | MjtGeomBase::mjGEOM_CAPSULE
+            | MjtGeomBase::mjGEOM_BOX
+    )
 }
 
 /// A local shape expressed in another frame: `rel` maps the shape's frame into it.
@@ -219,8 +241,8 @@ impl Screen {
         let collidable = |g: usize| ct[g] != 0 || ca[g] != 0;
         // Index of each geom's shape: moving ones first, then fixed ones.
         let mut index: Vec<Option<usize>> = vec![None; ngeom];
-        let mut moving: Vec<(usize, Local)> = Vec::new();
-        let mut fixed: Vec<(Shape, Option<(V3, f64)>)> = Vec::new();
+        let mut moving: Vec<(usize, Local, bool)> = Vec::new();
+        let mut fixed: Vec<Posed> = Vec::new();
         let mut fixed_geoms: Vec<usize> = Vec::new();
         for g in 0..ngeom {
             if !collidable(g) {
@@ -244,7 +266,7 @@ impl Screen {
                     Some(GeomShape::Solid(l)) => l.posed(&gr, &gt),
                 };
                 fixed_geoms.push(g);
-                fixed.push((s, s.bounding_sphere()));
+                fixed.push((s, s.bounding_sphere(), exact(m, g)));
             } else {
                 let Some(GeomShape::Solid(l)) = shape else {
                     return None;
@@ -254,11 +276,17 @@ impl Screen {
                 let rel_r = lr * gr;
                 let rel_t = lr * (gt - link.translation.vector);
                 index[g] = Some(moving.len());
-                moving.push((k as usize - 1, moved(&l, &rel_r, &rel_t)));
+                moving.push((k as usize - 1, moved(&l, &rel_r, &rel_t), exact(m, g)));
             }
         }
         for (i, &g) in fixed_geoms.iter().enumerate() {
             index[g] = Some(moving.len() + i);
+        }
+        let mut geoms = vec![0; moving.len() + fixed.len()];
+        for (g, i) in index.iter().enumerate() {
+            if let Some(i) = i {
+                geoms[*i] = g;
+            }
         }
         // The pairs MuJoCo tests in this model.
         let body = m.geom_bodyid();
@@ -267,7 +295,7 @@ impl Screen {
         let excluded = m.exclude_signature();
         let (margin, gap) = (m.geom_margin(), m.geom_gap());
         let mut pairs = Vec::new();
-        let mut add = |g1: usize, g2: usize, pair_margin: f64| -> bool {
+        let mut add = |g1: usize, g2: usize, pair_margin: f64, pair_gap: f64| -> bool {
             if b.group[g1] == 0 && b.group[g2] == 0 {
                 return true;
             }
@@ -278,6 +306,7 @@ impl Screen {
                         a: a as u16,
                         b: bb as u16,
                         gap: pair_margin.max(0.0) + PAD,
+                        block: (pair_margin - pair_gap.max(0.0)).min(0.0) - PAD,
                     });
                     true
                 }
@@ -312,14 +341,14 @@ impl Screen {
                 if excluded.contains(&sig) {
                     continue;
                 }
-                if !add(g1, g2, margin[g1].max(margin[g2]) - gap[g1].max(gap[g2]).min(0.0)) {
+                if !add(g1, g2, margin[g1].max(margin[g2]), gap[g1].max(gap[g2])) {
                     return None;
                 }
             }
         }
-        let (pg1, pg2, pm) = (m.pair_geom1(), m.pair_geom2(), m.pair_margin());
+        let (pg1, pg2, pm, pgap) = (m.pair_geom1(), m.pair_geom2(), m.pair_margin(), m.pair_gap());
         for p in 0..m.ffi().npair as usize {
-            if !add(pg1[p] as usize, pg2[p] as usize, pm[p]) {
+            if !add(pg1[p] as usize, pg2[p] as usize, pm[p], pgap[p]) {
                 return None;
             }
         }
@@ -335,6 +364,7 @@ impl Screen {
             moving,
             fixed,
             pairs,
+            geoms,
             posed,
         })
     }
@@ -355,17 +385,25 @@ impl Screen {
         })
     }
 
-    /// True when every tested pair keeps its margin plus [`PAD`] at `q` (radians): MuJoCo then
-    /// reports no contact there.
-    pub fn free(&mut self, q: &[f64; 6]) -> bool {
+    /// The screen's verdict at `q` (radians): `Some(true)` when every tested pair keeps its
+    /// margin plus [`PAD`] (MuJoCo then reports no contact), `Some(false)` when a pair of exact
+    /// shapes (no bounds) penetrates by more than [`PAD`] (MuJoCo then reports that contact),
+    /// `None` otherwise.
+    pub fn classify(&mut self, q: &[f64; 6]) -> Option<bool> {
+        self.decide(q).0
+    }
+
+    /// The verdict at `q` and the geom pair that decided a "blocked" (geom ids).
+    pub fn decide(&mut self, q: &[f64; 6]) -> (Option<bool>, Option<(usize, usize)>) {
         let frames = self.link_poses(q);
         self.posed.clear();
-        for (k, l) in &self.moving {
+        for (k, l, e) in &self.moving {
             let (r, t) = &frames[*k];
             let s = l.posed(r, t);
-            self.posed.push((s, s.bounding_sphere()));
+            self.posed.push((s, s.bounding_sphere(), *e));
         }
         let nm = self.posed.len();
+        let mut unsure = false;
         for p in &self.pairs {
             let x = &self.posed[p.a as usize];
             let y = if (p.b as usize) < nm {
@@ -381,10 +419,21 @@ impl Screen {
                 }
             }
             if near(&x.0, &y.0, p.gap) {
-                return false;
+                if x.2 && y.2 && within(&x.0, &y.0, p.block) {
+                    return (
+                        Some(false),
+                        Some((self.geoms[p.a as usize], self.geoms[p.b as usize])),
+                    );
+                }
+                unsure = true;
             }
         }
-        true
+        ((!unsure).then_some(true), None)
+    }
+
+    /// True when the screen vouches that `q` (radians) is free ([`Screen::classify`]).
+    pub fn free(&mut self, q: &[f64; 6]) -> bool {
+        self.classify(q) == Some(true)
     }
 
     /// Pairs tested per configuration.

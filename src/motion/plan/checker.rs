@@ -19,13 +19,16 @@ pub trait CollisionChecker {
         Vec::new()
     }
 
-    /// A conservative screen, asked before [`is_free`](Self::is_free): true only when `q`
-    /// (radians) is certainly free, e.g. when a fast model that bounds every part of the robot
-    /// and the scene keeps the margin; false when it cannot tell (the default: no screen). The
-    /// planner searches with "screen, else `is_free`" and re-checks every configuration of the
-    /// final path with `is_free` alone, so a screen that errs only costs time, never a collision.
-    fn certainly_free(&mut self, _q: &[f64; 6]) -> bool {
-        false
+    /// A fast screen, asked before [`is_free`](Self::is_free): `Some(true)` only when `q`
+    /// (radians) is certainly free (e.g. a model that bounds every part of the robot and the
+    /// scene keeps the margin), `Some(false)` only when it is certainly blocked (exact shapes
+    /// deeper than the margin), `None` when it cannot tell (the default: no screen). The
+    /// planner searches and shortcuts with "screen, else `is_free`" (the start and the goals
+    /// with `is_free` unless certainly free), then re-checks with `is_free` alone every
+    /// configuration of the final path the screen called free, so a screen that errs towards
+    /// "free" only costs time, never a collision.
+    fn screen(&mut self, _q: &[f64; 6]) -> Option<bool> {
+        None
     }
 }
 
@@ -36,8 +39,8 @@ impl<C: CollisionChecker + ?Sized> CollisionChecker for &mut C {
     fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
         (**self).collisions(q)
     }
-    fn certainly_free(&mut self, q: &[f64; 6]) -> bool {
-        (**self).certainly_free(q)
+    fn screen(&mut self, q: &[f64; 6]) -> Option<bool> {
+        (**self).screen(q)
     }
 }
 
@@ -72,9 +75,10 @@ impl fmt::Display for Collision {
 
 /// A checker that counts the configurations it is asked about (the planner's statistics) and,
 /// while a budget is set, answers "blocked" without asking once the budget is used (a refusal
-/// never lets a collision through; it only ends the search). While `screen` is on, a
-/// configuration the inner checker's [`certainly_free`](CollisionChecker::certainly_free)
-/// vouches for is free without `is_free`; each check counts once either way.
+/// never lets a collision through; it only ends the search). While `screen` is on, the inner
+/// checker's [`screen`](CollisionChecker::screen) answers first: its "free" is taken (and the
+/// configuration logged for the final re-check), its "blocked" too while `trust_blocked`; each
+/// check counts once either way.
 pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
     pub(crate) inner: &'a mut C,
     pub(crate) checks: u64,
@@ -82,9 +86,20 @@ pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
     pub(crate) budget: u64,
     /// Ask the inner checker's screen first.
     pub(crate) screen: bool,
-    /// Checks the screen answered (free without `is_free`).
+    /// Take the screen's "blocked" (off for the start and the goals, whose reasons name
+    /// what the exact checker finds).
+    pub(crate) trust_blocked: bool,
+    /// Checks the screen answered.
     pub(crate) screened: u64,
+    /// The configurations the screen called free, for the final re-check, at most
+    /// [`VOUCHED_LOG`]; `vouched_lost` when more were.
+    pub(crate) vouched: Vec<[f64; 6]>,
+    pub(crate) vouched_lost: bool,
 }
+
+/// Most configurations the screen called free that a query remembers for the final re-check
+/// (48 bytes each); past it, the final path is re-checked at its own edge resolution instead.
+pub(crate) const VOUCHED_LOG: usize = 1 << 20;
 
 impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
     pub(crate) fn new(inner: &'a mut C) -> Self {
@@ -93,7 +108,10 @@ impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
             checks: 0,
             budget: u64::MAX,
             screen: true,
+            trust_blocked: true,
             screened: 0,
+            vouched: Vec::new(),
+            vouched_lost: false,
         }
     }
 
@@ -109,9 +127,23 @@ impl<C: CollisionChecker + ?Sized> CollisionChecker for Counting<'_, C> {
             return false;
         }
         self.checks += 1;
-        if self.screen && self.inner.certainly_free(q) {
-            self.screened += 1;
-            return true;
+        if self.screen {
+            match self.inner.screen(q) {
+                Some(true) => {
+                    self.screened += 1;
+                    if self.vouched.len() < VOUCHED_LOG {
+                        self.vouched.push(*q);
+                    } else {
+                        self.vouched_lost = true;
+                    }
+                    return true;
+                }
+                Some(false) if self.trust_blocked => {
+                    self.screened += 1;
+                    return false;
+                }
+                _ => {}
+            }
         }
         self.inner.is_free(q)
     }

@@ -90,17 +90,57 @@ enum Attempt {
     ScreenWrong { checks: u64, screened: u64 },
 }
 
-/// True when every vertex of `path` and every segment between them is free at `res`, checked
-/// by `checker` (its screen off).
+/// Joint-space distance (radians) within which a configuration counts as lying on a segment of
+/// the path: rounding of the interpolation, nothing more.
+const ON_PATH: f64 = 1e-9;
+
+/// True when `q` lies on the segment `a`–`b` (within [`ON_PATH`]).
+fn on_segment(q: &[f64; 6], a: &[f64; 6], b: &[f64; 6]) -> bool {
+    let (mut dd, mut dq) = (0.0, 0.0);
+    for j in 0..6 {
+        dd += (b[j] - a[j]) * (b[j] - a[j]);
+        dq += (q[j] - a[j]) * (b[j] - a[j]);
+    }
+    let t = if dd > 0.0 { (dq / dd).clamp(0.0, 1.0) } else { 0.0 };
+    let mut e = 0.0;
+    for j in 0..6 {
+        let d = a[j] + (b[j] - a[j]) * t - q[j];
+        e += d * d;
+    }
+    e <= ON_PATH * ON_PATH
+}
+
+/// The exact re-check of a path the screen helped find: every configuration the screen called
+/// free that lies on `path` (the configurations its segments were checked at, at the edge
+/// resolution, also where a shortcut split a checked segment) is checked again by `checker`
+/// with its screen off. When the log of such configurations overflowed, every vertex and
+/// every segment of `path` is checked at `res` instead. True when all are free.
 fn revalidate<C: CollisionChecker + ?Sized>(
     checker: &mut Counting<'_, C>,
     path: &[[f64; 6]],
     res: &super::edge::Resolution,
 ) -> bool {
-    path.iter().all(|q| checker.is_free(q))
-        && path
-            .windows(2)
-            .all(|w| check_segment(checker, &w[0], &w[1], res).is_ok())
+    checker.screen = false;
+    if checker.vouched_lost {
+        return path.iter().all(|q| checker.is_free(q))
+            && path
+                .windows(2)
+                .all(|w| check_segment(checker, &w[0], &w[1], res).is_ok());
+    }
+    let mut on: Vec<[f64; 6]> = std::mem::take(&mut checker.vouched)
+        .into_iter()
+        .filter(|q| path.windows(2).any(|w| on_segment(q, &w[0], &w[1])))
+        .collect();
+    // Each configuration once, in a fixed order.
+    on.sort_by(|x, y| {
+        x.iter()
+            .zip(y)
+            .map(|(a, b)| a.total_cmp(b))
+            .find(|o| o.is_ne())
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    on.dedup();
+    on.iter().all(|q| checker.is_free(q))
 }
 
 /// One planning attempt, with the checker's screen asked first (`screen`) or not.
@@ -118,6 +158,8 @@ fn attempt<C: CollisionChecker + ?Sized>(
     };
     let mut checker = Counting::new(checker);
     checker.screen = screen;
+    // The start's and the goals' reasons name what the exact checker finds.
+    checker.trust_blocked = false;
     let fail = |reason: PlanFailure, mut stats: PlanStats, checks: u64| {
         stats.collision_checks = checks;
         stats.planning_time = started.elapsed();
@@ -170,6 +212,7 @@ fn attempt<C: CollisionChecker + ?Sized>(
         }
     }
     stats.free_goals = free.len();
+    checker.trust_blocked = true;
     if free.is_empty() {
         let named: Vec<_> = blocked
             .iter()
@@ -258,13 +301,13 @@ fn attempt<C: CollisionChecker + ?Sized>(
     stats.waypoints = path.len();
     // From here on every check is exact: the path the screen passed is re-checked, and the
     // corner arcs are checked, with the checker's exact test alone.
-    checker.screen = false;
-    if checker.screened > 0 && !revalidate(&mut checker, &path, &res) {
+    if checker.screen && checker.screened > 0 && !revalidate(&mut checker, &path, &res) {
         return Attempt::ScreenWrong {
             checks: checker.checks,
             screened: checker.screened,
         };
     }
+    checker.screen = false;
     let smoothed = smooth(&mut checker, &path, config.blend_deviation, &res);
     stats.blends = smoothed.blends;
     let trajectory = PathTrajectory::new(smoothed, path, &config.limits);

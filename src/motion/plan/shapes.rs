@@ -117,6 +117,47 @@ pub fn near(x: &Shape, y: &Shape, gap: f64) -> bool {
     }
 }
 
+/// True only when `x` and `y` certainly come closer than `d` metres: exact for every pair but
+/// two boxes, which count only when they overlap and `d` is positive (beyond 1 µm).
+pub fn within(x: &Shape, y: &Shape, d: f64) -> bool {
+    use Shape::*;
+    match (x, y) {
+        (
+            Capsule { a, b, radius },
+            Capsule {
+                a: c,
+                b: e,
+                radius: r2,
+            },
+        ) => {
+            let t = radius + r2 + d;
+            t > 0.0 && segment_segment_dist2(a, b, c, e) < t * t
+        }
+        (Capsule { a, b, radius }, Box { center, axes, half })
+        | (Box { center, axes, half }, Capsule { a, b, radius }) => {
+            let t = radius + d;
+            t > 0.0 && segment_box_dist2(a, b, center, axes, half) < t * t
+        }
+        (
+            Box {
+                center: c1,
+                axes: a1,
+                half: h1,
+            },
+            Box {
+                center: c2,
+                axes: a2,
+                half: h2,
+            },
+        ) => d > 1e-6 && boxes_overlap(c1, a1, h1, c2, a2, h2),
+        (Capsule { .. } | Box { .. }, HalfSpace { .. }) | (HalfSpace { .. }, Capsule { .. } | Box { .. }) => {
+            // The nearness test of a half-space is exact.
+            near(x, y, d)
+        }
+        (HalfSpace { .. }, HalfSpace { .. }) => false,
+    }
+}
+
 /// Squared distance between segments `p1`–`q1` and `p2`–`q2` (Ericson, *Real-Time Collision
 /// Detection*, 5.1.9), metres².
 pub fn segment_segment_dist2(p1: &V3, q1: &V3, p2: &V3, q2: &V3) -> f64 {
@@ -448,5 +489,15 @@ mod tests {
         assert!(near(&pad, &block, 0.101));
         assert!(!near(&block, &floor, 0.149));
         assert!(near(&block, &floor, 0.151));
+        // `within` is exact where it answers.
+        assert!(within(&cap, &block, 0.101) && !within(&cap, &block, 0.099));
+        assert!(within(&cap, &floor, 0.051) && !within(&cap, &floor, 0.049));
+        assert!(!within(&pad, &block, 0.101), "two boxes apart: no answer");
+        let inside = Shape::Box {
+            center: [0.21, 0.0, 0.2],
+            axes: I,
+            half: [0.05; 3],
+        };
+        assert!(within(&inside, &block, 0.001) && !within(&inside, &block, 0.0));
     }
 }

@@ -433,8 +433,8 @@ fn the_stats_summary_is_one_line_with_the_counts() {
     assert_eq!(m.stats.collision_checks, c.checks);
 }
 
-/// A checker with a screen: `inner` decides, the screen vouches for free configurations whose
-/// joint 1 is farther than `clear_above` from 0 (a lying screen vouches for everything).
+/// A checker with a screen: `inner` decides, the screen answers for configurations whose joint
+/// 1 is farther than `clear_above` from 0 (a lying screen calls everything free).
 struct Screened {
     inner: JointBoxes,
     clear_above: f64,
@@ -449,9 +449,12 @@ impl CollisionChecker for Screened {
     fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
         self.inner.collisions(q)
     }
-    fn certainly_free(&mut self, q: &[f64; 6]) -> bool {
+    fn screen(&mut self, q: &[f64; 6]) -> Option<bool> {
         self.asked += 1;
-        self.lies || (q[0].abs() > self.clear_above && self.inner.is_free(q))
+        if self.lies {
+            return Some(true);
+        }
+        (q[0].abs() > self.clear_above).then(|| self.inner.is_free(q))
     }
 }
 
