@@ -42,6 +42,14 @@ enum Local {
 }
 
 impl Local {
+    /// Radius of a sphere about the shape's centre that contains it, metres.
+    fn reach(&self) -> f64 {
+        match self {
+            Local::Capsule { a, b, radius } => (b - a).norm() / 2.0 + radius,
+            Local::Box { half, .. } => (half[0] * half[0] + half[1] * half[1] + half[2] * half[2]).sqrt(),
+        }
+    }
+
     fn posed(&self, r: &Matrix3<f64>, t: &Vector3<f64>) -> Shape {
         match self {
             Local::Capsule { a, b, radius } => {
@@ -69,13 +77,31 @@ impl Local {
     }
 }
 
-/// One arm link: its body's offset from its parent and its hinge.
+/// One arm link: its body's offset from its parent (rotation, translation) and its hinge.
 #[derive(Clone, Copy, Debug)]
 struct Link {
-    offset: Isometry3<f64>,
-    axis: Unit<Vector3<f64>>,
+    rot: Matrix3<f64>,
+    pos: Vector3<f64>,
+    axis: Vector3<f64>,
     anchor: Vector3<f64>,
     qpos0: f64,
+}
+
+/// Rotation by `angle` radians about the unit `axis` (Rodrigues).
+fn axis_angle(a: &Vector3<f64>, angle: f64) -> Matrix3<f64> {
+    let (s, c) = angle.sin_cos();
+    let t = 1.0 - c;
+    Matrix3::new(
+        c + t * a.x * a.x,
+        t * a.x * a.y - s * a.z,
+        t * a.x * a.z + s * a.y,
+        t * a.x * a.y + s * a.z,
+        c + t * a.y * a.y,
+        t * a.y * a.z - s * a.x,
+        t * a.x * a.z - s * a.y,
+        t * a.y * a.z + s * a.x,
+        c + t * a.z * a.z,
+    )
 }
 
 /// One pair to test: two shape indices (moving shapes first, then fixed ones), the distance
@@ -94,12 +120,12 @@ struct Pair {
 /// The conservative model of one snapshot of the cell (see the module docs).
 #[derive(Clone, Debug)]
 pub struct Screen {
-    /// World pose of the first arm link's parent body.
-    base: Isometry3<f64>,
+    /// World pose of the first arm link's parent body (rotation, translation).
+    base: (Matrix3<f64>, Vector3<f64>),
     links: [Link; 6],
     /// Shapes moved by the arm: (link index 0..6, shape in the link's frame, whether the
     /// shape is the geom itself rather than a bound of it).
-    moving: Vec<(usize, Local, bool)>,
+    moving: Vec<(usize, Local, bool, f64)>,
     /// Fixed shapes, world frame, with their bounding spheres and exactness.
     fixed: Vec<Posed>,
     pairs: Vec<Pair>,
@@ -215,19 +241,18 @@ impl Screen {
             )
         };
         let p0 = parent[b.link_bodies[0]] as usize;
-        let base = iso(&d.xpos()[p0], &d.xmat()[p0]);
+        let base = (mat(&d.xmat()[p0]), Vector3::from(d.xpos()[p0]));
         let links: [Link; 6] = std::array::from_fn(|k| {
             let body = b.link_bodies[k];
             let j = b.joints[k];
             let (p, q) = (m.body_pos()[body], m.body_quat()[body]);
             let ax = m.jnt_axis()[j];
             let an = m.jnt_pos()[j];
+            let offset = UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]));
             Link {
-                offset: Isometry3::from_parts(
-                    Translation3::new(p[0], p[1], p[2]),
-                    UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3])),
-                ),
-                axis: Unit::new_normalize(Vector3::new(ax[0], ax[1], ax[2])),
+                rot: offset.to_rotation_matrix().into_inner(),
+                pos: Vector3::new(p[0], p[1], p[2]),
+                axis: Unit::new_normalize(Vector3::new(ax[0], ax[1], ax[2])).into_inner(),
                 anchor: Vector3::new(an[0], an[1], an[2]),
                 qpos0: m.qpos0()[m.jnt_qposadr()[j] as usize],
             }
@@ -241,7 +266,7 @@ impl Screen {
         let collidable = |g: usize| ct[g] != 0 || ca[g] != 0;
         // Index of each geom's shape: moving ones first, then fixed ones.
         let mut index: Vec<Option<usize>> = vec![None; ngeom];
-        let mut moving: Vec<(usize, Local, bool)> = Vec::new();
+        let mut moving: Vec<(usize, Local, bool, f64)> = Vec::new();
         let mut fixed: Vec<Posed> = Vec::new();
         let mut fixed_geoms: Vec<usize> = Vec::new();
         for g in 0..ngeom {
@@ -276,7 +301,8 @@ impl Screen {
                 let rel_r = lr * gr;
                 let rel_t = lr * (gt - link.translation.vector);
                 index[g] = Some(moving.len());
-                moving.push((k as usize - 1, moved(&l, &rel_r, &rel_t), exact(m, g)));
+                let local = moved(&l, &rel_r, &rel_t);
+                moving.push((k as usize - 1, local, exact(m, g), local.reach()));
             }
         }
         for (i, &g) in fixed_geoms.iter().enumerate() {
@@ -372,16 +398,16 @@ impl Screen {
     /// World poses of the six arm links at joints `q` (radians), as `mj_kinematics` computes
     /// them: parent pose · body offset · rotation about the joint axis through its anchor.
     pub fn link_poses(&self, q: &[f64; 6]) -> [(Matrix3<f64>, Vector3<f64>); 6] {
-        let mut pose = self.base;
+        let (mut r, mut t) = self.base;
         std::array::from_fn(|k| {
             let l = &self.links[k];
-            let mut p = pose * l.offset;
-            let rot = UnitQuaternion::from_axis_angle(&l.axis, q[k] - l.qpos0);
-            // Rotation about the axis through the anchor: x ↦ anchor + R (x − anchor).
-            let shift = l.anchor - rot * l.anchor;
-            p = p * Isometry3::from_parts(Translation3::from(shift), rot);
-            pose = p;
-            (p.rotation.to_rotation_matrix().into_inner(), p.translation.vector)
+            t += r * l.pos;
+            r *= l.rot;
+            let j = axis_angle(&l.axis, q[k] - l.qpos0);
+            // Rotation about the axis through the anchor: x ↦ anchor + J (x − anchor).
+            t += r * (l.anchor - j * l.anchor);
+            r *= j;
+            (r, t)
         })
     }
 
@@ -397,10 +423,18 @@ impl Screen {
     pub fn decide(&mut self, q: &[f64; 6]) -> (Option<bool>, Option<(usize, usize)>) {
         let frames = self.link_poses(q);
         self.posed.clear();
-        for (k, l, e) in &self.moving {
+        for (k, l, e, reach) in &self.moving {
             let (r, t) = &frames[*k];
             let s = l.posed(r, t);
-            self.posed.push((s, s.bounding_sphere(), *e));
+            let sphere = match &s {
+                Shape::Capsule { a, b, .. } => (
+                    [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0, (a[2] + b[2]) / 2.0],
+                    *reach,
+                ),
+                Shape::Box { center, .. } => (*center, *reach),
+                Shape::HalfSpace { .. } => ([0.0; 3], f64::INFINITY),
+            };
+            self.posed.push((s, Some(sphere), *e));
         }
         let nm = self.posed.len();
         let mut unsure = false;

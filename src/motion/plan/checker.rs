@@ -77,8 +77,8 @@ impl fmt::Display for Collision {
 /// while a budget is set, answers "blocked" without asking once the budget is used (a refusal
 /// never lets a collision through; it only ends the search). While `screen` is on, the inner
 /// checker's [`screen`](CollisionChecker::screen) answers first: its "free" is taken (and the
-/// configuration logged for the final re-check), its "blocked" too while `trust_blocked`; each
-/// check counts once either way.
+/// configuration logged for the final re-check), its "blocked" too; each check counts once
+/// either way.
 pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
     pub(crate) inner: &'a mut C,
     pub(crate) checks: u64,
@@ -86,9 +86,6 @@ pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
     pub(crate) budget: u64,
     /// Ask the inner checker's screen first.
     pub(crate) screen: bool,
-    /// Take the screen's "blocked" (off for the start and the goals, whose reasons name
-    /// what the exact checker finds).
-    pub(crate) trust_blocked: bool,
     /// Checks the screen answered.
     pub(crate) screened: u64,
     /// The configurations the screen called free, for the final re-check, at most
@@ -108,7 +105,6 @@ impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
             checks: 0,
             budget: u64::MAX,
             screen: true,
-            trust_blocked: true,
             screened: 0,
             vouched: Vec::new(),
             vouched_lost: false,
@@ -138,7 +134,7 @@ impl<C: CollisionChecker + ?Sized> CollisionChecker for Counting<'_, C> {
                     }
                     return true;
                 }
-                Some(false) if self.trust_blocked => {
+                Some(false) => {
                     self.screened += 1;
                     return false;
                 }

@@ -157,9 +157,10 @@ fn attempt<C: CollisionChecker + ?Sized>(
         ..PlanStats::default()
     };
     let mut checker = Counting::new(checker);
-    checker.screen = screen;
-    // The start's and the goals' reasons name what the exact checker finds.
-    checker.trust_blocked = false;
+    // The start, the goals and the direct segments are checked exactly: their reasons name what
+    // the exact checker finds, and a free direct segment is the path (the screen would only
+    // add the re-check). The screen helps the search, the shortcuts and nothing else.
+    checker.screen = false;
     let fail = |reason: PlanFailure, mut stats: PlanStats, checks: u64| {
         stats.collision_checks = checks;
         stats.planning_time = started.elapsed();
@@ -212,7 +213,6 @@ fn attempt<C: CollisionChecker + ?Sized>(
         }
     }
     stats.free_goals = free.len();
-    checker.trust_blocked = true;
     if free.is_empty() {
         let named: Vec<_> = blocked
             .iter()
@@ -250,6 +250,7 @@ fn attempt<C: CollisionChecker + ?Sized>(
         }
     }
     stats.stage_checks[0] = checker.checks;
+    checker.screen = screen;
     if found.is_none() {
         let free_configs: Vec<[f64; 6]> = free.iter().map(|&i| goals.configs[i]).collect();
         let (outcome, log) = rrt_connect(&mut checker, start, &free_configs, config, started);
