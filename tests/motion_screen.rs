@@ -39,6 +39,9 @@ const SHELF: &str = "objects:
   top: {obstacle: {size: [0.25, 0.40, 0.02]}, pose: [0.3, 0.45]}
 ";
 
+/// Obstacles moved after the scene is built: (name, position of the bottom centre, metres).
+type Placed<'a> = &'a [(&'a str, [f64; 3])];
+
 fn cell(yaml: &str, placed: &[(&str, [f64; 3])]) -> (Scene, Sim) {
     let spec = SceneSpec::from_str(yaml, "screen.yaml").expect("valid scene");
     let scene = Scene::load_spec(&spec).expect("scene (run tools/bootstrap)");
@@ -156,7 +159,7 @@ fn report(what: &str, t: &Tally) {
 
 #[test]
 fn the_screen_never_calls_free_what_mujoco_finds_in_contact() {
-    let cells: [(&str, &str, &[(&str, [f64; 3])]); 3] = [
+    let cells: [(&str, &str, Placed); 3] = [
         ("bin", BIN, &[]),
         ("clutter", CLUTTER, &[]),
         ("shelf", SHELF, &[("top", [0.675, 0.0, 0.30])]),

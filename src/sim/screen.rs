@@ -269,7 +269,7 @@ impl Screen {
         let mut moving: Vec<(usize, Local, bool, f64)> = Vec::new();
         let mut fixed: Vec<Posed> = Vec::new();
         let mut fixed_geoms: Vec<usize> = Vec::new();
-        for g in 0..ngeom {
+        for (g, slot) in index.iter_mut().enumerate() {
             if !collidable(g) {
                 continue;
             }
@@ -300,7 +300,7 @@ impl Screen {
                 let lr = link.rotation.to_rotation_matrix().into_inner().transpose();
                 let rel_r = lr * gr;
                 let rel_t = lr * (gt - link.translation.vector);
-                index[g] = Some(moving.len());
+                *slot = Some(moving.len());
                 let local = moved(&l, &rel_r, &rel_t);
                 moving.push((k as usize - 1, local, exact(m, g), local.reach()));
             }

@@ -53,6 +53,13 @@ fn in_bounds(q: &[f64; 6], config: &PlannerConfig) -> bool {
 /// configuration the arm passes through was checked, at the edge resolution
 /// ([`PlannerConfig::edge_resolution`]) along segments and arcs.
 ///
+/// The search and the shortcuts ask the checker's [`screen`](CollisionChecker::screen) first
+/// and `is_free` only when it cannot tell; every configuration of the shortcut path the screen
+/// called free is then checked again with `is_free` alone (so are the corner arcs), and if one
+/// is blocked the query is planned again with `is_free` alone
+/// ([`PlanStats::screen_fallback`]). The start, the goals and the direct segments are checked
+/// with `is_free` alone.
+///
 /// # Errors
 /// A [`PlanError`]: the typed reason, and the statistics of the attempt.
 pub fn plan<C: CollisionChecker + ?Sized>(
@@ -81,7 +88,8 @@ pub fn plan<C: CollisionChecker + ?Sized>(
     }
 }
 
-/// How one attempt ended.
+/// How one attempt ended (short-lived: the size difference of the variants does not matter).
+#[allow(clippy::large_enum_variant)]
 enum Attempt {
     /// A motion or a reason.
     Done(Result<PlannedMotion, PlanError>),
