@@ -354,7 +354,7 @@ fn main() {
         },
     ];
     println!(
-        "motion planner benchmark: {n} queries per family, MuJoCo checker (margin {} mm), edge resolution {} rad{}, one thread",
+        "motion planner benchmark: {n} queries per family, the conservative screen then the MuJoCo checker (margin {} mm), edge resolution {} rad{}, one thread",
         DEFAULT_MARGIN * 1e3,
         PlannerConfig::default().resolution,
         if coarse {
@@ -391,7 +391,12 @@ fn main() {
             sim.data_mut().mocap_pos_mut()[m] = *at;
         }
         let mut checker = SceneChecker::from_sim(&sim, DEFAULT_MARGIN).expect("checker");
+        // The same query planned with MuJoCo checks only (no screen), interleaved: the times
+        // before the screen, in the same run.
+        let mut plain = SceneChecker::from_sim(&sim, DEFAULT_MARGIN).expect("checker");
+        plain.set_screen(false);
         let mut exact = SceneChecker::from_sim(&sim, 0.0).expect("checker");
+        let (mut plain_times, mut same, mut screened, mut fallbacks) = (Vec::new(), 0, 0u64, 0);
         let mut clean = 0;
         let mut worst: Vec<Collision> = Vec::new();
         let mut rng = ChaCha8Rng::seed_from_u64(0x0B07_0100);
@@ -430,11 +435,26 @@ fn main() {
                 max_displacement: if coarse { f64::INFINITY } else { 0.01 },
                 ..PlannerConfig::default()
             };
+            let before = plan(&mut plain, &q.start, &goals, &config);
             let out = plan(&mut checker, &q.start, &goals, &config);
             let stats = match &out {
                 Ok(m) => m.stats.clone(),
                 Err(e) => (*e.stats).clone(),
             };
+            let plain_stats = match &before {
+                Ok(m) => m.stats.clone(),
+                Err(e) => (*e.stats).clone(),
+            };
+            plain_times.push(plain_stats.planning_time.as_secs_f64() * 1e3);
+            screened += stats.screened;
+            fallbacks += usize::from(stats.screen_fallback);
+            same += usize::from(match (&before, &out) {
+                (Ok(a), Ok(b)) => {
+                    a.raw_path == b.raw_path && a.trajectory.waypoints() == b.trajectory.waypoints()
+                }
+                (Err(a), Err(b)) => a.reason.name() == b.reason.name(),
+                _ => false,
+            });
             times.push(stats.planning_time.as_secs_f64() * 1e3);
             for (s, c) in stages.iter_mut().zip(stats.stage_checks) {
                 *s += c;
@@ -503,7 +523,9 @@ fn main() {
                 }
             }
         }
+        let total_checks: f64 = checks.iter().sum();
         times.sort_by(f64::total_cmp);
+        plain_times.sort_by(f64::total_cmp);
         checks.sort_by(f64::total_cmp);
         let mean = |v: &[f64]| {
             if v.is_empty() {
@@ -535,6 +557,15 @@ fn main() {
             mean(&lengths),
             mean(&durations),
             reason
+        );
+        println!(
+            "    MuJoCo only (no screen), the same queries interleaved: p50 {:.2} ms, p95 {:.2} ms, max {:.2} ms (screen: p50 {:.2}x, p95 {:.2}x faster); same outcome and path {same}/{n}; checks answered by the screen {:.2}; fell back to exact {fallbacks}",
+            quantile(&plain_times, 0.5),
+            quantile(&plain_times, 0.95),
+            plain_times.last().copied().unwrap_or(f64::NAN),
+            quantile(&plain_times, 0.5) / quantile(&times, 0.5),
+            quantile(&plain_times, 0.95) / quantile(&times, 0.95),
+            screened as f64 / total_checks.max(1.0),
         );
         let total: u64 = stages.iter().sum::<u64>().max(1);
         println!(

@@ -143,6 +143,14 @@ impl CollisionChecker for Allowing<'_> {
         all.retain(|c| self.counts(c));
         all
     }
+
+    /// The inner checker's "certainly free" (what keeps the margin from everything is free
+    /// whatever is allowed; its "blocked" may be an allowed pair). Counted as a check.
+    fn screen(&mut self, q: &[f64; 6]) -> Option<bool> {
+        let free = self.inner.screen(q) == Some(true);
+        self.checks += u64::from(free);
+        free.then_some(true)
+    }
 }
 
 /// Resolution of the check of a leaf's direct motion: samples at most 0.05 rad of any joint

@@ -25,6 +25,7 @@ use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
 
 use super::error::SimError;
 use super::scene::{ARM_JOINTS, Scene};
+use super::screen::{Build, Screen};
 use crate::motion::fk;
 use crate::motion::plan::{Collision, CollisionChecker};
 use crate::scene::OBJECT_PREFIX;
@@ -70,6 +71,13 @@ pub struct SceneChecker {
     /// Private data built before for other (held block, margin) pairs, so a hold or release
     /// swaps data instead of copying the model again (a copy takes tens of milliseconds).
     built: Vec<(BuildKey, MjData<Arc<MjModel>>)>,
+    /// The conservative fast model of the current snapshot ([`Screen`]), built on first use
+    /// after a change; `None` inside when the cell has geometry it cannot bound.
+    screen: Option<Option<Screen>>,
+    /// Whether [`CollisionChecker::screen`] asks the screen (default true).
+    screen_on: bool,
+    /// Body and joint ids of the six arm links.
+    arm_links: ([usize; 6], [usize; 6]),
 }
 
 /// What a private model is edited for: the held block (scene index), the margin's bits.
@@ -152,6 +160,8 @@ impl SceneChecker {
             .map(|g| src.geom_contype()[g] != 0 || src.geom_conaffinity()[g] != 0)
             .collect();
         let labels = (0..ngeom).map(|g| label(src, g)).collect();
+        let joints: [usize; 6] = std::array::from_fn(|k| arm_joints[k]);
+        let bodies: [usize; 6] = std::array::from_fn(|k| src.jnt_bodyid()[arm_joints[k]] as usize);
         let mut checker = Self {
             scene: scene.clone(),
             // Replaced by a private copy of the model in `rebuild_model` below.
@@ -164,6 +174,9 @@ impl SceneChecker {
             margin,
             built_for: None,
             built: Vec::new(),
+            screen: None,
+            screen_on: true,
+            arm_links: (bodies, joints),
         };
         checker.rebuild_model();
         checker.sync(data)?;
@@ -181,6 +194,7 @@ impl SceneChecker {
     /// Writes the contact bitmasks and margins of the private model for the current groups
     /// (a held block joins the wrist-3 group) and margin.
     fn rebuild_model(&mut self) {
+        self.screen = None;
         let key = (self.held.as_ref().map(|h| h.object), self.margin.to_bits());
         if self.built_for == Some(key) {
             return;
@@ -309,6 +323,7 @@ impl SceneChecker {
         self.data.mocap_quat_mut().copy_from_slice(data.mocap_quat());
         let ids = &self.scene.ids;
         self.snapshot_q = ids.arm_qpos.map(|a| data.qpos()[a]);
+        self.screen = None;
         if let Some(h) = self.held.clone() {
             self.hold(h.object)?;
         }
@@ -340,6 +355,7 @@ impl SceneChecker {
             qpos,
             in_pinch,
         });
+        self.screen = None;
         if regroup {
             self.rebuild_model();
         }
@@ -352,6 +368,7 @@ impl SceneChecker {
             // Back at its snapshot pose: the pose at the snapshot's arm joints.
             let pose = fk(&self.snapshot_q) * h.in_pinch;
             write_pose(self.data.qpos_mut(), h.qpos, &pose);
+            self.screen = None;
             self.rebuild_model();
         }
     }
@@ -386,6 +403,17 @@ impl SceneChecker {
     /// Poses the arm (and a held block) at `q` and runs MuJoCo's collision detection; the
     /// number of contacts that count.
     fn detect(&mut self, q: &[f64; 6]) -> usize {
+        self.detect_pose(q);
+        self.data.collision();
+        self.data
+            .contact()
+            .iter()
+            .filter(|c| c.dist < self.margin)
+            .count()
+    }
+
+    /// Poses the arm (and a held block) at `q` with `mj_kinematics`.
+    fn detect_pose(&mut self, q: &[f64; 6]) {
         let ids = self.scene.ids.arm_qpos;
         {
             let qpos = self.data.qpos_mut();
@@ -399,12 +427,6 @@ impl SceneChecker {
             write_pose(self.data.qpos_mut(), at, &pose);
         }
         self.data.kinematics();
-        self.data.collision();
-        self.data
-            .contact()
-            .iter()
-            .filter(|c| c.dist < self.margin)
-            .count()
     }
 }
 
@@ -420,6 +442,15 @@ impl CollisionChecker for SceneChecker {
             return false;
         }
         self.detect(q) == 0
+    }
+
+    /// The [`Screen`]'s verdict ([`Screen::classify`]); `None` when the screen is off or the
+    /// cell has geometry it cannot bound.
+    fn screen(&mut self, q: &[f64; 6]) -> Option<bool> {
+        if !self.screen_on || !q.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        self.screen_model()?.classify(q)
     }
 
     fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
@@ -455,6 +486,40 @@ impl CollisionChecker for SceneChecker {
 }
 
 impl SceneChecker {
+    /// Turns the conservative screen on or off (on by default); off, the planner checks every
+    /// configuration with MuJoCo alone, as it did before the screen existed.
+    pub fn set_screen(&mut self, on: bool) {
+        self.screen_on = on;
+    }
+
+    /// The screen of the current snapshot, built if needed; `None` when the cell has geometry it
+    /// cannot bound.
+    pub fn screen_model(&mut self) -> Option<&mut Screen> {
+        if self.screen.is_none() {
+            // Pose the private data at the snapshot's joints (a held block from the pinch).
+            let q = self.snapshot_q;
+            self.detect_pose(&q);
+            let mut group = self.group.clone();
+            if let Some(h) = &self.held {
+                let [g0, g1] = self.scene.objects[h.object].geoms;
+                for g in group.iter_mut().take(g1).skip(g0) {
+                    *g = WRIST_3;
+                }
+            }
+            let built = Screen::build(&Build {
+                data: &self.data,
+                group: &group,
+                link_bodies: self.arm_links.0,
+                joints: self.arm_links.1,
+            });
+            if built.is_none() {
+                tracing::debug!(target: "macrotree::plan", "no collision screen for this cell: MuJoCo checks every configuration");
+            }
+            self.screen = Some(built);
+        }
+        self.screen.as_mut().and_then(Option::as_mut)
+    }
+
     fn group_of(&self, g: usize) -> u8 {
         match &self.held {
             Some(h)

@@ -8,6 +8,7 @@ pub mod layout;
 pub mod mjcf;
 pub mod planning;
 pub mod scene;
+pub mod screen;
 pub mod simulator;
 
 pub use collision::SceneChecker;

@@ -18,6 +18,18 @@ pub trait CollisionChecker {
     fn collisions(&mut self, _q: &[f64; 6]) -> Vec<Collision> {
         Vec::new()
     }
+
+    /// A fast screen, asked before [`is_free`](Self::is_free): `Some(true)` only when `q`
+    /// (radians) is certainly free (e.g. a model that bounds every part of the robot and the
+    /// scene keeps the margin), `Some(false)` only when it is certainly blocked (exact shapes
+    /// deeper than the margin), `None` when it cannot tell (the default: no screen). The
+    /// planner searches and shortcuts with "screen, else `is_free`" (the start and the goals
+    /// with `is_free` unless certainly free), then re-checks with `is_free` alone every
+    /// configuration of the final path the screen called free, so a screen that errs towards
+    /// "free" only costs time, never a collision.
+    fn screen(&mut self, _q: &[f64; 6]) -> Option<bool> {
+        None
+    }
 }
 
 impl<C: CollisionChecker + ?Sized> CollisionChecker for &mut C {
@@ -26,6 +38,9 @@ impl<C: CollisionChecker + ?Sized> CollisionChecker for &mut C {
     }
     fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
         (**self).collisions(q)
+    }
+    fn screen(&mut self, q: &[f64; 6]) -> Option<bool> {
+        (**self).screen(q)
     }
 }
 
@@ -60,13 +75,28 @@ impl fmt::Display for Collision {
 
 /// A checker that counts the configurations it is asked about (the planner's statistics) and,
 /// while a budget is set, answers "blocked" without asking once the budget is used (a refusal
-/// never lets a collision through; it only ends the search).
+/// never lets a collision through; it only ends the search). While `screen` is on, the inner
+/// checker's [`screen`](CollisionChecker::screen) answers first: its "free" is taken (and the
+/// configuration logged for the final re-check), its "blocked" too; each check counts once
+/// either way.
 pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
     pub(crate) inner: &'a mut C,
     pub(crate) checks: u64,
     /// Checks at most (`u64::MAX`: none).
     pub(crate) budget: u64,
+    /// Ask the inner checker's screen first.
+    pub(crate) screen: bool,
+    /// Checks the screen answered.
+    pub(crate) screened: u64,
+    /// The configurations the screen called free, for the final re-check, at most
+    /// [`VOUCHED_LOG`]; `vouched_lost` when more were.
+    pub(crate) vouched: Vec<[f64; 6]>,
+    pub(crate) vouched_lost: bool,
 }
+
+/// Most configurations the screen called free that a query remembers for the final re-check
+/// (48 bytes each); past it, the final path is re-checked at its own edge resolution instead.
+pub(crate) const VOUCHED_LOG: usize = 1 << 20;
 
 impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
     pub(crate) fn new(inner: &'a mut C) -> Self {
@@ -74,6 +104,10 @@ impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
             inner,
             checks: 0,
             budget: u64::MAX,
+            screen: true,
+            screened: 0,
+            vouched: Vec::new(),
+            vouched_lost: false,
         }
     }
 
@@ -89,6 +123,24 @@ impl<C: CollisionChecker + ?Sized> CollisionChecker for Counting<'_, C> {
             return false;
         }
         self.checks += 1;
+        if self.screen {
+            match self.inner.screen(q) {
+                Some(true) => {
+                    self.screened += 1;
+                    if self.vouched.len() < VOUCHED_LOG {
+                        self.vouched.push(*q);
+                    } else {
+                        self.vouched_lost = true;
+                    }
+                    return true;
+                }
+                Some(false) => {
+                    self.screened += 1;
+                    return false;
+                }
+                _ => {}
+            }
+        }
         self.inner.is_free(q)
     }
     fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {

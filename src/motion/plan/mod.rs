@@ -6,7 +6,8 @@
 //! yaws) and a [`PlannerConfig`], and returns a [`PlannedMotion`] whose [`PathTrajectory`] the
 //! cell tracks like any [`Trajectory`](crate::motion::Trajectory), or a [`PlanError`] with a typed
 //! [`PlanFailure`] naming the colliding pairs. The search is seeded RRT-Connect towards all free
-//! goals at once after the direct segment is tried; the path is shortcut (seeded), its corners
+//! goals at once after the direct segment is tried, asking the checker's fast screen first
+//! (re-checking the final path without it); the path is shortcut (seeded), its corners
 //! blended with checked arcs, and timed within per-joint [`JointLimits`]. Same checker, query and
 //! seed → the same path, bit for bit; see `docs/motion.md`.
 //!
@@ -24,6 +25,7 @@
 //! | [`stats`] | [`PlanStats`] and joint-space distances |
 //! | [`planner`] | [`plan`]: one query, stage by stage |
 //! | [`boxes`] | [`JointBoxes`]: obstacles as boxes in joint space, for tests and benchmarks |
+//! | [`shapes`] | capsules, boxes, half-spaces and conservative nearness tests (the screen's geometry) |
 
 pub mod blend;
 pub mod boxes;
@@ -35,6 +37,7 @@ pub mod planner;
 pub mod reason;
 mod rng;
 pub mod rrt;
+pub mod shapes;
 pub mod shortcut;
 pub mod stats;
 pub mod timing;

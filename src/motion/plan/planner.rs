@@ -53,6 +53,13 @@ fn in_bounds(q: &[f64; 6], config: &PlannerConfig) -> bool {
 /// configuration the arm passes through was checked, at the edge resolution
 /// ([`PlannerConfig::edge_resolution`]) along segments and arcs.
 ///
+/// The search and the shortcuts ask the checker's [`screen`](CollisionChecker::screen) first
+/// and `is_free` only when it cannot tell; every configuration of the shortcut path the screen
+/// called free is then checked again with `is_free` alone (so are the corner arcs), and if one
+/// is blocked the query is planned again with `is_free` alone
+/// ([`PlanStats::screen_fallback`]). The start, the goals and the direct segments are checked
+/// with `is_free` alone.
+///
 /// # Errors
 /// A [`PlanError`]: the typed reason, and the statistics of the attempt.
 pub fn plan<C: CollisionChecker + ?Sized>(
@@ -62,18 +69,113 @@ pub fn plan<C: CollisionChecker + ?Sized>(
     config: &PlannerConfig,
 ) -> Result<PlannedMotion, PlanError> {
     let started = Instant::now();
+    match attempt(checker, start, goals, config, true, started) {
+        Attempt::Done(result) => result,
+        Attempt::ScreenWrong { checks, screened } => {
+            tracing::warn!(target: "macrotree::plan", "the collision screen passed a configuration of the final path that the exact check finds blocked: planning again with exact checks only");
+            let Attempt::Done(mut result) = attempt(checker, start, goals, config, false, started) else {
+                unreachable!("an attempt without the screen is never re-checked")
+            };
+            let stats = match &mut result {
+                Ok(m) => &mut m.stats,
+                Err(e) => &mut *e.stats,
+            };
+            stats.collision_checks += checks;
+            stats.screened += screened;
+            stats.screen_fallback = true;
+            result
+        }
+    }
+}
+
+/// How one attempt ended (short-lived: the size difference of the variants does not matter).
+#[allow(clippy::large_enum_variant)]
+enum Attempt {
+    /// A motion or a reason.
+    Done(Result<PlannedMotion, PlanError>),
+    /// The exact re-check of the final path found a configuration the screen had passed blocked
+    /// (the checks spent, and how many of them the screen answered).
+    ScreenWrong { checks: u64, screened: u64 },
+}
+
+/// Joint-space distance (radians) within which a configuration counts as lying on a segment of
+/// the path: rounding of the interpolation, nothing more.
+const ON_PATH: f64 = 1e-9;
+
+/// True when `q` lies on the segment `a`–`b` (within [`ON_PATH`]).
+fn on_segment(q: &[f64; 6], a: &[f64; 6], b: &[f64; 6]) -> bool {
+    let (mut dd, mut dq) = (0.0, 0.0);
+    for j in 0..6 {
+        dd += (b[j] - a[j]) * (b[j] - a[j]);
+        dq += (q[j] - a[j]) * (b[j] - a[j]);
+    }
+    let t = if dd > 0.0 { (dq / dd).clamp(0.0, 1.0) } else { 0.0 };
+    let mut e = 0.0;
+    for j in 0..6 {
+        let d = a[j] + (b[j] - a[j]) * t - q[j];
+        e += d * d;
+    }
+    e <= ON_PATH * ON_PATH
+}
+
+/// The exact re-check of a path the screen helped find: every configuration the screen called
+/// free that lies on `path` (the configurations its segments were checked at, at the edge
+/// resolution, also where a shortcut split a checked segment) is checked again by `checker`
+/// with its screen off. When the log of such configurations overflowed, every vertex and
+/// every segment of `path` is checked at `res` instead. True when all are free.
+fn revalidate<C: CollisionChecker + ?Sized>(
+    checker: &mut Counting<'_, C>,
+    path: &[[f64; 6]],
+    res: &super::edge::Resolution,
+) -> bool {
+    checker.screen = false;
+    if checker.vouched_lost {
+        return path.iter().all(|q| checker.is_free(q))
+            && path
+                .windows(2)
+                .all(|w| check_segment(checker, &w[0], &w[1], res).is_ok());
+    }
+    let mut on: Vec<[f64; 6]> = std::mem::take(&mut checker.vouched)
+        .into_iter()
+        .filter(|q| path.windows(2).any(|w| on_segment(q, &w[0], &w[1])))
+        .collect();
+    // Each configuration once, in a fixed order.
+    on.sort_by(|x, y| {
+        x.iter()
+            .zip(y)
+            .map(|(a, b)| a.total_cmp(b))
+            .find(|o| o.is_ne())
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    on.dedup();
+    on.iter().all(|q| checker.is_free(q))
+}
+
+/// One planning attempt, with the checker's screen asked first (`screen`) or not.
+fn attempt<C: CollisionChecker + ?Sized>(
+    checker: &mut C,
+    start: &[f64; 6],
+    goals: &GoalSet,
+    config: &PlannerConfig,
+    screen: bool,
+    started: Instant,
+) -> Attempt {
     let mut stats = PlanStats {
         goals: goals.len(),
         ..PlanStats::default()
     };
     let mut checker = Counting::new(checker);
+    // The start, the goals and the direct segments are checked exactly: their reasons name what
+    // the exact checker finds, and a free direct segment is the path (the screen would only
+    // add the re-check). The screen helps the search, the shortcuts and nothing else.
+    checker.screen = false;
     let fail = |reason: PlanFailure, mut stats: PlanStats, checks: u64| {
         stats.collision_checks = checks;
         stats.planning_time = started.elapsed();
-        Err(PlanError {
+        Attempt::Done(Err(PlanError {
             reason,
             stats: Box::new(stats),
-        })
+        }))
     };
     if let Err(e) = config.check() {
         return fail(PlanFailure::InvalidQuery { reason: e }, stats, 0);
@@ -156,6 +258,7 @@ pub fn plan<C: CollisionChecker + ?Sized>(
         }
     }
     stats.stage_checks[0] = checker.checks;
+    checker.screen = screen;
     if found.is_none() {
         let free_configs: Vec<[f64; 6]> = free.iter().map(|&i| goals.configs[i]).collect();
         let (outcome, log) = rrt_connect(&mut checker, start, &free_configs, config, started);
@@ -176,6 +279,7 @@ pub fn plan<C: CollisionChecker + ?Sized>(
                     checks: checker.checks,
                     blocking: tally(named),
                 };
+                stats.screened = checker.screened;
                 return fail(reason, stats, checker.checks);
             }
             Search::TimeCap => {
@@ -204,18 +308,28 @@ pub fn plan<C: CollisionChecker + ?Sized>(
     stats.stage_checks[2] = checker.checks - stats.stage_checks[0] - stats.stage_checks[1];
     stats.length = path_length(&path);
     stats.waypoints = path.len();
+    // From here on every check is exact: the path the screen passed is re-checked, and the
+    // corner arcs are checked, with the checker's exact test alone.
+    if checker.screen && checker.screened > 0 && !revalidate(&mut checker, &path, &res) {
+        return Attempt::ScreenWrong {
+            checks: checker.checks,
+            screened: checker.screened,
+        };
+    }
+    checker.screen = false;
     let smoothed = smooth(&mut checker, &path, config.blend_deviation, &res);
     stats.blends = smoothed.blends;
     let trajectory = PathTrajectory::new(smoothed, path, &config.limits);
     stats.duration = crate::motion::trajectory::Trajectory::duration(&trajectory);
     stats.collision_checks = checker.checks;
     stats.stage_checks[3] = checker.checks - stats.stage_checks[..3].iter().sum::<u64>();
+    stats.screened = checker.screened;
     stats.planning_time = started.elapsed();
     debug_assert!(distance(&trajectory.start(), start) == 0.0);
-    Ok(PlannedMotion {
+    Attempt::Done(Ok(PlannedMotion {
         goal,
         raw_path,
         trajectory,
         stats,
-    })
+    }))
 }

@@ -32,18 +32,31 @@ pub struct PlanStats {
     pub duration: f64,
     /// Wall-clock time the query took (for reports only; no decision uses it).
     pub planning_time: Duration,
+    /// Checks the checker's screen answered ([`screen`](super::CollisionChecker::screen))
+    /// without its exact test.
+    pub screened: u64,
+    /// True when the exact re-check of the final path found a configuration the screen had
+    /// passed blocked, and the query was planned again with exact checks only (its checks
+    /// included).
+    pub screen_fallback: bool,
 }
 
 impl PlanStats {
     /// One line for logs: time, nodes, checks, lengths, duration.
     pub fn summary(&self) -> String {
         format!(
-            "{:.2} ms, {} iterations, {} nodes, {} checks ({:?} by stage), {}/{} goals free, length {:.3} rad ({:.3} found), {} waypoints, {} blends, {:.3} s{}",
+            "{:.2} ms, {} iterations, {} nodes, {} checks ({:?} by stage, {} screened{}), {}/{} goals free, length {:.3} rad ({:.3} found), {} waypoints, {} blends, {:.3} s{}",
             self.planning_time.as_secs_f64() * 1e3,
             self.iterations,
             self.nodes,
             self.collision_checks,
             self.stage_checks,
+            self.screened,
+            if self.screen_fallback {
+                ", fell back to exact checks"
+            } else {
+                ""
+            },
             self.free_goals,
             self.goals,
             self.length,

@@ -432,3 +432,77 @@ fn the_stats_summary_is_one_line_with_the_counts() {
     assert!(s.contains(&format!("{} nodes", m.stats.nodes)), "{s}");
     assert_eq!(m.stats.collision_checks, c.checks);
 }
+
+/// A checker with a screen: `inner` decides, the screen answers for configurations whose joint
+/// 1 is farther than `clear_above` from 0 (a lying screen calls everything free).
+struct Screened {
+    inner: JointBoxes,
+    clear_above: f64,
+    lies: bool,
+    asked: u64,
+}
+
+impl CollisionChecker for Screened {
+    fn is_free(&mut self, q: &[f64; 6]) -> bool {
+        self.inner.is_free(q)
+    }
+    fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
+        self.inner.collisions(q)
+    }
+    fn screen(&mut self, q: &[f64; 6]) -> Option<bool> {
+        self.asked += 1;
+        if self.lies {
+            return Some(true);
+        }
+        (q[0].abs() > self.clear_above).then(|| self.inner.is_free(q))
+    }
+}
+
+fn post() -> JointBoxes {
+    JointBoxes::new(vec![wall("post", (-0.3, 0.3), (-1.0, 1.0))]).with_margin(HALF_RES)
+}
+
+#[test]
+fn an_honest_screen_changes_no_path_and_the_final_path_is_rechecked_exactly() {
+    let (start, goal) = (q(-1.0, 0.0), q(1.0, 0.0));
+    for seed in 0..4 {
+        let config = PlannerConfig {
+            seed,
+            ..PlannerConfig::default()
+        };
+        let exact = plan(&mut post(), &start, &GoalSet::configs(vec![goal]), &config).unwrap();
+        let mut s = Screened {
+            inner: post(),
+            clear_above: 0.5,
+            lies: false,
+            asked: 0,
+        };
+        let fast = plan(&mut s, &start, &GoalSet::configs(vec![goal]), &config).unwrap();
+        assert_eq!(exact.raw_path, fast.raw_path, "seed {seed}");
+        assert_eq!(exact.trajectory.waypoints(), fast.trajectory.waypoints());
+        assert!(fast.stats.screened > 0 && s.asked > 0);
+        assert_eq!(exact.stats.screened, 0);
+        assert!(!fast.stats.screen_fallback);
+        // The re-check adds exact checks of the final path, nothing else.
+        assert!(fast.stats.collision_checks > exact.stats.collision_checks);
+        assert_eq!(fast.stats.stage_checks[..3], exact.stats.stage_checks[..3]);
+    }
+}
+
+#[test]
+fn a_screen_that_lies_is_caught_by_the_recheck_and_the_query_planned_exactly() {
+    let (start, goal) = (q(-1.0, 0.0), q(1.0, 0.0));
+    let config = PlannerConfig::default();
+    let mut s = Screened {
+        inner: post(),
+        clear_above: 0.0,
+        lies: true,
+        asked: 0,
+    };
+    let m = plan(&mut s, &start, &GoalSet::configs(vec![goal]), &config).unwrap();
+    assert!(m.stats.screen_fallback);
+    let exact = plan(&mut post(), &start, &GoalSet::configs(vec![goal]), &config).unwrap();
+    assert_eq!(m.raw_path, exact.raw_path);
+    assert!(m.stats.collision_checks > exact.stats.collision_checks);
+    assert_trajectory_free(&post(), &m.trajectory);
+}

@@ -1,0 +1,503 @@
+//! Convex primitives for a conservative collision screen: capsules (a sphere is a capsule of
+//! zero length), oriented boxes and half-spaces, and whether two of them come closer than a
+//! distance. Every test errs on the side of "near": it may call a pair near that is a little
+//! farther apart (a box's rounded offset is bounded by a larger box), never the other way.
+//! Plain `[f64; 3]` arithmetic, no allocation.
+
+/// A point or direction in metres (world or local frame, as documented at each use).
+pub type V3 = [f64; 3];
+
+#[inline]
+fn sub(a: &V3, b: &V3) -> V3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+#[inline]
+fn dot(a: &V3, b: &V3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[inline]
+fn axpy(s: f64, a: &V3, b: &V3) -> V3 {
+    [b[0] + s * a[0], b[1] + s * a[1], b[2] + s * a[2]]
+}
+
+/// A convex primitive posed in the world.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shape {
+    /// Every point within `radius` metres of the segment `a`–`b`.
+    Capsule {
+        /// One end of the axis, metres.
+        a: V3,
+        /// The other end, metres.
+        b: V3,
+        /// Radius, metres.
+        radius: f64,
+    },
+    /// An oriented box: `center + Σ_i s_i · axes[i]`, `|s_i| ≤ half[i]`.
+    Box {
+        /// Centre, metres.
+        center: V3,
+        /// Orthonormal axes (the rows).
+        axes: [V3; 3],
+        /// Half extents along the axes, metres.
+        half: V3,
+    },
+    /// Every point `p` with `normal · p ≤ offset` (the solid below a plane).
+    HalfSpace {
+        /// Unit outward normal.
+        normal: V3,
+        /// `normal · p` on the plane, metres.
+        offset: f64,
+    },
+}
+
+impl Shape {
+    /// Centre and radius (metres) of a sphere around the shape; `None` for a half-space.
+    pub fn bounding_sphere(&self) -> Option<(V3, f64)> {
+        match self {
+            Shape::Capsule { a, b, radius } => {
+                let c = [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0, (a[2] + b[2]) / 2.0];
+                let h = dot(&sub(b, a), &sub(b, a)).sqrt() / 2.0;
+                Some((c, h + radius))
+            }
+            Shape::Box { center, half, .. } => Some((*center, dot(half, half).sqrt())),
+            Shape::HalfSpace { .. } => None,
+        }
+    }
+}
+
+/// True when `x` and `y` may come closer than `gap` metres (`gap` ≥ 0): always true when they
+/// are that close, possibly true when a box's corner region makes them look closer than they
+/// are. Two half-spaces are always near.
+pub fn near(x: &Shape, y: &Shape, gap: f64) -> bool {
+    use Shape::*;
+    match (x, y) {
+        (
+            Capsule { a, b, radius },
+            Capsule {
+                a: c,
+                b: d,
+                radius: r2,
+            },
+        ) => {
+            let t = radius + r2 + gap;
+            segment_segment_dist2(a, b, c, d) < t * t
+        }
+        (Capsule { a, b, radius }, Box { center, axes, half })
+        | (Box { center, axes, half }, Capsule { a, b, radius }) => {
+            let t = radius + gap;
+            segment_box_dist2(a, b, center, axes, half) < t * t
+        }
+        (
+            Box {
+                center: c1,
+                axes: a1,
+                half: h1,
+            },
+            Box {
+                center: c2,
+                axes: a2,
+                half: h2,
+            },
+        ) => {
+            let inflated = [h1[0] + gap, h1[1] + gap, h1[2] + gap];
+            boxes_overlap(c1, a1, &inflated, c2, a2, h2)
+        }
+        (Capsule { a, b, radius }, HalfSpace { normal, offset })
+        | (HalfSpace { normal, offset }, Capsule { a, b, radius }) => {
+            dot(normal, a).min(dot(normal, b)) - offset < radius + gap
+        }
+        (Box { center, axes, half }, HalfSpace { normal, offset })
+        | (HalfSpace { normal, offset }, Box { center, axes, half }) => {
+            let reach: f64 = (0..3).map(|i| half[i] * dot(&axes[i], normal).abs()).sum();
+            dot(normal, center) - reach - offset < gap
+        }
+        (HalfSpace { .. }, HalfSpace { .. }) => true,
+    }
+}
+
+/// True only when `x` and `y` certainly come closer than `d` metres: exact for every pair but
+/// two boxes, which count only when they overlap and `d` is positive (beyond 1 µm).
+pub fn within(x: &Shape, y: &Shape, d: f64) -> bool {
+    use Shape::*;
+    match (x, y) {
+        (
+            Capsule { a, b, radius },
+            Capsule {
+                a: c,
+                b: e,
+                radius: r2,
+            },
+        ) => {
+            let t = radius + r2 + d;
+            t > 0.0 && segment_segment_dist2(a, b, c, e) < t * t
+        }
+        (Capsule { a, b, radius }, Box { center, axes, half })
+        | (Box { center, axes, half }, Capsule { a, b, radius }) => {
+            let t = radius + d;
+            t > 0.0 && segment_box_dist2(a, b, center, axes, half) < t * t
+        }
+        (
+            Box {
+                center: c1,
+                axes: a1,
+                half: h1,
+            },
+            Box {
+                center: c2,
+                axes: a2,
+                half: h2,
+            },
+        ) => d > 1e-6 && boxes_overlap(c1, a1, h1, c2, a2, h2),
+        (Capsule { .. } | Box { .. }, HalfSpace { .. }) | (HalfSpace { .. }, Capsule { .. } | Box { .. }) => {
+            // The nearness test of a half-space is exact.
+            near(x, y, d)
+        }
+        (HalfSpace { .. }, HalfSpace { .. }) => false,
+    }
+}
+
+/// Squared distance between segments `p1`–`q1` and `p2`–`q2` (Ericson, *Real-Time Collision
+/// Detection*, 5.1.9), metres².
+pub fn segment_segment_dist2(p1: &V3, q1: &V3, p2: &V3, q2: &V3) -> f64 {
+    const EPS: f64 = 1e-18;
+    let d1 = sub(q1, p1);
+    let d2 = sub(q2, p2);
+    let r = sub(p1, p2);
+    let a = dot(&d1, &d1);
+    let e = dot(&d2, &d2);
+    let f = dot(&d2, &r);
+    let (s, t);
+    if a <= EPS && e <= EPS {
+        return dot(&r, &r);
+    }
+    if a <= EPS {
+        s = 0.0;
+        t = (f / e).clamp(0.0, 1.0);
+    } else {
+        let c = dot(&d1, &r);
+        if e <= EPS {
+            t = 0.0;
+            s = (-c / a).clamp(0.0, 1.0);
+        } else {
+            let b = dot(&d1, &d2);
+            let denom = a * e - b * b;
+            let mut s0 = if denom > EPS {
+                ((b * f - c * e) / denom).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let mut t0 = (b * s0 + f) / e;
+            if t0 < 0.0 {
+                t0 = 0.0;
+                s0 = (-c / a).clamp(0.0, 1.0);
+            } else if t0 > 1.0 {
+                t0 = 1.0;
+                s0 = ((b - c) / a).clamp(0.0, 1.0);
+            }
+            s = s0;
+            t = t0;
+        }
+    }
+    let c1 = axpy(s, &d1, p1);
+    let c2 = axpy(t, &d2, p2);
+    let w = sub(&c1, &c2);
+    dot(&w, &w)
+}
+
+/// Squared distance from local point `x` to the box `|x_i| ≤ h_i`.
+#[inline]
+fn point_box_dist2(x: &V3, h: &V3) -> f64 {
+    let mut d = 0.0;
+    for i in 0..3 {
+        let e = x[i].abs() - h[i];
+        if e > 0.0 {
+            d += e * e;
+        }
+    }
+    d
+}
+
+/// Squared distance between the segment `p`–`q` and an oriented box, metres². Exact: the
+/// squared distance along the segment is a convex piecewise quadratic whose pieces change where
+/// a coordinate crosses a face plane; each piece's minimum is found in closed form.
+pub fn segment_box_dist2(p: &V3, q: &V3, center: &V3, axes: &[V3; 3], half: &V3) -> f64 {
+    let rp = sub(p, center);
+    let rq = sub(q, center);
+    let a = [dot(&axes[0], &rp), dot(&axes[1], &rp), dot(&axes[2], &rp)];
+    let b = [dot(&axes[0], &rq), dot(&axes[1], &rq), dot(&axes[2], &rq)];
+    let d = sub(&b, &a);
+    // Break points: where a coordinate crosses ±h.
+    let mut ts = [0.0f64; 8];
+    let mut n = 0;
+    ts[n] = 0.0;
+    n += 1;
+    for i in 0..3 {
+        if d[i] != 0.0 {
+            for s in [-half[i], half[i]] {
+                let t = (s - a[i]) / d[i];
+                if t > 0.0 && t < 1.0 {
+                    ts[n] = t;
+                    n += 1;
+                }
+            }
+        }
+    }
+    ts[n] = 1.0;
+    n += 1;
+    ts[..n].sort_by(f64::total_cmp);
+    let at = |t: f64| [a[0] + d[0] * t, a[1] + d[1] * t, a[2] + d[2] * t];
+    let mut best = point_box_dist2(&a, half).min(point_box_dist2(&b, half));
+    for w in ts[..n].windows(2) {
+        let (t0, t1) = (w[0], w[1]);
+        if t1 <= t0 {
+            continue;
+        }
+        let m = at(0.5 * (t0 + t1));
+        // On this piece, coordinate i contributes (x_i − c_i)² where c_i = ±h_i outside, none inside.
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..3 {
+            let c = if m[i] > half[i] {
+                half[i]
+            } else if m[i] < -half[i] {
+                -half[i]
+            } else {
+                continue;
+            };
+            num -= (a[i] - c) * d[i];
+            den += d[i] * d[i];
+        }
+        let t = if den > 0.0 { (num / den).clamp(t0, t1) } else { t0 };
+        best = best.min(point_box_dist2(&at(t), half));
+    }
+    best
+}
+
+/// True when two oriented boxes overlap (the separating axis test over the 15 candidate axes;
+/// Ericson 4.4.1). Touching counts as overlapping; near-parallel edge axes are treated
+/// conservatively (an epsilon added to the projections).
+pub fn boxes_overlap(c1: &V3, a1: &[V3; 3], h1: &V3, c2: &V3, a2: &[V3; 3], h2: &V3) -> bool {
+    const EPS: f64 = 1e-9;
+    let mut r = [[0.0; 3]; 3];
+    let mut abs_r = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            r[i][j] = dot(&a1[i], &a2[j]);
+            abs_r[i][j] = r[i][j].abs() + EPS;
+        }
+    }
+    let tw = sub(c2, c1);
+    let t = [dot(&tw, &a1[0]), dot(&tw, &a1[1]), dot(&tw, &a1[2])];
+    for i in 0..3 {
+        let ra = h1[i];
+        let rb = h2[0] * abs_r[i][0] + h2[1] * abs_r[i][1] + h2[2] * abs_r[i][2];
+        if t[i].abs() > ra + rb {
+            return false;
+        }
+    }
+    for j in 0..3 {
+        let ra = h1[0] * abs_r[0][j] + h1[1] * abs_r[1][j] + h1[2] * abs_r[2][j];
+        let rb = h2[j];
+        let tj = t[0] * r[0][j] + t[1] * r[1][j] + t[2] * r[2][j];
+        if tj.abs() > ra + rb {
+            return false;
+        }
+    }
+    for i in 0..3 {
+        let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
+        for j in 0..3 {
+            let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
+            let ra = h1[i1] * abs_r[i2][j] + h1[i2] * abs_r[i1][j];
+            let rb = h2[j1] * abs_r[i][j2] + h2[j2] * abs_r[i][j1];
+            let tl = (t[i2] * r[i1][j] - t[i1] * r[i2][j]).abs();
+            if tl > ra + rb {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    const I: [V3; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+    fn rot(r: &mut ChaCha8Rng) -> [V3; 3] {
+        let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+            r.random_range(-1.0..1.0),
+            r.random_range(-1.0..1.0),
+            r.random_range(-1.0..1.0),
+            r.random_range(-1.0..1.0),
+        ));
+        let m = q.to_rotation_matrix();
+        let m = m.matrix();
+        [
+            [m[(0, 0)], m[(1, 0)], m[(2, 0)]],
+            [m[(0, 1)], m[(1, 1)], m[(2, 1)]],
+            [m[(0, 2)], m[(1, 2)], m[(2, 2)]],
+        ]
+    }
+
+    fn v(r: &mut ChaCha8Rng, s: f64) -> V3 {
+        [
+            r.random_range(-s..s),
+            r.random_range(-s..s),
+            r.random_range(-s..s),
+        ]
+    }
+
+    /// Points of a box, dense on its surface.
+    fn box_points(c: &V3, axes: &[V3; 3], h: &V3) -> Vec<V3> {
+        let mut out = Vec::new();
+        let n = 6;
+        for i in 0..=n {
+            for j in 0..=n {
+                for k in 0..=n {
+                    let s = [
+                        -h[0] + 2.0 * h[0] * i as f64 / n as f64,
+                        -h[1] + 2.0 * h[1] * j as f64 / n as f64,
+                        -h[2] + 2.0 * h[2] * k as f64 / n as f64,
+                    ];
+                    let mut p = *c;
+                    for a in 0..3 {
+                        p = axpy(s[a], &axes[a], &p);
+                    }
+                    out.push(p);
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn segment_box_distance_is_exact_against_dense_sampling() {
+        let mut r = ChaCha8Rng::seed_from_u64(7);
+        for _ in 0..300 {
+            let axes = rot(&mut r);
+            let h = [
+                r.random_range(0.01..0.2),
+                r.random_range(0.01..0.2),
+                r.random_range(0.01..0.2),
+            ];
+            let c = v(&mut r, 0.1);
+            let p = v(&mut r, 0.4);
+            let q = v(&mut r, 0.4);
+            let exact = segment_box_dist2(&p, &q, &c, &axes, &h).sqrt();
+            // Sampled: points along the segment against the box (local coordinates).
+            let mut sampled = f64::INFINITY;
+            for k in 0..=2000 {
+                let x = axpy(k as f64 / 2000.0, &sub(&q, &p), &p);
+                let rx = sub(&x, &c);
+                let l = [dot(&axes[0], &rx), dot(&axes[1], &rx), dot(&axes[2], &rx)];
+                sampled = sampled.min(point_box_dist2(&l, &h).sqrt());
+            }
+            assert!(exact <= sampled + 1e-12, "{exact} > {sampled}");
+            assert!(sampled - exact < 1e-3, "{exact} vs {sampled}");
+        }
+    }
+
+    #[test]
+    fn segment_distance_never_exceeds_sampled_distance() {
+        let mut r = ChaCha8Rng::seed_from_u64(8);
+        for _ in 0..300 {
+            let (p1, q1, p2, q2) = (v(&mut r, 0.3), v(&mut r, 0.3), v(&mut r, 0.3), v(&mut r, 0.3));
+            let exact = segment_segment_dist2(&p1, &q1, &p2, &q2).sqrt();
+            let mut sampled = f64::INFINITY;
+            for i in 0..=200 {
+                let x = axpy(i as f64 / 200.0, &sub(&q1, &p1), &p1);
+                for j in 0..=200 {
+                    let y = axpy(j as f64 / 200.0, &sub(&q2, &p2), &p2);
+                    let w = sub(&x, &y);
+                    sampled = sampled.min(dot(&w, &w).sqrt());
+                }
+            }
+            assert!(exact <= sampled + 1e-12, "{exact} > {sampled}");
+            assert!(sampled - exact < 5e-3, "{exact} vs {sampled}");
+        }
+    }
+
+    #[test]
+    fn boxes_that_share_a_point_overlap_and_separated_ones_do_not() {
+        let mut r = ChaCha8Rng::seed_from_u64(9);
+        let (mut hits, mut misses) = (0, 0);
+        for _ in 0..400 {
+            let (a1, a2) = (rot(&mut r), rot(&mut r));
+            let h1 = [
+                r.random_range(0.02..0.1),
+                r.random_range(0.02..0.1),
+                r.random_range(0.02..0.1),
+            ];
+            let h2 = [
+                r.random_range(0.02..0.1),
+                r.random_range(0.02..0.1),
+                r.random_range(0.02..0.1),
+            ];
+            let (c1, c2) = (v(&mut r, 0.1), v(&mut r, 0.1));
+            // A point of box 2 inside box 1 proves overlap.
+            let inside = box_points(&c2, &a2, &h2).iter().any(|p| {
+                let d = sub(p, &c1);
+                (0..3).all(|i| dot(&a1[i], &d).abs() <= h1[i])
+            });
+            let overlap = boxes_overlap(&c1, &a1, &h1, &c2, &a2, &h2);
+            if inside {
+                assert!(overlap);
+                hits += 1;
+            }
+            // Far apart (bounding spheres disjoint): never an overlap.
+            let far =
+                dot(&sub(&c1, &c2), &sub(&c1, &c2)).sqrt() > dot(&h1, &h1).sqrt() + dot(&h2, &h2).sqrt();
+            if far {
+                assert!(!overlap);
+                misses += 1;
+            }
+        }
+        assert!(hits > 50 && misses > 10, "{hits} {misses}");
+    }
+
+    #[test]
+    fn near_inflates_by_the_gap() {
+        let cap = Shape::Capsule {
+            a: [0.0, 0.0, 0.1],
+            b: [0.0, 0.0, 0.3],
+            radius: 0.05,
+        };
+        let floor = Shape::HalfSpace {
+            normal: [0.0, 0.0, 1.0],
+            offset: 0.0,
+        };
+        assert!(!near(&cap, &floor, 0.04));
+        assert!(near(&cap, &floor, 0.051));
+        let block = Shape::Box {
+            center: [0.2, 0.0, 0.2],
+            axes: I,
+            half: [0.05; 3],
+        };
+        // Capsule surface at x = 0.05, box face at x = 0.15: 10 cm apart.
+        assert!(!near(&cap, &block, 0.099));
+        assert!(near(&cap, &block, 0.101));
+        let pad = Shape::Box {
+            center: [0.0, 0.0, 0.2],
+            axes: I,
+            half: [0.05; 3],
+        };
+        assert!(!near(&pad, &block, 0.099));
+        assert!(near(&pad, &block, 0.101));
+        assert!(!near(&block, &floor, 0.149));
+        assert!(near(&block, &floor, 0.151));
+        // `within` is exact where it answers.
+        assert!(within(&cap, &block, 0.101) && !within(&cap, &block, 0.099));
+        assert!(within(&cap, &floor, 0.051) && !within(&cap, &floor, 0.049));
+        assert!(!within(&pad, &block, 0.101), "two boxes apart: no answer");
+        let inside = Shape::Box {
+            center: [0.21, 0.0, 0.2],
+            axes: I,
+            half: [0.05; 3],
+        };
+        assert!(within(&inside, &block, 0.001) && !within(&inside, &block, 0.0));
+    }
+}

@@ -1,0 +1,477 @@
+//! [`Screen`]: a conservative fast collision model of the cell, asked before MuJoCo
+//! ([`SceneChecker::certainly_free`](super::collision::SceneChecker)).
+//!
+//! Each collidable geom is bounded by one convex primitive ([`Shape`]): capsules and spheres
+//! exactly, a cylinder by the capsule of its radius and half-height, a box exactly, a plane as
+//! its half-space, and a mesh or an ellipsoid by MuJoCo's bounding box of it (`geom_aabb`, which
+//! contains its convex hull, what MuJoCo collides). Robot geoms are fixed in the frame of the
+//! arm link that moves them (the gripper at its snapshot opening, a held block in the wrist-3
+//! frame); the six link frames are computed from the model's own body offsets and joint axes
+//! (the same products as `mj_kinematics`). The pairs tested are exactly the pairs MuJoCo tests
+//! in the checker's private model: its contact bitmasks, its body filters (same weld body,
+//! weld parent and child unless disabled, `<exclude>`), plus explicit `<pair>`s. A configuration
+//! is certainly free when every pair's primitives are at least the pair's margin plus
+//! [`PAD`] apart: the geoms inside them are then farther apart than the margin, so MuJoCo
+//! reports no contact. `tests/motion_screen.rs` checks this against MuJoCo over thousands of
+//! configurations near obstacles.
+
+use std::sync::Arc;
+
+use mujoco_rs::prelude::*;
+use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, Unit, UnitQuaternion, Vector3};
+
+use crate::motion::plan::shapes::{Shape, V3, near, within};
+
+/// Extra distance every pair must keep beyond its margin for the screen to vouch, metres: room
+/// for MuJoCo's own tolerances (its convex-hull distances converge to about 1e-6 m).
+pub const PAD: f64 = 5e-4;
+
+/// A primitive in a body frame.
+#[derive(Clone, Copy, Debug)]
+enum Local {
+    Capsule {
+        a: Vector3<f64>,
+        b: Vector3<f64>,
+        radius: f64,
+    },
+    Box {
+        center: Vector3<f64>,
+        axes: Matrix3<f64>,
+        half: V3,
+    },
+}
+
+impl Local {
+    /// Radius of a sphere about the shape's centre that contains it, metres.
+    fn reach(&self) -> f64 {
+        match self {
+            Local::Capsule { a, b, radius } => (b - a).norm() / 2.0 + radius,
+            Local::Box { half, .. } => (half[0] * half[0] + half[1] * half[1] + half[2] * half[2]).sqrt(),
+        }
+    }
+
+    fn posed(&self, r: &Matrix3<f64>, t: &Vector3<f64>) -> Shape {
+        match self {
+            Local::Capsule { a, b, radius } => {
+                let (a, b) = (r * a + t, r * b + t);
+                Shape::Capsule {
+                    a: [a.x, a.y, a.z],
+                    b: [b.x, b.y, b.z],
+                    radius: *radius,
+                }
+            }
+            Local::Box { center, axes, half } => {
+                let c = r * center + t;
+                let m = r * axes;
+                Shape::Box {
+                    center: [c.x, c.y, c.z],
+                    axes: [
+                        [m[(0, 0)], m[(1, 0)], m[(2, 0)]],
+                        [m[(0, 1)], m[(1, 1)], m[(2, 1)]],
+                        [m[(0, 2)], m[(1, 2)], m[(2, 2)]],
+                    ],
+                    half: *half,
+                }
+            }
+        }
+    }
+}
+
+/// One arm link: its body's offset from its parent (rotation, translation) and its hinge.
+#[derive(Clone, Copy, Debug)]
+struct Link {
+    rot: Matrix3<f64>,
+    pos: Vector3<f64>,
+    axis: Vector3<f64>,
+    anchor: Vector3<f64>,
+    qpos0: f64,
+}
+
+/// Rotation by `angle` radians about the unit `axis` (Rodrigues).
+fn axis_angle(a: &Vector3<f64>, angle: f64) -> Matrix3<f64> {
+    let (s, c) = angle.sin_cos();
+    let t = 1.0 - c;
+    Matrix3::new(
+        c + t * a.x * a.x,
+        t * a.x * a.y - s * a.z,
+        t * a.x * a.z + s * a.y,
+        t * a.x * a.y + s * a.z,
+        c + t * a.y * a.y,
+        t * a.y * a.z - s * a.x,
+        t * a.x * a.z - s * a.y,
+        t * a.y * a.z + s * a.x,
+        c + t * a.z * a.z,
+    )
+}
+
+/// One pair to test: two shape indices (moving shapes first, then fixed ones), the distance
+/// they must keep for "free" (the pair's margin plus [`PAD`], metres), and the distance below
+/// which exact shapes are "blocked": [`PAD`] of penetration (MuJoCo reports every
+/// penetration, but not every pair closer than a margin: its plane–box and capsule–box
+/// contacts within a margin were found missing in `tests/motion_screen.rs`).
+#[derive(Clone, Copy, Debug)]
+struct Pair {
+    a: u16,
+    b: u16,
+    gap: f64,
+    block: f64,
+}
+
+/// The conservative model of one snapshot of the cell (see the module docs).
+#[derive(Clone, Debug)]
+pub struct Screen {
+    /// World pose of the first arm link's parent body (rotation, translation).
+    base: (Matrix3<f64>, Vector3<f64>),
+    links: [Link; 6],
+    /// Shapes moved by the arm: (link index 0..6, shape in the link's frame, whether the
+    /// shape is the geom itself rather than a bound of it).
+    moving: Vec<(usize, Local, bool, f64)>,
+    /// Fixed shapes, world frame, with their bounding spheres and exactness.
+    fixed: Vec<Posed>,
+    pairs: Vec<Pair>,
+    /// Geom id of each shape (moving ones, then fixed ones).
+    geoms: Vec<usize>,
+    /// Scratch: the moving shapes posed.
+    posed: Vec<Posed>,
+}
+
+/// A shape in the world, its bounding sphere, and whether it is the geom itself.
+type Posed = (Shape, Option<(V3, f64)>, bool);
+
+/// Rotation matrix of MuJoCo's row-major `xmat`.
+fn mat(x: &[f64; 9]) -> Matrix3<f64> {
+    Matrix3::new(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], x[8])
+}
+
+/// The geom's bounding primitive in its own frame; `None` for a type the screen cannot bound
+/// (a height field, an SDF).
+fn geom_local(m: &MjModel, g: usize) -> Option<GeomShape> {
+    let size = m.geom_size()[g];
+    let aabb = m.geom_aabb()[g];
+    Some(match m.geom_type()[g] {
+        MjtGeomBase::mjGEOM_PLANE => GeomShape::Plane,
+        MjtGeomBase::mjGEOM_SPHERE => GeomShape::Solid(Local::Capsule {
+            a: Vector3::zeros(),
+            b: Vector3::zeros(),
+            radius: size[0],
+        }),
+        MjtGeomBase::mjGEOM_CAPSULE | MjtGeomBase::mjGEOM_CYLINDER => GeomShape::Solid(Local::Capsule {
+            a: Vector3::new(0.0, 0.0, -size[1]),
+            b: Vector3::new(0.0, 0.0, size[1]),
+            radius: size[0],
+        }),
+        MjtGeomBase::mjGEOM_BOX => GeomShape::Solid(Local::Box {
+            center: Vector3::zeros(),
+            axes: Matrix3::identity(),
+            half: size,
+        }),
+        MjtGeomBase::mjGEOM_MESH | MjtGeomBase::mjGEOM_ELLIPSOID => GeomShape::Solid(Local::Box {
+            center: Vector3::new(aabb[0], aabb[1], aabb[2]),
+            axes: Matrix3::identity(),
+            half: [aabb[3], aabb[4], aabb[5]],
+        }),
+        _ => return None,
+    })
+}
+
+enum GeomShape {
+    Plane,
+    Solid(Local),
+}
+
+/// True when the screen's shape of the geom is the geom itself (a sphere, capsule, box or
+/// plane), not a bound of it.
+fn exact(m: &MjModel, g: usize) -> bool {
+    matches!(
+        m.geom_type()[g],
+        MjtGeomBase::mjGEOM_PLANE
+            | MjtGeomBase::mjGEOM_SPHERE
+            | MjtGeomBase::mjGEOM_CAPSULE
+            | MjtGeomBase::mjGEOM_BOX
+    )
+}
+
+/// A local shape expressed in another frame: `rel` maps the shape's frame into it.
+fn moved(l: &Local, r: &Matrix3<f64>, t: &Vector3<f64>) -> Local {
+    match l {
+        Local::Capsule { a, b, radius } => Local::Capsule {
+            a: r * a + t,
+            b: r * b + t,
+            radius: *radius,
+        },
+        Local::Box { center, axes, half } => Local::Box {
+            center: r * center + t,
+            axes: r * axes,
+            half: *half,
+        },
+    }
+}
+
+/// What the screen needs of the checker that builds it.
+pub(crate) struct Build<'a> {
+    /// The checker's private data, posed by `mj_kinematics` (any arm joints; a held block at
+    /// its pose for those joints).
+    pub(crate) data: &'a MjData<Arc<MjModel>>,
+    /// Arm group of each geom (0 fixed, 1..=6 moved by that arm joint; a held block's geoms 6).
+    pub(crate) group: &'a [u8],
+    /// Body ids of the six arm links, base to wrist 3.
+    pub(crate) link_bodies: [usize; 6],
+    /// Joint ids of the six arm joints.
+    pub(crate) joints: [usize; 6],
+}
+
+impl Screen {
+    /// The screen of the private model and data in `b`; `None` when some geom that can touch
+    /// the arm is of a type the screen cannot bound, or the arm is not a chain of six links.
+    pub(crate) fn build(b: &Build<'_>) -> Option<Self> {
+        let m: &MjModel = b.data.model();
+        let d = b.data;
+        let ngeom = m.ffi().ngeom as usize;
+        let parent = m.body_parentid();
+        for k in 1..6 {
+            if parent[b.link_bodies[k]] as usize != b.link_bodies[k - 1] {
+                return None;
+            }
+        }
+        let iso = |pos: &[f64; 3], xmat: &[f64; 9]| {
+            let r = nalgebra::Rotation3::from_matrix_unchecked(mat(xmat));
+            Isometry3::from_parts(
+                Translation3::new(pos[0], pos[1], pos[2]),
+                UnitQuaternion::from_rotation_matrix(&r),
+            )
+        };
+        let p0 = parent[b.link_bodies[0]] as usize;
+        let base = (mat(&d.xmat()[p0]), Vector3::from(d.xpos()[p0]));
+        let links: [Link; 6] = std::array::from_fn(|k| {
+            let body = b.link_bodies[k];
+            let j = b.joints[k];
+            let (p, q) = (m.body_pos()[body], m.body_quat()[body]);
+            let ax = m.jnt_axis()[j];
+            let an = m.jnt_pos()[j];
+            let offset = UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]));
+            Link {
+                rot: offset.to_rotation_matrix().into_inner(),
+                pos: Vector3::new(p[0], p[1], p[2]),
+                axis: Unit::new_normalize(Vector3::new(ax[0], ax[1], ax[2])).into_inner(),
+                anchor: Vector3::new(an[0], an[1], an[2]),
+                qpos0: m.qpos0()[m.jnt_qposadr()[j] as usize],
+            }
+        });
+        let link_pose: Vec<Isometry3<f64>> = b
+            .link_bodies
+            .iter()
+            .map(|&l| iso(&d.xpos()[l], &d.xmat()[l]))
+            .collect();
+        let (ct, ca) = (m.geom_contype(), m.geom_conaffinity());
+        let collidable = |g: usize| ct[g] != 0 || ca[g] != 0;
+        // Index of each geom's shape: moving ones first, then fixed ones.
+        let mut index: Vec<Option<usize>> = vec![None; ngeom];
+        let mut moving: Vec<(usize, Local, bool, f64)> = Vec::new();
+        let mut fixed: Vec<Posed> = Vec::new();
+        let mut fixed_geoms: Vec<usize> = Vec::new();
+        for (g, slot) in index.iter_mut().enumerate() {
+            if !collidable(g) {
+                continue;
+            }
+            let shape = geom_local(m, g);
+            let k = b.group[g];
+            let (gr, gt) = (mat(&d.geom_xmat()[g]), Vector3::from(d.geom_xpos()[g]));
+            if k == 0 {
+                let s = match shape {
+                    // A fixed geom of a type the screen cannot bound: fine while nothing moving
+                    // can touch it (checked below through the pairs).
+                    None => continue,
+                    Some(GeomShape::Plane) => {
+                        let n = gr.column(2).into_owned();
+                        Shape::HalfSpace {
+                            normal: [n.x, n.y, n.z],
+                            offset: n.dot(&gt),
+                        }
+                    }
+                    Some(GeomShape::Solid(l)) => l.posed(&gr, &gt),
+                };
+                fixed_geoms.push(g);
+                fixed.push((s, s.bounding_sphere(), exact(m, g)));
+            } else {
+                let Some(GeomShape::Solid(l)) = shape else {
+                    return None;
+                };
+                let link = &link_pose[k as usize - 1];
+                let lr = link.rotation.to_rotation_matrix().into_inner().transpose();
+                let rel_r = lr * gr;
+                let rel_t = lr * (gt - link.translation.vector);
+                *slot = Some(moving.len());
+                let local = moved(&l, &rel_r, &rel_t);
+                moving.push((k as usize - 1, local, exact(m, g), local.reach()));
+            }
+        }
+        for (i, &g) in fixed_geoms.iter().enumerate() {
+            index[g] = Some(moving.len() + i);
+        }
+        let mut geoms = vec![0; moving.len() + fixed.len()];
+        for (g, i) in index.iter().enumerate() {
+            if let Some(i) = i {
+                geoms[*i] = g;
+            }
+        }
+        // The pairs MuJoCo tests in this model.
+        let body = m.geom_bodyid();
+        let weld = m.body_weldid();
+        let filterparent = m.ffi().opt.disableflags & MjtDisableBit::mjDSBL_FILTERPARENT as i32 == 0;
+        let excluded = m.exclude_signature();
+        let (margin, gap) = (m.geom_margin(), m.geom_gap());
+        let mut pairs = Vec::new();
+        let mut add = |g1: usize, g2: usize, pair_margin: f64, pair_gap: f64| -> bool {
+            if b.group[g1] == 0 && b.group[g2] == 0 {
+                return true;
+            }
+            match (index[g1], index[g2]) {
+                (Some(x), Some(y)) => {
+                    let (a, bb) = if x < y { (x, y) } else { (y, x) };
+                    pairs.push(Pair {
+                        a: a as u16,
+                        b: bb as u16,
+                        gap: pair_margin.max(0.0) + PAD,
+                        block: (pair_margin - pair_gap.max(0.0)).min(0.0) - PAD,
+                    });
+                    true
+                }
+                // A geom that can touch the arm but has no bounding shape.
+                _ => false,
+            }
+        };
+        for g1 in 0..ngeom {
+            if !collidable(g1) {
+                continue;
+            }
+            for g2 in g1 + 1..ngeom {
+                if !collidable(g2) {
+                    continue;
+                }
+                if ct[g1] & ca[g2] == 0 && ct[g2] & ca[g1] == 0 {
+                    continue;
+                }
+                let (b1, b2) = (body[g1] as usize, body[g2] as usize);
+                let (w1, w2) = (weld[b1] as usize, weld[b2] as usize);
+                if w1 == w2 {
+                    continue;
+                }
+                let (wp1, wp2) = (
+                    weld[parent[w1] as usize] as usize,
+                    weld[parent[w2] as usize] as usize,
+                );
+                if filterparent && w1 != 0 && w2 != 0 && (w1 == wp2 || w2 == wp1) {
+                    continue;
+                }
+                let sig = ((b1.min(b2) as i32) << 16) + b1.max(b2) as i32;
+                if excluded.contains(&sig) {
+                    continue;
+                }
+                if !add(g1, g2, margin[g1].max(margin[g2]), gap[g1].max(gap[g2])) {
+                    return None;
+                }
+            }
+        }
+        let (pg1, pg2, pm, pgap) = (m.pair_geom1(), m.pair_geom2(), m.pair_margin(), m.pair_gap());
+        for p in 0..m.ffi().npair as usize {
+            if !add(pg1[p] as usize, pg2[p] as usize, pm[p], pgap[p]) {
+                return None;
+            }
+        }
+        if moving.len() + fixed.len() > u16::MAX as usize {
+            return None;
+        }
+        // Cheapest rejections first: fixed partners before self pairs.
+        pairs.sort_by_key(|p| (p.b as usize) < moving.len());
+        let posed = Vec::with_capacity(moving.len());
+        Some(Self {
+            base,
+            links,
+            moving,
+            fixed,
+            pairs,
+            geoms,
+            posed,
+        })
+    }
+
+    /// World poses of the six arm links at joints `q` (radians), as `mj_kinematics` computes
+    /// them: parent pose · body offset · rotation about the joint axis through its anchor.
+    pub fn link_poses(&self, q: &[f64; 6]) -> [(Matrix3<f64>, Vector3<f64>); 6] {
+        let (mut r, mut t) = self.base;
+        std::array::from_fn(|k| {
+            let l = &self.links[k];
+            t += r * l.pos;
+            r *= l.rot;
+            let j = axis_angle(&l.axis, q[k] - l.qpos0);
+            // Rotation about the axis through the anchor: x ↦ anchor + J (x − anchor).
+            t += r * (l.anchor - j * l.anchor);
+            r *= j;
+            (r, t)
+        })
+    }
+
+    /// The screen's verdict at `q` (radians): `Some(true)` when every tested pair keeps its
+    /// margin plus [`PAD`] (MuJoCo then reports no contact), `Some(false)` when a pair of exact
+    /// shapes (no bounds) penetrates by more than [`PAD`] (MuJoCo then reports that contact),
+    /// `None` otherwise.
+    pub fn classify(&mut self, q: &[f64; 6]) -> Option<bool> {
+        self.decide(q).0
+    }
+
+    /// The verdict at `q` and the geom pair that decided a "blocked" (geom ids).
+    pub fn decide(&mut self, q: &[f64; 6]) -> (Option<bool>, Option<(usize, usize)>) {
+        let frames = self.link_poses(q);
+        self.posed.clear();
+        for (k, l, e, reach) in &self.moving {
+            let (r, t) = &frames[*k];
+            let s = l.posed(r, t);
+            let sphere = match &s {
+                Shape::Capsule { a, b, .. } => (
+                    [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0, (a[2] + b[2]) / 2.0],
+                    *reach,
+                ),
+                Shape::Box { center, .. } => (*center, *reach),
+                Shape::HalfSpace { .. } => ([0.0; 3], f64::INFINITY),
+            };
+            self.posed.push((s, Some(sphere), *e));
+        }
+        let nm = self.posed.len();
+        let mut unsure = false;
+        for p in &self.pairs {
+            let x = &self.posed[p.a as usize];
+            let y = if (p.b as usize) < nm {
+                &self.posed[p.b as usize]
+            } else {
+                &self.fixed[p.b as usize - nm]
+            };
+            if let (Some((c1, r1)), Some((c2, r2))) = (x.1, y.1) {
+                let t = r1 + r2 + p.gap;
+                let d = [c1[0] - c2[0], c1[1] - c2[1], c1[2] - c2[2]];
+                if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] >= t * t {
+                    continue;
+                }
+            }
+            if near(&x.0, &y.0, p.gap) {
+                if x.2 && y.2 && within(&x.0, &y.0, p.block) {
+                    return (
+                        Some(false),
+                        Some((self.geoms[p.a as usize], self.geoms[p.b as usize])),
+                    );
+                }
+                unsure = true;
+            }
+        }
+        ((!unsure).then_some(true), None)
+    }
+
+    /// True when the screen vouches that `q` (radians) is free ([`Screen::classify`]).
+    pub fn free(&mut self, q: &[f64; 6]) -> bool {
+        self.classify(q) == Some(true)
+    }
+
+    /// Pairs tested per configuration.
+    pub fn pairs(&self) -> usize {
+        self.pairs.len()
+    }
+}
