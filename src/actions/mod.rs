@@ -17,6 +17,7 @@ mod place;
 mod planning;
 mod reach;
 mod release;
+mod release_room;
 mod targets;
 
 pub(crate) use carry::Carry as CarryAction;
