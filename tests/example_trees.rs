@@ -206,7 +206,8 @@ fn recenter_and_grasp_recovers_a_missed_taught_pick() {
         // The presence check sends it to the recovery before anything moves to the taught spot:
         // no finger comes down on the cube.
         assert!(
-            o.trace.reached("cube_at[cube on the taught spot?]", NodeStatus::Failure),
+            o.trace
+                .reached("cube_at[cube on the taught spot?]", NodeStatus::Failure),
             "{layout:?}: the presence check did not fail"
         );
         assert!(
@@ -236,7 +237,10 @@ fn recenter_and_grasp_recovers_a_missed_taught_pick() {
         end * 1e3
     );
     assert!(o.report.success, "{:?}", o.report.failure_reason);
-    assert!(o.trace.reached("cube_at[cube on the taught spot?]", NodeStatus::Failure));
+    assert!(
+        o.trace
+            .reached("cube_at[cube on the taught spot?]", NodeStatus::Failure)
+    );
     assert!(s.touched, "the pads never touched the nudged cube");
     assert!(
         s.max_off > 0.003,

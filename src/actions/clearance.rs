@@ -20,8 +20,8 @@ use crate::world::World;
 
 /// Heights above the fingertips at which the finger envelope is tabulated, metres.
 const HEIGHTS: [f64; 19] = [
-    0.0, 0.005, 0.010, 0.015, 0.020, 0.025, 0.030, 0.035, 0.040, 0.045, 0.050, 0.055, 0.060, 0.070,
-    0.080, 0.090, 0.100, 0.110, 0.120,
+    0.0, 0.005, 0.010, 0.015, 0.020, 0.025, 0.030, 0.035, 0.040, 0.045, 0.050, 0.055, 0.060, 0.070, 0.080,
+    0.090, 0.100, 0.110, 0.120,
 ];
 /// Pad-face distances (openings) at which the envelope is tabulated, metres.
 const OPENINGS: [f64; 6] = [0.0265, 0.032, 0.0428, 0.0533, 0.0668, 0.0852];
@@ -53,8 +53,8 @@ const OUTSIDE_MM: [[f64; 6]; 19] = [
 /// `HEIGHTS[i]`, at any opening, millimetres (the pads are 22 mm wide; the base mount above
 /// 90 mm).
 const ACROSS_MM: [f64; 19] = [
-    11.0, 11.0, 11.0, 11.0, 11.0, 11.0, 11.0, 11.0, 12.5, 14.1, 15.2, 16.3, 17.2, 18.4, 19.6, 24.3,
-    29.0, 33.7, 37.5,
+    11.0, 11.0, 11.0, 11.0, 11.0, 11.0, 11.0, 11.0, 12.5, 14.1, 15.2, 16.3, 17.2, 18.4, 19.6, 24.3, 29.0,
+    33.7, 37.5,
 ];
 
 /// Where `x` falls in the increasing `xs`: the index of the segment and the fraction along it
