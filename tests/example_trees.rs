@@ -187,7 +187,7 @@ fn recenter_and_grasp_recovers_a_missed_taught_pick() {
         "the recovery ran on a clean layout"
     );
 
-    // Off the taught spot: across the fingers (they close on nothing), along them (a finger lands
+    // Off the taught spot: across the fingers, along them (a blind descent would land a finger
     // on the cube), and rotated (the squeeze squares it), with the bowl elsewhere too.
     for layout in [
         Layout::new(0.45, -0.145, 0.0, 0.45, 0.08),
@@ -203,17 +203,29 @@ fn recenter_and_grasp_recovers_a_missed_taught_pick() {
             o.trace.reached("sequence[taught pick]", NodeStatus::Failure),
             "{layout:?}: the taught pick did not fail"
         );
+        // The presence check sends it to the recovery before anything moves to the taught spot:
+        // no finger comes down on the cube.
+        assert!(
+            o.trace
+                .reached("cube_at[cube on the taught spot?]", NodeStatus::Failure),
+            "{layout:?}: the presence check did not fail"
+        );
+        assert!(
+            !o.trace.touched("reach[down at taught spot]"),
+            "{layout:?}: the blind descent ran on a cube off the taught spot"
+        );
+        assert!(r.collisions.is_empty(), "{layout:?}: {:?}", r.collisions);
         assert!(
             o.trace.reached("sequence[recentre]", NodeStatus::Success),
             "{layout:?}: the recovery did not succeed"
         );
-        // The miss (or none, when the descent was blocked), the squeeze, the real grasp.
+        // The squeeze and the real grasp.
         assert!(r.grasp_attempts >= 2, "{layout:?}: {} grasps", r.grasp_attempts);
     }
 
-    // The cube moves after it was looked at: the taught descent is blocked by the cube, so the
-    // squeeze is the first grasp leaf, and the nudge (seed 5: along the fingers) pushes the cube
-    // as it starts closing. The pads sweep it back to the middle.
+    // The cube moves after it was looked at: the cube is off the taught spot, so the squeeze is
+    // the first grasp leaf, and the nudge (seed 5: along the fingers) pushes the cube as it
+    // starts closing. The pads sweep it back to the middle.
     let layout = Layout::new(0.48, -0.18, 0.0, 0.45, 0.08);
     let o = run(&plan, layout, Some((FaultKind::Nudge, 5)));
     let s = o.trace.squeeze;
@@ -225,7 +237,10 @@ fn recenter_and_grasp_recovers_a_missed_taught_pick() {
         end * 1e3
     );
     assert!(o.report.success, "{:?}", o.report.failure_reason);
-    assert!(o.trace.reached("reach[down at taught spot]", NodeStatus::Failure));
+    assert!(
+        o.trace
+            .reached("cube_at[cube on the taught spot?]", NodeStatus::Failure)
+    );
     assert!(s.touched, "the pads never touched the nudged cube");
     assert!(
         s.max_off > 0.003,
@@ -238,6 +253,22 @@ fn recenter_and_grasp_recovers_a_missed_taught_pick() {
         "the squeeze left the cube {:.1} mm off the middle",
         end * 1e3
     );
+}
+
+/// Regression: the taught pick went down blind, so a cube lying beside the taught spot (along
+/// the fingers) had a finger land on it (`fingers-block` in 4 of 100 scenarios of
+/// `macrotree sweep trees/recenter_and_grasp.yaml --seed 2`). The pick now goes down only when
+/// the cube is on the spot, square; otherwise the recovery comes down around it.
+#[test]
+fn recenter_and_grasp_blind_descent_landed_a_finger_on_a_cube_beside_the_taught_spot() {
+    let plan = tree("recenter_and_grasp.yaml");
+    // 30 mm along the fingers from the taught spot: the pads' faces (65 mm apart) are 10.5 mm
+    // beyond a square cube's faces at the spot, so the blind descent put a finger on this one.
+    let o = run(&plan, Layout::new(0.48, -0.18, 0.0, 0.45, 0.08), None);
+    assert!(o.report.success, "{:?}", o.report.failure_reason);
+    assert!(o.oracle.inside(), "{:?}", o.oracle);
+    assert!(!o.trace.touched("reach[down at taught spot]"));
+    assert!(o.report.collisions.is_empty(), "{:?}", o.report.collisions);
 }
 
 #[test]

@@ -395,13 +395,8 @@ impl Carry {
         } else {
             // Lift and set-down stay straight; only real contact counts, with the destination
             // intended (its floor, the block it goes on).
-            let w = cell.world();
             let intended: Vec<String> = match phase {
-                Phase::Lower => self
-                    .destination(w)
-                    .map(|d| w.name(d).to_string())
-                    .into_iter()
-                    .collect(),
+                Phase::Lower => self.set_down_intended(cell.world()),
                 _ => Vec::new(),
             };
             let what = if phase == Phase::Lift { "lift" } else { "set-down" };
@@ -421,6 +416,21 @@ impl Carry {
         (r * self.rotation, r * self.pinch_from_block)
     }
 
+    /// What the set-down may touch, as the collision checker names it: a container
+    /// destination's floor (`bin/floor`: the held block comes down on it) but not its walls (the
+    /// arm or the fingers on a wall is a collision), or the whole destination otherwise (the block
+    /// it goes on, the surface of a `place`).
+    fn set_down_intended(&self, w: &World) -> Vec<String> {
+        let Some(d) = self.destination(w) else {
+            return Vec::new();
+        };
+        if w.spec(d).kind() == ObjectKind::Container {
+            vec![format!("{}/floor", w.name(d))]
+        } else {
+            vec![w.name(d).to_string()]
+        }
+    }
+
     /// True when the straight set-down from `q` (the arm above the place, tool turned `k`
     /// quarter turns) to the block centre `place` would touch something other than the
     /// destination.
@@ -434,12 +444,7 @@ impl Carry {
         let Ok(lower) = CartesianMove::new(*q, pose, &limits) else {
             return false;
         };
-        let w = cell.world();
-        let intended: Vec<String> = self
-            .destination(w)
-            .map(|d| w.name(d).to_string())
-            .into_iter()
-            .collect();
+        let intended = self.set_down_intended(cell.world());
         check_motion(cell, &[&lower], &intended, true).is_some()
     }
 

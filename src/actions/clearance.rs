@@ -3,12 +3,14 @@
 //! table plane (the closing axis at the tool's yaw), tested against the footprints of the
 //! objects beside the place and against the walls of the container it goes into.
 //!
-//! The finger dimensions are measured on the unmodified Menagerie model (`robotiq_2f85/2f85.xml`,
-//! its collision geoms at openings 0 … 85 mm; docs/nodes/place.md gives the table). Beyond
-//! the pad's face, along the closing axis, the finger reaches 8 mm (the pad) plus up to 8.5 mm
-//! (the follower's knuckle behind it) within 40 mm of the fingertip, and up to 33 mm (the
-//! follower and coupler) from 40 to 60 mm; across the closing axis the pads are 22 mm wide and
-//! the links above them up to 27 mm (39 mm higher up).
+//! The finger dimensions are measured on the unmodified Menagerie model (`robotiq_2f85/2f85.xml`)
+//! as MuJoCo collides it: a mesh geom collides as its convex hull, and the follower's hull
+//! reaches well beyond the curved finger itself (docs/nodes/place.md gives the table). How far
+//! the finger reaches beyond the pad's face along the closing axis grows with the height above
+//! the fingertips — 8 mm (the pad) at the tip, 18 mm at 20 mm, 28 mm at 40 mm, 31–38 mm at
+//! 60 mm — and, above 50 mm, with the fingers closing (the couplers and drivers stay where they
+//! are while the pads move in); across the closing axis the finger is 11 mm each side up to
+//! 35 mm, 17 mm at 60 mm, and the hand wider above.
 
 use nalgebra::{UnitQuaternion, Vector2, Vector3};
 
@@ -16,29 +18,76 @@ use crate::failure::{Failure, FailureKind};
 use crate::scene::{ObjectKind, Shape};
 use crate::world::World;
 
-/// Height above the fingertips of the pads' band, metres: within it the finger reaches
-/// [`PAD_OUTSIDE`] beyond the pad's face and [`PAD_HALF_WIDTH`] across.
-pub const PAD_BAND: f64 = 0.040;
-/// How far the finger reaches beyond its pad's face, along the closing axis, within
-/// [`PAD_BAND`] of the fingertip, metres (8 mm pad + 8.5 mm follower knuckle).
-pub const PAD_OUTSIDE: f64 = 0.0165;
-/// Half the finger's width across the closing axis within [`PAD_BAND`] of the fingertip, metres
-/// (the pads are 22 mm wide; the follower 15 mm; 12 mm at the band's top).
-pub const PAD_HALF_WIDTH: f64 = 0.012;
-/// Top of the knuckle band above the fingertips, metres: from [`PAD_BAND`] up to here the finger
-/// reaches [`KNUCKLE_OUTSIDE`] beyond the pad's face and [`KNUCKLE_HALF_WIDTH`] across.
-pub const KNUCKLE_BAND: f64 = 0.060;
-/// How far the finger reaches beyond its pad's face along the closing axis from [`PAD_BAND`] to
-/// [`KNUCKLE_BAND`] above the fingertip, metres (follower and coupler, any opening ≥ 39 mm).
-pub const KNUCKLE_OUTSIDE: f64 = 0.033;
-/// Half the finger's width across the closing axis from [`PAD_BAND`] to [`KNUCKLE_BAND`], metres.
-pub const KNUCKLE_HALF_WIDTH: f64 = 0.0135;
-/// How far the hand reaches beyond a pad's face along the closing axis higher than
-/// [`KNUCKLE_BAND`] above the fingertips (up to 80 mm: couplers and drivers), metres.
-pub const LINK_OUTSIDE: f64 = 0.043;
-/// Half the hand's width across the closing axis higher than [`KNUCKLE_BAND`] (the spring
-/// links), metres.
-pub const LINK_HALF_WIDTH: f64 = 0.0195;
+/// Heights above the fingertips at which the finger envelope is tabulated, metres.
+const HEIGHTS: [f64; 19] = [
+    0.0, 0.005, 0.010, 0.015, 0.020, 0.025, 0.030, 0.035, 0.040, 0.045, 0.050, 0.055, 0.060, 0.070, 0.080,
+    0.090, 0.100, 0.110, 0.120,
+];
+/// Pad-face distances (openings) at which the envelope is tabulated, metres.
+const OPENINGS: [f64; 6] = [0.0265, 0.032, 0.0428, 0.0533, 0.0668, 0.0852];
+/// How far the finger (the convex hulls of its collision geoms) reaches beyond its pad's face
+/// along the closing axis, anywhere from the fingertip up to `HEIGHTS[i]`, at opening
+/// `OPENINGS[j]`, millimetres (measured on the Menagerie model, gravity off, fingers at rest).
+const OUTSIDE_MM: [[f64; 6]; 19] = [
+    [8.0, 8.0, 8.0, 8.0, 8.0, 8.0],
+    [8.1, 8.1, 8.1, 8.1, 8.0, 8.0],
+    [13.5, 13.5, 13.4, 13.4, 13.3, 13.2],
+    [15.9, 15.9, 15.8, 15.7, 15.7, 15.5],
+    [18.3, 18.3, 18.2, 18.1, 18.0, 17.8],
+    [20.8, 20.7, 20.6, 20.5, 20.3, 20.1],
+    [23.2, 23.2, 23.0, 22.9, 22.7, 22.4],
+    [25.7, 25.6, 25.4, 25.3, 25.0, 24.7],
+    [28.1, 28.0, 27.8, 27.6, 27.4, 27.0],
+    [30.5, 30.4, 30.2, 30.0, 29.7, 29.3],
+    [33.0, 32.8, 32.4, 32.2, 31.8, 31.4],
+    [35.2, 34.8, 33.9, 33.1, 32.2, 31.5],
+    [37.5, 36.7, 35.3, 34.1, 32.5, 31.5],
+    [42.0, 40.7, 38.2, 36.0, 33.2, 31.5],
+    [46.5, 44.6, 41.1, 37.9, 33.8, 31.5],
+    [51.0, 48.5, 44.0, 39.7, 34.4, 31.5],
+    [52.3, 50.2, 45.7, 41.1, 34.9, 31.5],
+    [52.3, 50.2, 45.7, 41.1, 34.9, 31.5],
+    [52.3, 50.2, 45.7, 41.1, 34.9, 31.5],
+];
+/// Half the hand's width across the closing axis, anywhere from the fingertip up to
+/// `HEIGHTS[i]`, at any opening, millimetres (the pads are 22 mm wide; the base mount above
+/// 90 mm).
+const ACROSS_MM: [f64; 19] = [
+    11.0, 11.0, 11.0, 11.0, 11.0, 11.0, 11.0, 11.0, 12.5, 14.1, 15.2, 16.3, 17.2, 18.4, 19.6, 24.3, 29.0,
+    33.7, 37.5,
+];
+
+/// Where `x` falls in the increasing `xs`: the index of the segment and the fraction along it
+/// (clamped to the ends).
+fn locate(xs: &[f64], x: f64) -> (usize, f64) {
+    let last = xs.len() - 1;
+    if x <= xs[0] {
+        return (0, 0.0);
+    }
+    if x >= xs[last] {
+        return (last - 1, 1.0);
+    }
+    let i = xs.windows(2).position(|w| x <= w[1]).unwrap_or(last - 1);
+    (i, (x - xs[i]) / (xs[i + 1] - xs[i]))
+}
+
+/// How far a finger opened to `opening` (pad faces apart, metres) reaches beyond its pad's face
+/// along the closing axis, from the fingertip up to `h` metres above it, metres: interpolated in
+/// the measured table (an opening below 26.5 mm reads as 26.5 mm, a height above 120 mm as
+/// 120 mm).
+pub fn finger_outside(h: f64, opening: f64) -> f64 {
+    let (i, a) = locate(&HEIGHTS, h);
+    let (j, b) = locate(&OPENINGS, opening);
+    let at = |i: usize| OUTSIDE_MM[i][j] + (OUTSIDE_MM[i][j + 1] - OUTSIDE_MM[i][j]) * b;
+    (at(i) + (at(i + 1) - at(i)) * a) * 1e-3
+}
+
+/// Half the hand's width across the closing axis from the fingertip up to `h` metres above it,
+/// metres (interpolated in the measured table).
+pub fn finger_half_width(h: f64) -> f64 {
+    let (i, a) = locate(&HEIGHTS, h);
+    (ACROSS_MM[i] + (ACROSS_MM[i + 1] - ACROSS_MM[i]) * a) * 1e-3
+}
 /// Half the height of a pad (two 18.75 mm silicone boxes stacked), metres: the fingertips are
 /// this far below the pads' centre.
 pub const PAD_HALF_HEIGHT: f64 = 0.01875;
@@ -150,13 +199,7 @@ impl SetDown {
     /// `h` metres above the fingertips: the block's footprint (its faces square to the closing
     /// axis) and the fingers' band at that height.
     fn envelope(&self, h: f64) -> [Rect; 2] {
-        let (outside, across) = if h <= PAD_BAND {
-            (PAD_OUTSIDE, PAD_HALF_WIDTH)
-        } else if h <= KNUCKLE_BAND {
-            (KNUCKLE_OUTSIDE, KNUCKLE_HALF_WIDTH)
-        } else {
-            (LINK_OUTSIDE, LINK_HALF_WIDTH)
-        };
+        let (outside, across) = (finger_outside(h, self.opening), finger_half_width(h));
         let centre = self.centre.xy();
         [
             Rect {
@@ -321,8 +364,31 @@ mod tests {
         };
         let [block, fingers] = s.envelope(0.04);
         assert_eq!(block.half, [0.022, 0.022]);
-        // 54 mm opening: 27 mm to each pad face, 16.5 mm of finger beyond it.
-        assert!((fingers.half[0] - 0.0435).abs() < 1e-12);
-        assert!((fingers.half[1] - PAD_HALF_WIDTH).abs() < 1e-12);
+        // 54 mm opening: 27 mm to each pad face, 27.6 mm of finger (hull) beyond it at 40 mm.
+        let outside = finger_outside(0.04, 0.054);
+        assert!((outside - 0.0276).abs() < 2e-4, "{outside}");
+        assert!((fingers.half[0] - (0.027 + outside)).abs() < 1e-12);
+        assert!((fingers.half[1] - 0.0125).abs() < 1e-12);
+    }
+
+    /// Regression: the bands were measured on the finger's mesh, not on the convex hull MuJoCo
+    /// collides, so 35 mm above the fingertips the follower reached 25 mm beyond the pad's face
+    /// where the check allowed 16.5 mm, and a release in the bin put it on the wall's top edge
+    /// (`clear_table` scenario 267 of seed 1).
+    #[test]
+    fn follower_hull_reached_past_the_pad_band() {
+        assert!(finger_outside(0.035, 0.053) >= 0.0253);
+        assert!(finger_outside(0.0, 0.053) >= 0.008);
+        // Monotone in height, and wider beyond the pad as the fingers close, high up.
+        let mut last = 0.0;
+        for k in 0..=130 {
+            let h = k as f64 * 1e-3;
+            let o = finger_outside(h, 0.046);
+            assert!(o >= last - 1e-12, "{h}: {o} < {last}");
+            last = o;
+        }
+        assert!(finger_outside(0.08, 0.03) > finger_outside(0.08, 0.08));
+        assert!((finger_outside(0.5, 0.01) - 0.0523).abs() < 1e-12);
+        assert!((finger_half_width(0.02) - 0.011).abs() < 1e-12);
     }
 }

@@ -17,6 +17,7 @@ mod place;
 mod planning;
 mod reach;
 mod release;
+mod release_room;
 mod side;
 mod targets;
 

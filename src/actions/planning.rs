@@ -10,7 +10,8 @@
 //!   motion is blocked only by a pair that is not touching at its start;
 //! - a straight final segment (a Cartesian `reach`, the carry's lift and set-down) counts only
 //!   real contact (penetration), not the clearance margin, and contact with the object the leaf
-//!   goes to (the reach's target, the carry's destination) is intended;
+//!   goes to (the reach's target, the carry's destination: a container's floor, not its walls)
+//!   is intended;
 //! - a planned motion keeps the full margin from everything except the pairs touching at its
 //!   start, and ends at the pre-grasp or pre-place pose, never in contact.
 

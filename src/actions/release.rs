@@ -51,10 +51,17 @@ impl MacroAction for Release {
         if cell.arm_motion_finished() {
             cell.hold();
         }
-        let (ctrl, width) = match self.spec.width {
+        let (mut ctrl, mut width) = match self.spec.width {
             Some(w) => (ctrl_for_width(w), w.min(width_for_ctrl(OPEN_CTRL))),
             None => (OPEN_CTRL, width_for_ctrl(OPEN_CTRL)),
         };
+        // Letting a block go beside a wall or a neighbour: open only as wide as the fingers
+        // clear it.
+        let room = super::release_room::room_to_open(cell.world(), width);
+        if room < width {
+            tracing::debug!(target: "macrotree::actions", "release: opening to {:.1} mm, not {:.1} mm: the fingers would touch what is beside the block", room * 1e3, width * 1e3);
+            (ctrl, width) = (ctrl_for_width(room), room);
+        }
         cell.set_gripper(ctrl);
         self.target_width = width;
         self.retreating = false;
