@@ -351,7 +351,7 @@ fn carry_chose_a_free_spot_in_a_020_m_bin_that_its_own_descent_check_refused() {
 #[test]
 fn a_deep_bin_could_not_take_a_second_block_held_diagonally() {
     let objects = format!(
-        "{}{}  bin:\n    container: {{inner: [0.22, 0.22], wall_height: 0.12, color: gray}}\n    pose: [0.50, 0.14]\n",
+        "{}{}  bin:\n    container: {{inner: [0.21, 0.21], wall_height: 0.12, color: gray}}\n    pose: [0.50, 0.14]\n",
         block("a", 0.40, -0.20, 0.0),
         block("b", 0.55, -0.20, 40.0),
     );
@@ -361,7 +361,7 @@ fn a_deep_bin_could_not_take_a_second_block_held_diagonally() {
         steps += "      - carry: {to: bin, lift: 0.20}\n      - release: {width: 0.08, retreat: 0.15}\n";
     }
     let (r, cell) = run("deep_bin_square", &objects, &sequence(&steps));
-    assert_success(&r, "two blocks into a deep 0.22 m bin");
+    assert_success(&r, "two blocks into a deep 0.21 m bin");
     assert!(r.collisions.is_empty(), "{:?}", r.collisions);
     let w = cell.world();
     let bin = index(w, "bin");

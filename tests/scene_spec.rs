@@ -57,7 +57,19 @@ fn every_shipped_scene_loads_and_passes_the_schema() {
     assert!(scenes.len() >= 4, "{scenes:?}");
     for path in scenes {
         let text = std::fs::read_to_string(&path).unwrap();
-        assert!(text.starts_with("# yaml-language-server: $schema=../schema/scene.schema.json"));
+        // `../schema/…` from `scenes/`, `../../schema/…` from `scenes/held_out/`.
+        let depth = path
+            .strip_prefix(Path::new(ROOT).join("scenes"))
+            .map_or(1, |p| p.components().count());
+        let header = format!(
+            "# yaml-language-server: $schema={}schema/scene.schema.json",
+            "../".repeat(depth)
+        );
+        assert!(
+            text.starts_with(&header),
+            "{}: starts with {header}",
+            path.display()
+        );
         let scene = macrotree::scene::load_scene_file(&path)
             .unwrap_or_else(|d| panic!("{}: {}", path.display(), d[0]));
         assert!(
