@@ -59,12 +59,7 @@ impl Cell {
         let sim = Sim::new(scene);
         let world = sim.observe();
         let steps_per_tick = ((control_period / TIMESTEP).round() as u32).max(1);
-        let blocks: Vec<usize> = (0..scene.objects.len())
-            .filter(|&i| scene.objects[i].qpos.is_some())
-            .collect();
-        let checker = match SceneChecker::from_sim(&sim, DEFAULT_MARGIN)
-            .and_then(|mut c| c.prepare_holds(&blocks).map(|()| c))
-        {
+        let checker = match SceneChecker::from_sim(&sim, DEFAULT_MARGIN) {
             Ok(c) => Some(c),
             Err(e) => {
                 tracing::warn!(target: "macrotree::plan", "no collision checker for this cell, motions run unchecked: {e}");

@@ -54,7 +54,9 @@ struct Held {
 /// A MuJoCo collision checker of the cell for the motion planner (see the module docs).
 pub struct SceneChecker {
     scene: Scene,
-    data: MjData<Arc<MjModel>>,
+    /// The private data, owning its private copy of the scene's model (edited in place when
+    /// the groups or the margin change).
+    data: MjData<Box<MjModel>>,
     /// Arm group of each geom: 0 = fixed (scene, robot base), 1..=6 = moved by that arm joint.
     group: Vec<u8>,
     /// Collidable in the scene's model (contype or conaffinity set).
@@ -65,12 +67,9 @@ pub struct SceneChecker {
     snapshot_q: [f64; 6],
     held: Option<Held>,
     margin: f64,
-    /// What the private data was built for: (held block, margin bits); `None` before the first
-    /// build.
+    /// What the private model's bitmasks and margins are written for: (held block, margin
+    /// bits); `None` before the first write.
     built_for: Option<BuildKey>,
-    /// Private data built before for other (held block, margin) pairs, so a hold or release
-    /// swaps data instead of copying the model again (a copy takes tens of milliseconds).
-    built: Vec<(BuildKey, MjData<Arc<MjModel>>)>,
     /// The conservative fast model of the current snapshot ([`Screen`]), built on first use
     /// after a change; `None` inside when the cell has geometry it cannot bound.
     screen: Option<Option<Screen>>,
@@ -82,9 +81,6 @@ pub struct SceneChecker {
 
 /// What a private model is edited for: the held block (scene index), the margin's bits.
 type BuildKey = (Option<usize>, u64);
-
-/// Most private data kept for other (held block, margin) pairs.
-const MAX_BUILT: usize = 16;
 
 /// `a` if the geom's name is set, else its body's; the scene-object prefix dropped; the floor
 /// is `table`.
@@ -164,8 +160,9 @@ impl SceneChecker {
         let bodies: [usize; 6] = std::array::from_fn(|k| src.jnt_bodyid()[arm_joints[k]] as usize);
         let mut checker = Self {
             scene: scene.clone(),
-            // Replaced by a private copy of the model in `rebuild_model` below.
-            data: MjData::new(scene.model.clone()),
+            // The one copy of the model this checker makes (a copy takes tens of milliseconds;
+            // holds, releases and margin changes edit it in place).
+            data: MjData::new(Box::new((*scene.model).clone())),
             group,
             collidable,
             labels,
@@ -173,7 +170,6 @@ impl SceneChecker {
             held: None,
             margin,
             built_for: None,
-            built: Vec::new(),
             screen: None,
             screen_on: true,
             arm_links: (bodies, joints),
@@ -192,60 +188,15 @@ impl SceneChecker {
     }
 
     /// Writes the contact bitmasks and margins of the private model for the current groups
-    /// (a held block joins the wrist-3 group) and margin.
+    /// (a held block joins the wrist-3 group) and margin, in place: the model's sizes do not
+    /// change, so the private data stays valid.
     fn rebuild_model(&mut self) {
         self.screen = None;
         let key = (self.held.as_ref().map(|h| h.object), self.margin.to_bits());
         if self.built_for == Some(key) {
             return;
         }
-        let data = match self.built.iter().position(|(k, _)| *k == key) {
-            Some(i) => {
-                let (_, mut data) = self.built.swap_remove(i);
-                data.qpos_mut().copy_from_slice(self.data.qpos());
-                data.mocap_pos_mut().copy_from_slice(self.data.mocap_pos());
-                data.mocap_quat_mut().copy_from_slice(self.data.mocap_quat());
-                data
-            }
-            None => self.build_data(),
-        };
-        let old = std::mem::replace(&mut self.data, data);
-        if let Some(k) = self.built_for.replace(key) {
-            if self.built.len() >= MAX_BUILT {
-                self.built.remove(0);
-            }
-            self.built.push((k, old));
-        }
-    }
-
-    /// Builds every private data a hold of one of `blocks` (scene indices) needs now, so the
-    /// holds during an episode cost no model copy; the checker's state does not change.
-    ///
-    /// # Errors
-    /// An index that is not a block of the scene.
-    pub fn prepare_holds(&mut self, blocks: &[usize]) -> Result<(), SimError> {
-        let before = self.held.clone();
-        for &b in blocks {
-            let qpos = self
-                .scene
-                .objects
-                .get(b)
-                .and_then(|o| o.qpos)
-                .ok_or_else(|| SimError::Scene(format!("object {b} is not a block of the scene")))?;
-            self.held = Some(Held {
-                object: b,
-                qpos,
-                in_pinch: Isometry3::identity(),
-            });
-            self.rebuild_model();
-        }
-        self.held = before;
-        self.rebuild_model();
-        Ok(())
-    }
-
-    /// A fresh private data of the model edited for the current groups and margin.
-    fn build_data(&self) -> MjData<Arc<MjModel>> {
+        self.built_for = Some(key);
         let mut group = self.group.clone();
         if let Some(h) = &self.held {
             let [g0, g1] = self.scene.objects[h.object].geoms;
@@ -254,35 +205,29 @@ impl SceneChecker {
             }
         }
         let margin = self.margin;
-        let collidable = self.collidable.clone();
-        // A fresh copy of the scene's model, edited, and the data rebuilt around it (only on
-        // construction, hold / release and margin changes).
-        let mut model = (*self.scene.model).clone();
+        let collidable = &self.collidable;
+        let floor = self.scene.ids.floor_geom;
+        // SAFETY: only per-geom values (contact bitmasks, margins, gaps) are written; no size,
+        // address or index table of the model changes, so the data stays consistent with it.
+        let model = unsafe { self.data.model_mut() };
         // Bits: 0 = fixed scene geoms, 1..=6 = moved by arm joint k, 7 = the table. A geom of
         // group k collides with every bit but its own (and but the table's for k = 1: the
         // shoulder link only turns about the vertical axis above the table, its distance to it
         // never changes); fixed geoms and the table collide with nothing by themselves.
-        let floor = self.scene.ids.floor_geom;
-        {
-            let ct = model.geom_contype_mut();
-            for (g, c) in ct.iter_mut().enumerate() {
-                *c = match (collidable[g], group[g]) {
-                    (false, _) => 0,
-                    (true, 0) if g == floor => 1 << 7,
-                    (true, 0) => 1,
-                    (true, k) => 1 << k,
-                };
-            }
+        for (g, c) in model.geom_contype_mut().iter_mut().enumerate() {
+            *c = match (collidable[g], group[g]) {
+                (false, _) => 0,
+                (true, 0) if g == floor => 1 << 7,
+                (true, 0) => 1,
+                (true, k) => 1 << k,
+            };
         }
-        {
-            let ca = model.geom_conaffinity_mut();
-            for (g, c) in ca.iter_mut().enumerate() {
-                *c = match (collidable[g], group[g]) {
-                    (false, _) | (true, 0) => 0,
-                    (true, 1) => 0x7F & !(1 << 1),
-                    (true, k) => 0xFF & !(1 << k),
-                };
-            }
+        for (g, c) in model.geom_conaffinity_mut().iter_mut().enumerate() {
+            *c = match (collidable[g], group[g]) {
+                (false, _) | (true, 0) => 0,
+                (true, 1) => 0x7F & !(1 << 1),
+                (true, k) => 0xFF & !(1 << k),
+            };
         }
         for (g, m) in model.geom_margin_mut().iter_mut().enumerate() {
             *m = if collidable[g] && group[g] != 0 {
@@ -296,11 +241,6 @@ impl SceneChecker {
                 *m = 0.0;
             }
         }
-        let mut data = MjData::new(Arc::new(model));
-        data.qpos_mut().copy_from_slice(self.data.qpos());
-        data.mocap_pos_mut().copy_from_slice(self.data.mocap_pos());
-        data.mocap_quat_mut().copy_from_slice(self.data.mocap_quat());
-        data
     }
 
     /// Takes a new snapshot from `data` (a running simulation of the same scene): every block's

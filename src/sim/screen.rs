@@ -15,8 +15,6 @@
 //! reports no contact. `tests/motion_screen.rs` checks this against MuJoCo over thousands of
 //! configurations near obstacles.
 
-use std::sync::Arc;
-
 use mujoco_rs::prelude::*;
 use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, Unit, UnitQuaternion, Vector3};
 
@@ -211,7 +209,7 @@ fn moved(l: &Local, r: &Matrix3<f64>, t: &Vector3<f64>) -> Local {
 pub(crate) struct Build<'a> {
     /// The checker's private data, posed by `mj_kinematics` (any arm joints; a held block at
     /// its pose for those joints).
-    pub(crate) data: &'a MjData<Arc<MjModel>>,
+    pub(crate) data: &'a MjData<Box<MjModel>>,
     /// Arm group of each geom (0 fixed, 1..=6 moved by that arm joint; a held block's geoms 6).
     pub(crate) group: &'a [u8],
     /// Body ids of the six arm links, base to wrist 3.
