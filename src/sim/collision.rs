@@ -24,6 +24,7 @@ use mujoco_rs::prelude::*;
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
 
 use super::error::SimError;
+use super::margin::MarginPairs;
 use super::scene::{ARM_JOINTS, Scene};
 use super::screen::{Build, Screen};
 use crate::motion::fk;
@@ -77,6 +78,9 @@ pub struct SceneChecker {
     screen_on: bool,
     /// Body and joint ids of the six arm links.
     arm_links: ([usize; 6], [usize; 6]),
+    /// The private model's pairs whose margin MuJoCo's narrow phase may leave out, and those of
+    /// them found closer than the margin at the last configuration posed (geoms, distance).
+    margin_pairs: (MarginPairs, Vec<(usize, usize, f64)>),
 }
 
 /// What a private model is edited for: the held block (scene index), the margin's bits.
@@ -173,6 +177,7 @@ impl SceneChecker {
             screen: None,
             screen_on: true,
             arm_links: (bodies, joints),
+            margin_pairs: Default::default(),
         };
         checker.rebuild_model();
         checker.sync(data)?;
@@ -241,6 +246,7 @@ impl SceneChecker {
                 *m = 0.0;
             }
         }
+        self.margin_pairs = (MarginPairs::new(self.data.model()), Vec::new());
     }
 
     /// Takes a new snapshot from `data` (a running simulation of the same scene): every block's
@@ -345,11 +351,13 @@ impl SceneChecker {
     fn detect(&mut self, q: &[f64; 6]) -> usize {
         self.detect_pose(q);
         self.data.collision();
+        self.margin_pairs.1 = self.margin_pairs.0.missing(&mut self.data);
         self.data
             .contact()
             .iter()
             .filter(|c| c.dist < self.margin)
             .count()
+            + self.margin_pairs.1.len()
     }
 
     /// Poses the arm (and a held block) at `q` with `mj_kinematics`.
@@ -399,11 +407,15 @@ impl CollisionChecker for SceneChecker {
         }
         self.detect(q);
         let mut out: Vec<Collision> = Vec::new();
-        for c in self.data.contact() {
-            if c.dist >= self.margin {
+        let reported = self
+            .data
+            .contact()
+            .iter()
+            .map(|c| (c.geom[0] as usize, c.geom[1] as usize, c.dist));
+        for (g1, g2, dist) in reported.chain(self.margin_pairs.1.iter().copied()) {
+            if dist >= self.margin {
                 continue;
             }
-            let (g1, g2) = (c.geom[0] as usize, c.geom[1] as usize);
             // The moving part first (the higher arm group: nearer the tool).
             let (a, b) = if self.group_of(g1) >= self.group_of(g2) {
                 (g1, g2)
@@ -412,12 +424,8 @@ impl CollisionChecker for SceneChecker {
             };
             let (a, b) = (self.labels[a].clone(), self.labels[b].clone());
             match out.iter_mut().find(|o| o.a == a && o.b == b) {
-                Some(o) => o.distance = o.distance.min(c.dist),
-                None => out.push(Collision {
-                    a,
-                    b,
-                    distance: c.dist,
-                }),
+                Some(o) => o.distance = o.distance.min(dist),
+                None => out.push(Collision { a, b, distance: dist }),
             }
         }
         out.sort_by(|x, y| x.distance.total_cmp(&y.distance));

@@ -5,6 +5,7 @@ pub mod cache;
 pub mod collision;
 pub mod error;
 pub mod layout;
+mod margin;
 pub mod mjcf;
 pub mod planning;
 pub mod scene;
