@@ -10,9 +10,10 @@
 //! tracking error put the forearm on the fixture.
 //!
 //! [`MarginPairs`] lists the pairs of those types that MuJoCo tests in a model (contact bitmasks,
-//! body filters, `<exclude>`) and, after `mj_collision`, measures each one that is near by its
-//! bounding spheres with `mj_geomDistance` (GJK on the exact shapes), so a checker counts it when
-//! it is closer than the margin, as for every other pair.
+//! body filters, `<exclude>`) and, after `mj_collision`, measures each one that MuJoCo did not
+//! report and that may be within the margin (the other geom's bounding sphere against the box, or
+//! against the plane's half-space) with `mj_geomDistance` (GJK on the exact shapes), so a checker
+//! counts it when it is closer than the margin, as for every other pair.
 
 use mujoco_rs::prelude::*;
 use mujoco_rs::wrappers::mj_model::traits::ModelType;
@@ -117,26 +118,40 @@ impl MarginPairs {
     }
 }
 
-/// False when the pair's bounding spheres (a plane: its half-space) keep the pair's margin, so
-/// the geoms inside them do too.
+/// False when the pair surely keeps its margin: a box's distance from the other geom's centre
+/// less the other's bounding radius (both ways round when both are boxes), or a plane's
+/// half-space against the other's bounding sphere, is at least the margin; the geoms then keep
+/// it too.
 fn near<M: ModelType>(data: &MjData<M>, p: &Pair) -> bool {
     let m = data.model();
-    let (pos, mat, rbound) = (data.geom_xpos(), data.geom_xmat(), m.geom_rbound());
-    let plane = |g: usize| m.geom_type()[g] == MjtGeomBase::mjGEOM_PLANE;
-    let gap = |plane_g: usize, other: usize| {
-        let (o, r) = (pos[plane_g], mat[plane_g]);
-        let n = [r[2], r[5], r[8]];
-        let x = pos[other];
-        (0..3).map(|i| (x[i] - o[i]) * n[i]).sum::<f64>() - rbound[other]
+    let (pos, mat, rbound, types) = (data.geom_xpos(), data.geom_xmat(), m.geom_rbound(), m.geom_type());
+    // A lower bound of the distance from geom `shape` (a box or a plane) to geom `other`.
+    let bound = |shape: usize, other: usize| -> f64 {
+        let (o, r, x) = (pos[shape], mat[shape], pos[other]);
+        let d = [x[0] - o[0], x[1] - o[1], x[2] - o[2]];
+        // The offset in the shape's frame (`geom_xmat` is row-major: columns are its axes).
+        let local = |i: usize| d[0] * r[i] + d[1] * r[3 + i] + d[2] * r[6 + i];
+        let apart = match types[shape] {
+            MjtGeomBase::mjGEOM_PLANE => local(2),
+            _ => {
+                let size = m.geom_size()[shape];
+                (0..3)
+                    .map(|i| (local(i).abs() - size[i]).max(0.0).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            }
+        };
+        apart - rbound[other]
     };
-    let apart = if plane(p.a) {
-        gap(p.a, p.b)
-    } else if plane(p.b) {
-        gap(p.b, p.a)
-    } else {
-        let (x, y) = (pos[p.a], pos[p.b]);
-        let d2: f64 = (0..3).map(|i| (x[i] - y[i]).powi(2)).sum();
-        d2.sqrt() - rbound[p.a] - rbound[p.b]
-    };
+    let is_box = |g: usize| types[g] == MjtGeomBase::mjGEOM_BOX;
+    let plane = |g: usize| types[g] == MjtGeomBase::mjGEOM_PLANE;
+    let mut apart = f64::NEG_INFINITY;
+    // A plane is unbounded: only its own half-space bounds the distance to it.
+    if plane(p.a) || (is_box(p.a) && !plane(p.b)) {
+        apart = apart.max(bound(p.a, p.b));
+    }
+    if plane(p.b) || (is_box(p.b) && !plane(p.a)) {
+        apart = apart.max(bound(p.b, p.a));
+    }
     apart < p.margin
 }
