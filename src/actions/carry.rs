@@ -27,6 +27,13 @@ const LOST_TICKS: u32 = 3;
 /// new place (a bowl slid aside), metres.
 const GOAL_MOVED: f64 = 0.005;
 
+/// Least lift (block centre, metres) a carry takes when a straight lift to its own height would
+/// leave the arm's workspace: the lift ends below that, where the line is still reachable.
+const MIN_LIFT: f64 = 0.05;
+
+/// Bisection steps finding how high a straight lift stays reachable (0.15 m / 2¹⁰: under 0.2 mm).
+const LIFT_BISECTIONS: u32 = 10;
+
 /// Re-plans of the transfer allowed in one carry.
 const MAX_REPLANS: u32 = 3;
 
@@ -686,16 +693,45 @@ impl MacroAction for Carry {
         self.replans = 0;
         self.lost = 0;
         let base_z = (self.spec.lift + self.half).max(pos.z);
-        match self.start_phase(cell, Phase::Lift, lift) {
-            // High over a tall post, far out, the straight line up can cross a branch flip: lift
-            // to the carry's own height, and the transfer (checked, planned when it would touch)
-            // takes the block on from there.
-            Err(e) if e.kind == FailureKind::Unreachable && lift_z > base_z => {
-                tracing::debug!(target: "macrotree::actions", "carry: the lift to {lift_z:.3} m is impossible ({}); lifting to {base_z:.3} m", e.message);
-                self.start_phase(cell, Phase::Lift, Vector3::new(pos.x, pos.y, base_z))
+        let e = match self.start_phase(cell, Phase::Lift, lift) {
+            Err(e) if e.kind == FailureKind::Unreachable => e,
+            started => return started,
+        };
+        // High over a tall post, far out, the straight line up can cross a branch flip: lift
+        // to the carry's own height, and the transfer (checked, planned when it would touch)
+        // takes the block on from there.
+        if lift_z > base_z {
+            tracing::debug!(target: "macrotree::actions", "carry: the lift to {lift_z:.3} m is impossible ({}); lifting to {base_z:.3} m", e.message);
+            match self.start_phase(cell, Phase::Lift, Vector3::new(pos.x, pos.y, base_z)) {
+                Err(e) if e.kind == FailureKind::Unreachable => {}
+                started => return started,
             }
-            started => started,
         }
+        // At the edge of the workspace even that line leaves it (the elbow straightens): lift as
+        // high as the line stays reachable, at least `MIN_LIFT`; the transfer, which comes in
+        // towards the goal, takes the block on.
+        let from = cell.arm_setpoint();
+        let reachable = |z: f64| {
+            let pose = Isometry3::from_parts(
+                Translation3::from(Vector3::new(pos.x, pos.y, z) + self.pinch_from_block),
+                self.rotation,
+            );
+            CartesianMove::new(from, pose, &MotionLimits::default()).is_ok()
+        };
+        let (mut lo, mut hi) = (pos.z + MIN_LIFT, base_z.min(lift_z));
+        if lo >= hi || !reachable(lo) {
+            return Err(e);
+        }
+        for _ in 0..LIFT_BISECTIONS {
+            let mid = 0.5 * (lo + hi);
+            if reachable(mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        tracing::debug!(target: "macrotree::actions", "carry: the straight lift leaves the workspace ({}); lifting to {lo:.3} m", e.message);
+        self.start_phase(cell, Phase::Lift, Vector3::new(pos.x, pos.y, lo))
     }
 
     fn waiting_for(&self, cell: &Cell) -> String {
