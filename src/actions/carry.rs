@@ -471,7 +471,7 @@ impl Carry {
                         tracing::debug!(target: "macrotree::actions", "carry: the transfer would touch {}; planning", describe(pairs))
                     }
                     None => {
-                        tracing::debug!(target: "macrotree::actions", "carry: the set-down from the transfer's end would touch something; planning the transfer to another arm configuration")
+                        tracing::debug!(target: "macrotree::actions", "carry: the set-down from the transfer's end would touch something or cannot be made straight; planning the transfer to another arm configuration")
                     }
                 }
                 let motion = self.plan_transfer(cell, &from, &end, &place)?;
@@ -522,7 +522,8 @@ impl Carry {
 
     /// True when the straight set-down from `q` (the arm above the place, tool turned `k`
     /// quarter turns) to the block centre `place` would touch something other than the
-    /// destination.
+    /// destination, or cannot be made at all (the line crosses a wrist singularity or a branch
+    /// flip from this arm configuration).
     fn set_down_hits(&self, cell: &mut Cell, q: &[f64; 6], place: &Vector3<f64>, k: usize) -> bool {
         let (rotation, offset) = self.turned(k);
         let pose = Isometry3::from_parts(Translation3::from(place + offset), rotation);
@@ -531,7 +532,7 @@ impl Carry {
             ..MotionLimits::default()
         };
         let Ok(lower) = CartesianMove::new(*q, pose, &limits) else {
-            return false;
+            return true;
         };
         let intended = self.set_down_intended(cell.world());
         check_motion(cell, &[&lower], &intended, true).is_some()
