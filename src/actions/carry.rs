@@ -259,7 +259,15 @@ impl Carry {
                 .map(|p| (p, turn))
         });
         let floor = z - self.spec.place_height - self.half;
-        let ahead = Lookahead::new(w, c, self.held, floor, self.spec.place_height, self.tip, FINE_GRID);
+        let ahead = Lookahead::new(
+            w,
+            c,
+            self.held,
+            floor,
+            self.spec.place_height,
+            self.tip,
+            FINE_GRID,
+        );
         let room_after = |p: Vector2<f64>, turn: f64| {
             let down = SetDown {
                 closing: nalgebra::Rotation2::new(turn) * closing,

@@ -148,8 +148,8 @@ fn detour(
         Translation3::new(here.translation.x, here.translation.y, z),
         here.rotation,
     );
-    let rise =
-        CartesianMove::new(*from, up, limits).map_err(|e| unreachable(format!("unreachable detour (up): {e}")))?;
+    let rise = CartesianMove::new(*from, up, limits)
+        .map_err(|e| unreachable(format!("unreachable detour (up): {e}")))?;
     let over_at = Vector3::new(position.x, position.y, z);
     let over_q = ik_down(&over_at, yaw, quarter, &rise.end())
         .map_err(|e| unreachable(format!("unreachable detour (over): {e}")))?;
