@@ -57,6 +57,10 @@ const SPOT_GRID: i32 = 9;
 /// little room for the blocks still to come (odd; every point of the [`SPOT_GRID`] is on it).
 const FINE_GRID: i32 = 17;
 
+/// A spot the packing search scored: where (world, metres), the tool's turn (radians), and how
+/// many blocks still to come fit after it, the walls' gap and the room (metres).
+type PackedSpot = (Vector2<f64>, f64, (usize, f64, f64));
+
 /// The carry's phases, in order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Phase {
@@ -282,7 +286,7 @@ impl Carry {
         // Packing: the spot (finer grid, any turn) that leaves room for the most blocks still to
         // come; the first turn, then the walls and the room, as above, on ties.
         let fine = self.grid(w, c, FINE_GRID);
-        let mut best: Option<(Vector2<f64>, f64, (usize, f64, f64))> = None;
+        let mut best: Option<PackedSpot> = None;
         for &turn in &turns {
             for &p in &fine {
                 let Some((walls, room)) = self.spot_score(w, c, z, p, &inside, turn) else {

@@ -16,6 +16,9 @@ use nalgebra::{Rotation2, Vector2, Vector3};
 use super::clearance::{MARGIN, SetDown, release_opening};
 use crate::world::World;
 
+/// Fill orders the estimate tries: from each of the container's four corners, along either axis.
+const FILL_ORDERS: usize = 8;
+
 /// A block as the look-ahead puts it down: footprint centre (world table plane), a side along
 /// the unit `axis`, half-edge and top, metres.
 #[derive(Clone, Copy, Debug)]
@@ -105,12 +108,11 @@ impl Lookahead {
                         }
                     }
                 }
-                let orders = fill_orders()
-                    .into_iter()
-                    .map(|key| {
+                let orders = (0..FILL_ORDERS)
+                    .map(|order| {
                         let mut o = free.clone();
                         o.sort_by(|a, b| {
-                            let (ka, kb) = (key(&a.local), key(&b.local));
+                            let (ka, kb) = (fill_key(order, &a.local), fill_key(order, &b.local));
                             ka.0.total_cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
                         });
                         o
@@ -142,7 +144,7 @@ impl Lookahead {
     pub fn capacity(&self, first: Planned) -> usize {
         let total = self.total();
         let mut best = 0;
-        for o in 0..8 {
+        for o in 0..FILL_ORDERS {
             let mut placed = vec![first];
             let mut fitted = 0;
             for block in &self.coming {
@@ -184,17 +186,16 @@ fn cube_clear(s: &Spot, half: f64, p: &Planned) -> bool {
         })
 }
 
-/// The eight fill orders, as sort keys over a spot's coordinates in the container's frame:
-/// from each corner, along either axis first.
-fn fill_orders() -> Vec<Box<dyn Fn(&Vector2<f64>) -> (f64, f64)>> {
-    let mut orders: Vec<Box<dyn Fn(&Vector2<f64>) -> (f64, f64)>> = Vec::with_capacity(8);
-    for sx in [1.0, -1.0] {
-        for sy in [1.0, -1.0] {
-            orders.push(Box::new(move |l: &Vector2<f64>| (sy * l.y, sx * l.x)));
-            orders.push(Box::new(move |l: &Vector2<f64>| (sx * l.x, sy * l.y)));
-        }
+/// The sort key of fill order `order` (0…7) over a spot's coordinates in the container's frame:
+/// from each of the four corners (the signs), along either axis first.
+fn fill_key(order: usize, l: &Vector2<f64>) -> (f64, f64) {
+    let sx = if order & 4 == 0 { 1.0 } else { -1.0 };
+    let sy = if order & 2 == 0 { 1.0 } else { -1.0 };
+    if order & 1 == 0 {
+        (sy * l.y, sx * l.x)
+    } else {
+        (sx * l.x, sy * l.y)
     }
-    orders
 }
 
 #[cfg(test)]
@@ -204,7 +205,7 @@ mod tests {
     #[test]
     fn there_are_eight_distinct_fill_orders() {
         let p = Vector2::new(0.3, -0.7);
-        let keys: Vec<(f64, f64)> = fill_orders().iter().map(|k| k(&p)).collect();
+        let keys: Vec<(f64, f64)> = (0..FILL_ORDERS).map(|o| fill_key(o, &p)).collect();
         for (i, a) in keys.iter().enumerate() {
             for b in &keys[i + 1..] {
                 assert_ne!(a, b);

@@ -132,6 +132,9 @@ impl Reach {
     }
 }
 
+/// Motions run one after the other, and the configuration they end in.
+type Legs = (Vec<Box<dyn Trajectory>>, [f64; 6]);
+
 /// The legs of a detour from `from` (the pinch at `here`) to `position`: straight up to `z`
 /// (metres), a joint move over to above `position`, straight down; and the configuration it
 /// ends in. A failure of kind `unreachable` names the leg no straight line or IK solution makes.
@@ -143,7 +146,7 @@ fn detour(
     yaw: f64,
     quarter: bool,
     limits: &MotionLimits,
-) -> Result<(Vec<Box<dyn Trajectory>>, [f64; 6]), Failure> {
+) -> Result<Legs, Failure> {
     let up = Isometry3::from_parts(
         Translation3::new(here.translation.x, here.translation.y, z),
         here.rotation,
