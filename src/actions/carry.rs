@@ -300,10 +300,11 @@ impl Carry {
                     best = Some((p, turn, (n, walls, room)));
                 }
             }
-            if best.is_some_and(|(_, _, (n, _, _))| n == ahead.total()) {
+            if best.is_some_and(|(_, _, (n, _, _))| n == ahead.total()) || ahead.spent() {
                 break;
             }
         }
+        tracing::debug!(target: "macrotree::actions", "carry: packing look-ahead made {} spot tests", ahead.work());
         match (kept, best) {
             (Some((p, turn, n)), Some((_, _, (bn, _, _)))) if n >= bn => return Ok((p, turn)),
             (_, Some((p, turn, (n, _, _)))) => {

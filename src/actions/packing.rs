@@ -52,7 +52,18 @@ struct Coming {
 pub struct Lookahead {
     coming: Vec<Coming>,
     floor: f64,
+    /// Spot tests left of [`WORK_BUDGET`].
+    budget: std::cell::Cell<u64>,
 }
+
+/// Most blocks still to come the estimate packs (the largest): enough to see whether a spot
+/// wastes room, and a bound on its work.
+pub const MAX_COMING: usize = 4;
+
+/// Spot tests (one candidate spot against the blocks the estimate has put down) one look-ahead
+/// may make over all its [`Lookahead::capacity`] calls; once spent, `capacity` answers 0 and the
+/// search keeps the best spot it has. A count, not a time, so the choice is deterministic.
+pub const WORK_BUDGET: u64 = 2_000_000;
 
 /// The half-edges of the blocks (other than `held`) that the scene's goal sends into container
 /// `c` and that are not inside it yet, largest first, metres.
@@ -75,6 +86,7 @@ impl Lookahead {
             return Self {
                 coming: Vec::new(),
                 floor,
+                budget: std::cell::Cell::new(WORK_BUDGET),
             };
         };
         let yaw = crate::world::snapshot::yaw_of(&w.objects[c].quat);
@@ -84,6 +96,7 @@ impl Lookahead {
         let n = grid / 2;
         let coming = still_to_come(w, c, held)
             .into_iter()
+            .take(MAX_COMING)
             .map(|half| {
                 let usable = inner_half.map(|h| (h - half).max(0.0));
                 let mut free = Vec::new();
@@ -121,7 +134,11 @@ impl Lookahead {
                 Coming { half, orders }
             })
             .collect();
-        Self { coming, floor }
+        Self {
+            coming,
+            floor,
+            budget: std::cell::Cell::new(WORK_BUDGET),
+        }
     }
 
     /// How many blocks are still to come.
@@ -140,15 +157,34 @@ impl Lookahead {
         }
     }
 
-    /// How many of the blocks still to come fit (by the best fill order) once `first` is down.
+    /// Spot tests made so far.
+    pub fn work(&self) -> u64 {
+        WORK_BUDGET - self.budget.get()
+    }
+
+    /// Whether the work budget is spent.
+    pub fn spent(&self) -> bool {
+        self.budget.get() == 0
+    }
+
+    /// How many of the blocks still to come (at most [`MAX_COMING`]) fit (by the best fill
+    /// order) once `first` is down; 0 once the work budget is spent.
     pub fn capacity(&self, first: Planned) -> usize {
         let total = self.total();
         let mut best = 0;
+        if self.spent() {
+            return 0;
+        }
         for o in 0..FILL_ORDERS {
             let mut placed = vec![first];
             let mut fitted = 0;
             for block in &self.coming {
                 let spot = block.orders[o].iter().find(|s| {
+                    let left = self.budget.get();
+                    if left == 0 {
+                        return false;
+                    }
+                    self.budget.set(left - 1);
                     placed.iter().all(|p| {
                         s.down
                             .gap_to_cube(p.centre, p.axis, p.half, p.top)
@@ -160,6 +196,9 @@ impl Lookahead {
                     placed.push(self.planned(&s.down));
                     fitted += 1;
                 }
+            }
+            if self.spent() {
+                return 0;
             }
             best = best.max(fitted);
             if best == total {
