@@ -10,6 +10,7 @@ use super::clearance::{
     MARGIN, SetDown, blocks_inside, closing_axis_in_pinch, closing_in_world, release_opening, tip_above_block,
 };
 use super::macro_action::{Arrival, MacroAction, Progress};
+use super::packing::Lookahead;
 use super::planning::{check_motion, check_straight, describe};
 use super::targets::{resolve, segment_distance, target_object, target_spot};
 use crate::failure::{Failure, FailureKind};
@@ -25,6 +26,13 @@ const LOST_TICKS: u32 = 3;
 /// How far the goal may have moved during the transfer before the transfer is re-planned to its
 /// new place (a bowl slid aside), metres.
 const GOAL_MOVED: f64 = 0.005;
+
+/// Least lift (block centre, metres) a carry takes when a straight lift to its own height would
+/// leave the arm's workspace: the lift ends below that, where the line is still reachable.
+const MIN_LIFT: f64 = 0.05;
+
+/// Bisection steps finding how high a straight lift stays reachable (0.15 m / 2¹⁰: under 0.2 mm).
+const LIFT_BISECTIONS: u32 = 10;
 
 /// Re-plans of the transfer allowed in one carry.
 const MAX_REPLANS: u32 = 3;
@@ -44,6 +52,14 @@ pub const FINGER_MARGIN: f64 = 0.025;
 /// Steps of the grid of candidate spots across a container's floor, each way (odd: the centre
 /// is one of them).
 const SPOT_GRID: i32 = 9;
+
+/// Steps of the finer grid the packing look-ahead searches when the first choice leaves too
+/// little room for the blocks still to come (odd; every point of the [`SPOT_GRID`] is on it).
+const FINE_GRID: i32 = 17;
+
+/// A spot the packing search scored: where (world, metres), the tool's turn (radians), and how
+/// many blocks still to come fit after it, the walls' gap and the room (metres).
+type PackedSpot = (Vector2<f64>, f64, (usize, f64, f64));
 
 /// The carry's phases, in order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -218,28 +234,21 @@ impl Carry {
     /// default) clear its walls by [`MARGIN`] (or come nearest to), and among them the one with
     /// the most room to the blocks already in it (ties go to the spot nearest the centre; the
     /// centre when it is empty), world frame, metres; with the tool as held, else turned about
-    /// the vertical by the angle returned (radians). A container with no such spot any way
-    /// fails with `container_full`, before anything moves.
+    /// the vertical by the angle returned (radians).
+    ///
+    /// That spot stands unless it leaves too little room: when the scene's goal sends more
+    /// blocks into the container, the spot must leave room for as many of them as any spot
+    /// does ([`Lookahead::capacity`]: bottom-left fill of the blocks still to come, largest
+    /// first); otherwise the spot, of a finer grid and any of the turns, that leaves room for
+    /// the most of them is taken (ties as above). A container with no spot that takes the block
+    /// any way fails with `container_full`, before anything moves.
     fn free_spot(&self, w: &World, c: usize, z: f64) -> Result<(Vector2<f64>, f64), Failure> {
         let centre = w.objects[c].pos.xy();
-        let crate::scene::Shape::Container { inner_half, .. } = w.spec(c).shape else {
+        let crate::scene::Shape::Container { .. } = w.spec(c).shape else {
             return Ok((centre, 0.0));
         };
         let inside = blocks_inside(w, c, self.held);
-        let usable = inner_half.map(|h| (h - self.half).max(0.0));
-        let (s, co) = crate::world::snapshot::yaw_of(&w.objects[c].quat).sin_cos();
-        let n = SPOT_GRID / 2;
-        let mut candidates: Vec<Vector2<f64>> = Vec::with_capacity((SPOT_GRID * SPOT_GRID) as usize);
-        for i in -n..=n {
-            for k in -n..=n {
-                let (lx, ly) = (
-                    usable[0] * f64::from(i) / f64::from(n),
-                    usable[1] * f64::from(k) / f64::from(n),
-                );
-                candidates.push(centre + Vector2::new(co * lx - s * ly, s * lx + co * ly));
-            }
-        }
-        candidates.sort_by(|a, b| (a - centre).norm().total_cmp(&(b - centre).norm()));
+        let candidates = self.grid(w, c, SPOT_GRID);
         // The tool as held first. Only when no spot takes it so (a deep bin, where the opened
         // hand reaches far along its closing axis), the block goes square to the container, its
         // fingers along one of the container's axes, then the other, then a quarter turn from
@@ -248,10 +257,62 @@ impl Carry {
         let bin_x = crate::world::snapshot::yaw_of(&w.objects[c].quat);
         let square = crate::world::snapshot::fold_quarter_turn(bin_x - closing.y.atan2(closing.x));
         let quarter = std::f64::consts::FRAC_PI_2;
-        for turn in [0.0, square, square + quarter, quarter] {
-            if let Some(p) = self.best_spot(w, c, z, &candidates, &inside, turn) {
+        let turns = [0.0, square, square + quarter, quarter];
+        let first = turns.iter().find_map(|&turn| {
+            self.best_spot(w, c, z, &candidates, &inside, turn)
+                .map(|p| (p, turn))
+        });
+        let floor = z - self.spec.place_height - self.half;
+        let ahead = Lookahead::new(
+            w,
+            c,
+            self.held,
+            floor,
+            self.spec.place_height,
+            self.tip,
+            FINE_GRID,
+        );
+        let room_after = |p: Vector2<f64>, turn: f64| {
+            let down = SetDown {
+                closing: nalgebra::Rotation2::new(turn) * closing,
+                ..self.set_down(Vector3::new(p.x, p.y, z))
+            };
+            ahead.capacity(ahead.planned(&down))
+        };
+        let kept = first.map(|(p, turn)| (p, turn, room_after(p, turn)));
+        if kept.is_some_and(|(_, _, n)| n == ahead.total()) {
+            return Ok(first.unwrap_or((centre, 0.0)));
+        }
+        // Packing: the spot (finer grid, any turn) that leaves room for the most blocks still to
+        // come; the first turn, then the walls and the room, as above, on ties.
+        let fine = self.grid(w, c, FINE_GRID);
+        let mut best: Option<PackedSpot> = None;
+        for &turn in &turns {
+            for &p in &fine {
+                let Some((walls, room)) = self.spot_score(w, c, z, p, &inside, turn) else {
+                    continue;
+                };
+                let n = room_after(p, turn);
+                let better = best.is_none_or(|(_, _, (bn, bw, br))| {
+                    n > bn || (n == bn && (walls > bw + 1e-9 || (walls > bw - 1e-9 && room > br + 1e-9)))
+                });
+                if better {
+                    best = Some((p, turn, (n, walls, room)));
+                }
+            }
+            if best.is_some_and(|(_, _, (n, _, _))| n == ahead.total()) || ahead.spent() {
+                break;
+            }
+        }
+        tracing::debug!(target: "macrotree::actions", "carry: packing look-ahead made {} spot tests", ahead.work());
+        match (kept, best) {
+            (Some((p, turn, n)), Some((_, _, (bn, _, _)))) if n >= bn => return Ok((p, turn)),
+            (_, Some((p, turn, (n, _, _)))) => {
+                tracing::debug!(target: "macrotree::actions", "carry: spot ({:.3}, {:.3}) turned {:.0}° leaves room for {n} of the {} blocks still to come", p.x, p.y, turn.to_degrees(), ahead.total());
                 return Ok((p, turn));
             }
+            (Some((p, turn, _)), None) => return Ok((p, turn)),
+            (None, None) => {}
         }
         let names: Vec<&str> = inside.iter().map(|&j| w.name(j)).collect();
         let holding = if names.is_empty() {
@@ -270,6 +331,30 @@ impl Carry {
         ))
     }
 
+    /// A `steps` × `steps` grid of spots for the held block's centre over container `c`'s floor
+    /// (`steps` odd: the centre is one of them), world frame, nearest the centre first, metres.
+    fn grid(&self, w: &World, c: usize, steps: i32) -> Vec<Vector2<f64>> {
+        let centre = w.objects[c].pos.xy();
+        let crate::scene::Shape::Container { inner_half, .. } = w.spec(c).shape else {
+            return vec![centre];
+        };
+        let usable = inner_half.map(|h| (h - self.half).max(0.0));
+        let (s, co) = crate::world::snapshot::yaw_of(&w.objects[c].quat).sin_cos();
+        let n = steps / 2;
+        let mut candidates: Vec<Vector2<f64>> = Vec::with_capacity((steps * steps) as usize);
+        for i in -n..=n {
+            for k in -n..=n {
+                let (lx, ly) = (
+                    usable[0] * f64::from(i) / f64::from(n),
+                    usable[1] * f64::from(k) / f64::from(n),
+                );
+                candidates.push(centre + Vector2::new(co * lx - s * ly, s * lx + co * ly));
+            }
+        }
+        candidates.sort_by(|a, b| (a - centre).norm().total_cmp(&(b - centre).norm()));
+        candidates
+    }
+
     /// Of `candidates` in container `c` (block centre at height `z`), the spot [`Self::free_spot`]
     /// prefers with the tool turned by `turn` radians about the vertical; `None` when the
     /// descent check refuses all.
@@ -282,25 +367,11 @@ impl Carry {
         inside: &[usize],
         turn: f64,
     ) -> Option<Vector2<f64>> {
-        let r = nalgebra::Rotation2::new(turn);
         let mut best: Option<(Vector2<f64>, (f64, f64))> = None;
         for &p in candidates {
-            let down = SetDown {
-                closing: r * self.set_down(Vector3::zeros()).closing,
-                ..self.set_down(Vector3::new(p.x, p.y, z))
-            };
-            if down.obstruction(w, self.held, Some(c)).is_some() {
+            let Some((walls, room)) = self.spot_score(w, c, z, p, inside, turn) else {
                 continue;
-            }
-            // First the walls: the fingers fully open (a `release` after the carry opens them
-            // fully by default) clear them by the margin where they can; then the most room to
-            // the blocks in it.
-            let open = SetDown {
-                opening: crate::motion::gripper::width_for_ctrl(crate::motion::gripper::OPEN_CTRL),
-                ..down
             };
-            let walls = open.wall_gap(w, c).unwrap_or(f64::INFINITY).min(MARGIN);
-            let room = down.room(w, inside);
             let better =
                 best.is_none_or(|(_, (bw, br))| walls > bw + 1e-9 || (walls > bw - 1e-9 && room > br + 1e-9));
             if better {
@@ -308,6 +379,37 @@ impl Carry {
             }
         }
         best.map(|(p, _)| p)
+    }
+
+    /// How spot `p` of container `c` (block centre at height `z`, the tool turned by `turn`
+    /// radians) suits the set-down: `None` when the descent check refuses it; else how far the
+    /// fully opened fingers stay inside the walls (capped at [`MARGIN`]) and the room to the
+    /// blocks `inside`, metres.
+    fn spot_score(
+        &self,
+        w: &World,
+        c: usize,
+        z: f64,
+        p: Vector2<f64>,
+        inside: &[usize],
+        turn: f64,
+    ) -> Option<(f64, f64)> {
+        let down = SetDown {
+            closing: nalgebra::Rotation2::new(turn) * self.set_down(Vector3::zeros()).closing,
+            ..self.set_down(Vector3::new(p.x, p.y, z))
+        };
+        if down.obstruction(w, self.held, Some(c)).is_some() {
+            return None;
+        }
+        // First the walls: the fingers fully open (a `release` after the carry opens them
+        // fully by default) clear them by the margin where they can; then the most room to
+        // the blocks in it.
+        let open = SetDown {
+            opening: crate::motion::gripper::width_for_ctrl(crate::motion::gripper::OPEN_CTRL),
+            ..down
+        };
+        let walls = open.wall_gap(w, c).unwrap_or(f64::INFINITY).min(MARGIN);
+        Some((walls, down.room(w, inside)))
     }
 
     /// Height of the block's centre for a transfer from `from` to `to` (table plane), metres:
@@ -382,7 +484,7 @@ impl Carry {
                         tracing::debug!(target: "macrotree::actions", "carry: the transfer would touch {}; planning", describe(pairs))
                     }
                     None => {
-                        tracing::debug!(target: "macrotree::actions", "carry: the set-down from the transfer's end would touch something; planning the transfer to another arm configuration")
+                        tracing::debug!(target: "macrotree::actions", "carry: the set-down from the transfer's end would touch something or cannot be made straight; planning the transfer to another arm configuration")
                     }
                 }
                 let motion = self.plan_transfer(cell, &from, &end, &place)?;
@@ -433,7 +535,8 @@ impl Carry {
 
     /// True when the straight set-down from `q` (the arm above the place, tool turned `k`
     /// quarter turns) to the block centre `place` would touch something other than the
-    /// destination.
+    /// destination, or cannot be made at all (the line crosses a wrist singularity or a branch
+    /// flip from this arm configuration).
     fn set_down_hits(&self, cell: &mut Cell, q: &[f64; 6], place: &Vector3<f64>, k: usize) -> bool {
         let (rotation, offset) = self.turned(k);
         let pose = Isometry3::from_parts(Translation3::from(place + offset), rotation);
@@ -442,7 +545,7 @@ impl Carry {
             ..MotionLimits::default()
         };
         let Ok(lower) = CartesianMove::new(*q, pose, &limits) else {
-            return false;
+            return true;
         };
         let intended = self.set_down_intended(cell.world());
         check_motion(cell, &[&lower], &intended, true).is_some()
@@ -604,16 +707,45 @@ impl MacroAction for Carry {
         self.replans = 0;
         self.lost = 0;
         let base_z = (self.spec.lift + self.half).max(pos.z);
-        match self.start_phase(cell, Phase::Lift, lift) {
-            // High over a tall post, far out, the straight line up can cross a branch flip: lift
-            // to the carry's own height, and the transfer (checked, planned when it would touch)
-            // takes the block on from there.
-            Err(e) if e.kind == FailureKind::Unreachable && lift_z > base_z => {
-                tracing::debug!(target: "macrotree::actions", "carry: the lift to {lift_z:.3} m is impossible ({}); lifting to {base_z:.3} m", e.message);
-                self.start_phase(cell, Phase::Lift, Vector3::new(pos.x, pos.y, base_z))
+        let e = match self.start_phase(cell, Phase::Lift, lift) {
+            Err(e) if e.kind == FailureKind::Unreachable => e,
+            started => return started,
+        };
+        // High over a tall post, far out, the straight line up can cross a branch flip: lift
+        // to the carry's own height, and the transfer (checked, planned when it would touch)
+        // takes the block on from there.
+        if lift_z > base_z {
+            tracing::debug!(target: "macrotree::actions", "carry: the lift to {lift_z:.3} m is impossible ({}); lifting to {base_z:.3} m", e.message);
+            match self.start_phase(cell, Phase::Lift, Vector3::new(pos.x, pos.y, base_z)) {
+                Err(e) if e.kind == FailureKind::Unreachable => {}
+                started => return started,
             }
-            started => started,
         }
+        // At the edge of the workspace even that line leaves it (the elbow straightens): lift as
+        // high as the line stays reachable, at least `MIN_LIFT`; the transfer, which comes in
+        // towards the goal, takes the block on.
+        let from = cell.arm_setpoint();
+        let reachable = |z: f64| {
+            let pose = Isometry3::from_parts(
+                Translation3::from(Vector3::new(pos.x, pos.y, z) + self.pinch_from_block),
+                self.rotation,
+            );
+            CartesianMove::new(from, pose, &MotionLimits::default()).is_ok()
+        };
+        let (mut lo, mut hi) = (pos.z + MIN_LIFT, base_z.min(lift_z));
+        if lo >= hi || !reachable(lo) {
+            return Err(e);
+        }
+        for _ in 0..LIFT_BISECTIONS {
+            let mid = 0.5 * (lo + hi);
+            if reachable(mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        tracing::debug!(target: "macrotree::actions", "carry: the straight lift leaves the workspace ({}); lifting to {lo:.3} m", e.message);
+        self.start_phase(cell, Phase::Lift, Vector3::new(pos.x, pos.y, lo))
     }
 
     fn waiting_for(&self, cell: &Cell) -> String {

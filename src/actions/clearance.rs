@@ -229,12 +229,34 @@ impl SetDown {
             axis: Vector2::new(yaw.cos(), yaw.sin()),
             half: w.spec(j).shape.footprint_half(),
         };
-        Some(
-            self.envelope(h)
-                .iter()
-                .map(|e| gap(e, &r))
-                .fold(f64::INFINITY, f64::min),
-        )
+        Some(self.gap_to_rect(&r, h))
+    }
+
+    /// The smallest gap between the envelope and a footprint `r` whose top stands `h` metres
+    /// above the fingertips, metres.
+    fn gap_to_rect(&self, r: &Rect, h: f64) -> f64 {
+        self.envelope(h)
+            .iter()
+            .map(|e| gap(e, r))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The smallest gap between the envelope and a block that is not in the world yet: a cube of
+    /// half-edge `half` standing at `centre` (table plane) with a side along the unit `axis`, its
+    /// top at `top` (all metres); `None` when its top is below the fingertips. The packing
+    /// look-ahead sees the blocks it plans to set down so.
+    pub fn gap_to_cube(&self, centre: Vector2<f64>, axis: Vector2<f64>, half: f64, top: f64) -> Option<f64> {
+        let h = top - self.bottom();
+        (h > 0.0).then(|| {
+            self.gap_to_rect(
+                &Rect {
+                    centre,
+                    axis,
+                    half: [half, half],
+                },
+                h,
+            )
+        })
     }
 
     /// How far the envelope stays inside container `c`'s inner walls, metres (negative: it

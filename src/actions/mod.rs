@@ -13,6 +13,7 @@ mod clearance;
 mod grasp;
 mod joints;
 mod macro_action;
+mod packing;
 mod place;
 mod planning;
 mod reach;

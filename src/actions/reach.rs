@@ -105,6 +105,65 @@ impl Reach {
     }
 }
 
+impl Reach {
+    /// Plans a motion to the pose (any IK branch, any equivalent grasp yaw) around whatever is
+    /// in the way, to the branches whose straight descent is free when the reach is a pick's
+    /// approach ([`Self::descent_free_goals`]), and starts it.
+    fn plan(
+        &mut self,
+        cell: &mut Cell,
+        from: &[f64; 6],
+        position: &Vector3<f64>,
+        yaw: f64,
+        quarter: bool,
+        offset: Vector3<f64>,
+    ) -> Result<(), Failure> {
+        let goals = GoalSet::down(position, yaw, quarter, from);
+        let mut motion = plan_motion(cell, "reach", from, &goals)?;
+        if let Some(free) = self.descent_free_goals(cell, &goals, &motion.trajectory.end(), offset)? {
+            // The straight descent a pick runs next from the pose reached would touch
+            // (the forearm on the table): plan again to the branches whose descent is free.
+            tracing::debug!(target: "macrotree::actions", "reach: the descent from the planned pose would touch; planning to the {} goal(s) whose descent is free", free.configs.len());
+            motion = plan_motion(cell, "reach", from, &free)?;
+        }
+        self.goal_q = motion.trajectory.end();
+        cell.track(Box::new(motion.trajectory));
+        Ok(())
+    }
+}
+
+/// Motions run one after the other, and the configuration they end in.
+type Legs = (Vec<Box<dyn Trajectory>>, [f64; 6]);
+
+/// The legs of a detour from `from` (the pinch at `here`) to `position`: straight up to `z`
+/// (metres), a joint move over to above `position`, straight down; and the configuration it
+/// ends in. A failure of kind `unreachable` names the leg no straight line or IK solution makes.
+fn detour(
+    from: &[f64; 6],
+    here: &Isometry3<f64>,
+    z: f64,
+    position: &Vector3<f64>,
+    yaw: f64,
+    quarter: bool,
+    limits: &MotionLimits,
+) -> Result<Legs, Failure> {
+    let up = Isometry3::from_parts(
+        Translation3::new(here.translation.x, here.translation.y, z),
+        here.rotation,
+    );
+    let rise = CartesianMove::new(*from, up, limits)
+        .map_err(|e| unreachable(format!("unreachable detour (up): {e}")))?;
+    let over_at = Vector3::new(position.x, position.y, z);
+    let over_q = ik_down(&over_at, yaw, quarter, &rise.end())
+        .map_err(|e| unreachable(format!("unreachable detour (over): {e}")))?;
+    let over = JointMove::new(rise.end(), over_q, limits);
+    let down_pose = down_pose(position, yaw_of_solution(&over_q));
+    let down = CartesianMove::new(over_q, down_pose, limits)
+        .map_err(|e| unreachable(format!("unreachable detour (down): {e}")))?;
+    let end = down.end();
+    Ok((vec![Box::new(rise), Box::new(over), Box::new(down)], end))
+}
+
 /// The first object (other than `skip`) the pinch passes over lower than [`PATH_CLEARANCE`]
 /// above its top on the joint-space line from `from` to `to`, with the pinch there.
 /// Objects taller than [`super::carry::MAX_LIFT_OVER`] are not detoured over (the check of the
@@ -177,21 +236,15 @@ impl MacroAction for Reach {
                         let here = fk(&from);
                         let z = detour_height(w, &here.translation.vector, &position);
                         tracing::debug!(target: "macrotree::actions", "reach: the direct path passes low over {}; detour at {z:.3} m", w.name(j));
-                        let up = Isometry3::from_parts(
-                            Translation3::new(here.translation.x, here.translation.y, z),
-                            here.rotation,
-                        );
-                        let rise = CartesianMove::new(from, up, &limits)
-                            .map_err(|e| unreachable(format!("unreachable detour (up): {e}")))?;
-                        let over_at = Vector3::new(position.x, position.y, z);
-                        let over_q = ik_down(&over_at, yaw, quarter, &rise.end())
-                            .map_err(|e| unreachable(format!("unreachable detour (over): {e}")))?;
-                        let over = JointMove::new(rise.end(), over_q, &limits);
-                        let down_pose = down_pose(&position, yaw_of_solution(&over_q));
-                        let down = CartesianMove::new(over_q, down_pose, &limits)
-                            .map_err(|e| unreachable(format!("unreachable detour (down): {e}")))?;
-                        let end = down.end();
-                        (vec![Box::new(rise), Box::new(over), Box::new(down)], end)
+                        match detour(&from, &here, z, &position, yaw, quarter, &limits) {
+                            Ok(legs) => legs,
+                            // Far out the straight rise can leave the workspace (the elbow
+                            // straightens): the planner finds the way instead.
+                            Err(e) => {
+                                tracing::debug!(target: "macrotree::actions", "reach: {e}; planning");
+                                return self.plan(cell, &from, &position, yaw, quarter, offset);
+                            }
+                        }
                     }
                 };
                 let refs: Vec<&dyn Trajectory> = legs.iter().map(|l| l.as_ref()).collect();
@@ -199,19 +252,7 @@ impl MacroAction for Reach {
                     // The motion would collide: plan one to the same pose (any IK branch, any
                     // equivalent grasp yaw) around whatever is in the way.
                     tracing::debug!(target: "macrotree::actions", "reach: the {} would touch {}; planning", if legs.len() == 1 { "direct joint move" } else { "detour" }, describe(&pairs));
-                    let goals = GoalSet::down(&position, yaw, quarter, &from);
-                    let mut motion = plan_motion(cell, "reach", &from, &goals)?;
-                    if let Some(free) =
-                        self.descent_free_goals(cell, &goals, &motion.trajectory.end(), offset)?
-                    {
-                        // The straight descent a pick runs next from the pose reached would touch
-                        // (the forearm on the table): plan again to the branches whose descent is free.
-                        tracing::debug!(target: "macrotree::actions", "reach: the descent from the planned pose would touch; planning to the {} goal(s) whose descent is free", free.configs.len());
-                        motion = plan_motion(cell, "reach", &from, &free)?;
-                    }
-                    self.goal_q = motion.trajectory.end();
-                    cell.track(Box::new(motion.trajectory));
-                    return Ok(());
+                    return self.plan(cell, &from, &position, yaw, quarter, offset);
                 }
                 // The direct motion is free; the straight descent a pick runs next from where it
                 // ends may not be (the forearm on a post beside the block): then plan to the
