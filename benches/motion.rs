@@ -1,11 +1,12 @@
 //! The motion planner's benchmark: `cargo bench --bench motion` (add `-- N` for N queries per
 //! family, default 40; `-- coarse` checks joint steps only, without the displacement bound;
-//! `-- shortcuts=N` sets the random shortcut attempts). Families in the spirit of MotionBenchMaker on the real cell (Menagerie
+//! `-- shortcuts=N` sets the random shortcut attempts; `-- only=NAME` runs one family; `-- noplain`
+//! skips the MuJoCo-only comparison, e.g. for a profiler). Families in the spirit of MotionBenchMaker on the real cell (Menagerie
 //! UR5e + 2F-85, MuJoCo collision checking with the default 5 mm margin): open table, deep bin,
 //! tall obstacle between, clutter, a shelf opening, a wrist-singular transfer, infeasible
 //! queries whose reason must be right, and a check budget too small for a search. Queries are
 //! drawn from a seeded stream, so every run plans the same queries; times are wall clock of
-//! `plan` alone (one thread), the checker built once per family. Starts are redrawn until free (the arm never starts in
+//! `plan` alone (one thread), with the thread's CPU time beside them, the checker built once per family. Starts are redrawn until free (the arm never starts in
 //! collision); a feasible-family query whose every goal configuration is blocked is reported
 //! apart, not counted.
 
