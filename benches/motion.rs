@@ -1,11 +1,12 @@
 //! The motion planner's benchmark: `cargo bench --bench motion` (add `-- N` for N queries per
 //! family, default 40; `-- coarse` checks joint steps only, without the displacement bound;
-//! `-- shortcuts=N` sets the random shortcut attempts). Families in the spirit of MotionBenchMaker on the real cell (Menagerie
+//! `-- shortcuts=N` sets the random shortcut attempts; `-- only=NAME` runs one family; `-- noplain`
+//! skips the MuJoCo-only comparison, e.g. for a profiler). Families in the spirit of MotionBenchMaker on the real cell (Menagerie
 //! UR5e + 2F-85, MuJoCo collision checking with the default 5 mm margin): open table, deep bin,
 //! tall obstacle between, clutter, a shelf opening, a wrist-singular transfer, infeasible
 //! queries whose reason must be right, and a check budget too small for a search. Queries are
 //! drawn from a seeded stream, so every run plans the same queries; times are wall clock of
-//! `plan` alone (one thread), the checker built once per family. Starts are redrawn until free (the arm never starts in
+//! `plan` alone (one thread), with the thread's CPU time beside them, the checker built once per family. Starts are redrawn until free (the arm never starts in
 //! collision); a feasible-family query whose every goal configuration is blocked is reported
 //! apart, not counted.
 
@@ -274,6 +275,19 @@ fn budget(r: &mut ChaCha8Rng) -> Query {
     }
 }
 
+/// CPU time this thread has run, seconds (`CLOCK_THREAD_CPUTIME_ID`): what a query costs one
+/// core, whatever else the machine runs.
+fn thread_cpu() -> f64 {
+    let mut t = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `t` is a valid timespec the call writes.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut t) };
+    assert_eq!(rc, 0, "clock_gettime");
+    t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9
+}
+
 fn quantile(sorted: &[f64], q: f64) -> f64 {
     if sorted.is_empty() {
         return f64::NAN;
@@ -294,6 +308,9 @@ fn main() {
     let shortcuts: usize = std::env::args()
         .find_map(|a| a.strip_prefix("shortcuts=").and_then(|v| v.parse().ok()))
         .unwrap_or(PlannerConfig::default().shortcut_attempts);
+    // `only=NAME`: run one family (for profiling); `noplain`: skip the MuJoCo-only comparison.
+    let only: Option<String> = std::env::args().find_map(|a| a.strip_prefix("only=").map(str::to_string));
+    let with_plain = !std::env::args().any(|a| a == "noplain");
 
     let families = [
         Family {
@@ -377,7 +394,10 @@ fn main() {
         "duration",
         "reason"
     );
-    for f in &families {
+    for f in families
+        .iter()
+        .filter(|f| only.as_deref().is_none_or(|o| o == f.name))
+    {
         let spec = SceneSpec::from_str(f.scene, "bench.yaml").expect("valid scene");
         let scene = Scene::load_spec(&spec).expect("scene (run tools/bootstrap)");
         let mut sim = Sim::new(&scene);
@@ -404,6 +424,8 @@ fn main() {
         let (mut times, mut checks, mut lengths, mut durations) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let mut direct = 0;
+        // CPU time of each screened query on this thread, ms.
+        let mut cpu: Vec<f64> = Vec::new();
         let mut stages = [0u64; 4];
         let mut blocked_goal = 0;
         let mut failures: Vec<String> = Vec::new();
@@ -435,8 +457,14 @@ fn main() {
                 max_displacement: if coarse { f64::INFINITY } else { 0.01 },
                 ..PlannerConfig::default()
             };
-            let before = plan(&mut plain, &q.start, &goals, &config);
+            let before = if with_plain {
+                plan(&mut plain, &q.start, &goals, &config)
+            } else {
+                plan(&mut checker, &q.start, &goals, &config)
+            };
+            let cpu0 = thread_cpu();
             let out = plan(&mut checker, &q.start, &goals, &config);
+            cpu.push((thread_cpu() - cpu0) * 1e3);
             let stats = match &out {
                 Ok(m) => m.stats.clone(),
                 Err(e) => (*e.stats).clone(),
@@ -566,6 +594,13 @@ fn main() {
             quantile(&plain_times, 0.5) / quantile(&times, 0.5),
             quantile(&plain_times, 0.95) / quantile(&times, 0.95),
             screened as f64 / total_checks.max(1.0),
+        );
+        cpu.sort_by(f64::total_cmp);
+        println!(
+            "    CPU time of this thread (one core, whatever the load): p50 {:.2} ms, p95 {:.2} ms, max {:.2} ms",
+            quantile(&cpu, 0.5),
+            quantile(&cpu, 0.95),
+            cpu.last().copied().unwrap_or(f64::NAN)
         );
         let total: u64 = stages.iter().sum::<u64>().max(1);
         println!(

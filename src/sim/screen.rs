@@ -127,10 +127,40 @@ pub struct Screen {
     /// Fixed shapes, world frame, with their bounding spheres and exactness.
     fixed: Vec<Posed>,
     pairs: Vec<Pair>,
+    /// The pairs in groups of one arm link against one partner (a fixed shape or another
+    /// link), each group tested first with bounding spheres ([`Group`]).
+    groups: Vec<Group>,
+    /// Bounding sphere of each link's moving shapes in the link's frame (centre, radius,
+    /// metres); radius negative for a link without shapes.
+    link_spheres: [(Vector3<f64>, f64); 6],
     /// Geom id of each shape (moving ones, then fixed ones).
     geoms: Vec<usize>,
-    /// Scratch: the moving shapes posed.
+    /// Scratch: the moving shapes posed, when `stamp` matches `call`.
     posed: Vec<Posed>,
+    stamp: Vec<u32>,
+    call: u32,
+}
+
+/// The partner of an arm link in a [`Group`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Partner {
+    /// A fixed shape (index into `fixed`).
+    Fixed(usize),
+    /// Another arm link (0..6).
+    Link(usize),
+}
+
+/// Consecutive pairs (`pairs[start..end]`) between the shapes of arm link `link` and one
+/// partner. When the link's bounding sphere keeps `gap` (the largest of the pairs' gaps, metres)
+/// from the partner's (a fixed shape's bounding sphere or half-space, or the other link's
+/// sphere), every pair of the group does, and none needs testing.
+#[derive(Clone, Copy, Debug)]
+struct Group {
+    link: usize,
+    partner: Partner,
+    gap: f64,
+    start: u32,
+    end: u32,
 }
 
 /// A shape in the world, its bounding sphere, and whether it is the geom itself.
@@ -216,6 +246,74 @@ pub(crate) struct Build<'a> {
     pub(crate) link_bodies: [usize; 6],
     /// Joint ids of the six arm joints.
     pub(crate) joints: [usize; 6],
+}
+
+/// A moving shape posed at the link frames, with its bounding sphere and exactness.
+fn pose(m: &(usize, Local, bool, f64), frames: &[(Matrix3<f64>, Vector3<f64>); 6]) -> Posed {
+    let (k, l, e, reach) = m;
+    let (r, t) = &frames[*k];
+    let s = l.posed(r, t);
+    let sphere = match &s {
+        Shape::Capsule { a, b, .. } => (
+            [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0, (a[2] + b[2]) / 2.0],
+            *reach,
+        ),
+        Shape::Box { center, .. } => (*center, *reach),
+        Shape::HalfSpace { .. } => ([0.0; 3], f64::INFINITY),
+    };
+    (s, Some(sphere), *e)
+}
+
+/// True when spheres `(c1, r1)` and `(c2, r2)` (metres) keep at least `gap` between them; a
+/// negative radius (no shape) is always apart.
+fn sphere_apart(c1: &V3, r1: f64, c2: &V3, r2: f64, gap: f64) -> bool {
+    if r1 < 0.0 || r2 < 0.0 {
+        return true;
+    }
+    let t = r1 + r2 + gap;
+    let d = [c1[0] - c2[0], c1[1] - c2[1], c1[2] - c2[2]];
+    d[0] * d[0] + d[1] * d[1] + d[2] * d[2] >= t * t
+}
+
+/// True when `shape` is a box and the sphere `(c, r)` (metres) keeps at least `gap` from it
+/// (the distance from the centre to the box, less the radius); false otherwise.
+fn sphere_box_apart(c: &V3, r: f64, shape: &Shape, gap: f64) -> bool {
+    let Shape::Box { center, axes, half } = shape else {
+        return false;
+    };
+    let d = [c[0] - center[0], c[1] - center[1], c[2] - center[2]];
+    let mut out2 = 0.0;
+    for i in 0..3 {
+        let u = (d[0] * axes[i][0] + d[1] * axes[i][1] + d[2] * axes[i][2]).abs() - half[i];
+        if u > 0.0 {
+            out2 += u * u;
+        }
+    }
+    let t = r + gap;
+    out2 >= t * t
+}
+
+/// A sphere (centre, radius, metres) containing every one of `shapes` (each within its own
+/// bounding sphere about its centre); radius −1 when there are none.
+fn link_sphere<'a>(shapes: impl Iterator<Item = &'a Local> + Clone) -> (Vector3<f64>, f64) {
+    let centre = |l: &Local| match l {
+        Local::Capsule { a, b, .. } => (a + b) / 2.0,
+        Local::Box { center, .. } => *center,
+    };
+    let (mut lo, mut hi) = (Vector3::repeat(f64::INFINITY), Vector3::repeat(f64::NEG_INFINITY));
+    for l in shapes.clone() {
+        let (c, r) = (centre(l), l.reach());
+        lo = lo.inf(&(c - Vector3::repeat(r)));
+        hi = hi.sup(&(c + Vector3::repeat(r)));
+    }
+    if !lo.x.is_finite() {
+        return (Vector3::zeros(), -1.0);
+    }
+    let mid = (lo + hi) / 2.0;
+    let r = shapes
+        .map(|l| (centre(l) - mid).norm() + l.reach())
+        .fold(0.0, f64::max);
+    (mid, r)
 }
 
 impl Screen {
@@ -381,15 +479,67 @@ impl Screen {
         }
         // Cheapest rejections first: fixed partners before self pairs.
         pairs.sort_by_key(|p| (p.b as usize) < moving.len());
-        let posed = Vec::with_capacity(moving.len());
+        let nm = moving.len();
+        let partner = |p: &Pair| {
+            if (p.b as usize) < nm {
+                Partner::Link(moving[p.b as usize].0)
+            } else {
+                Partner::Fixed(p.b as usize - nm)
+            }
+        };
+        // Each link–partner group together, the groups in the order of their first pair.
+        let mut order: Vec<(usize, Partner)> = Vec::new();
+        for p in &pairs {
+            let key = (moving[p.a as usize].0, partner(p));
+            if !order.contains(&key) {
+                order.push(key);
+            }
+        }
+        let mut grouped = Vec::with_capacity(pairs.len());
+        let mut groups = Vec::with_capacity(order.len());
+        for &(link, with) in &order {
+            let start = grouped.len() as u32;
+            let mut gap: f64 = 0.0;
+            for p in pairs
+                .iter()
+                .filter(|p| (moving[p.a as usize].0, partner(p)) == (link, with))
+            {
+                gap = gap.max(p.gap);
+                grouped.push(*p);
+            }
+            groups.push(Group {
+                link,
+                partner: with,
+                gap,
+                start,
+                end: grouped.len() as u32,
+            });
+        }
+        let link_spheres =
+            std::array::from_fn(|k| link_sphere(moving.iter().filter(|m| m.0 == k).map(|m| &m.1)));
+        let posed = vec![
+            (
+                Shape::HalfSpace {
+                    normal: [0.0; 3],
+                    offset: 0.0
+                },
+                None,
+                false
+            );
+            nm
+        ];
         Some(Self {
             base,
             links,
             moving,
             fixed,
-            pairs,
+            pairs: grouped,
+            groups,
+            link_spheres,
             geoms,
             posed,
+            stamp: vec![0; nm],
+            call: 0,
         })
     }
 
@@ -420,44 +570,66 @@ impl Screen {
     /// The verdict at `q` and the geom pair that decided a "blocked" (geom ids).
     pub fn decide(&mut self, q: &[f64; 6]) -> (Option<bool>, Option<(usize, usize)>) {
         let frames = self.link_poses(q);
-        self.posed.clear();
-        for (k, l, e, reach) in &self.moving {
-            let (r, t) = &frames[*k];
-            let s = l.posed(r, t);
-            let sphere = match &s {
-                Shape::Capsule { a, b, .. } => (
-                    [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0, (a[2] + b[2]) / 2.0],
-                    *reach,
-                ),
-                Shape::Box { center, .. } => (*center, *reach),
-                Shape::HalfSpace { .. } => ([0.0; 3], f64::INFINITY),
-            };
-            self.posed.push((s, Some(sphere), *e));
+        // A new stamp: every moving shape is posed again when first needed.
+        self.call = self.call.wrapping_add(1);
+        if self.call == 0 {
+            self.stamp.iter_mut().for_each(|s| *s = u32::MAX);
+            self.call = 1;
         }
-        let nm = self.posed.len();
+        let spheres: [(V3, f64); 6] = std::array::from_fn(|k| {
+            let (c, r) = &self.link_spheres[k];
+            let w = frames[k].0 * c + frames[k].1;
+            ([w.x, w.y, w.z], *r)
+        });
+        let nm = self.moving.len();
         let mut unsure = false;
-        for p in &self.pairs {
-            let x = &self.posed[p.a as usize];
-            let y = if (p.b as usize) < nm {
-                &self.posed[p.b as usize]
-            } else {
-                &self.fixed[p.b as usize - nm]
+        for g in &self.groups {
+            let (c1, r1) = spheres[g.link];
+            let apart = match g.partner {
+                Partner::Link(m) => sphere_apart(&c1, r1, &spheres[m].0, spheres[m].1, g.gap),
+                Partner::Fixed(f) => match &self.fixed[f] {
+                    (y, Some((c2, r2)), _) => {
+                        sphere_apart(&c1, r1, c2, *r2, g.gap) || sphere_box_apart(&c1, r1, y, g.gap)
+                    }
+                    (Shape::HalfSpace { normal, offset }, None, _) => {
+                        normal[0] * c1[0] + normal[1] * c1[1] + normal[2] * c1[2] - offset - r1 >= g.gap
+                    }
+                    _ => false,
+                },
             };
-            if let (Some((c1, r1)), Some((c2, r2))) = (x.1, y.1) {
-                let t = r1 + r2 + p.gap;
-                let d = [c1[0] - c2[0], c1[1] - c2[1], c1[2] - c2[2]];
-                if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] >= t * t {
-                    continue;
-                }
+            if apart {
+                continue;
             }
-            if near(&x.0, &y.0, p.gap) {
-                if x.2 && y.2 && within(&x.0, &y.0, p.block) {
-                    return (
-                        Some(false),
-                        Some((self.geoms[p.a as usize], self.geoms[p.b as usize])),
-                    );
+            for p in &self.pairs[g.start as usize..g.end as usize] {
+                let (a, b) = (p.a as usize, p.b as usize);
+                for i in [a, b] {
+                    if i < nm && self.stamp[i] != self.call {
+                        self.posed[i] = pose(&self.moving[i], &frames);
+                        self.stamp[i] = self.call;
+                    }
                 }
-                unsure = true;
+                let x = &self.posed[a];
+                let y = if b < nm {
+                    &self.posed[b]
+                } else {
+                    &self.fixed[b - nm]
+                };
+                if let (Some((c1, r1)), Some((c2, r2))) = (x.1, y.1) {
+                    let t = r1 + r2 + p.gap;
+                    let d = [c1[0] - c2[0], c1[1] - c2[1], c1[2] - c2[2]];
+                    if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] >= t * t {
+                        continue;
+                    }
+                    if b >= nm && sphere_box_apart(&c1, r1, &y.0, p.gap) {
+                        continue;
+                    }
+                }
+                if near(&x.0, &y.0, p.gap) {
+                    if x.2 && y.2 && within(&x.0, &y.0, p.block) {
+                        return (Some(false), Some((self.geoms[a], self.geoms[b])));
+                    }
+                    unsure = true;
+                }
             }
         }
         ((!unsure).then_some(true), None)
@@ -471,5 +643,83 @@ impl Screen {
     /// Pairs tested per configuration.
     pub fn pairs(&self) -> usize {
         self.pairs.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::motion::plan::shapes::near;
+
+    #[test]
+    fn a_link_sphere_contains_every_shape_of_the_link() {
+        let shapes = [
+            Local::Capsule {
+                a: Vector3::new(0.0, 0.0, -0.1),
+                b: Vector3::new(0.0, 0.0, 0.3),
+                radius: 0.05,
+            },
+            Local::Box {
+                center: Vector3::new(0.2, -0.1, 0.0),
+                axes: Matrix3::identity(),
+                half: [0.02, 0.03, 0.04],
+            },
+        ];
+        let (c, r) = link_sphere(shapes.iter());
+        for l in &shapes {
+            let centre = match l {
+                Local::Capsule { a, b, .. } => (a + b) / 2.0,
+                Local::Box { center, .. } => *center,
+            };
+            assert!(
+                (centre - c).norm() + l.reach() <= r + 1e-12,
+                "{l:?} outside ({c}, {r})"
+            );
+        }
+        // No shape: a negative radius, always apart.
+        let (_, none) = link_sphere(std::iter::empty());
+        assert!(none < 0.0);
+        assert!(sphere_apart(&[0.0; 3], none, &[0.0; 3], 1.0, 0.01));
+    }
+
+    #[test]
+    fn sphere_box_apart_agrees_with_the_box_nearness_test() {
+        let b = Shape::Box {
+            center: [0.5, 0.0, 0.2],
+            axes: [[0.8, 0.6, 0.0], [-0.6, 0.8, 0.0], [0.0, 0.0, 1.0]],
+            half: [0.1, 0.05, 0.2],
+        };
+        let gap = 0.0055;
+        let mut apart = 0;
+        // Seeded points on a grid around the box: whenever the sphere test says apart, the
+        // (conservative) nearness test of the sphere as a capsule says not near either.
+        for i in 0..20 {
+            for j in 0..20 {
+                for k in 0..10 {
+                    let c = [
+                        0.2 + 0.03 * i as f64,
+                        -0.3 + 0.03 * j as f64,
+                        0.05 * k as f64 - 0.1,
+                    ];
+                    let r = 0.02;
+                    let s = Shape::Capsule {
+                        a: c,
+                        b: c,
+                        radius: r,
+                    };
+                    if sphere_box_apart(&c, r, &b, gap) {
+                        apart += 1;
+                        assert!(!near(&s, &b, gap), "{c:?}");
+                    }
+                }
+            }
+        }
+        assert!(apart > 1000, "{apart}");
+        // Not a box: never apart by this test.
+        let h = Shape::HalfSpace {
+            normal: [0.0, 0.0, 1.0],
+            offset: 0.0,
+        };
+        assert!(!sphere_box_apart(&[0.0, 0.0, 5.0], 0.1, &h, gap));
     }
 }

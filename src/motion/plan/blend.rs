@@ -128,9 +128,32 @@ fn corner(
     ))
 }
 
+/// Steps needed along `arc` so that no joint turns more than `res.joint` radians and no point
+/// moves more than `res.displacement` metres between neighbouring samples: on the arc
+/// `q_j = c_j + r (x_j cos φ + y_j sin φ)`, joint `j` moves at most `√(x_j² + y_j²)` radians per
+/// radian of arc length, so over a piece of length `l` it moves at most `l √(x_j² + y_j²)` and a
+/// point at most `l Σ_j r_j √(x_j² + y_j²)` (at most [`Resolution::curve_steps`]; a line piece
+/// takes that bound).
+pub(crate) fn arc_steps(arc: &Piece, res: &Resolution) -> usize {
+    let Piece::Arc { x, y, .. } = arc else {
+        return res.curve_steps(arc.len());
+    };
+    let (mut fastest, mut sweep) = (0.0f64, 0.0);
+    for j in 0..6 {
+        let w = (x[j] * x[j] + y[j] * y[j]).sqrt();
+        fastest = fastest.max(w);
+        sweep += res.lever_arms[j] * w;
+    }
+    let len = arc.len();
+    (((len * fastest) / res.joint)
+        .max(len * sweep / res.displacement)
+        .ceil() as usize)
+        .max(1)
+}
+
 /// True when the arc is free at `res` (its ends lie on the checked segments).
 fn arc_free<C: CollisionChecker + ?Sized>(checker: &mut C, arc: &Piece, res: &Resolution) -> bool {
-    let n = res.curve_steps(arc.len());
+    let n = arc_steps(arc, res);
     (1..n).all(|k| checker.is_free(&arc.eval(arc.len() * k as f64 / n as f64).0))
 }
 
@@ -252,6 +275,41 @@ mod tests {
         let (mid, _, _) = arc.eval(arc.len() / 2.0);
         let dev = distance(&mid, &path[1]);
         assert!((dev - 0.1).abs() < 1e-9, "deviation {dev}");
+    }
+
+    #[test]
+    fn arc_steps_keep_the_resolution_between_samples_and_never_exceed_the_curve_bound() {
+        let res = Resolution {
+            joint: 0.05,
+            displacement: 0.01,
+            lever_arms: [1.16, 1.19, 0.77, 0.38, 0.34, 0.12],
+        };
+        let y_in = [0.6, 0.0, 0.8, 0.0, 0.0, 0.0];
+        let y_out = [0.0, 0.0, 0.6, 0.0, 0.8, 0.0];
+        let (arc, _) = corner(&[0.3, -1.0, 1.2, 0.0, 0.5, 0.0], &y_in, &y_out, 0.1, 1.0).unwrap();
+        let n = arc_steps(&arc, &res);
+        assert!(
+            n <= res.curve_steps(arc.len()),
+            "{n} > {}",
+            res.curve_steps(arc.len())
+        );
+        assert!(
+            n < res.curve_steps(arc.len()),
+            "no gain on an arc in two joints' planes"
+        );
+        // Between neighbouring samples (and finely inside each), no joint moves more than the
+        // joint step and the lever-arm sweep stays within the displacement bound.
+        let fine = 50;
+        for k in 0..n {
+            let q0 = arc.eval(arc.len() * k as f64 / n as f64).0;
+            for m in 1..=fine {
+                let s = arc.len() * (k as f64 + m as f64 / fine as f64) / n as f64;
+                let q = arc.eval(s).0;
+                let sweep: f64 = (0..6).map(|j| res.lever_arms[j] * (q[j] - q0[j]).abs()).sum();
+                assert!(sweep <= res.displacement + 1e-12, "sweep {sweep} at {k}/{m}");
+                assert!((0..6).all(|j| (q[j] - q0[j]).abs() <= res.joint + 1e-12));
+            }
+        }
     }
 
     #[test]
