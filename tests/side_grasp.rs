@@ -2,7 +2,8 @@
 //! where the 2F-85 cannot come from above, grasped from the side, pulled out and held without
 //! touching the shelf; set down upright on a pedestal; `approach: auto` choosing the side under
 //! the board and the top where it is free; a block too deep under the board refused before
-//! anything moves; and the loader's checks of `approach` with the other parameters.
+//! anything moves; a side-held block refused a set-down on the table before anything moves;
+//! and the loader's checks of `approach` with the other parameters.
 
 use macrotree::App;
 use macrotree::env::{Action, EnvConfig, MacroEnv, Reset, Status, StepResult};
@@ -21,7 +22,7 @@ const HALF: f64 = 0.02;
 
 /// A two-level shelf (boards 0.10 m deep, the lower one's top 0.12 m high, the upper one's
 /// underside 0.22 m: 6 cm above a 4 cm block), `low` on the lower board (at `low_x`, turned
-/// 10°), `free` on the table, a 3 cm pedestal with the `stage` spot on it.
+/// 10°), `free` on the table, a 3 cm pedestal with the `stage` spot on it, an `on_table` spot.
 fn shelf(low_x: f64) -> MacroEnv {
     let yaml = format!(
         "
@@ -35,6 +36,7 @@ objects:
   free: {{block: {{size: 0.04}}, pose: [0.40, -0.12]}}
 spots:
   stage: [0.48, -0.33]
+  on_table: [0.40, 0.15]
 "
     );
     let spec = SceneSpec::from_str(&yaml, "shelf.yaml").unwrap_or_else(|d| panic!("{}", d[0]));
@@ -233,4 +235,45 @@ fn approach_side_needs_a_block_and_a_stand_off_and_auto_only_a_stand_off() {
         assert!(e.contains(want), "{body}: {e}");
         assert!(e.contains("tree.yaml:2:"), "{body}: not located: {e}");
     }
+}
+
+/// Set down on a spot on the table (`place`, or `carry` into a bin), a block held from the side
+/// put the gripper's base into what was under it (the base reaches 3.75 cm below the tool axis, a
+/// 4 cm block only 2 cm): the leaf moved, and the arm hit the table or the bin. It is now refused
+/// before anything moves, `goal_in_collision`, with what to do instead.
+#[test]
+fn a_side_held_block_carried_onto_the_table_put_the_gripper_into_it() {
+    let mut env = shelf(0.60);
+    ok(&mut env, "release: {width: 0.065, retreat: 0}");
+    ok(
+        &mut env,
+        "reach: {target: low, approach: side, offset: [0, 0, 0.12]}",
+    );
+    ok(&mut env, "reach: {target: low, approach: side, path: cartesian}");
+    ok(&mut env, "grasp: {object: low}");
+    ok(
+        &mut env,
+        "reach: {target: low, approach: side, offset: [0, 0.01, 0.12], path: cartesian}",
+    );
+    let before = env.observe().joint_pos;
+    let r = env.step(&Action::Leaf("place: {spot: on_table}".into())).unwrap();
+    assert_eq!(r.status, Status::Failure);
+    let f = r.failure.expect("a failure");
+    assert_eq!(f.kind, FailureKind::GoalInCollision, "{f}");
+    assert!(
+        f.message.contains("held from the side cannot be set down")
+            && f.message.contains("table")
+            && f.message.contains("grasp it again from above"),
+        "{f}"
+    );
+    assert!(r.collisions.is_empty(), "{:?}", r.collisions);
+    let after = env.observe().joint_pos;
+    let moved = before
+        .iter()
+        .zip(&after)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(moved < 0.01, "the arm moved {moved} rad");
+    // Onto the pedestal, narrower than the block, the same hold sets it down.
+    ok(&mut env, "place: {spot: stage}");
 }

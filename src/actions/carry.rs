@@ -12,6 +12,7 @@ use super::clearance::{
 use super::macro_action::{Arrival, MacroAction, Progress};
 use super::packing::Lookahead;
 use super::planning::{check_motion, check_straight, describe};
+use super::side_set_down::{held_from_side, refuse_side_set_down};
 use super::targets::{resolve, segment_distance, target_object, target_spot};
 use crate::failure::{Failure, FailureKind};
 use crate::kinds::Carry as CarrySpec;
@@ -704,6 +705,22 @@ impl MacroAction for Carry {
         let place = self.place(w)?;
         let lift_z = self.transfer_z(w, pos.xy(), place.xy()).max(pos.z);
         let lift = Vector3::new(pos.x, pos.y, lift_z);
+        if held_from_side(&self.rotation) {
+            let held_name = w.name(held).to_string();
+            let surface = self
+                .destination(w)
+                .map_or_else(|| "table".to_string(), |d| w.name(d).to_string());
+            let poses: Vec<Isometry3<f64>> = (0..4)
+                .map(|k| {
+                    let (rotation, offset) = self.turned(k);
+                    Isometry3::from_parts(Translation3::from(place + offset), rotation)
+                })
+                .collect();
+            let from = cell.arm_setpoint();
+            if let Some(checker) = cell.checker() {
+                refuse_side_set_down(checker, &poses, &from, &held_name, &surface)?;
+            }
+        }
         self.replans = 0;
         self.lost = 0;
         let base_z = (self.spec.lift + self.half).max(pos.z);

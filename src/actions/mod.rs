@@ -20,6 +20,7 @@ mod reach;
 mod release;
 mod release_room;
 mod side;
+mod side_set_down;
 mod targets;
 
 pub(crate) use carry::Carry as CarryAction;

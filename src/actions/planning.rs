@@ -77,7 +77,7 @@ impl PlanningTally {
 
 /// True when the robot–scene pair `c` names object `name` (the object itself or one of its
 /// parts, e.g. `bin/wall_px`).
-fn names(c: &Collision, name: &str) -> bool {
+pub(crate) fn names(c: &Collision, name: &str) -> bool {
     let is = |s: &str| s == name || s.strip_prefix(name).is_some_and(|r| r.starts_with('/'));
     is(&c.a) || is(&c.b)
 }
