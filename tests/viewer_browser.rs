@@ -215,17 +215,31 @@ fn recorded_replay_plays_offline_and_animates() {
     eprintln!("replay of 2 s: {size} bytes");
     assert!(size < 15 << 20, "{size}");
     let early = screenshot_file(&html, 150, &dir.join("early.png"));
-    let late = screenshot_file(&html, 3000, &dir.join("late.png"));
-    let (ce, cl) = (classify(&early), classify(&late));
-    eprintln!("replay early {ce:?}\nreplay late {cl:?}");
+    let ce = classify(&early);
+    eprintln!("replay early {ce:?}");
     assert_scene_visible(ce, "replay at 0.15 s");
-    assert_scene_visible(cl, "replay at 3 s");
-    let diff = early
-        .rgb
-        .iter()
-        .zip(&late.rgb)
-        .filter(|(a, b)| a.abs_diff(**b) > 30)
-        .count();
+    let differing = |late: &Image| {
+        early
+            .rgb
+            .iter()
+            .zip(&late.rgb)
+            .filter(|(a, b)| a.abs_diff(**b) > 30)
+            .count()
+    };
+    // Chromium's virtual time budget also runs while the 10 MB page is parsed: on a machine
+    // loaded by other jobs, 3 s may end before the replay's clock has started; a longer budget
+    // is asked for before calling it still.
+    let mut diff = 0;
+    for budget in [3000, 10_000] {
+        let late = screenshot_file(&html, budget, &dir.join("late.png"));
+        let cl = classify(&late);
+        eprintln!("replay late ({budget} ms) {cl:?}");
+        assert_scene_visible(cl, "replay late");
+        diff = differing(&late);
+        if diff > 1000 {
+            break;
+        }
+    }
     assert!(diff > 1000, "the replay did not animate: {diff} bytes differ");
     let _ = std::fs::remove_dir_all(&dir);
 }
