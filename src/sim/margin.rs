@@ -18,6 +18,8 @@
 use mujoco_rs::prelude::*;
 use mujoco_rs::wrappers::mj_model::traits::ModelType;
 
+use super::pair_filter::PairFilter;
+
 /// A pair whose MuJoCo collider does not honour the margin: capsule–box, box–box, box–plane.
 fn margin_unreliable(a: MjtGeomBase, b: MjtGeomBase) -> bool {
     type G = MjtGeomBase;
@@ -48,46 +50,19 @@ impl MarginPairs {
     /// its body filters, `<exclude>`) with a positive margin.
     pub(crate) fn new(m: &MjModel) -> Self {
         let ngeom = m.ffi().ngeom as usize;
-        let (ct, ca) = (m.geom_contype(), m.geom_conaffinity());
         let (types, margin) = (m.geom_type(), m.geom_margin());
-        let body = m.geom_bodyid();
-        let (weld, parent) = (m.body_weldid(), m.body_parentid());
-        let filterparent = m.ffi().opt.disableflags & MjtDisableBit::mjDSBL_FILTERPARENT as i32 == 0;
-        let excluded = m.exclude_signature();
+        let filter = PairFilter::new(m);
         let mut pairs = Vec::new();
         for g1 in 0..ngeom {
             for g2 in g1 + 1..ngeom {
-                if ct[g1] & ca[g2] == 0 && ct[g2] & ca[g1] == 0 {
-                    continue;
-                }
-                if !margin_unreliable(types[g1], types[g2]) {
-                    continue;
-                }
                 let pair_margin = margin[g1].max(margin[g2]);
-                if pair_margin <= 0.0 {
-                    continue;
+                if margin_unreliable(types[g1], types[g2]) && pair_margin > 0.0 && filter.tested(g1, g2) {
+                    pairs.push(Pair {
+                        a: g1,
+                        b: g2,
+                        margin: pair_margin,
+                    });
                 }
-                let (b1, b2) = (body[g1] as usize, body[g2] as usize);
-                let (w1, w2) = (weld[b1] as usize, weld[b2] as usize);
-                if w1 == w2 {
-                    continue;
-                }
-                let (wp1, wp2) = (
-                    weld[parent[w1] as usize] as usize,
-                    weld[parent[w2] as usize] as usize,
-                );
-                if filterparent && w1 != 0 && w2 != 0 && (w1 == wp2 || w2 == wp1) {
-                    continue;
-                }
-                let sig = ((b1.min(b2) as i32) << 16) + b1.max(b2) as i32;
-                if excluded.contains(&sig) {
-                    continue;
-                }
-                pairs.push(Pair {
-                    a: g1,
-                    b: g2,
-                    margin: pair_margin,
-                });
             }
         }
         Self { pairs }

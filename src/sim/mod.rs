@@ -7,6 +7,7 @@ pub mod error;
 pub mod layout;
 mod margin;
 pub mod mjcf;
+mod pair_filter;
 pub mod planning;
 pub mod scene;
 pub mod screen;

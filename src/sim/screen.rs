@@ -18,6 +18,7 @@
 use mujoco_rs::prelude::*;
 use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, Unit, UnitQuaternion, Vector3};
 
+use super::pair_filter::PairFilter;
 use crate::motion::plan::shapes::{Shape, V3, near, within};
 
 /// Extra distance every pair must keep beyond its margin for the screen to vouch, metres: room
@@ -411,10 +412,7 @@ impl Screen {
             }
         }
         // The pairs MuJoCo tests in this model.
-        let body = m.geom_bodyid();
-        let weld = m.body_weldid();
-        let filterparent = m.ffi().opt.disableflags & MjtDisableBit::mjDSBL_FILTERPARENT as i32 == 0;
-        let excluded = m.exclude_signature();
+        let filter = PairFilter::new(m);
         let (margin, gap) = (m.geom_margin(), m.geom_gap());
         let mut pairs = Vec::new();
         let mut add = |g1: usize, g2: usize, pair_margin: f64, pair_gap: f64| -> bool {
@@ -444,23 +442,7 @@ impl Screen {
                 if !collidable(g2) {
                     continue;
                 }
-                if ct[g1] & ca[g2] == 0 && ct[g2] & ca[g1] == 0 {
-                    continue;
-                }
-                let (b1, b2) = (body[g1] as usize, body[g2] as usize);
-                let (w1, w2) = (weld[b1] as usize, weld[b2] as usize);
-                if w1 == w2 {
-                    continue;
-                }
-                let (wp1, wp2) = (
-                    weld[parent[w1] as usize] as usize,
-                    weld[parent[w2] as usize] as usize,
-                );
-                if filterparent && w1 != 0 && w2 != 0 && (w1 == wp2 || w2 == wp1) {
-                    continue;
-                }
-                let sig = ((b1.min(b2) as i32) << 16) + b1.max(b2) as i32;
-                if excluded.contains(&sig) {
+                if !filter.tested(g1, g2) {
                     continue;
                 }
                 if !add(g1, g2, margin[g1].max(margin[g2]), gap[g1].max(gap[g2])) {
