@@ -5,11 +5,12 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use macrotree::actions::{CONTROL_PERIOD, Cell};
-use macrotree::episode::{EpisodeConfig, EpisodeReport, Goal, NoObserver, run_in_cell};
+use macrotree::actions::Cell;
+use macrotree::episode::{EpisodeReport, Goal};
 use macrotree::plan::Loader;
-use macrotree::sim::{Layout, Scene};
 
+#[path = "support/cell_run.rs"]
+mod cell_run;
 #[path = "support/oracle.rs"]
 mod oracle;
 
@@ -21,31 +22,13 @@ fn run(name: &str, scene: &str, main: &str) -> (EpisodeReport, Cell) {
     let dir: PathBuf = Path::new(ROOT)
         .join("target")
         .join(format!("container_packing_{name}"));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join("cell.yaml"), scene).unwrap();
-    let tree = dir.join("tree.yaml");
-    std::fs::write(&tree, format!("scene: cell.yaml\nmain:\n{main}")).unwrap();
+    let tree = cell_run::write_cell_tree(&dir, scene, main);
     let plan = Arc::new(
         Loader::default()
             .load(&tree)
             .unwrap_or_else(|d| panic!("{}", d[0])),
     );
-    let scene = Scene::load_spec(&plan.scene).expect("scene compiles");
-    let mut cell = Cell::new(&scene, &Layout::default(), CONTROL_PERIOD);
-    let config = EpisodeConfig {
-        goal: Goal::Scene,
-        max_sim_time: 60.0,
-        ..EpisodeConfig::default()
-    };
-    let r = run_in_cell(
-        &mut cell,
-        plan,
-        &macrotree::factory::Factory::builtin(),
-        &config,
-        &mut NoObserver,
-    );
-    oracle::assert_no_warning(cell.sim(), name);
-    (r, cell)
+    cell_run::run_plan(plan, Goal::Scene, 60.0, name)
 }
 
 /// The steps `clear_table`'s `move_one` runs for `block` into `bin` (pre-shape, above, down,

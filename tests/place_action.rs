@@ -7,13 +7,14 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use macrotree::FailureKind;
-use macrotree::actions::{CONTROL_PERIOD, Cell};
-use macrotree::episode::{EpisodeConfig, EpisodeReport, Goal, NoObserver, run_in_cell};
+use macrotree::actions::Cell;
+use macrotree::episode::{EpisodeReport, Goal};
 use macrotree::plan::Loader;
-use macrotree::sim::{Layout, Scene};
 use macrotree::world::World;
 use nalgebra::Vector2;
 
+#[path = "support/cell_run.rs"]
+mod cell_run;
 #[path = "support/oracle.rs"]
 mod oracle;
 
@@ -53,34 +54,14 @@ fn run_with_spots(
     } else {
         format!("spots:\n{spots}")
     };
-    std::fs::write(
-        dir.join("cell.yaml"),
-        format!("description: {name}\nobjects:\n{objects}{spots}"),
-    )
-    .unwrap();
-    let tree = dir.join("tree.yaml");
-    std::fs::write(&tree, format!("scene: cell.yaml\nmain:\n{main}")).unwrap();
+    let scene = format!("description: {name}\nobjects:\n{objects}{spots}");
+    let tree = cell_run::write_cell_tree(&dir, &scene, main);
     let plan = Arc::new(
         Loader::default()
             .load(&tree)
             .unwrap_or_else(|d| panic!("{}", d[0])),
     );
-    let scene = Scene::load_spec(&plan.scene).expect("scene compiles");
-    let mut cell = Cell::new(&scene, &Layout::default(), CONTROL_PERIOD);
-    let config = EpisodeConfig {
-        goal: Goal::Tree,
-        max_sim_time: 60.0,
-        ..EpisodeConfig::default()
-    };
-    let r = run_in_cell(
-        &mut cell,
-        plan,
-        &macrotree::factory::Factory::builtin(),
-        &config,
-        &mut NoObserver,
-    );
-    oracle::assert_no_warning(cell.sim(), name);
-    (r, cell)
+    cell_run::run_plan(plan, Goal::Tree, 60.0, name)
 }
 
 /// The steps that pick `block` up (pre-shape, above, straight down, close), as sequence children

@@ -6,14 +6,15 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use macrotree::actions::{CONTROL_PERIOD, Cell};
-use macrotree::episode::{EpisodeConfig, EpisodeReport, Goal, NoObserver, run_in_cell};
+use macrotree::actions::Cell;
+use macrotree::episode::{EpisodeReport, Goal};
 use macrotree::plan::Loader;
-use macrotree::sim::{Layout, Scene};
 use macrotree::spec::Diagnostic;
 use macrotree::world::World;
 use nalgebra::Vector2;
 
+#[path = "support/cell_run.rs"]
+mod cell_run;
 #[path = "support/oracle.rs"]
 mod oracle;
 
@@ -44,10 +45,7 @@ fn dir(name: &str) -> PathBuf {
 
 /// Writes the scene and a tree whose `main:` is `main` (YAML, indented two spaces); loads it.
 fn load(name: &str, main: &str) -> Result<Arc<macrotree::plan::Plan>, Vec<Diagnostic>> {
-    let d = dir(name);
-    std::fs::write(d.join("cell.yaml"), SCENE).unwrap();
-    let tree = d.join("tree.yaml");
-    std::fs::write(&tree, format!("scene: cell.yaml\nmain:\n{main}")).unwrap();
+    let tree = cell_run::write_cell_tree(&dir(name), SCENE, main);
     Loader::default().load(&tree).map(Arc::new)
 }
 
@@ -65,22 +63,7 @@ fn find<'a>(diags: &'a [Diagnostic], needle: &str) -> &'a Diagnostic {
 /// Runs `main` with the tree's own outcome as success; the report and the final cell.
 fn run(name: &str, main: &str) -> (EpisodeReport, Cell) {
     let plan = load(name, main).unwrap_or_else(|d| panic!("{}", d[0]));
-    let scene = Scene::load_spec(&plan.scene).expect("scene compiles");
-    let mut cell = Cell::new(&scene, &Layout::default(), CONTROL_PERIOD);
-    let config = EpisodeConfig {
-        goal: Goal::Tree,
-        max_sim_time: 90.0,
-        ..EpisodeConfig::default()
-    };
-    let r = run_in_cell(
-        &mut cell,
-        plan,
-        &macrotree::factory::Factory::builtin(),
-        &config,
-        &mut NoObserver,
-    );
-    oracle::assert_no_warning(cell.sim(), name);
-    (r, cell)
+    cell_run::run_plan(plan, Goal::Tree, 90.0, name)
 }
 
 fn assert_success(r: &EpisodeReport, what: &str) {
