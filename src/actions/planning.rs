@@ -125,7 +125,9 @@ impl<'a> Allowing<'a> {
     /// The pairs that count at `q`.
     pub(crate) fn blocking(&mut self, q: &[f64; 6]) -> Vec<Collision> {
         self.checks += 1;
-        if self.inner.is_free(q) {
+        // What keeps the margin from everything by the screen's bounds is free whatever is
+        // allowed; else one MuJoCo pass names the pairs.
+        if self.inner.screen(q) == Some(true) {
             return Vec::new();
         }
         let mut all = self.inner.collisions(q);
