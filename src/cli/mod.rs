@@ -15,6 +15,7 @@ mod logging;
 mod nodes;
 mod output_set;
 mod outputs;
+mod plan;
 mod report;
 mod run;
 mod schema;
@@ -70,6 +71,8 @@ pub enum Command {
     Test(test::TestArgs),
     /// Merge the --out files of sharded sweeps or tests into the summary of one run.
     Report(report::ReportArgs),
+    /// Plan one arm motion in a scene (from home or given joints to joints or a point) and print the path or the typed reason there is none.
+    Plan(plan::PlanArgs),
 }
 
 /// A failure that maps to an exit code.
@@ -152,6 +155,7 @@ pub fn main_with(app: crate::App) -> ExitCode {
         Command::Run(args) => run::run(app, args),
         Command::Validate(args) => validate::validate(app, args),
         Command::Bench(args) => bench::bench(app, args),
+        Command::Plan(args) => plan::plan(args),
         Command::Sweep(args) => sweep::sweep(app, args),
         Command::Schema(args) => schema::schema(app, args),
         Command::Graph(args) => graph::graph(app, args),
