@@ -98,6 +98,21 @@ pub fn repeat(s: &str) -> Result<usize, String> {
     }
 }
 
+/// `plan --yaw DEG`: −360 ≤ DEG ≤ 360.
+pub fn yaw_deg(s: &str) -> Result<f64, String> {
+    number_in(s, |v| v.abs() <= 360.0, "degrees from -360 to 360")
+}
+
+/// `plan --margin M`: 0 ≤ M ≤ [`crate::sim::collision::MAX_MARGIN`], metres.
+pub fn margin(s: &str) -> Result<f64, String> {
+    let max = crate::sim::collision::MAX_MARGIN;
+    number_in(
+        s,
+        |v| (0.0..=max).contains(&v),
+        &format!("metres from 0 to {max}"),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -123,6 +138,14 @@ mod tests {
         assert_eq!(jobs("1024"), Ok(1024));
         for bad in ["0", "1025", "100000", "-1", "x"] {
             assert!(jobs(bad).is_err(), "{bad}");
+        }
+        assert_eq!(yaw_deg("-360"), Ok(-360.0));
+        for bad in ["360.5", "nan", "inf"] {
+            assert!(yaw_deg(bad).is_err(), "{bad}");
+        }
+        assert_eq!(margin("0"), Ok(0.0));
+        for bad in ["-0.001", "0.2", "nan"] {
+            assert!(margin(bad).is_err(), "{bad}");
         }
         assert_eq!(repeat("1000"), Ok(1000));
         for bad in ["0", "1001", "1000000000000", "-3"] {

@@ -56,10 +56,10 @@ pub struct PlanArgs {
     pub to_point: Option<PointArg>,
     /// The finger axis's yaw at --to-point, degrees (−360 … 360); the yaw half a turn away is
     /// equivalent and also a goal.
-    #[arg(long, value_name = "DEG", default_value_t = 0.0, requires = "to_point", allow_hyphen_values = true, value_parser = yaw_deg)]
+    #[arg(long, value_name = "DEG", default_value_t = 0.0, requires = "to_point", allow_hyphen_values = true, value_parser = super::limits::yaw_deg)]
     pub yaw: f64,
     /// Clearance margin, metres (0 … 0.1; the leaves use 0.005).
-    #[arg(long, value_name = "M", value_parser = margin)]
+    #[arg(long, value_name = "M", value_parser = super::limits::margin)]
     pub margin: Option<f64>,
     /// The planner's seed (its random samples; the same query and seed give the same path).
     #[arg(long, default_value_t = 0)]
@@ -70,21 +70,6 @@ pub struct PlanArgs {
     /// Print the result as one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
-}
-
-fn yaw_deg(s: &str) -> Result<f64, String> {
-    match s.trim().parse::<f64>() {
-        Ok(v) if v.is_finite() && v.abs() <= 360.0 => Ok(v),
-        _ => Err(format!("must be degrees from -360 to 360, got {s}")),
-    }
-}
-
-fn margin(s: &str) -> Result<f64, String> {
-    let max = crate::sim::collision::MAX_MARGIN;
-    match s.trim().parse::<f64>() {
-        Ok(v) if v.is_finite() && (0.0..=max).contains(&v) => Ok(v),
-        _ => Err(format!("must be metres from 0 to {max}, got {s}")),
-    }
 }
 
 /// What `plan --json` prints. Angles in radians, lengths in metres, times in seconds.
