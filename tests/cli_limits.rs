@@ -8,17 +8,6 @@ mod cli;
 use cli::*;
 const TREE: &str = "trees/cube_to_bowl.yaml";
 
-fn assert_bad_input(args: &[&str], needle: &str) {
-    let out = macrotree(args);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
-    assert!(
-        stderr.contains(needle),
-        "{args:?}: stderr lacks {needle:?}: {stderr}"
-    );
-    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
-}
-
 #[test]
 fn speed_is_bounded() {
     // 1e-22 panicked converting to a Duration; 1e-18 slept forever.

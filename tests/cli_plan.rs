@@ -137,14 +137,7 @@ fn plan_refuses_bad_input_with_exit_2() {
     ] {
         let mut all = vec!["plan", SCENE];
         all.extend_from_slice(&args);
-        let out = macrotree(&all);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
-        assert!(
-            stderr.contains(needle),
-            "{args:?}: stderr lacks {needle:?}: {stderr}"
-        );
-        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert_bad_input(&all, needle);
     }
     // A scene file with an error: located, exit 2.
     let dir = scratch("plan");

@@ -18,6 +18,18 @@ pub fn macrotree(args: &[&str]) -> Output {
         .expect("runs the binary")
 }
 
+/// Runs `macrotree ARGS…` and asserts bad input: exit 2, `needle` on stderr, no panic.
+pub fn assert_bad_input(args: &[&str], needle: &str) {
+    let out = macrotree(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+    assert!(
+        stderr.contains(needle),
+        "{args:?}: stderr lacks {needle:?}: {stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+}
+
 /// A fresh, empty folder for this test process (`name` tells the tests of one file apart).
 pub fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("macrotree-test-{name}-{}", std::process::id()));
