@@ -239,6 +239,38 @@ pub(crate) fn look_ahead_pairs(
     hit
 }
 
+/// The pairs a pick's straight descent `mv` (a look-ahead from a pre-grasp) would bring too
+/// close, but the `intended` objects: real contact of anything, and the arm's links (`ur5e/…`;
+/// not the fingers, which straddle the block beside its neighbours) closer than the checker's
+/// clearance margin. Nothing is allowed for touching at the start. `None` when it is clear. Its
+/// checks count in the tally's `collision_checks`, not as a motion checked.
+pub(crate) fn look_ahead_clear(
+    cell: &mut Cell,
+    mv: &dyn Trajectory,
+    intended: &[String],
+) -> Option<Vec<Collision>> {
+    let t = Instant::now();
+    let res = DIRECT_RESOLUTION;
+    let start = mv.sample(0.0).0;
+    let checker = cell.checker()?;
+    let mut allow = Allowing::new(checker, &start, intended, false);
+    allow.pairs.clear();
+    let mut hit = None;
+    for q in samples(mv, &res) {
+        let mut b = allow.blocking(&q);
+        b.retain(|c| c.distance < 0.0 || c.a.starts_with("ur5e/"));
+        if !b.is_empty() {
+            hit = Some(b);
+            break;
+        }
+    }
+    let checks = allow.checks;
+    let tally = cell.planning_mut();
+    tally.collision_checks += checks;
+    tally.add_time(t.elapsed());
+    hit
+}
+
 /// Checks a straight segment (`what`: "descent", "lift", "set-down") along its length, only
 /// real contact counting and contact with `intended` objects allowed; a hit is logged and
 /// counted in the tally, and the segment runs anyway (the leaf asked for a straight line, and
