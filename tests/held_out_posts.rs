@@ -66,3 +66,46 @@ fn pick_beside_a_post_was_blocked_from_every_straight_down_pre_grasp() {
 fn pick_descent_grazed_a_post_the_contact_only_look_ahead_passed() {
     clean(6, 1);
 }
+
+/// After the last block the wrist stood wound a turn from home (joints 4 and 5 at −5.0 and −4.7
+/// rad), the straight way home swept the gripper through the forearm, and the planner's default
+/// budget (20 000 checks) ran out in that narrow passage (`no_path` at the final `home`). A
+/// joint move without its own budget now searches once more, with a new seed and three times
+/// the checks.
+#[test]
+fn final_home_ran_out_of_planner_budget_with_the_wrist_wound_a_turn_from_home() {
+    let r = clean(20, 1);
+    assert!(
+        r["planning"]["plan_failures"].as_u64() == Some(1),
+        "the first search of the way home runs out, the second finds it: {}",
+        r["planning"]
+    );
+}
+
+/// The block slipped from the fingers early in a carry and slid on after landing; the next
+/// approach was chosen for where it lay then, and the descent, found to run the upper arm 2.4 mm
+/// into a post once the block had slid 3 cm further, ran anyway (`arm-obstacle` at
+/// `reach[descend]`). A descent onto an object that would run the arm's links into something else
+/// is now refused before it moves (`blocked`), and the retry approaches the block again.
+#[test]
+fn descent_ran_the_arm_into_a_post_after_the_block_slid_on() {
+    let (ks, ss) = ("89", "2");
+    let out = cli::macrotree(&[
+        "run",
+        TREE,
+        "--scene",
+        SCENE,
+        "--scenario",
+        ks,
+        "--sweep-seed",
+        ss,
+        "--json",
+    ]);
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON report");
+    assert_eq!(
+        r["collisions"].as_array().map(Vec::len),
+        Some(0),
+        "{}",
+        r["collisions"]
+    );
+}

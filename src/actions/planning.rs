@@ -274,13 +274,19 @@ pub(crate) fn look_ahead_clear(
 /// Checks a straight segment (`what`: "descent", "lift", "set-down") along its length, only
 /// real contact counting and contact with `intended` objects allowed; a hit is logged and
 /// counted in the tally, and the segment runs anyway (the leaf asked for a straight line, and
-/// its physics is what it was before the check).
-pub(crate) fn check_straight(cell: &mut Cell, what: &str, mv: &dyn Trajectory, intended: &[String]) {
-    if let Some((q, pairs)) = check_motion(cell, &[mv], intended, true) {
-        let p = crate::motion::fk(&q).translation.vector;
-        tracing::debug!(target: "macrotree::plan", "the straight {what} touches {} (pinch at ({:.3}, {:.3}, {:.3}) m)", describe(&pairs), p.x, p.y, p.z);
-        cell.planning_mut().straight_contacts += 1;
-    }
+/// its physics is what it was before the check) unless the caller refuses it: the pairs at the
+/// first configuration that touches, `None` when it is free.
+pub(crate) fn check_straight(
+    cell: &mut Cell,
+    what: &str,
+    mv: &dyn Trajectory,
+    intended: &[String],
+) -> Option<Vec<Collision>> {
+    let (q, pairs) = check_motion(cell, &[mv], intended, true)?;
+    let p = crate::motion::fk(&q).translation.vector;
+    tracing::debug!(target: "macrotree::plan", "the straight {what} touches {} (pinch at ({:.3}, {:.3}, {:.3}) m)", describe(&pairs), p.x, p.y, p.z);
+    cell.planning_mut().straight_contacts += 1;
+    Some(pairs)
 }
 
 /// Pairs as text for messages: `a–b (−1.2 mm)`, at most four.

@@ -296,6 +296,32 @@ impl Reach {
     }
 }
 
+/// A straight descent onto an object (`intended` names it) that would run the arm's links
+/// (`ur5e/…`, not the fingers) into something else (`touching`: the pairs [`check_straight`]
+/// found) is refused with a failure of kind `blocked` before it moves (the world changed since
+/// its approach was chosen: the block slid on); a retry approaches it again. Other contacts run
+/// as before.
+fn refuse_arm_contact(
+    touching: Option<Vec<crate::motion::plan::Collision>>,
+    intended: &[String],
+) -> Result<(), Failure> {
+    let Some(pairs) = touching else {
+        return Ok(());
+    };
+    let arm: Vec<_> = pairs.into_iter().filter(|c| c.a.starts_with("ur5e/")).collect();
+    if arm.is_empty() || intended.is_empty() {
+        return Ok(());
+    }
+    Err(Failure::new(
+        FailureKind::Blocked,
+        format!(
+            "the straight descent onto `{}` would run the arm into {}; not started",
+            intended.join(", "),
+            describe(&arm)
+        ),
+    ))
+}
+
 /// Failure kinds of a pick's approach that a tilted pre-grasp may avoid: every straight-down
 /// descent blocked, every straight-down pre-grasp configuration in collision, or no path to them.
 fn tilt_may_help(kind: FailureKind) -> bool {
@@ -341,7 +367,7 @@ impl MacroAction for Reach {
                 .map(|j| w.name(j).to_string())
                 .into_iter()
                 .collect();
-            check_straight(cell, "descent", &mv, &intended);
+            refuse_arm_contact(check_straight(cell, "descent", &mv, &intended), &intended)?;
             self.pending.clear();
             self.goal_q = mv.end();
             cell.track(Box::new(mv));
@@ -373,7 +399,7 @@ impl MacroAction for Reach {
                     .map(|j| w.name(j).to_string())
                     .into_iter()
                     .collect();
-                check_straight(cell, "descent", &mv, &intended);
+                refuse_arm_contact(check_straight(cell, "descent", &mv, &intended), &intended)?;
                 cell.track(Box::new(mv));
                 self.goal_q = goal_q;
                 Ok(())
