@@ -13,7 +13,11 @@
 //!   goes to (the reach's target, the carry's destination: a container's floor, not its walls)
 //!   is intended;
 //! - a planned motion keeps the full margin from everything except the pairs touching at its
-//!   start, and ends at the pre-grasp or pre-place pose, never in contact.
+//!   start, and ends at the pre-grasp or pre-place pose, never in contact;
+//! - the look-ahead at a pick's descent from a pre-grasp ([`look_ahead_clear`]) allows nothing
+//!   for touching at the start and keeps the arm's links the margin from everything but the
+//!   block; a descent onto an object that would really run the arm's links into something else
+//!   is refused before it moves (`reach`, kind `blocked`).
 
 use std::time::{Duration, Instant};
 
