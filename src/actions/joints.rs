@@ -3,8 +3,14 @@
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
 use super::planning::{check_motion, describe, plan_motion_within};
-use crate::motion::plan::GoalSet;
+use crate::failure::FailureKind;
+use crate::motion::plan::{GoalSet, PlannerConfig};
 use crate::motion::{JointMove, MotionLimits};
+
+/// How many times the planner's default check budget a joint move without its own
+/// `max_checks` gets for a second search (a new seed) when the first runs out: a wrist wound a turn
+/// from its goal leaves a narrow passage past the forearm that one seed may miss.
+const SECOND_SEARCH_BUDGET: u64 = 3;
 
 /// Moves the arm in joint space to fixed joint angles (radians).
 pub struct MoveJoints {
@@ -45,7 +51,14 @@ impl MacroAction for MoveJoints {
             // exactly these joint angles.
             tracing::debug!(target: "macrotree::actions", "move_joints: the direct joint move would touch {}; planning", describe(&pairs));
             let goals = GoalSet::configs(vec![self.goal_q]);
-            let motion = plan_motion_within(cell, "move_joints", &from, &goals, self.max_checks)?;
+            let motion = match plan_motion_within(cell, "move_joints", &from, &goals, self.max_checks) {
+                Err(e) if e.kind == FailureKind::NoPath && self.max_checks.is_none() => {
+                    let budget = SECOND_SEARCH_BUDGET * PlannerConfig::default().max_checks;
+                    tracing::debug!(target: "macrotree::actions", "move_joints: {e}; searching once more with {budget} checks");
+                    plan_motion_within(cell, "move_joints", &from, &goals, Some(budget))?
+                }
+                planned => planned?,
+            };
             cell.track(Box::new(motion.trajectory));
             return Ok(());
         }

@@ -22,6 +22,7 @@ mod release_room;
 mod side;
 mod side_set_down;
 mod targets;
+mod tilted;
 
 pub(crate) use carry::Carry as CarryAction;
 pub use cell::{CONTROL_PERIOD, Cell, PlanCounts, PlanningTally, StepObserver};

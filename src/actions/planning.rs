@@ -13,7 +13,11 @@
 //!   goes to (the reach's target, the carry's destination: a container's floor, not its walls)
 //!   is intended;
 //! - a planned motion keeps the full margin from everything except the pairs touching at its
-//!   start, and ends at the pre-grasp or pre-place pose, never in contact.
+//!   start, and ends at the pre-grasp or pre-place pose, never in contact;
+//! - the look-ahead at a pick's descent from a pre-grasp ([`look_ahead_clear`]) allows nothing
+//!   for touching at the start and keeps the arm's links the margin from everything but the
+//!   block; a descent onto an object that would really run the arm's links into something else
+//!   is refused before it moves (`reach`, kind `blocked`).
 
 use std::time::{Duration, Instant};
 
@@ -241,16 +245,54 @@ pub(crate) fn look_ahead_pairs(
     hit
 }
 
+/// The pairs a pick's straight descent `mv` (a look-ahead from a pre-grasp) would bring too
+/// close, but the `intended` objects: real contact of anything, and the arm's links (`ur5e/…`;
+/// not the fingers, which straddle the block beside its neighbours) closer than the checker's
+/// clearance margin. Nothing is allowed for touching at the start. `None` when it is clear. Its
+/// checks count in the tally's `collision_checks`, not as a motion checked.
+pub(crate) fn look_ahead_clear(
+    cell: &mut Cell,
+    mv: &dyn Trajectory,
+    intended: &[String],
+) -> Option<Vec<Collision>> {
+    let t = Instant::now();
+    let res = DIRECT_RESOLUTION;
+    let start = mv.sample(0.0).0;
+    let checker = cell.checker()?;
+    let mut allow = Allowing::new(checker, &start, intended, false);
+    allow.pairs.clear();
+    let mut hit = None;
+    for q in samples(mv, &res) {
+        let mut b = allow.blocking(&q);
+        b.retain(|c| c.distance < 0.0 || c.a.starts_with("ur5e/"));
+        if !b.is_empty() {
+            hit = Some(b);
+            break;
+        }
+    }
+    let checks = allow.checks;
+    let tally = cell.planning_mut();
+    tally.collision_checks += checks;
+    tally.add_time(t.elapsed());
+    hit
+}
+
 /// Checks a straight segment (`what`: "descent", "lift", "set-down") along its length, only
 /// real contact counting and contact with `intended` objects allowed; a hit is logged and
 /// counted in the tally, and the segment runs anyway (the leaf asked for a straight line, and
-/// its physics is what it was before the check).
-pub(crate) fn check_straight(cell: &mut Cell, what: &str, mv: &dyn Trajectory, intended: &[String]) {
-    if let Some((q, pairs)) = check_motion(cell, &[mv], intended, true) {
-        let p = crate::motion::fk(&q).translation.vector;
-        tracing::debug!(target: "macrotree::plan", "the straight {what} touches {} (pinch at ({:.3}, {:.3}, {:.3}) m)", describe(&pairs), p.x, p.y, p.z);
-        cell.planning_mut().straight_contacts += 1;
-    }
+/// its physics is what it was before the check) unless the caller refuses it: the pairs at the
+/// first configuration that touches, `None` when it is free.
+pub(crate) fn check_straight(
+    cell: &mut Cell,
+    what: &str,
+    mv: &dyn Trajectory,
+    intended: &[String],
+) -> Option<Vec<Collision>> {
+    let (q, pairs) = check_motion(cell, &[mv], intended, true)?;
+    let p = crate::motion::fk(&q).translation.vector;
+    tracing::debug!(target: "macrotree::plan", "the straight {what} touches {} (pinch at ({:.3}, {:.3}, {:.3}) m)", describe(&pairs), p.x, p.y, p.z);
+    cell.planning_mut().straight_contacts += 1;
+    Some(pairs)
 }
 
 /// Pairs as text for messages: `a–b (−1.2 mm)`, at most four.

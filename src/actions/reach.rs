@@ -4,9 +4,7 @@ use nalgebra::{Isometry3, Translation3, Vector3};
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
-use super::planning::{
-    check_motion, check_straight, describe, look_ahead_hits, look_ahead_pairs, plan_motion,
-};
+use super::planning::{check_motion, check_straight, describe, look_ahead_clear, plan_motion};
 use super::targets::{resolve, segment_distance, target_block, target_object, tool_yaw};
 use crate::failure::{Failure, FailureKind};
 use crate::kinds::{PathKind, Reach as ReachSpec, Yaw};
@@ -79,7 +77,7 @@ impl Reach {
             CartesianMove::new(*q, down, &limits).ok()
         };
         let hits = |cell: &mut Cell, q: &[f64; 6]| match descent(q) {
-            Some(mv) => look_ahead_hits(cell, &mv, &intended),
+            Some(mv) => look_ahead_clear(cell, &mv, &intended).is_some(),
             None => true,
         };
         if !hits(cell, reached) {
@@ -90,7 +88,7 @@ impl Reach {
             return Ok(Some(GoalSet::configs(free)));
         }
         let what = descent(reached)
-            .and_then(|mv| look_ahead_pairs(cell, &mv, &intended))
+            .and_then(|mv| look_ahead_clear(cell, &mv, &intended))
             .map_or_else(
                 || "the arm's joint limits or a singularity".to_string(),
                 |pairs| describe(&pairs),
@@ -194,6 +192,145 @@ fn detour_height(w: &World, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
         .fold(a.z.max(b.z), f64::max)
 }
 
+impl Reach {
+    /// A joint-space `reach` from `from` (goal configuration `goal_q`, pinch at `position`):
+    /// straight in joint space, or a detour over an object the pinch would pass low over, or
+    /// planned around whatever is in the way; to the branches whose straight descent is free when
+    /// the reach is a pick's approach.
+    #[allow(clippy::too_many_arguments)]
+    fn start_joint(
+        &mut self,
+        cell: &mut Cell,
+        from: &[f64; 6],
+        position: &Vector3<f64>,
+        (yaw, quarter): (f64, bool),
+        goal_q: [f64; 6],
+        offset: Vector3<f64>,
+        limits: &MotionLimits,
+    ) -> Result<(), Failure> {
+        let (from, position, limits) = (*from, *position, *limits);
+        let w = cell.world();
+        let skip = target_object(&self.spec.target, w);
+        // Today's motion: straight in joint space, or up, over and down around an
+        // object the pinch would pass low over.
+        let (legs, goal_q): (Vec<Box<dyn Trajectory>>, [f64; 6]) = match joint_path_conflict(
+            w, &from, &goal_q, skip,
+        ) {
+            None => (vec![Box::new(JointMove::new(from, goal_q, &limits))], goal_q),
+            Some(j) => {
+                // Up, over at a height that clears everything in the way, then down.
+                let here = fk(&from);
+                let z = detour_height(w, &here.translation.vector, &position);
+                tracing::debug!(target: "macrotree::actions", "reach: the direct path passes low over {}; detour at {z:.3} m", w.name(j));
+                match detour(&from, &here, z, &position, yaw, quarter, &limits) {
+                    Ok(legs) => legs,
+                    // Far out the straight rise can leave the workspace (the elbow
+                    // straightens): the planner finds the way instead.
+                    Err(e) => {
+                        tracing::debug!(target: "macrotree::actions", "reach: {e}; planning");
+                        return self.plan(cell, &from, &position, yaw, quarter, offset);
+                    }
+                }
+            }
+        };
+        let refs: Vec<&dyn Trajectory> = legs.iter().map(|l| l.as_ref()).collect();
+        if let Some((_, pairs)) = check_motion(cell, &refs, &[], false) {
+            // The motion would collide: plan one to the same pose (any IK branch, any
+            // equivalent grasp yaw) around whatever is in the way.
+            tracing::debug!(target: "macrotree::actions", "reach: the {} would touch {}; planning", if legs.len() == 1 { "direct joint move" } else { "detour" }, describe(&pairs));
+            return self.plan(cell, &from, &position, yaw, quarter, offset);
+        }
+        // The direct motion is free; the straight descent a pick runs next from where it
+        // ends may not be (the forearm on a post beside the block): then plan to the
+        // branches whose descent is free.
+        let goals = GoalSet::down(&position, yaw, quarter, &from);
+        if let Some(free) = self.descent_free_goals(cell, &goals, &goal_q, offset)? {
+            tracing::debug!(target: "macrotree::actions", "reach: the descent from the direct move's end would touch; planning to the {} goal(s) whose descent is free", free.configs.len());
+            let motion = plan_motion(cell, "reach", &from, &free)?;
+            self.goal_q = motion.trajectory.end();
+            cell.track(Box::new(motion.trajectory));
+            return Ok(());
+        }
+        let mut legs = legs;
+        self.goal_q = goal_q;
+        let first = legs.remove(0);
+        legs.reverse();
+        self.pending = legs;
+        cell.track(first);
+        Ok(())
+    }
+
+    /// A pick's approach whose straight-down pre-grasps are all blocked (`why`): to a tilted
+    /// pre-grasp ([`super::tilted`]) of the target block when its offset is straight up and one
+    /// has a free configuration and descent; `why` otherwise.
+    fn start_tilted(
+        &mut self,
+        cell: &mut Cell,
+        from: &[f64; 6],
+        grasp_yaw: (f64, bool),
+        offset: Vector3<f64>,
+        why: Failure,
+    ) -> Result<(), Failure> {
+        let w = cell.world();
+        let Some(b) = target_block(&self.spec.target, w) else {
+            return Err(why);
+        };
+        if offset.z <= 0.0 || offset.x != 0.0 || offset.y != 0.0 {
+            return Err(why);
+        }
+        let centre = w.objects[b].pos;
+        let name = w.name(b).to_string();
+        tracing::debug!(target: "macrotree::actions", "reach: {why}; trying tilted pre-grasps");
+        match super::tilted::plan(cell, from, &centre, grasp_yaw, offset.z, &name) {
+            Ok(Some(motion)) => {
+                self.goal_q = motion.trajectory.end();
+                cell.track(Box::new(motion.trajectory));
+                Ok(())
+            }
+            Ok(None) => Err(why),
+            Err(e) => {
+                tracing::debug!(target: "macrotree::actions", "reach: no path to a tilted pre-grasp: {e}");
+                Err(why)
+            }
+        }
+    }
+}
+
+/// A straight descent onto an object (`intended` names it) that would run the arm's links
+/// (`ur5e/…`, not the fingers) into something else (`touching`: the pairs [`check_straight`]
+/// found) is refused with a failure of kind `blocked` before it moves (the world changed since
+/// its approach was chosen: the block slid on); a retry approaches it again. Other contacts run
+/// as before.
+fn refuse_arm_contact(
+    touching: Option<Vec<crate::motion::plan::Collision>>,
+    intended: &[String],
+) -> Result<(), Failure> {
+    let Some(pairs) = touching else {
+        return Ok(());
+    };
+    let arm: Vec<_> = pairs.into_iter().filter(|c| c.a.starts_with("ur5e/")).collect();
+    if arm.is_empty() || intended.is_empty() {
+        return Ok(());
+    }
+    Err(Failure::new(
+        FailureKind::Blocked,
+        format!(
+            "the straight descent onto `{}` would run the arm into {}; not started",
+            intended.join(", "),
+            describe(&arm)
+        ),
+    ))
+}
+
+/// Failure kinds of a pick's approach that a tilted pre-grasp may avoid: every straight-down
+/// descent blocked, every straight-down pre-grasp configuration in collision, or no path to them.
+fn tilt_may_help(kind: FailureKind) -> bool {
+    matches!(
+        kind,
+        FailureKind::Blocked | FailureKind::GoalInCollision | FailureKind::NoPath
+    )
+}
+
 impl MacroAction for Reach {
     fn start(&mut self, cell: &mut Cell) -> Result<(), Failure> {
         // `approach: side | auto`: docs/motion.md "Side grasps"; `top` goes on below.
@@ -215,6 +352,27 @@ impl MacroAction for Reach {
             (Yaw::Angle(a), _) => (*a, false),
         };
         let from = cell.arm_setpoint();
+        if matches!(self.spec.path, PathKind::Cartesian)
+            && let Some(rotation) = super::tilted::keeps_tilt(&from)
+        {
+            // A tilted pick's descent: along the tool axis, the tilt kept.
+            let pose = Isometry3::from_parts(Translation3::from(position), rotation);
+            let limits = MotionLimits {
+                tool_speed: self.spec.speed,
+                ..MotionLimits::default()
+            };
+            let mv = CartesianMove::new(from, pose, &limits)
+                .map_err(|e| unreachable(format!("unreachable path: {e}")))?;
+            let intended: Vec<String> = target_object(&self.spec.target, w)
+                .map(|j| w.name(j).to_string())
+                .into_iter()
+                .collect();
+            refuse_arm_contact(check_straight(cell, "descent", &mv, &intended), &intended)?;
+            self.pending.clear();
+            self.goal_q = mv.end();
+            cell.track(Box::new(mv));
+            return Ok(());
+        }
         let goal_q =
             ik_down(&position, yaw, quarter, &from).map_err(|e| unreachable(format!("unreachable: {e}")))?;
         let limits = MotionLimits {
@@ -224,54 +382,12 @@ impl MacroAction for Reach {
         self.pending.clear();
         match self.spec.path {
             PathKind::Joint => {
-                let skip = target_object(&self.spec.target, w);
-                // Today's motion: straight in joint space, or up, over and down around an
-                // object the pinch would pass low over.
-                let (legs, goal_q): (Vec<Box<dyn Trajectory>>, [f64; 6]) = match joint_path_conflict(
-                    w, &from, &goal_q, skip,
-                ) {
-                    None => (vec![Box::new(JointMove::new(from, goal_q, &limits))], goal_q),
-                    Some(j) => {
-                        // Up, over at a height that clears everything in the way, then down.
-                        let here = fk(&from);
-                        let z = detour_height(w, &here.translation.vector, &position);
-                        tracing::debug!(target: "macrotree::actions", "reach: the direct path passes low over {}; detour at {z:.3} m", w.name(j));
-                        match detour(&from, &here, z, &position, yaw, quarter, &limits) {
-                            Ok(legs) => legs,
-                            // Far out the straight rise can leave the workspace (the elbow
-                            // straightens): the planner finds the way instead.
-                            Err(e) => {
-                                tracing::debug!(target: "macrotree::actions", "reach: {e}; planning");
-                                return self.plan(cell, &from, &position, yaw, quarter, offset);
-                            }
-                        }
+                match self.start_joint(cell, &from, &position, (yaw, quarter), goal_q, offset, &limits) {
+                    Err(e) if tilt_may_help(e.kind) => {
+                        self.start_tilted(cell, &from, (yaw, quarter), offset, e)
                     }
-                };
-                let refs: Vec<&dyn Trajectory> = legs.iter().map(|l| l.as_ref()).collect();
-                if let Some((_, pairs)) = check_motion(cell, &refs, &[], false) {
-                    // The motion would collide: plan one to the same pose (any IK branch, any
-                    // equivalent grasp yaw) around whatever is in the way.
-                    tracing::debug!(target: "macrotree::actions", "reach: the {} would touch {}; planning", if legs.len() == 1 { "direct joint move" } else { "detour" }, describe(&pairs));
-                    return self.plan(cell, &from, &position, yaw, quarter, offset);
+                    started => started,
                 }
-                // The direct motion is free; the straight descent a pick runs next from where it
-                // ends may not be (the forearm on a post beside the block): then plan to the
-                // branches whose descent is free.
-                let goals = GoalSet::down(&position, yaw, quarter, &from);
-                if let Some(free) = self.descent_free_goals(cell, &goals, &goal_q, offset)? {
-                    tracing::debug!(target: "macrotree::actions", "reach: the descent from the direct move's end would touch; planning to the {} goal(s) whose descent is free", free.configs.len());
-                    let motion = plan_motion(cell, "reach", &from, &free)?;
-                    self.goal_q = motion.trajectory.end();
-                    cell.track(Box::new(motion.trajectory));
-                    return Ok(());
-                }
-                let mut legs = legs;
-                self.goal_q = goal_q;
-                let first = legs.remove(0);
-                legs.reverse();
-                self.pending = legs;
-                cell.track(first);
-                return Ok(());
             }
             PathKind::Cartesian => {
                 let pose = down_pose(&position, yaw_of_solution(&goal_q));
@@ -283,12 +399,12 @@ impl MacroAction for Reach {
                     .map(|j| w.name(j).to_string())
                     .into_iter()
                     .collect();
-                check_straight(cell, "descent", &mv, &intended);
+                refuse_arm_contact(check_straight(cell, "descent", &mv, &intended), &intended)?;
                 cell.track(Box::new(mv));
+                self.goal_q = goal_q;
+                Ok(())
             }
         }
-        self.goal_q = goal_q;
-        Ok(())
     }
 
     fn waiting_for(&self, cell: &Cell) -> String {
