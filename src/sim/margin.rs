@@ -74,7 +74,7 @@ impl MarginPairs {
     pub(crate) fn missing<M: ModelType>(&self, data: &mut MjData<M>) -> Vec<(usize, usize, f64)> {
         let mut out = Vec::new();
         for p in &self.pairs {
-            if !near(data, p) {
+            if !near(data, p, p.margin) {
                 continue;
             }
             let reported = data.contact().iter().any(|c| {
@@ -93,11 +93,32 @@ impl MarginPairs {
     }
 }
 
+impl MarginPairs {
+    /// The least distance of the listed pairs of `data` (posed) that may be closer than `wide`
+    /// metres, each measured with `mj_geomDistance` whether or not `mj_collision` reported it
+    /// (its distance for these pair types is not trusted); `wide` when none is. The pairs are
+    /// those of the checker's own margin (none when that margin is zero).
+    pub(crate) fn least<M: ModelType>(&self, data: &mut MjData<M>, wide: f64) -> f64 {
+        let mut least = wide;
+        for p in &self.pairs {
+            if near(data, p, least) {
+                least = least.min(data.geom_distance(p.a, p.b, least, None));
+            }
+        }
+        least
+    }
+
+    /// True when no pair is listed.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.pairs.is_empty()
+    }
+}
+
 /// False when the pair surely keeps its margin: a box's distance from the other geom's centre
 /// less the other's bounding radius (both ways round when both are boxes), or a plane's
 /// half-space against the other's bounding sphere, is at least the margin; the geoms then keep
 /// it too.
-fn near<M: ModelType>(data: &MjData<M>, p: &Pair) -> bool {
+fn near<M: ModelType>(data: &MjData<M>, p: &Pair, margin: f64) -> bool {
     let m = data.model();
     let (pos, mat, rbound, types) = (data.geom_xpos(), data.geom_xmat(), m.geom_rbound(), m.geom_type());
     // A lower bound of the distance from geom `shape` (a box or a plane) to geom `other`.
@@ -128,5 +149,5 @@ fn near<M: ModelType>(data: &MjData<M>, p: &Pair) -> bool {
     if plane(p.b) || (is_box(p.b) && !plane(p.a)) {
         apart = apart.max(bound(p.b, p.a));
     }
-    apart < p.margin
+    apart < margin
 }

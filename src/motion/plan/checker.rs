@@ -30,6 +30,16 @@ pub trait CollisionChecker {
     fn screen(&mut self, _q: &[f64; 6]) -> Option<bool> {
         None
     }
+
+    /// The exact checker's spare clearance at `q` (radians): a lower bound, in metres, on how
+    /// much farther than the clearance margin everything the arm must not touch is, at most
+    /// `cap` (metres); negative when `q` may not be free. `None` when the checker cannot
+    /// measure it (the default). The planner's final re-check uses it to vouch for the
+    /// configurations near `q`: a point of the robot moves at most `Σ_j r_j |Δq_j|` (lever
+    /// arms `r_j`), so within that much of the spare clearance every pair still keeps the margin.
+    fn exact_spare(&mut self, _q: &[f64; 6], _cap: f64) -> Option<f64> {
+        None
+    }
 }
 
 impl<C: CollisionChecker + ?Sized> CollisionChecker for &mut C {
@@ -41,6 +51,9 @@ impl<C: CollisionChecker + ?Sized> CollisionChecker for &mut C {
     }
     fn screen(&mut self, q: &[f64; 6]) -> Option<bool> {
         (**self).screen(q)
+    }
+    fn exact_spare(&mut self, q: &[f64; 6], cap: f64) -> Option<f64> {
+        (**self).exact_spare(q, cap)
     }
 }
 

@@ -102,8 +102,9 @@ enum Attempt {
 /// the path: rounding of the interpolation, nothing more.
 const ON_PATH: f64 = 1e-9;
 
-/// True when `q` lies on the segment `a`–`b` (within [`ON_PATH`]).
-fn on_segment(q: &[f64; 6], a: &[f64; 6], b: &[f64; 6]) -> bool {
+/// Where `q` lies on the segment `a`–`b` (the fraction of the way, 0 to 1), if it does (within
+/// [`ON_PATH`]).
+fn on_segment(q: &[f64; 6], a: &[f64; 6], b: &[f64; 6]) -> Option<f64> {
     let (mut dd, mut dq) = (0.0, 0.0);
     for j in 0..6 {
         dd += (b[j] - a[j]) * (b[j] - a[j]);
@@ -115,7 +116,20 @@ fn on_segment(q: &[f64; 6], a: &[f64; 6], b: &[f64; 6]) -> bool {
         let d = a[j] + (b[j] - a[j]) * t - q[j];
         e += d * d;
     }
-    e <= ON_PATH * ON_PATH
+    (e <= ON_PATH * ON_PATH).then_some(t)
+}
+
+/// Widest spare clearance the final re-check asks the exact checker for, metres
+/// ([`CollisionChecker::exact_spare`]): a configuration measured with this much to spare vouches
+/// for those up to this far (in the lever-arm displacement bound) along the path.
+pub const SPARE_CAP: f64 = 0.03;
+
+/// The lever arms the final re-check's vouching uses, metres: the configured ones, and never
+/// less than [`UR5E_LEVER_ARMS`](super::config::UR5E_LEVER_ARMS) (a setting that bounds fewer
+/// joints or shorter arms only coarsens the search's edges; it never lets the re-check skip a
+/// configuration the documented bound does not cover).
+fn vouching_arms(res: &super::edge::Resolution) -> [f64; 6] {
+    std::array::from_fn(|j| res.lever_arms[j].max(super::config::UR5E_LEVER_ARMS[j]))
 }
 
 /// The exact re-check of a path the screen helped find: every configuration the screen called
@@ -135,20 +149,53 @@ fn revalidate<C: CollisionChecker + ?Sized>(
                 .windows(2)
                 .all(|w| check_segment(checker, &w[0], &w[1], res).is_ok());
     }
-    let mut on: Vec<[f64; 6]> = std::mem::take(&mut checker.vouched)
+    // Each configuration on the path once, in the order of the path (segment, fraction).
+    let mut on: Vec<(usize, f64, [f64; 6])> = std::mem::take(&mut checker.vouched)
         .into_iter()
-        .filter(|q| path.windows(2).any(|w| on_segment(q, &w[0], &w[1])))
+        .filter_map(|q| {
+            path.windows(2)
+                .enumerate()
+                .find_map(|(i, w)| on_segment(&q, &w[0], &w[1]).map(|t| (i, t, q)))
+        })
         .collect();
-    // Each configuration once, in a fixed order.
-    on.sort_by(|x, y| {
+    let order = |x: &[f64; 6], y: &[f64; 6]| {
         x.iter()
             .zip(y)
             .map(|(a, b)| a.total_cmp(b))
             .find(|o| o.is_ne())
             .unwrap_or(std::cmp::Ordering::Equal)
-    });
-    on.dedup();
-    on.iter().all(|q| checker.is_free(q))
+    };
+    on.sort_by(|x, y| x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)).then(order(&x.2, &y.2)));
+    on.dedup_by(|x, y| x.2 == y.2);
+    // Each configuration is free when the exact checker finds it so, or when it lies within the
+    // spare clearance the exact checker measured at an earlier one (the lever-arm bound).
+    let arms = vouching_arms(res);
+    let mut ball: Option<([f64; 6], f64)> = None;
+    for (_, _, q) in &on {
+        if let Some((c, spare)) = &ball {
+            let moved: f64 = (0..6).map(|j| arms[j] * (q[j] - c[j]).abs()).sum();
+            if moved <= *spare {
+                continue;
+            }
+        }
+        if checker.spent() {
+            return false;
+        }
+        match checker.inner.exact_spare(q, SPARE_CAP) {
+            Some(spare) if spare >= 0.0 => {
+                checker.checks += 1;
+                ball = Some((*q, spare));
+            }
+            // Not measured, or maybe not free: the exact test decides.
+            _ => {
+                if !checker.is_free(q) {
+                    return false;
+                }
+                ball = None;
+            }
+        }
+    }
+    true
 }
 
 /// One planning attempt, with the checker's screen asked first (`screen`) or not.
