@@ -35,6 +35,12 @@ use crate::scene::OBJECT_PREFIX;
 /// everything they must not touch.
 pub const DEFAULT_MARGIN: f64 = 0.005;
 
+/// What the spare clearance ([`CollisionChecker::exact_spare`]) leaves for MuJoCo's own
+/// tolerances, metres: its `mj_geomDistance` and `mj_collision`'s contact distances of the same
+/// pair differ by the convex-hull iterations' tolerance (about 1e-6 m); the screen's
+/// [`PAD`](super::screen::PAD) again.
+pub const SPARE_TOLERANCE: f64 = 5e-4;
+
 /// Largest clearance margin accepted, metres.
 pub const MAX_MARGIN: f64 = 0.1;
 
@@ -81,8 +87,6 @@ pub struct SceneChecker {
     /// The private model's pairs whose margin MuJoCo's narrow phase may leave out, and those of
     /// them found closer than the margin at the last configuration posed (geoms, distance).
     margin_pairs: (MarginPairs, Vec<(usize, usize, f64)>),
-    /// The geoms the clearance margin is set on in the private model (the moving ones).
-    margined: Vec<usize>,
 }
 
 /// What a private model is edited for: the held block (scene index), the margin's bits.
@@ -180,7 +184,6 @@ impl SceneChecker {
             screen_on: true,
             arm_links: (bodies, joints),
             margin_pairs: Default::default(),
-            margined: Vec::new(),
         };
         checker.rebuild_model();
         checker.sync(data)?;
@@ -250,9 +253,6 @@ impl SceneChecker {
             }
         }
         self.margin_pairs = (MarginPairs::new(self.data.model()), Vec::new());
-        self.margined = (0..group.len())
-            .filter(|&g| collidable[g] && group[g] != 0 && margin > 0.0)
-            .collect();
     }
 
     /// Takes a new snapshot from `data` (a running simulation of the same scene): every block's
@@ -367,37 +367,14 @@ impl SceneChecker {
     }
 
     /// The least distance at `q` (radians) of every pair the checker tests, metres, at most
-    /// `wide` (> the margin): the moving geoms' margins are widened to `wide` for one
-    /// `mj_collision` (then restored), every reported contact counts with its distance, and the
-    /// capsule–box, box–box and box–plane pairs that may be within `wide` are measured with
-    /// `mj_geomDistance` too (reported or not). `None` when the margin is zero (no pairs to
-    /// widen).
+    /// `wide`: `mj_geomDistance` of each pair that may be closer ([`MarginPairs::least`]).
+    /// `None` when the margin is zero (no pairs listed).
     fn least_distance(&mut self, q: &[f64; 6], wide: f64) -> Option<f64> {
-        if self.margined.is_empty() || self.margin_pairs.0.is_empty() {
+        if self.margin_pairs.0.is_empty() {
             return None;
         }
         self.detect_pose(q);
-        self.set_moving_margin(wide);
-        self.data.collision();
-        self.set_moving_margin(self.margin);
-        let reported = self
-            .data
-            .contact()
-            .iter()
-            .map(|c| c.dist)
-            .fold(wide, f64::min);
-        let least = self.margin_pairs.0.least(&mut self.data, reported);
-        Some(least)
-    }
-
-    /// Writes `margin` (metres) on the moving geoms of the private model.
-    fn set_moving_margin(&mut self, margin: f64) {
-        // SAFETY: only per-geom margins are written; no size or index of the model changes.
-        let model = unsafe { self.data.model_mut() };
-        let m = model.geom_margin_mut();
-        for &g in &self.margined {
-            m[g] = margin;
-        }
+        Some(self.margin_pairs.0.least(&mut self.data, wide))
     }
 
     /// Poses the arm (and a held block) at `q` with `mj_kinematics`.
@@ -441,14 +418,14 @@ impl CollisionChecker for SceneChecker {
         self.screen_model()?.classify(q)
     }
 
-    /// The least distance of [`SceneChecker::least_distance`] with the margin `cap` metres
-    /// wider, less the margin (see the trait).
+    /// The least distance of [`SceneChecker::least_distance`] up to `cap` metres beyond the
+    /// margin, less the margin and [`SPARE_TOLERANCE`] (see the trait).
     fn exact_spare(&mut self, q: &[f64; 6], cap: f64) -> Option<f64> {
         if !(q.iter().all(|v| v.is_finite()) && cap.is_finite() && cap > 0.0) {
             return None;
         }
         let wide = self.margin + cap.min(MAX_MARGIN);
-        Some(self.least_distance(q, wide)? - self.margin)
+        Some(self.least_distance(q, wide)? - self.margin - SPARE_TOLERANCE)
     }
 
     fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
@@ -535,3 +512,7 @@ impl SceneChecker {
         self.held.as_ref().map(|h| fk(q) * h.in_pinch)
     }
 }
+
+#[cfg(test)]
+#[path = "collision_tests.rs"]
+mod tests;
