@@ -122,7 +122,7 @@ fn on_segment(q: &[f64; 6], a: &[f64; 6], b: &[f64; 6]) -> Option<f64> {
 /// Widest spare clearance the final re-check asks the exact checker for, metres
 /// ([`CollisionChecker::exact_spare`]): a configuration measured with this much to spare vouches
 /// for those up to this far (in the lever-arm displacement bound) along the path.
-pub const SPARE_CAP: f64 = 0.03;
+pub const SPARE_CAP: f64 = 0.05;
 
 /// The lever arms the final re-check's vouching uses, metres: the configured ones, and never
 /// less than [`UR5E_LEVER_ARMS`](super::config::UR5E_LEVER_ARMS) (a setting that bounds fewer
