@@ -120,7 +120,10 @@ fn spare_is_conservative(hold: bool, seed: u64) {
     }
     eprintln!("spare clearance: worst excess over mj_geomDistance of every pair {worst:.2e} m");
     assert!(worst < SPARE_TOLERANCE);
-    assert!(measured > 200 && near > 100 && vouched > 600, "{measured} {near} {vouched}");
+    assert!(
+        measured > 200 && near > 100 && vouched > 600,
+        "{measured} {near} {vouched}"
+    );
 }
 
 #[test]
