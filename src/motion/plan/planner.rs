@@ -58,7 +58,10 @@ fn in_bounds(q: &[f64; 6], config: &PlannerConfig) -> bool {
 /// called free is then checked again with `is_free` alone (so are the corner arcs), and if one
 /// is blocked the query is planned again with `is_free` alone
 /// ([`PlanStats::screen_fallback`]). The start, the goals and the direct segments are checked
-/// with `is_free` alone.
+/// with `is_free` alone. Wherever the screen is off, a configuration within the lever-arm reach
+/// of the exact checker's spare clearance at a measured one
+/// ([`exact_spare`](CollisionChecker::exact_spare)) counts as checked free without asking again
+/// (the same verdict `is_free` gives; see `docs/motion.md`).
 ///
 /// # Errors
 /// A [`PlanError`]: the typed reason, and the statistics of the attempt.
@@ -135,7 +138,8 @@ fn vouching_arms(res: &super::edge::Resolution) -> [f64; 6] {
 /// The exact re-check of a path the screen helped find: every configuration the screen called
 /// free that lies on `path` (the configurations its segments were checked at, at the edge
 /// resolution, also where a shortcut split a checked segment) is checked again by `checker`
-/// with its screen off. When the log of such configurations overflowed, every vertex and
+/// with its screen off, in the order of the path (so the exact checker's spare clearance at one
+/// vouches for the next ones within its reach). When the log of such configurations overflowed, every vertex and
 /// every segment of `path` is checked at `res` instead. True when all are free.
 fn revalidate<C: CollisionChecker + ?Sized>(
     checker: &mut Counting<'_, C>,
