@@ -35,6 +35,12 @@ use crate::scene::OBJECT_PREFIX;
 /// everything they must not touch.
 pub const DEFAULT_MARGIN: f64 = 0.005;
 
+/// What the spare clearance ([`CollisionChecker::exact_spare`]) leaves for MuJoCo's own
+/// tolerances, metres: its `mj_geomDistance` and `mj_collision`'s contact distances of the same
+/// pair differ by the convex-hull iterations' tolerance (about 1e-6 m); the screen's
+/// [`PAD`](super::screen::PAD) again.
+pub const SPARE_TOLERANCE: f64 = 5e-4;
+
 /// Largest clearance margin accepted, metres.
 pub const MAX_MARGIN: f64 = 0.1;
 
@@ -360,6 +366,17 @@ impl SceneChecker {
             + self.margin_pairs.1.len()
     }
 
+    /// The least distance at `q` (radians) of every pair the checker tests, metres, at most
+    /// `wide`: `mj_geomDistance` of each pair that may be closer ([`MarginPairs::least`]).
+    /// `None` when the margin is zero (no pairs listed).
+    fn least_distance(&mut self, q: &[f64; 6], wide: f64) -> Option<f64> {
+        if self.margin_pairs.0.is_empty() {
+            return None;
+        }
+        self.detect_pose(q);
+        Some(self.margin_pairs.0.least(&mut self.data, wide))
+    }
+
     /// Poses the arm (and a held block) at `q` with `mj_kinematics`.
     fn detect_pose(&mut self, q: &[f64; 6]) {
         let ids = self.scene.ids.arm_qpos;
@@ -399,6 +416,16 @@ impl CollisionChecker for SceneChecker {
             return None;
         }
         self.screen_model()?.classify(q)
+    }
+
+    /// The least distance of [`SceneChecker::least_distance`] up to `cap` metres beyond the
+    /// margin, less the margin and [`SPARE_TOLERANCE`] (see the trait).
+    fn exact_spare(&mut self, q: &[f64; 6], cap: f64) -> Option<f64> {
+        if !(q.iter().all(|v| v.is_finite()) && cap.is_finite() && cap > 0.0) {
+            return None;
+        }
+        let wide = self.margin + cap.min(MAX_MARGIN);
+        Some(self.least_distance(q, wide)? - self.margin - SPARE_TOLERANCE)
     }
 
     fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
@@ -485,3 +512,7 @@ impl SceneChecker {
         self.held.as_ref().map(|h| fk(q) * h.in_pinch)
     }
 }
+
+#[cfg(test)]
+#[path = "collision_tests.rs"]
+mod tests;

@@ -43,6 +43,9 @@ struct Pair {
 #[derive(Clone, Debug, Default)]
 pub(crate) struct MarginPairs {
     pairs: Vec<Pair>,
+    /// Every pair MuJoCo tests in the model with a positive margin, whatever its types (for
+    /// [`MarginPairs::least`]).
+    all: Vec<Pair>,
 }
 
 impl MarginPairs {
@@ -52,20 +55,24 @@ impl MarginPairs {
         let ngeom = m.ffi().ngeom as usize;
         let (types, margin) = (m.geom_type(), m.geom_margin());
         let filter = PairFilter::new(m);
-        let mut pairs = Vec::new();
+        let (mut pairs, mut all) = (Vec::new(), Vec::new());
         for g1 in 0..ngeom {
             for g2 in g1 + 1..ngeom {
                 let pair_margin = margin[g1].max(margin[g2]);
-                if margin_unreliable(types[g1], types[g2]) && pair_margin > 0.0 && filter.tested(g1, g2) {
-                    pairs.push(Pair {
+                if pair_margin > 0.0 && filter.tested(g1, g2) {
+                    let p = Pair {
                         a: g1,
                         b: g2,
                         margin: pair_margin,
-                    });
+                    };
+                    all.push(p);
+                    if margin_unreliable(types[g1], types[g2]) {
+                        pairs.push(p);
+                    }
                 }
             }
         }
-        Self { pairs }
+        Self { pairs, all }
     }
 
     /// The listed pairs of `data` (posed: `mj_kinematics` run) closer than their margin that
@@ -74,7 +81,7 @@ impl MarginPairs {
     pub(crate) fn missing<M: ModelType>(&self, data: &mut MjData<M>) -> Vec<(usize, usize, f64)> {
         let mut out = Vec::new();
         for p in &self.pairs {
-            if !near(data, p) {
+            if !near(data, p, p.margin) {
                 continue;
             }
             let reported = data.contact().iter().any(|c| {
@@ -93,11 +100,32 @@ impl MarginPairs {
     }
 }
 
+impl MarginPairs {
+    /// The least distance of every pair MuJoCo tests in the model (with a positive margin) at
+    /// `data` (posed), metres, at most `wide`: each pair that may be closer (bounding spheres,
+    /// a box's or a plane's own bound) measured with `mj_geomDistance`, the exact distance of
+    /// the shapes MuJoCo collides (a mesh's convex hull).
+    pub(crate) fn least<M: ModelType>(&self, data: &mut MjData<M>, wide: f64) -> f64 {
+        let mut least = wide;
+        for p in &self.all {
+            if near(data, p, least) {
+                least = least.min(data.geom_distance(p.a, p.b, least, None));
+            }
+        }
+        least
+    }
+
+    /// True when the model has no pair with a positive margin.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.all.is_empty()
+    }
+}
+
 /// False when the pair surely keeps its margin: a box's distance from the other geom's centre
 /// less the other's bounding radius (both ways round when both are boxes), or a plane's
 /// half-space against the other's bounding sphere, is at least the margin; the geoms then keep
 /// it too.
-fn near<M: ModelType>(data: &MjData<M>, p: &Pair) -> bool {
+fn near<M: ModelType>(data: &MjData<M>, p: &Pair, margin: f64) -> bool {
     let m = data.model();
     let (pos, mat, rbound, types) = (data.geom_xpos(), data.geom_xmat(), m.geom_rbound(), m.geom_type());
     // A lower bound of the distance from geom `shape` (a box or a plane) to geom `other`.
@@ -121,6 +149,11 @@ fn near<M: ModelType>(data: &MjData<M>, p: &Pair) -> bool {
     let is_box = |g: usize| types[g] == MjtGeomBase::mjGEOM_BOX;
     let plane = |g: usize| types[g] == MjtGeomBase::mjGEOM_PLANE;
     let mut apart = f64::NEG_INFINITY;
+    if !plane(p.a) && !plane(p.b) {
+        let (x, y) = (pos[p.a], pos[p.b]);
+        let d = ((x[0] - y[0]).powi(2) + (x[1] - y[1]).powi(2) + (x[2] - y[2]).powi(2)).sqrt();
+        apart = d - rbound[p.a] - rbound[p.b];
+    }
     // A plane is unbounded: only its own half-space bounds the distance to it.
     if plane(p.a) || (is_box(p.a) && !plane(p.b)) {
         apart = apart.max(bound(p.a, p.b));
@@ -128,5 +161,5 @@ fn near<M: ModelType>(data: &MjData<M>, p: &Pair) -> bool {
     if plane(p.b) || (is_box(p.b) && !plane(p.a)) {
         apart = apart.max(bound(p.b, p.a));
     }
-    apart < p.margin
+    apart < margin
 }

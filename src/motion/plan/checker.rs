@@ -2,6 +2,8 @@
 
 use std::fmt;
 
+use super::planner::SPARE_CAP;
+
 /// A collision model of the arm in its cell, queried one joint configuration at a time.
 ///
 /// The planner only calls [`is_free`](Self::is_free) while it searches; it asks
@@ -30,6 +32,16 @@ pub trait CollisionChecker {
     fn screen(&mut self, _q: &[f64; 6]) -> Option<bool> {
         None
     }
+
+    /// The exact checker's spare clearance at `q` (radians): a lower bound, in metres, on how
+    /// much farther than the clearance margin everything the arm must not touch is, at most
+    /// `cap` (metres); negative when `q` may not be free. `None` when the checker cannot
+    /// measure it (the default). The planner's final re-check uses it to vouch for the
+    /// configurations near `q`: a point of the robot moves at most `Σ_j r_j |Δq_j|` (lever
+    /// arms `r_j`), so within that much of the spare clearance every pair still keeps the margin.
+    fn exact_spare(&mut self, _q: &[f64; 6], _cap: f64) -> Option<f64> {
+        None
+    }
 }
 
 impl<C: CollisionChecker + ?Sized> CollisionChecker for &mut C {
@@ -41,6 +53,9 @@ impl<C: CollisionChecker + ?Sized> CollisionChecker for &mut C {
     }
     fn screen(&mut self, q: &[f64; 6]) -> Option<bool> {
         (**self).screen(q)
+    }
+    fn exact_spare(&mut self, q: &[f64; 6], cap: f64) -> Option<f64> {
+        (**self).exact_spare(q, cap)
     }
 }
 
@@ -92,7 +107,17 @@ pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
     /// [`VOUCHED_LOG`]; `vouched_lost` when more were.
     pub(crate) vouched: Vec<[f64; 6]>,
     pub(crate) vouched_lost: bool,
+    /// While the screen is off: lever arms (metres) to vouch with the exact checker's spare
+    /// clearance ([`CollisionChecker::exact_spare`]) for configurations near a measured one;
+    /// `None`: every configuration asks `is_free`.
+    pub(crate) exact_vouch: Option<[f64; 6]>,
+    /// Recently measured configurations and their spare clearance (radians; metres), a ring.
+    balls: Vec<([f64; 6], f64)>,
+    ball_next: usize,
 }
+
+/// Measured configurations [`Counting`] remembers to vouch with.
+const EXACT_BALLS: usize = 32;
 
 /// Most configurations the screen called free that a query remembers for the final re-check
 /// (48 bytes each); past it, the final path is re-checked at its own edge resolution instead.
@@ -108,6 +133,37 @@ impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
             screened: 0,
             vouched: Vec::new(),
             vouched_lost: false,
+            exact_vouch: None,
+            balls: Vec::with_capacity(EXACT_BALLS),
+            ball_next: 0,
+        }
+    }
+
+    /// True when `q` (radians) is free by the exact checker's spare clearance: within the
+    /// lever-arm reach of a measured configuration's, or measured now with some to spare.
+    /// False when that cannot tell (the caller asks `is_free`).
+    fn exact_vouched(&mut self, q: &[f64; 6]) -> bool {
+        let Some(arms) = self.exact_vouch else {
+            return false;
+        };
+        let near = self.balls.iter().rev().any(|(c, spare)| {
+            let moved: f64 = (0..6).map(|j| arms[j] * (q[j] - c[j]).abs()).sum();
+            moved <= *spare
+        });
+        if near {
+            return true;
+        }
+        match self.inner.exact_spare(q, SPARE_CAP) {
+            Some(spare) if spare >= 0.0 => {
+                if self.balls.len() < EXACT_BALLS {
+                    self.balls.push((*q, spare));
+                } else {
+                    self.balls[self.ball_next] = (*q, spare);
+                    self.ball_next = (self.ball_next + 1) % EXACT_BALLS;
+                }
+                true
+            }
+            _ => false,
         }
     }
 
@@ -140,6 +196,8 @@ impl<C: CollisionChecker + ?Sized> CollisionChecker for Counting<'_, C> {
                 }
                 _ => {}
             }
+        } else if self.exact_vouched(q) {
+            return true;
         }
         self.inner.is_free(q)
     }

@@ -58,7 +58,10 @@ fn in_bounds(q: &[f64; 6], config: &PlannerConfig) -> bool {
 /// called free is then checked again with `is_free` alone (so are the corner arcs), and if one
 /// is blocked the query is planned again with `is_free` alone
 /// ([`PlanStats::screen_fallback`]). The start, the goals and the direct segments are checked
-/// with `is_free` alone.
+/// with `is_free` alone. Wherever the screen is off, a configuration within the lever-arm reach
+/// of the exact checker's spare clearance at a measured one
+/// ([`exact_spare`](CollisionChecker::exact_spare)) counts as checked free without asking again
+/// (the same verdict `is_free` gives; see `docs/motion.md`).
 ///
 /// # Errors
 /// A [`PlanError`]: the typed reason, and the statistics of the attempt.
@@ -102,8 +105,9 @@ enum Attempt {
 /// the path: rounding of the interpolation, nothing more.
 const ON_PATH: f64 = 1e-9;
 
-/// True when `q` lies on the segment `a`–`b` (within [`ON_PATH`]).
-fn on_segment(q: &[f64; 6], a: &[f64; 6], b: &[f64; 6]) -> bool {
+/// Where `q` lies on the segment `a`–`b` (the fraction of the way, 0 to 1), if it does (within
+/// [`ON_PATH`]).
+fn on_segment(q: &[f64; 6], a: &[f64; 6], b: &[f64; 6]) -> Option<f64> {
     let (mut dd, mut dq) = (0.0, 0.0);
     for j in 0..6 {
         dd += (b[j] - a[j]) * (b[j] - a[j]);
@@ -115,13 +119,27 @@ fn on_segment(q: &[f64; 6], a: &[f64; 6], b: &[f64; 6]) -> bool {
         let d = a[j] + (b[j] - a[j]) * t - q[j];
         e += d * d;
     }
-    e <= ON_PATH * ON_PATH
+    (e <= ON_PATH * ON_PATH).then_some(t)
+}
+
+/// Widest spare clearance the final re-check asks the exact checker for, metres
+/// ([`CollisionChecker::exact_spare`]): a configuration measured with this much to spare vouches
+/// for those up to this far (in the lever-arm displacement bound) along the path.
+pub const SPARE_CAP: f64 = 0.05;
+
+/// The lever arms the final re-check's vouching uses, metres: the configured ones, and never
+/// less than [`UR5E_LEVER_ARMS`](super::config::UR5E_LEVER_ARMS) (a setting that bounds fewer
+/// joints or shorter arms only coarsens the search's edges; it never lets the re-check skip a
+/// configuration the documented bound does not cover).
+fn vouching_arms(res: &super::edge::Resolution) -> [f64; 6] {
+    std::array::from_fn(|j| res.lever_arms[j].max(super::config::UR5E_LEVER_ARMS[j]))
 }
 
 /// The exact re-check of a path the screen helped find: every configuration the screen called
 /// free that lies on `path` (the configurations its segments were checked at, at the edge
 /// resolution, also where a shortcut split a checked segment) is checked again by `checker`
-/// with its screen off. When the log of such configurations overflowed, every vertex and
+/// with its screen off, in the order of the path (so the exact checker's spare clearance at one
+/// vouches for the next ones within its reach). When the log of such configurations overflowed, every vertex and
 /// every segment of `path` is checked at `res` instead. True when all are free.
 fn revalidate<C: CollisionChecker + ?Sized>(
     checker: &mut Counting<'_, C>,
@@ -135,20 +153,27 @@ fn revalidate<C: CollisionChecker + ?Sized>(
                 .windows(2)
                 .all(|w| check_segment(checker, &w[0], &w[1], res).is_ok());
     }
-    let mut on: Vec<[f64; 6]> = std::mem::take(&mut checker.vouched)
+    // Each configuration on the path once, in the order of the path (segment, fraction).
+    let mut on: Vec<(usize, f64, [f64; 6])> = std::mem::take(&mut checker.vouched)
         .into_iter()
-        .filter(|q| path.windows(2).any(|w| on_segment(q, &w[0], &w[1])))
+        .filter_map(|q| {
+            path.windows(2)
+                .enumerate()
+                .find_map(|(i, w)| on_segment(&q, &w[0], &w[1]).map(|t| (i, t, q)))
+        })
         .collect();
-    // Each configuration once, in a fixed order.
-    on.sort_by(|x, y| {
+    let order = |x: &[f64; 6], y: &[f64; 6]| {
         x.iter()
             .zip(y)
             .map(|(a, b)| a.total_cmp(b))
             .find(|o| o.is_ne())
             .unwrap_or(std::cmp::Ordering::Equal)
-    });
-    on.dedup();
-    on.iter().all(|q| checker.is_free(q))
+    };
+    on.sort_by(|x, y| x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)).then(order(&x.2, &y.2)));
+    on.dedup_by(|x, y| x.2 == y.2);
+    // In the order of the path, each measured configuration vouches for the next ones within its
+    // spare clearance (the checker's exact vouching, on for the re-check).
+    on.iter().all(|(_, _, q)| checker.is_free(q))
 }
 
 /// One planning attempt, with the checker's screen asked first (`screen`) or not.
@@ -165,6 +190,9 @@ fn attempt<C: CollisionChecker + ?Sized>(
         ..PlanStats::default()
     };
     let mut checker = Counting::new(checker);
+    // Wherever the screen is off, the exact checker's spare clearance vouches for nearby
+    // configurations (the same verdicts, fewer MuJoCo calls).
+    checker.exact_vouch = Some(vouching_arms(&config.edge_resolution()));
     // The start, the goals and the direct segments are checked exactly: their reasons name what
     // the exact checker finds, and a free direct segment is the path (the screen would only
     // add the re-check). The screen helps the search, the shortcuts and nothing else.
