@@ -418,7 +418,7 @@ impl CollisionChecker for SceneChecker {
         self.screen_model()?.classify(q)
     }
 
-    /// The least distance of [`SceneChecker::least_distance`] up to `cap` metres beyond the
+    /// The least distance of the tested pairs (`least_distance`) up to `cap` metres beyond the
     /// margin, less the margin and [`SPARE_TOLERANCE`] (see the trait).
     fn exact_spare(&mut self, q: &[f64; 6], cap: f64) -> Option<f64> {
         if !(q.iter().all(|v| v.is_finite()) && cap.is_finite() && cap > 0.0) {
