@@ -9,9 +9,9 @@ mod cli;
 const TREE: &str = "trees/clear_table.yaml";
 const SCENE: &str = "scenes/held_out/posts_and_deep_bin.yaml";
 
-/// The `run --json` report of scenario `k` of sweep seed `seed`, asserted successful and free of
-/// collisions.
-fn clean(k: u64, seed: u64) -> serde_json::Value {
+/// Runs scenario `k` of sweep seed `seed`: whether the process succeeded, and its `run --json`
+/// report.
+fn run(k: u64, seed: u64) -> (std::process::Output, serde_json::Value) {
     let (ks, ss) = (k.to_string(), seed.to_string());
     let out = cli::macrotree(&[
         "run",
@@ -24,12 +24,19 @@ fn clean(k: u64, seed: u64) -> serde_json::Value {
         &ss,
         "--json",
     ]);
+    let r = serde_json::from_slice(&out.stdout).expect("one JSON report");
+    (out, r)
+}
+
+/// The `run --json` report of scenario `k` of sweep seed `seed`, asserted successful and free of
+/// collisions.
+fn clean(k: u64, seed: u64) -> serde_json::Value {
+    let (out, r) = run(k, seed);
     assert!(
         out.status.success(),
         "#{k} of seed {seed}: {}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let r: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON report");
     assert_eq!(
         r["success"], true,
         "#{k} of seed {seed}: {} at {}",
@@ -89,19 +96,7 @@ fn final_home_ran_out_of_planner_budget_with_the_wrist_wound_a_turn_from_home() 
 /// is now refused before it moves (`blocked`), and the retry approaches the block again.
 #[test]
 fn descent_ran_the_arm_into_a_post_after_the_block_slid_on() {
-    let (ks, ss) = ("89", "2");
-    let out = cli::macrotree(&[
-        "run",
-        TREE,
-        "--scene",
-        SCENE,
-        "--scenario",
-        ks,
-        "--sweep-seed",
-        ss,
-        "--json",
-    ]);
-    let r: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON report");
+    let (_, r) = run(89, 2);
     assert_eq!(
         r["collisions"].as_array().map(Vec::len),
         Some(0),

@@ -193,13 +193,7 @@ fn a_block_too_deep_under_the_board_for_the_hand_is_refused_before_anything_move
         "{f}"
     );
     assert!(r.collisions.is_empty());
-    let after = env.observe().joint_pos;
-    let moved = before
-        .iter()
-        .zip(&after)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max);
-    assert!(moved < 0.01, "the arm moved {moved} rad");
+    assert_arm_still(&before, &env.observe().joint_pos);
 }
 
 #[test]
@@ -267,13 +261,17 @@ fn a_side_held_block_carried_onto_the_table_put_the_gripper_into_it() {
         "{f}"
     );
     assert!(r.collisions.is_empty(), "{:?}", r.collisions);
-    let after = env.observe().joint_pos;
+    assert_arm_still(&before, &env.observe().joint_pos);
+    // Onto the pedestal, narrower than the block, the same hold sets it down.
+    ok(&mut env, "place: {spot: stage}");
+}
+
+/// Asserts the arm's joints moved less than 0.01 rad from `before` to `after`.
+fn assert_arm_still(before: &[f64], after: &[f64]) {
     let moved = before
         .iter()
-        .zip(&after)
+        .zip(after)
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f64::max);
     assert!(moved < 0.01, "the arm moved {moved} rad");
-    // Onto the pedestal, narrower than the block, the same hold sets it down.
-    ok(&mut env, "place: {spot: stage}");
 }

@@ -77,6 +77,12 @@ impl PlanningTally {
     fn add_time(&mut self, t: Duration) {
         self.planning_wall_s += t.as_secs_f64();
     }
+
+    /// Counts `checks` collision checks and the time since `since`.
+    fn add_checks(&mut self, checks: u64, since: Instant) {
+        self.collision_checks += checks;
+        self.add_time(since.elapsed());
+    }
 }
 
 /// True when the robot–scene pair `c` names object `name` (the object itself or one of its
@@ -115,6 +121,18 @@ impl<'a> Allowing<'a> {
             pairs,
             intended: intended.to_vec(),
             contact_only,
+            checks: 1,
+        }
+    }
+
+    /// Allows on `inner` nothing for touching at the start, only contact with `intended`
+    /// objects (the start is counted as one check, as in [`Allowing::new`]).
+    fn strict(inner: &'a mut SceneChecker, intended: &[String]) -> Self {
+        Self {
+            inner,
+            pairs: Vec::new(),
+            intended: intended.to_vec(),
+            contact_only: false,
             checks: 1,
         }
     }
@@ -192,6 +210,33 @@ fn samples(traj: &dyn Trajectory, res: &Resolution) -> Vec<[f64; 6]> {
     out
 }
 
+/// The first configuration along `legs` (motions run one after the other; each leg's first
+/// sample skipped, unless `check_start` and it is the first leg) where `allow` finds pairs that
+/// `keep` counts, with those pairs; `None` when there is none.
+fn first_blocked(
+    allow: &mut Allowing,
+    legs: &[&dyn Trajectory],
+    check_start: bool,
+    keep: impl Fn(&Collision) -> bool,
+) -> Option<([f64; 6], Vec<Collision>)> {
+    for (i, leg) in legs.iter().enumerate() {
+        let skip = usize::from(i > 0 || !check_start);
+        for q in samples(*leg, &DIRECT_RESOLUTION).into_iter().skip(skip) {
+            let mut b = allow.blocking(&q);
+            b.retain(&keep);
+            if !b.is_empty() {
+                return Some((q, b));
+            }
+        }
+    }
+    None
+}
+
+/// True for a pair whose moving part is one of the arm's links (not the fingers or a held block).
+pub(crate) fn arm_link(c: &Collision) -> bool {
+    c.a.starts_with(crate::sim::ARM_PREFIX)
+}
+
 /// The first configuration along `legs` (motions run one after the other) where something
 /// that is not allowed touches, with the pairs; `None` when the motion is free or the cell has no
 /// checker. Straight final segments pass `contact_only`; `intended` names the objects the leaf
@@ -203,25 +248,14 @@ pub(crate) fn check_motion(
     contact_only: bool,
 ) -> Option<([f64; 6], Vec<Collision>)> {
     let t = Instant::now();
-    let res = DIRECT_RESOLUTION;
     let start = legs.first()?.sample(0.0).0;
     let checker = cell.checker()?;
     let mut allow = Allowing::new(checker, &start, intended, contact_only);
-    let mut hit = None;
-    'legs: for leg in legs {
-        for q in samples(*leg, &res).into_iter().skip(1) {
-            let b = allow.blocking(&q);
-            if !b.is_empty() {
-                hit = Some((q, b));
-                break 'legs;
-            }
-        }
-    }
+    let hit = first_blocked(&mut allow, legs, false, |_| true);
     let checks = allow.checks;
     let tally = cell.planning_mut();
     tally.motions_checked += 1;
-    tally.collision_checks += checks;
-    tally.add_time(t.elapsed());
+    tally.add_checks(checks, t);
     hit
 }
 
@@ -256,25 +290,12 @@ pub(crate) fn look_ahead_clear(
     intended: &[String],
 ) -> Option<Vec<Collision>> {
     let t = Instant::now();
-    let res = DIRECT_RESOLUTION;
-    let start = mv.sample(0.0).0;
     let checker = cell.checker()?;
-    let mut allow = Allowing::new(checker, &start, intended, false);
-    allow.pairs.clear();
-    let mut hit = None;
-    for q in samples(mv, &res) {
-        let mut b = allow.blocking(&q);
-        b.retain(|c| c.distance < 0.0 || c.a.starts_with("ur5e/"));
-        if !b.is_empty() {
-            hit = Some(b);
-            break;
-        }
-    }
+    let mut allow = Allowing::strict(checker, intended);
+    let hit = first_blocked(&mut allow, &[mv], true, |c| c.distance < 0.0 || arm_link(c));
     let checks = allow.checks;
-    let tally = cell.planning_mut();
-    tally.collision_checks += checks;
-    tally.add_time(t.elapsed());
-    hit
+    cell.planning_mut().add_checks(checks, t);
+    hit.map(|(_, pairs)| pairs)
 }
 
 /// Checks a straight segment (`what`: "descent", "lift", "set-down") along its length, only

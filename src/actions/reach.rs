@@ -4,7 +4,7 @@ use nalgebra::{Isometry3, Translation3, Vector3};
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
-use super::planning::{check_motion, check_straight, describe, look_ahead_clear, plan_motion};
+use super::planning::{arm_link, check_motion, check_straight, describe, look_ahead_clear, plan_motion};
 use super::targets::{resolve, segment_distance, target_block, target_object, tool_yaw};
 use crate::failure::{Failure, FailureKind};
 use crate::kinds::{PathKind, Reach as ReachSpec, Yaw};
@@ -294,6 +294,29 @@ impl Reach {
             }
         }
     }
+
+    /// The straight final approach from `from` (radians) to the tool pose `pose`, checked along
+    /// its length: only real contact counts and the target may be touched; refused
+    /// ([`refuse_arm_contact`]) when it would run the arm's links into something else.
+    fn straight_descent(
+        &self,
+        cell: &mut Cell,
+        from: [f64; 6],
+        pose: Isometry3<f64>,
+        limits: &MotionLimits,
+    ) -> Result<CartesianMove, Failure> {
+        let mv = CartesianMove::new(from, pose, limits)
+            .map_err(|e| unreachable(format!("unreachable path: {e}")))?;
+        let intended: Vec<String> = {
+            let w = cell.world();
+            target_object(&self.spec.target, w)
+                .map(|j| w.name(j).to_string())
+                .into_iter()
+                .collect()
+        };
+        refuse_arm_contact(check_straight(cell, "descent", &mv, &intended), &intended)?;
+        Ok(mv)
+    }
 }
 
 /// A straight descent onto an object (`intended` names it) that would run the arm's links
@@ -308,7 +331,7 @@ fn refuse_arm_contact(
     let Some(pairs) = touching else {
         return Ok(());
     };
-    let arm: Vec<_> = pairs.into_iter().filter(|c| c.a.starts_with("ur5e/")).collect();
+    let arm: Vec<_> = pairs.into_iter().filter(arm_link).collect();
     if arm.is_empty() || intended.is_empty() {
         return Ok(());
     }
@@ -352,22 +375,16 @@ impl MacroAction for Reach {
             (Yaw::Angle(a), _) => (*a, false),
         };
         let from = cell.arm_setpoint();
+        let limits = MotionLimits {
+            tool_speed: self.spec.speed,
+            ..MotionLimits::default()
+        };
         if matches!(self.spec.path, PathKind::Cartesian)
             && let Some(rotation) = super::tilted::keeps_tilt(&from)
         {
             // A tilted pick's descent: along the tool axis, the tilt kept.
             let pose = Isometry3::from_parts(Translation3::from(position), rotation);
-            let limits = MotionLimits {
-                tool_speed: self.spec.speed,
-                ..MotionLimits::default()
-            };
-            let mv = CartesianMove::new(from, pose, &limits)
-                .map_err(|e| unreachable(format!("unreachable path: {e}")))?;
-            let intended: Vec<String> = target_object(&self.spec.target, w)
-                .map(|j| w.name(j).to_string())
-                .into_iter()
-                .collect();
-            refuse_arm_contact(check_straight(cell, "descent", &mv, &intended), &intended)?;
+            let mv = self.straight_descent(cell, from, pose, &limits)?;
             self.pending.clear();
             self.goal_q = mv.end();
             cell.track(Box::new(mv));
@@ -375,10 +392,6 @@ impl MacroAction for Reach {
         }
         let goal_q =
             ik_down(&position, yaw, quarter, &from).map_err(|e| unreachable(format!("unreachable: {e}")))?;
-        let limits = MotionLimits {
-            tool_speed: self.spec.speed,
-            ..MotionLimits::default()
-        };
         self.pending.clear();
         match self.spec.path {
             PathKind::Joint => {
@@ -391,15 +404,7 @@ impl MacroAction for Reach {
             }
             PathKind::Cartesian => {
                 let pose = down_pose(&position, yaw_of_solution(&goal_q));
-                let mv = CartesianMove::new(from, pose, &limits)
-                    .map_err(|e| unreachable(format!("unreachable path: {e}")))?;
-                // A straight final approach: only real contact counts, and the target may be
-                // touched.
-                let intended: Vec<String> = target_object(&self.spec.target, w)
-                    .map(|j| w.name(j).to_string())
-                    .into_iter()
-                    .collect();
-                refuse_arm_contact(check_straight(cell, "descent", &mv, &intended), &intended)?;
+                let mv = self.straight_descent(cell, from, pose, &limits)?;
                 cell.track(Box::new(mv));
                 self.goal_q = goal_q;
                 Ok(())

@@ -16,5 +16,5 @@ pub mod simulator;
 pub use collision::SceneChecker;
 pub use error::SimError;
 pub use layout::Layout;
-pub use scene::{ModelOrigin, ObjectIds, Scene};
+pub use scene::{ARM_PREFIX, ModelOrigin, ObjectIds, Scene};
 pub use simulator::{HOME_Q, Sim, TIMESTEP};

@@ -253,6 +253,9 @@ fn cached_model(
     Ok((model, origin))
 }
 
+/// The prefix of every name the UR5e brings into a cell's model (`ur5e/wrist_1_link`).
+pub const ARM_PREFIX: &str = "ur5e/";
+
 /// Parses the cell `xml`, attaches the UR5e (`ur5e/`) and the 2F-85 at its attachment site
 /// (`gripper/`) and compiles the whole.
 pub fn compile_model(xml: &str, ur5e: &Path, gripper: &Path) -> Result<MjModel, SimError> {
@@ -262,7 +265,7 @@ pub fn compile_model(xml: &str, ur5e: &Path, gripper: &Path) -> Result<MjModel, 
     let mut hand = MjSpec::from_xml(gripper).map_err(|e| spec_err("2f85.xml", e))?;
     scene
         .world_body_mut()
-        .attach_by_deep_copy(&mut arm, "ur5e/", "")
+        .attach_by_deep_copy(&mut arm, ARM_PREFIX, "")
         .map_err(|e| spec_err("attaching the UR5e", e))?;
     scene
         .site_mut("ur5e/attachment_site")
