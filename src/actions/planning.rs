@@ -27,7 +27,7 @@ use super::cell::Cell;
 use crate::failure::Failure;
 use crate::motion::Trajectory;
 use crate::motion::plan::edge::{Resolution, steps};
-use crate::motion::plan::{Collision, CollisionChecker, GoalSet, PlannedMotion, PlannerConfig};
+use crate::motion::plan::{Collision, CollisionChecker, GoalSet, JointSpare, PlannedMotion, PlannerConfig};
 use crate::sim::collision::SceneChecker;
 
 /// What motion checking and planning cost in one episode (reported per episode in `run --json`
@@ -175,6 +175,15 @@ impl CollisionChecker for Allowing<'_> {
         let free = self.inner.screen(q) == Some(true);
         self.checks += u64::from(free);
         free.then_some(true)
+    }
+
+    /// The inner checker's "certainly free" and its spare (what keeps the margin and more from
+    /// everything is free whatever is allowed). Counted as a check.
+    fn screen_spare(&mut self, q: &[f64; 6], cap: f64) -> (Option<bool>, JointSpare) {
+        let (verdict, spare) = self.inner.screen_spare(q, cap);
+        let free = verdict == Some(true);
+        self.checks += u64::from(free);
+        (free.then_some(true), if free { spare } else { JointSpare::NONE })
     }
 }
 

@@ -28,7 +28,8 @@ use super::margin::MarginPairs;
 use super::scene::{ARM_JOINTS, Scene};
 use super::screen::{Build, Screen};
 use crate::motion::fk;
-use crate::motion::plan::{Collision, CollisionChecker};
+use crate::motion::plan::config::HELD_BLOCK_REACH;
+use crate::motion::plan::{Collision, CollisionChecker, JointSpare};
 use crate::scene::OBJECT_PREFIX;
 
 /// Default clearance margin, metres: the arm, gripper and held block must stay this far from
@@ -56,6 +57,9 @@ struct Held {
     qpos: usize,
     /// Its pose in the pinch frame.
     in_pinch: Isometry3<f64>,
+    /// Every point of its geoms lies within [`HELD_BLOCK_REACH`] of the pinch point, so the
+    /// lever arms the planner vouches with cover it.
+    within_arms: bool,
 }
 
 /// A MuJoCo collision checker of the cell for the motion planner (see the module docs).
@@ -301,11 +305,21 @@ impl SceneChecker {
             UnitQuaternion::from_quaternion(Quaternion::new(p[3], p[4], p[5], p[6])),
         );
         let in_pinch = fk(&self.snapshot_q).inverse() * block;
+        let [g0, g1] = self.scene.objects[object].geoms;
+        let m = self.data.model();
+        let (pos, rbound) = (m.geom_pos(), m.geom_rbound());
+        // Geom positions in the block's body frame: a point of a geom lies within its bounding
+        // radius of its centre.
+        let within_arms = (g0..g1).all(|g| {
+            let c = in_pinch * nalgebra::Point3::new(pos[g][0], pos[g][1], pos[g][2]);
+            c.coords.norm() + rbound[g] <= HELD_BLOCK_REACH
+        });
         let regroup = self.held.as_ref().is_none_or(|h| h.object != object);
         self.held = Some(Held {
             object,
             qpos,
             in_pinch,
+            within_arms,
         });
         self.screen = None;
         if regroup {
@@ -418,14 +432,32 @@ impl CollisionChecker for SceneChecker {
         self.screen_model()?.classify(q)
     }
 
+    /// The [`Screen`]'s verdict and spare clearance ([`Screen::free_spare`]).
+    /// With a held block beyond [`HELD_BLOCK_REACH`] of the pinch, the verdict alone.
+    fn screen_spare(&mut self, q: &[f64; 6], cap: f64) -> (Option<bool>, JointSpare) {
+        if !self.screen_on || !q.iter().all(|v| v.is_finite()) {
+            return (None, JointSpare::NONE);
+        }
+        if !self.spare_covered() {
+            return (self.screen(q), JointSpare::NONE);
+        }
+        match self.screen_model() {
+            Some(screen) => screen.free_spare(q, cap),
+            None => (None, JointSpare::NONE),
+        }
+    }
+
     /// The least distance of the tested pairs (`least_distance`) up to `cap` metres beyond the
-    /// margin, less the margin and [`SPARE_TOLERANCE`] (see the trait).
-    fn exact_spare(&mut self, q: &[f64; 6], cap: f64) -> Option<f64> {
-        if !(q.iter().all(|v| v.is_finite()) && cap.is_finite() && cap > 0.0) {
+    /// margin, less the margin and [`SPARE_TOLERANCE`], the same for every joint range; `None`
+    /// when a pair is closer than that, and with a held block beyond [`HELD_BLOCK_REACH`] of the
+    /// pinch (see the trait).
+    fn exact_spare(&mut self, q: &[f64; 6], cap: f64) -> Option<JointSpare> {
+        if !(q.iter().all(|v| v.is_finite()) && cap.is_finite() && cap > 0.0 && self.spare_covered()) {
             return None;
         }
         let wide = self.margin + cap.min(MAX_MARGIN);
-        Some(self.least_distance(q, wide)? - self.margin - SPARE_TOLERANCE)
+        let spare = self.least_distance(q, wide)? - self.margin - SPARE_TOLERANCE;
+        (spare >= 0.0).then(|| JointSpare::uniform(spare.min(cap)))
     }
 
     fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
@@ -505,6 +537,12 @@ impl SceneChecker {
             }
             _ => self.group[g],
         }
+    }
+
+    /// True when the planner's lever arms cover every moving part: no block held, or one within
+    /// [`HELD_BLOCK_REACH`] of the pinch.
+    fn spare_covered(&self) -> bool {
+        self.held.as_ref().is_none_or(|h| h.within_arms)
     }
 
     /// The block's pose the checker uses at `q` if it is held (world frame), for tests and logs.

@@ -104,7 +104,9 @@ impl MarginPairs {
     /// The least distance of every pair MuJoCo tests in the model (with a positive margin) at
     /// `data` (posed), metres, at most `wide`: each pair that may be closer (bounding spheres,
     /// a box's or a plane's own bound) measured with `mj_geomDistance`, the exact distance of
-    /// the shapes MuJoCo collides (a mesh's convex hull).
+    /// the shapes MuJoCo collides (a mesh's convex hull). One least for every pair, not one per
+    /// joint range as the screen's spare: measured on the motion benchmark, the pruning by the
+    /// least so far saves more `mj_geomDistance` calls than ranges would vouch for.
     pub(crate) fn least<M: ModelType>(&self, data: &mut MjData<M>, wide: f64) -> f64 {
         let mut least = wide;
         for p in &self.all {

@@ -19,7 +19,8 @@ use mujoco_rs::prelude::*;
 use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, Unit, UnitQuaternion, Vector3};
 
 use super::pair_filter::PairFilter;
-use crate::motion::plan::shapes::{Shape, V3, near, within};
+use crate::motion::plan::JointSpare;
+use crate::motion::plan::shapes::{Shape, V3, clearance, near, within};
 
 /// Extra distance every pair must keep beyond its margin for the screen to vouch, metres: room
 /// for MuJoCo's own tolerances (its convex-hull distances converge to about 1e-6 m).
@@ -294,6 +295,46 @@ fn sphere_box_apart(c: &V3, r: f64, shape: &Shape, gap: f64) -> bool {
     out2 >= t * t
 }
 
+/// A lower bound on the distance between spheres `(c1, r1)` and `(c2, r2)`, metres (infinite
+/// when either has no shape).
+fn sphere_gap(c1: &V3, r1: f64, c2: &V3, r2: f64) -> f64 {
+    if r1 < 0.0 || r2 < 0.0 {
+        return f64::INFINITY;
+    }
+    let d = [c1[0] - c2[0], c1[1] - c2[1], c1[2] - c2[2]];
+    (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() - r1 - r2
+}
+
+/// A lower bound on the distance between the sphere `(c, r)` and a posed shape, metres: the
+/// larger of the bounds through the shape's bounding sphere and, for a box or a half-space,
+/// through the shape itself.
+fn sphere_shape_gap(c: &V3, r: f64, shape: &Posed) -> f64 {
+    if r < 0.0 {
+        return f64::INFINITY;
+    }
+    let through_sphere = shape
+        .1
+        .map_or(f64::NEG_INFINITY, |(c2, r2)| sphere_gap(c, r, &c2, r2));
+    let through_shape = match &shape.0 {
+        Shape::HalfSpace { normal, offset } => {
+            normal[0] * c[0] + normal[1] * c[1] + normal[2] * c[2] - offset - r
+        }
+        Shape::Box { center, axes, half } => {
+            let d = [c[0] - center[0], c[1] - center[1], c[2] - center[2]];
+            let mut out2 = 0.0;
+            for i in 0..3 {
+                let u = (d[0] * axes[i][0] + d[1] * axes[i][1] + d[2] * axes[i][2]).abs() - half[i];
+                if u > 0.0 {
+                    out2 += u * u;
+                }
+            }
+            out2.sqrt() - r
+        }
+        Shape::Capsule { .. } => f64::NEG_INFINITY,
+    };
+    through_sphere.max(through_shape)
+}
+
 /// A sphere (centre, radius, metres) containing every one of `shapes` (each within its own
 /// bounding sphere about its centre); radius −1 when there are none.
 fn link_sphere<'a>(shapes: impl Iterator<Item = &'a Local> + Clone) -> (Vector3<f64>, f64) {
@@ -551,6 +592,35 @@ impl Screen {
 
     /// The verdict at `q` and the geom pair that decided a "blocked" (geom ids).
     pub fn decide(&mut self, q: &[f64; 6]) -> (Option<bool>, Option<(usize, usize)>) {
+        let (verdict, hit, _) = self.judge::<false>(q, 0.0);
+        (verdict, hit)
+    }
+
+    /// The verdict at `q` (radians), as [`Screen::classify`], and with a "free" the spare
+    /// clearance by joint range ([`JointSpare`], at most `cap` metres; none with any other
+    /// verdict): for each tested pair, a lower bound on how much farther apart than its margin
+    /// plus [`PAD`] its primitives are, in the range of the joints that move the pair's parts
+    /// relative to each other. Geoms lie inside their primitives, so the geoms keep the margin
+    /// wherever no point of the robot moved relative to its partner farther than that.
+    pub fn free_spare(&mut self, q: &[f64; 6], cap: f64) -> (Option<bool>, JointSpare) {
+        let (verdict, _, spare) = self.judge::<true>(q, cap.max(0.0));
+        (
+            verdict,
+            if verdict == Some(true) {
+                spare
+            } else {
+                JointSpare::NONE
+            },
+        )
+    }
+
+    /// The verdict, the pair that decided a "blocked", and with `SPARE` the spare clearance by
+    /// joint range up to `cap` (metres; only meaningful with a "free").
+    fn judge<const SPARE: bool>(
+        &mut self,
+        q: &[f64; 6],
+        cap: f64,
+    ) -> (Option<bool>, Option<(usize, usize)>, JointSpare) {
         let frames = self.link_poses(q);
         // A new stamp: every moving shape is posed again when first needed.
         self.call = self.call.wrapping_add(1);
@@ -565,8 +635,16 @@ impl Screen {
         });
         let nm = self.moving.len();
         let mut unsure = false;
+        let mut spare = JointSpare::uniform(cap);
         for g in &self.groups {
             let (c1, r1) = spheres[g.link];
+            // The joints that move the group's pair relative to each other (none: the pair
+            // never moves apart or closer, and limits no spare).
+            let (lo, hi) = match g.partner {
+                Partner::Fixed(_) => (0, g.link),
+                Partner::Link(m) => (g.link.min(m) + 1, g.link.max(m)),
+            };
+            let ranged = lo <= hi;
             let apart = match g.partner {
                 Partner::Link(m) => sphere_apart(&c1, r1, &spheres[m].0, spheres[m].1, g.gap),
                 Partner::Fixed(f) => match &self.fixed[f] {
@@ -580,7 +658,27 @@ impl Screen {
                 },
             };
             if apart {
-                continue;
+                if !SPARE || !ranged {
+                    continue;
+                }
+                // The link's sphere keeps more than the range's spare found so far: nothing to
+                // learn from the group's pairs; else they may keep more than the sphere does.
+                let need = g.gap + spare.get(lo, hi);
+                let far = match g.partner {
+                    Partner::Link(m) => sphere_apart(&c1, r1, &spheres[m].0, spheres[m].1, need),
+                    Partner::Fixed(f) => match &self.fixed[f] {
+                        (y, Some((c2, r2)), _) => {
+                            sphere_apart(&c1, r1, c2, *r2, need) || sphere_box_apart(&c1, r1, y, need)
+                        }
+                        (Shape::HalfSpace { normal, offset }, None, _) => {
+                            normal[0] * c1[0] + normal[1] * c1[1] + normal[2] * c1[2] - offset - r1 >= need
+                        }
+                        _ => false,
+                    },
+                };
+                if far {
+                    continue;
+                }
             }
             for p in &self.pairs[g.start as usize..g.end as usize] {
                 let (a, b) = (p.a as usize, p.b as usize);
@@ -599,22 +697,36 @@ impl Screen {
                 if let (Some((c1, r1)), Some((c2, r2))) = (x.1, y.1) {
                     let t = r1 + r2 + p.gap;
                     let d = [c1[0] - c2[0], c1[1] - c2[1], c1[2] - c2[2]];
-                    if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] >= t * t {
-                        continue;
-                    }
-                    if b >= nm && sphere_box_apart(&c1, r1, &y.0, p.gap) {
+                    if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] >= t * t
+                        || (b >= nm && sphere_box_apart(&c1, r1, &y.0, p.gap))
+                    {
+                        if SPARE && ranged {
+                            let need = p.gap + spare.get(lo, hi);
+                            let t = r1 + r2 + need;
+                            let far = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] >= t * t
+                                || (b >= nm && sphere_box_apart(&c1, r1, &y.0, need));
+                            if !far {
+                                spare.tighten(lo, hi, sphere_shape_gap(&c1, r1, y) - p.gap);
+                            }
+                        }
                         continue;
                     }
                 }
                 if near(&x.0, &y.0, p.gap) {
                     if x.2 && y.2 && within(&x.0, &y.0, p.block) {
-                        return (Some(false), Some((self.geoms[a], self.geoms[b])));
+                        return (
+                            Some(false),
+                            Some((self.geoms[a], self.geoms[b])),
+                            JointSpare::NONE,
+                        );
                     }
                     unsure = true;
+                } else if SPARE && ranged && !unsure {
+                    spare.tighten(lo, hi, clearance(&x.0, &y.0) - p.gap);
                 }
             }
         }
-        ((!unsure).then_some(true), None)
+        ((!unsure).then_some(true), None, spare)
     }
 
     /// True when the screen vouches that `q` (radians) is free ([`Screen::classify`]).

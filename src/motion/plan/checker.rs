@@ -33,13 +33,23 @@ pub trait CollisionChecker {
         None
     }
 
-    /// The exact checker's spare clearance at `q` (radians): a lower bound, in metres, on how
-    /// much farther than the clearance margin everything the arm must not touch is, at most
-    /// `cap` (metres); negative when `q` may not be free. `None` when the checker cannot
-    /// measure it (the default). The planner's final re-check uses it to vouch for the
-    /// configurations near `q`: a point of the robot moves at most `Σ_j r_j |Δq_j|` (lever
-    /// arms `r_j`), so within that much of the spare clearance every pair still keeps the margin.
-    fn exact_spare(&mut self, _q: &[f64; 6], _cap: f64) -> Option<f64> {
+    /// The [`screen`](Self::screen)'s verdict at `q` (radians) and, with a "free", its spare
+    /// clearance by joint range ([`JointSpare`], metres, at most `cap`; none with any other
+    /// verdict, and none by default). The planner vouches with it for the configurations the
+    /// joints reach within it, as with [`exact_spare`](Self::exact_spare), and re-checks them
+    /// like every configuration the screen called free.
+    fn screen_spare(&mut self, q: &[f64; 6], _cap: f64) -> (Option<bool>, JointSpare) {
+        (self.screen(q), JointSpare::NONE)
+    }
+
+    /// The exact checker's spare clearance at `q` (radians) by joint range ([`JointSpare`]):
+    /// lower bounds, in metres, on how much farther than the clearance margin everything the arm
+    /// must not touch is, at most `cap` (metres). `None` when `q` may not be free, or the checker
+    /// cannot measure it (the default). The planner vouches with it for the configurations near
+    /// `q`: a point of the robot moves relative to a partner at most `Σ_j r_j |Δq_j|` over the
+    /// joints that move the pair (lever arms `r_j`), so within the range's spare every pair
+    /// still keeps the margin.
+    fn exact_spare(&mut self, _q: &[f64; 6], _cap: f64) -> Option<JointSpare> {
         None
     }
 }
@@ -54,7 +64,10 @@ impl<C: CollisionChecker + ?Sized> CollisionChecker for &mut C {
     fn screen(&mut self, q: &[f64; 6]) -> Option<bool> {
         (**self).screen(q)
     }
-    fn exact_spare(&mut self, q: &[f64; 6], cap: f64) -> Option<f64> {
+    fn screen_spare(&mut self, q: &[f64; 6], cap: f64) -> (Option<bool>, JointSpare) {
+        (**self).screen_spare(q, cap)
+    }
+    fn exact_spare(&mut self, q: &[f64; 6], cap: f64) -> Option<JointSpare> {
         (**self).exact_spare(q, cap)
     }
 }
@@ -88,12 +101,72 @@ impl fmt::Display for Collision {
     }
 }
 
+/// Spare clearance by joint range, metres: for each range of arm joints `lo..=hi` (0 = base …
+/// 5 = wrist 3), a lower bound on how much farther than the clearance margin every pair of
+/// parts that only those joints move relative to each other is. The fixed cell and a part of
+/// link `k` (moved by joints `0..=k`) form a pair of range `0..=k`; parts of links `a < b`, a pair
+/// of range `a+1..=b`. A point of a part moves relative to its partner at most
+/// `Σ_{j in range} r_j |Δq_j|` (lever arms `r_j`), so a configuration whose joint changes keep
+/// every range's sum within its spare keeps the margin too. Self pairs of the wrist links change
+/// only with the wrist joints: a single spare for all joints would be held down by them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointSpare {
+    /// `by_range[lo][hi]` for `lo ≤ hi`, metres; unused below the diagonal.
+    by_range: [[f64; 6]; 6],
+}
+
+impl JointSpare {
+    /// No spare anywhere: vouches for nothing.
+    pub const NONE: JointSpare = JointSpare {
+        by_range: [[0.0; 6]; 6],
+    };
+
+    /// The same spare `s` (metres) for every range.
+    pub fn uniform(s: f64) -> Self {
+        Self {
+            by_range: [[s; 6]; 6],
+        }
+    }
+
+    /// The spare of the range `lo..=hi` (joint indices, `lo ≤ hi ≤ 5`), metres.
+    pub fn get(&self, lo: usize, hi: usize) -> f64 {
+        self.by_range[lo][hi]
+    }
+
+    /// Lowers the spare of the range `lo..=hi` to `s` metres (to 0 for a negative `s`: a bound
+    /// too weak to vouch) if it is less.
+    pub fn tighten(&mut self, lo: usize, hi: usize, s: f64) {
+        let v = &mut self.by_range[lo][hi];
+        *v = v.min(s.max(0.0));
+    }
+
+    /// The least spare of any range, metres.
+    pub fn least(&self) -> f64 {
+        (0..6)
+            .flat_map(|lo| (lo..6).map(move |hi| (lo, hi)))
+            .map(|(lo, hi)| self.by_range[lo][hi])
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// True when displacements `moved[j]` (metres: joint `j`'s lever arm times its change) keep
+    /// every range's sum within its spare.
+    pub fn covers(&self, moved: &[f64; 6]) -> bool {
+        let mut prefix = [0.0; 7];
+        for j in 0..6 {
+            prefix[j + 1] = prefix[j] + moved[j];
+        }
+        (0..6).all(|lo| (lo..6).all(|hi| prefix[hi + 1] - prefix[lo] <= self.by_range[lo][hi]))
+    }
+}
+
 /// A checker that counts the configurations it is asked about (the planner's statistics) and,
 /// while a budget is set, answers "blocked" without asking once the budget is used (a refusal
 /// never lets a collision through; it only ends the search). While `screen` is on, the inner
 /// checker's [`screen`](CollisionChecker::screen) answers first: its "free" is taken (and the
 /// configuration logged for the final re-check), its "blocked" too; each check counts once
-/// either way.
+/// either way. With `vouch_arms` set, a configuration a remembered spare clearance covers is
+/// free without asking: the screen's while `screen` is on (logged like the screen's "free"),
+/// the exact checker's while it is off.
 pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
     pub(crate) inner: &'a mut C,
     pub(crate) checks: u64,
@@ -107,17 +180,63 @@ pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
     /// [`VOUCHED_LOG`]; `vouched_lost` when more were.
     pub(crate) vouched: Vec<[f64; 6]>,
     pub(crate) vouched_lost: bool,
-    /// While the screen is off: lever arms (metres) to vouch with the exact checker's spare
-    /// clearance ([`CollisionChecker::exact_spare`]) for configurations near a measured one;
-    /// `None`: every configuration asks `is_free`.
-    pub(crate) exact_vouch: Option<[f64; 6]>,
-    /// Recently measured configurations and their spare clearance (radians; metres), a ring.
-    balls: Vec<([f64; 6], f64)>,
-    ball_next: usize,
+    /// Lever arms (metres) to vouch with a measured spare clearance for configurations near
+    /// the measured one: the exact checker's ([`CollisionChecker::exact_spare`]) while the
+    /// screen is off, the screen's ([`CollisionChecker::screen_spare`]) while it is on; `None`:
+    /// every configuration is asked.
+    pub(crate) vouch_arms: Option<[f64; 6]>,
+    /// Configurations the exact checker measured, with their spare clearance.
+    balls: Balls,
+    /// Configurations the screen called free, with its spare clearance (while `screen` is on;
+    /// what they vouch for is logged for the final re-check like the screen's own answers).
+    screen_balls: Balls,
 }
 
-/// Measured configurations [`Counting`] remembers to vouch with.
+/// Measured configurations [`Counting`] remembers to vouch with the exact checker's spare.
 const EXACT_BALLS: usize = 32;
+
+/// Configurations [`Counting`] remembers to vouch with the screen's spare: enough to hold the
+/// neighbours of a segment's deepest bisection level (checked up to half the segment's samples
+/// earlier) for segments of a few hundred samples.
+const SCREEN_BALLS: usize = 128;
+
+/// Recently measured configurations and their spare clearance by joint range (radians;
+/// metres), a ring: a configuration the joints reach within a remembered spare keeps the margin
+/// too ([`JointSpare::covers`]).
+struct Balls {
+    ring: Vec<([f64; 6], JointSpare)>,
+    next: usize,
+    size: usize,
+}
+
+impl Balls {
+    fn new(size: usize) -> Self {
+        Self {
+            ring: Vec::with_capacity(size),
+            next: 0,
+            size,
+        }
+    }
+
+    /// True when `q` lies within a remembered spare, joint `j` moving a point at most
+    /// `arms[j]` metres per radian.
+    fn cover(&self, q: &[f64; 6], arms: &[f64; 6]) -> bool {
+        self.ring.iter().rev().any(|(c, spare)| {
+            let moved: [f64; 6] = std::array::from_fn(|j| arms[j] * (q[j] - c[j]).abs());
+            // The whole chain first: it fails first for most configurations far away.
+            moved.iter().sum::<f64>() <= spare.by_range[0][5] && spare.covers(&moved)
+        })
+    }
+
+    fn remember(&mut self, q: &[f64; 6], spare: JointSpare) {
+        if self.ring.len() < self.size {
+            self.ring.push((*q, spare));
+        } else {
+            self.ring[self.next] = (*q, spare);
+            self.next = (self.next + 1) % self.size;
+        }
+    }
+}
 
 /// Most configurations the screen called free that a query remembers for the final re-check
 /// (48 bytes each); past it, the final path is re-checked at its own edge resolution instead.
@@ -133,9 +252,9 @@ impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
             screened: 0,
             vouched: Vec::new(),
             vouched_lost: false,
-            exact_vouch: None,
-            balls: Vec::with_capacity(EXACT_BALLS),
-            ball_next: 0,
+            vouch_arms: None,
+            balls: Balls::new(EXACT_BALLS),
+            screen_balls: Balls::new(SCREEN_BALLS),
         }
     }
 
@@ -143,28 +262,35 @@ impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
     /// lever-arm reach of a measured configuration's, or measured now with some to spare.
     /// False when that cannot tell (the caller asks `is_free`).
     fn exact_vouched(&mut self, q: &[f64; 6]) -> bool {
-        let Some(arms) = self.exact_vouch else {
+        let Some(arms) = self.vouch_arms else {
             return false;
         };
-        let near = self.balls.iter().rev().any(|(c, spare)| {
-            let moved: f64 = (0..6).map(|j| arms[j] * (q[j] - c[j]).abs()).sum();
-            moved <= *spare
-        });
-        if near {
+        if self.balls.cover(q, &arms) {
             return true;
         }
         match self.inner.exact_spare(q, SPARE_CAP) {
-            Some(spare) if spare >= 0.0 => {
-                if self.balls.len() < EXACT_BALLS {
-                    self.balls.push((*q, spare));
-                } else {
-                    self.balls[self.ball_next] = (*q, spare);
-                    self.ball_next = (self.ball_next + 1) % EXACT_BALLS;
-                }
+            Some(spare) => {
+                self.balls.remember(q, spare);
                 true
             }
-            _ => false,
+            None => false,
         }
+    }
+
+    /// The screen's verdict at `q` (radians): vouched free within the reach of a remembered
+    /// screen spare, else asked (its spare remembered).
+    fn screened(&mut self, q: &[f64; 6]) -> Option<bool> {
+        let Some(arms) = self.vouch_arms else {
+            return self.inner.screen(q);
+        };
+        if self.screen_balls.cover(q, &arms) {
+            return Some(true);
+        }
+        let (verdict, spare) = self.inner.screen_spare(q, SPARE_CAP);
+        if verdict == Some(true) {
+            self.screen_balls.remember(q, spare);
+        }
+        verdict
     }
 
     /// True when the budget is used.
@@ -180,7 +306,7 @@ impl<C: CollisionChecker + ?Sized> CollisionChecker for Counting<'_, C> {
         }
         self.checks += 1;
         if self.screen {
-            match self.inner.screen(q) {
+            match self.screened(q) {
                 Some(true) => {
                     self.screened += 1;
                     if self.vouched.len() < VOUCHED_LOG {

@@ -18,6 +18,12 @@ pub const UR5E_RATED_JOINT_SPEED: f64 = std::f64::consts::PI;
 /// is 1.08, 1.11, 0.70, 0.31, 0.27, 0.10 m), plus a held block's 6.1 cm half diagonal.
 pub const UR5E_LEVER_ARMS: [f64; 6] = [1.16, 1.19, 0.77, 0.38, 0.34, 0.12];
 
+/// How far from the pinch point (metres) every point of a held block may lie for
+/// [`UR5E_LEVER_ARMS`] to cover it: the half diagonal of a 7 cm cube held at its centre. A
+/// checker holding a block that reaches farther measures no spare clearance (the planner then
+/// asks it about every configuration).
+pub const HELD_BLOCK_REACH: f64 = 0.061;
+
 /// Per-joint speed and acceleration limits a planned trajectory keeps, base to wrist 3.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct JointLimits {

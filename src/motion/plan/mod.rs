@@ -46,7 +46,7 @@ pub mod timing;
 mod tests;
 
 pub use boxes::{JointBox, JointBoxes};
-pub use checker::{Collision, CollisionChecker};
+pub use checker::{Collision, CollisionChecker, JointSpare};
 pub use config::{JointLimits, PlannerConfig, UR5E_RATED_JOINT_SPEED};
 pub use goal::GoalSet;
 pub use planner::{PlannedMotion, SPARE_CAP, plan};

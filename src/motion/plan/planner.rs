@@ -61,7 +61,10 @@ fn in_bounds(q: &[f64; 6], config: &PlannerConfig) -> bool {
 /// with `is_free` alone. Wherever the screen is off, a configuration within the lever-arm reach
 /// of the exact checker's spare clearance at a measured one
 /// ([`exact_spare`](CollisionChecker::exact_spare)) counts as checked free without asking again
-/// (the same verdict `is_free` gives; see `docs/motion.md`).
+/// (the same verdict `is_free` gives); wherever it is on, one within the reach of the screen's
+/// spare clearance by joint range at a screened one
+/// ([`screen_spare`](CollisionChecker::screen_spare)) counts as screened free (the same verdict
+/// the screen gives, re-checked like it; see `docs/motion.md`).
 ///
 /// # Errors
 /// A [`PlanError`]: the typed reason, and the statistics of the attempt.
@@ -192,7 +195,7 @@ fn attempt<C: CollisionChecker + ?Sized>(
     let mut checker = Counting::new(checker);
     // Wherever the screen is off, the exact checker's spare clearance vouches for nearby
     // configurations (the same verdicts, fewer MuJoCo calls).
-    checker.exact_vouch = Some(vouching_arms(&config.edge_resolution()));
+    checker.vouch_arms = Some(vouching_arms(&config.edge_resolution()));
     // The start, the goals and the direct segments are checked exactly: their reasons name what
     // the exact checker finds, and a free direct segment is the path (the screen would only
     // add the re-check). The screen helps the search, the shortcuts and nothing else.

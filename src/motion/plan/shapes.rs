@@ -117,6 +117,74 @@ pub fn near(x: &Shape, y: &Shape, gap: f64) -> bool {
     }
 }
 
+/// A lower bound on the distance between `x` and `y`, metres (0 when they may touch, and for
+/// two half-spaces): exact for capsule pairs, capsule–box and anything against a half-space; for
+/// two boxes the widest gap of their projections on the six face axes (every separating
+/// projection bounds the distance from below).
+pub fn clearance(x: &Shape, y: &Shape) -> f64 {
+    use Shape::*;
+    let d = match (x, y) {
+        (
+            Capsule { a, b, radius },
+            Capsule {
+                a: c,
+                b: e,
+                radius: r2,
+            },
+        ) => segment_segment_dist2(a, b, c, e).sqrt() - radius - r2,
+        (Capsule { a, b, radius }, Box { center, axes, half })
+        | (Box { center, axes, half }, Capsule { a, b, radius }) => {
+            segment_box_dist2(a, b, center, axes, half).sqrt() - radius
+        }
+        (
+            Box {
+                center: c1,
+                axes: a1,
+                half: h1,
+            },
+            Box {
+                center: c2,
+                axes: a2,
+                half: h2,
+            },
+        ) => boxes_face_gap(c1, a1, h1, c2, a2, h2),
+        (Capsule { a, b, radius }, HalfSpace { normal, offset })
+        | (HalfSpace { normal, offset }, Capsule { a, b, radius }) => {
+            dot(normal, a).min(dot(normal, b)) - offset - radius
+        }
+        (Box { center, axes, half }, HalfSpace { normal, offset })
+        | (HalfSpace { normal, offset }, Box { center, axes, half }) => {
+            let reach: f64 = (0..3).map(|i| half[i] * dot(&axes[i], normal).abs()).sum();
+            dot(normal, center) - reach - offset
+        }
+        (HalfSpace { .. }, HalfSpace { .. }) => 0.0,
+    };
+    d.max(0.0)
+}
+
+/// The widest gap between the projections of two oriented boxes on their six face axes,
+/// metres (negative when every projection overlaps): a lower bound on their distance when
+/// positive.
+fn boxes_face_gap(c1: &V3, a1: &[V3; 3], h1: &V3, c2: &V3, a2: &[V3; 3], h2: &V3) -> f64 {
+    let mut r = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            r[i][j] = dot(&a1[i], &a2[j]).abs();
+        }
+    }
+    let tw = sub(c2, c1);
+    let mut best = f64::NEG_INFINITY;
+    for i in 0..3 {
+        let rb = h2[0] * r[i][0] + h2[1] * r[i][1] + h2[2] * r[i][2];
+        best = best.max(dot(&tw, &a1[i]).abs() - h1[i] - rb);
+    }
+    for j in 0..3 {
+        let ra = h1[0] * r[0][j] + h1[1] * r[1][j] + h1[2] * r[2][j];
+        best = best.max(dot(&tw, &a2[j]).abs() - ra - h2[j]);
+    }
+    best
+}
+
 /// True only when `x` and `y` certainly come closer than `d` metres: exact for every pair but
 /// two boxes, which count only when they overlap and `d` is positive (beyond 1 µm).
 pub fn within(x: &Shape, y: &Shape, d: f64) -> bool {
@@ -499,5 +567,98 @@ mod tests {
             half: [0.05; 3],
         };
         assert!(within(&inside, &block, 0.001) && !within(&inside, &block, 0.0));
+    }
+
+    /// Points of a shape for sampling distances: a box's dense lattice, a capsule's axis points
+    /// pushed out by its radius towards `towards` (its nearest surface to that point lies on one).
+    fn sampled_distance(x: &Shape, y: &Shape) -> f64 {
+        let points = |s: &Shape| -> Vec<V3> {
+            match s {
+                Shape::Box { center, axes, half } => box_points(center, axes, half),
+                Shape::Capsule { a, b, .. } => {
+                    (0..=200).map(|k| axpy(k as f64 / 200.0, &sub(b, a), a)).collect()
+                }
+                Shape::HalfSpace { .. } => unreachable!("sampled against solids only"),
+            }
+        };
+        let radius = |s: &Shape| match s {
+            Shape::Capsule { radius, .. } => *radius,
+            _ => 0.0,
+        };
+        let (px, py) = (points(x), points(y));
+        let mut best = f64::INFINITY;
+        for p in &px {
+            for q in &py {
+                let w = sub(p, q);
+                best = best.min(dot(&w, &w).sqrt());
+            }
+        }
+        best - radius(x) - radius(y)
+    }
+
+    #[test]
+    fn clearance_never_exceeds_the_sampled_distance_and_is_exact_where_documented() {
+        let mut r = ChaCha8Rng::seed_from_u64(10);
+        let shape = |r: &mut ChaCha8Rng, boxy: bool| {
+            if boxy {
+                Shape::Box {
+                    center: v(r, 0.15),
+                    axes: rot(r),
+                    half: [
+                        r.random_range(0.01..0.08),
+                        r.random_range(0.01..0.08),
+                        r.random_range(0.01..0.08),
+                    ],
+                }
+            } else {
+                Shape::Capsule {
+                    a: v(r, 0.15),
+                    b: v(r, 0.15),
+                    radius: r.random_range(0.005..0.05),
+                }
+            }
+        };
+        let (mut apart, mut tight) = (0, 0);
+        for k in 0..240 {
+            let (x, y) = (shape(&mut r, k % 3 != 0), shape(&mut r, k % 2 == 0));
+            let c = clearance(&x, &y);
+            let sampled = sampled_distance(&x, &y);
+            assert!(c >= 0.0);
+            // The lattice of a box misses its nearest point by at most a cell's half diagonal.
+            assert!(c <= sampled.max(0.0) + 1e-9, "{x:?} {y:?}: {c} > {sampled}");
+            // Consistent with the nearness test: a pair kept apart by more than the gap is not
+            // near (two boxes excepted: their nearness test inflates a box along its axes,
+            // which may call a pair near that this bound keeps apart).
+            let boxes = matches!((x, y), (Shape::Box { .. }, Shape::Box { .. }));
+            for gap in [0.0, 0.005, 0.02] {
+                if c > gap && !boxes {
+                    assert!(!near(&x, &y, gap), "{x:?} {y:?}: clearance {c}, near at {gap}");
+                }
+            }
+            if c > 0.0 {
+                apart += 1;
+                if !boxes && sampled - c < 0.02 {
+                    tight += 1;
+                }
+            }
+        }
+        assert!(apart > 60 && tight > 20, "{apart} {tight}");
+        let floor = Shape::HalfSpace {
+            normal: [0.0, 0.0, 1.0],
+            offset: 0.0,
+        };
+        let cube = Shape::Box {
+            center: [0.3, 0.0, 0.07],
+            axes: I,
+            half: [0.02; 3],
+        };
+        assert!((clearance(&cube, &floor) - 0.05).abs() < 1e-12);
+        let far = Shape::Box {
+            center: [0.5, 0.0, 0.07],
+            axes: I,
+            half: [0.02; 3],
+        };
+        assert!((clearance(&cube, &far) - 0.16).abs() < 1e-12);
+        assert_eq!(clearance(&floor, &floor), 0.0);
     }
 }
