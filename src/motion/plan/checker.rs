@@ -155,7 +155,10 @@ impl JointSpare {
         for j in 0..6 {
             prefix[j + 1] = prefix[j] + moved[j];
         }
-        (0..6).all(|lo| (lo..6).all(|hi| prefix[hi + 1] - prefix[lo] <= self.by_range[lo][hi]))
+        // The wrists' ranges first: their own pairs hold the smallest spares.
+        (0..6)
+            .rev()
+            .all(|lo| (lo..6).all(|hi| prefix[hi + 1] - prefix[lo] <= self.by_range[lo][hi]))
     }
 }
 
@@ -204,7 +207,8 @@ const SCREEN_BALLS: usize = 128;
 /// metres), a ring: a configuration the joints reach within a remembered spare keeps the margin
 /// too ([`JointSpare::covers`]).
 struct Balls {
-    ring: Vec<([f64; 6], JointSpare)>,
+    /// Configuration, spare, and the spare's least range (metres).
+    ring: Vec<([f64; 6], JointSpare, f64)>,
     next: usize,
     size: usize,
 }
@@ -221,18 +225,21 @@ impl Balls {
     /// True when `q` lies within a remembered spare, joint `j` moving a point at most
     /// `arms[j]` metres per radian.
     fn cover(&self, q: &[f64; 6], arms: &[f64; 6]) -> bool {
-        self.ring.iter().rev().any(|(c, spare)| {
+        self.ring.iter().rev().any(|(c, spare, least)| {
             let moved: [f64; 6] = std::array::from_fn(|j| arms[j] * (q[j] - c[j]).abs());
-            // The whole chain first: it fails first for most configurations far away.
-            moved.iter().sum::<f64>() <= spare.by_range[0][5] && spare.covers(&moved)
+            // Within the least range's spare every range holds; beyond the whole chain's,
+            // that range fails (most configurations far away); else each range decides.
+            let total: f64 = moved.iter().sum();
+            total <= *least || (total <= spare.by_range[0][5] && spare.covers(&moved))
         })
     }
 
     fn remember(&mut self, q: &[f64; 6], spare: JointSpare) {
+        let entry = (*q, spare, spare.least());
         if self.ring.len() < self.size {
-            self.ring.push((*q, spare));
+            self.ring.push(entry);
         } else {
-            self.ring[self.next] = (*q, spare);
+            self.ring[self.next] = entry;
             self.next = (self.next + 1) % self.size;
         }
     }
