@@ -268,26 +268,6 @@ pub(crate) fn check_motion(
     hit
 }
 
-/// True when the straight segment `mv`, a look-ahead at a motion the tree will ask for next (a
-/// descent from a planned pre-grasp pose), would really touch something but the `intended`
-/// objects. Its checks count in the tally's `collision_checks`, not as a motion checked.
-pub(crate) fn look_ahead_hits(cell: &mut Cell, mv: &dyn Trajectory, intended: &[String]) -> bool {
-    look_ahead_pairs(cell, mv, intended).is_some()
-}
-
-/// The pairs the straight segment `mv` (a look-ahead, as in [`look_ahead_hits`]) would really
-/// touch, but the `intended` objects; `None` when it is free.
-pub(crate) fn look_ahead_pairs(
-    cell: &mut Cell,
-    mv: &dyn Trajectory,
-    intended: &[String],
-) -> Option<Vec<Collision>> {
-    let before = cell.planning().motions_checked;
-    let hit = check_motion(cell, &[mv], intended, true).map(|(_, pairs)| pairs);
-    cell.planning_mut().motions_checked = before;
-    hit
-}
-
 /// The pairs a pick's straight descent `mv` (a look-ahead from a pre-grasp) would bring too
 /// close, but the `intended` objects: real contact of anything, and the arm's links (`ur5e/…`;
 /// not the fingers, which straddle the block beside its neighbours) closer than the checker's

@@ -15,7 +15,7 @@
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
 use super::cell::Cell;
-use super::planning::{check_motion, check_straight, look_ahead_hits, plan_motion};
+use super::planning::{check_motion, check_straight, look_ahead_clear, plan_motion};
 use crate::failure::{Failure, FailureKind};
 use crate::motion::plan::GoalSet;
 use crate::motion::{CartesianMove, JointMove, MotionLimits, Trajectory, fk};
@@ -180,8 +180,9 @@ fn free_pregrasps(
 /// The top-down pre-grasp configurations of block `b` (the pinch `standoff` metres above its
 /// centre, the tool yaw `reach` would take for it and the turns its symmetry allows, every IK
 /// branch) that are free (the planner's margin, the block intended) and whose straight descent to
-/// the centre touches nothing but the block; nearest to `from` first. Empty: the block cannot be
-/// grasped from above.
+/// the centre passes the pick's look-ahead (`look_ahead_clear`: nothing but the block touched,
+/// the arm's links kept the margin from everything); nearest to `from` first. Empty: the block
+/// cannot be grasped from above.
 pub(crate) fn top_free_goals(cell: &mut Cell, b: usize, standoff: f64, from: &[f64; 6]) -> Vec<[f64; 6]> {
     let w = cell.world();
     let centre = w.objects[b].pos;
@@ -199,7 +200,7 @@ pub(crate) fn top_free_goals(cell: &mut Cell, b: usize, standoff: f64, from: &[f
         if standoff > 1e-6 {
             let to = Isometry3::from_parts(Translation3::from(centre), fk(&q).rotation);
             match CartesianMove::new(q, to, &limits) {
-                Ok(mv) if !look_ahead_hits(cell, &mv, &intended) => {}
+                Ok(mv) if look_ahead_clear(cell, &mv, &intended).is_none() => {}
                 _ => continue,
             }
         }
