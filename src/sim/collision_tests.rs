@@ -124,22 +124,7 @@ fn spare_is_conservative(hold: bool, seed: u64) {
         near += usize::from(least < SPARE_CAP);
         // Configurations within the reach of the spare clearance keep the margin.
         for _ in 0..3 {
-            let dir: [f64; 6] = std::array::from_fn(|_| r.random_range(-1.0..1.0));
-            let s = reach_within(&spare, &dir);
-            if !s.is_finite() || s <= 0.0 {
-                continue;
-            }
-            let s = s * r.random_range(0.5..1.0);
-            let q2: [f64; 6] = std::array::from_fn(|j| q[j] + dir[j] * s);
-            let moved: [f64; 6] = std::array::from_fn(|j| UR5E_LEVER_ARMS[j] * (q2[j] - q[j]).abs());
-            assert!(spare.covers(&moved));
-            let exact2 = truth(&mut c, &q2);
-            assert!(
-                exact2 >= c.margin() - 1e-6,
-                "{q2:?} within the reach of {q:?} ({spare:?}) is {exact2} m from something"
-            );
-            assert!(c.is_free(&q2), "{q2:?} within the reach of {q:?} is not free");
-            vouched += 1;
+            vouched += usize::from(vouched_step(&mut c, &mut r, &q, &spare).is_some());
         }
     }
     eprintln!("spare clearance: worst excess over mj_geomDistance of every pair {worst:.2e} m");
@@ -192,6 +177,33 @@ fn reach_within(spare: &JointSpare, dir: &[f64; 6]) -> f64 {
     s
 }
 
+/// A seeded step from `q` in a random direction, within the reach of `spare` (half to all of
+/// it), asserted to keep the margin by `mj_geomDistance` and to be free by `is_free`; its
+/// lever-arm displacements per joint (metres), or `None` when the spare allows no step.
+fn vouched_step(
+    c: &mut SceneChecker,
+    r: &mut ChaCha8Rng,
+    q: &[f64; 6],
+    spare: &JointSpare,
+) -> Option<[f64; 6]> {
+    let dir: [f64; 6] = std::array::from_fn(|_| r.random_range(-1.0..1.0));
+    let s = reach_within(spare, &dir);
+    if !s.is_finite() || s <= 0.0 {
+        return None;
+    }
+    let s = s * r.random_range(0.5..1.0);
+    let q2: [f64; 6] = std::array::from_fn(|j| q[j] + dir[j] * s);
+    let moved: [f64; 6] = std::array::from_fn(|j| UR5E_LEVER_ARMS[j] * (q2[j] - q[j]).abs());
+    assert!(spare.covers(&moved));
+    let exact = truth(c, &q2);
+    assert!(
+        exact >= c.margin() - 1e-6,
+        "{q2:?} within the spare of {q:?} ({spare:?}) is {exact} m from something"
+    );
+    assert!(c.is_free(&q2), "{q2:?} within the spare of {q:?} is not free");
+    Some(moved)
+}
+
 /// Over seeded configurations near the obstacles, every configuration the screen's spare
 /// clearance by joint range vouches for keeps the margin: `is_free` finds it free, and every
 /// tested pair is at least the margin apart by `mj_geomDistance`.
@@ -214,21 +226,9 @@ fn screen_spare_is_conservative(hold: bool, seed: u64) {
             }
         }
         for _ in 0..3 {
-            let dir: [f64; 6] = std::array::from_fn(|_| r.random_range(-1.0..1.0));
-            let s = reach_within(&spare, &dir);
-            if !s.is_finite() || s <= 0.0 {
+            let Some(moved) = vouched_step(&mut c, &mut r, &q, &spare) else {
                 continue;
-            }
-            let s = s * r.random_range(0.5..1.0);
-            let q2: [f64; 6] = std::array::from_fn(|j| q[j] + dir[j] * s);
-            let moved: [f64; 6] = std::array::from_fn(|j| UR5E_LEVER_ARMS[j] * (q2[j] - q[j]).abs());
-            assert!(spare.covers(&moved));
-            let exact = truth(&mut c, &q2);
-            assert!(
-                exact >= c.margin() - 1e-6,
-                "{q2:?} within the spare of {q:?} ({spare:?}) is {exact} m from something"
-            );
-            assert!(c.is_free(&q2), "{q2:?} within the spare of {q:?} is not free");
+            };
             vouched += 1;
             // The whole chain's reach is where the single-spare vouching ends: count the steps
             // that go beyond it (the per-range spares let the wrists move farther).

@@ -280,8 +280,17 @@ fn sphere_apart(c1: &V3, r1: f64, c2: &V3, r2: f64, gap: f64) -> bool {
 /// True when `shape` is a box and the sphere `(c, r)` (metres) keeps at least `gap` from it
 /// (the distance from the centre to the box, less the radius); false otherwise.
 fn sphere_box_apart(c: &V3, r: f64, shape: &Shape, gap: f64) -> bool {
-    let Shape::Box { center, axes, half } = shape else {
+    let Some(out2) = box_dist2(c, shape) else {
         return false;
+    };
+    let t = r + gap;
+    out2 >= t * t
+}
+
+/// The squared distance from the point `c` to `shape` if it is a box, metres².
+fn box_dist2(c: &V3, shape: &Shape) -> Option<f64> {
+    let Shape::Box { center, axes, half } = shape else {
+        return None;
     };
     let d = [c[0] - center[0], c[1] - center[1], c[2] - center[2]];
     let mut out2 = 0.0;
@@ -291,8 +300,7 @@ fn sphere_box_apart(c: &V3, r: f64, shape: &Shape, gap: f64) -> bool {
             out2 += u * u;
         }
     }
-    let t = r + gap;
-    out2 >= t * t
+    Some(out2)
 }
 
 /// A lower bound on the distance between spheres `(c1, r1)` and `(c2, r2)`, metres (infinite
@@ -319,17 +327,7 @@ fn sphere_shape_gap(c: &V3, r: f64, shape: &Posed) -> f64 {
         Shape::HalfSpace { normal, offset } => {
             normal[0] * c[0] + normal[1] * c[1] + normal[2] * c[2] - offset - r
         }
-        Shape::Box { center, axes, half } => {
-            let d = [c[0] - center[0], c[1] - center[1], c[2] - center[2]];
-            let mut out2 = 0.0;
-            for i in 0..3 {
-                let u = (d[0] * axes[i][0] + d[1] * axes[i][1] + d[2] * axes[i][2]).abs() - half[i];
-                if u > 0.0 {
-                    out2 += u * u;
-                }
-            }
-            out2.sqrt() - r
-        }
+        Shape::Box { .. } => box_dist2(c, &shape.0).map_or(f64::NEG_INFINITY, |d2| d2.sqrt() - r),
         Shape::Capsule { .. } => f64::NEG_INFINITY,
     };
     through_sphere.max(through_shape)
