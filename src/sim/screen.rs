@@ -635,7 +635,6 @@ impl Screen {
         let mut unsure = false;
         let mut spare = JointSpare::uniform(cap);
         for g in &self.groups {
-            let (c1, r1) = spheres[g.link];
             // The joints that move the group's pair relative to each other (none: the pair
             // never moves apart or closer, and limits no spare).
             let (lo, hi) = match g.partner {
@@ -643,38 +642,13 @@ impl Screen {
                 Partner::Link(m) => (g.link.min(m) + 1, g.link.max(m)),
             };
             let ranged = lo <= hi;
-            let apart = match g.partner {
-                Partner::Link(m) => sphere_apart(&c1, r1, &spheres[m].0, spheres[m].1, g.gap),
-                Partner::Fixed(f) => match &self.fixed[f] {
-                    (y, Some((c2, r2)), _) => {
-                        sphere_apart(&c1, r1, c2, *r2, g.gap) || sphere_box_apart(&c1, r1, y, g.gap)
-                    }
-                    (Shape::HalfSpace { normal, offset }, None, _) => {
-                        normal[0] * c1[0] + normal[1] * c1[1] + normal[2] * c1[2] - offset - r1 >= g.gap
-                    }
-                    _ => false,
-                },
-            };
-            if apart {
+            if self.group_apart(g, &spheres, g.gap) {
                 if !SPARE || !ranged {
                     continue;
                 }
                 // The link's sphere keeps more than the range's spare found so far: nothing to
                 // learn from the group's pairs; else they may keep more than the sphere does.
-                let need = g.gap + spare.get(lo, hi);
-                let far = match g.partner {
-                    Partner::Link(m) => sphere_apart(&c1, r1, &spheres[m].0, spheres[m].1, need),
-                    Partner::Fixed(f) => match &self.fixed[f] {
-                        (y, Some((c2, r2)), _) => {
-                            sphere_apart(&c1, r1, c2, *r2, need) || sphere_box_apart(&c1, r1, y, need)
-                        }
-                        (Shape::HalfSpace { normal, offset }, None, _) => {
-                            normal[0] * c1[0] + normal[1] * c1[1] + normal[2] * c1[2] - offset - r1 >= need
-                        }
-                        _ => false,
-                    },
-                };
-                if far {
+                if self.group_apart(g, &spheres, g.gap + spare.get(lo, hi)) {
                     continue;
                 }
             }
@@ -725,6 +699,25 @@ impl Screen {
             }
         }
         ((!unsure).then_some(true), None, spare)
+    }
+
+    /// True when the sphere of group `g`'s link (`spheres`: each link's, world frame) keeps
+    /// `gap` metres from the group's partner: the other link's sphere, or a fixed shape's
+    /// bounding sphere, its box or its half-space.
+    fn group_apart(&self, g: &Group, spheres: &[(V3, f64); 6], gap: f64) -> bool {
+        let (c1, r1) = spheres[g.link];
+        match g.partner {
+            Partner::Link(m) => sphere_apart(&c1, r1, &spheres[m].0, spheres[m].1, gap),
+            Partner::Fixed(f) => match &self.fixed[f] {
+                (y, Some((c2, r2)), _) => {
+                    sphere_apart(&c1, r1, c2, *r2, gap) || sphere_box_apart(&c1, r1, y, gap)
+                }
+                (Shape::HalfSpace { normal, offset }, None, _) => {
+                    normal[0] * c1[0] + normal[1] * c1[1] + normal[2] * c1[2] - offset - r1 >= gap
+                }
+                _ => false,
+            },
+        }
     }
 
     /// True when the screen vouches that `q` (radians) is free ([`Screen::classify`]).
