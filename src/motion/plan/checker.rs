@@ -355,4 +355,51 @@ mod tests {
         let near = Collision { distance: 0.003, ..c };
         assert_eq!(near.to_string(), "forearm_link within 3.0 mm of post");
     }
+
+    #[test]
+    fn a_joint_spare_bounds_each_range_by_its_own_joints() {
+        // 3 cm everywhere but the wrists' own pairs (joints 4..=5): 5 mm.
+        let mut spare = JointSpare::uniform(0.03);
+        spare.tighten(4, 5, 0.005);
+        assert_eq!(spare.least(), 0.005);
+        assert_eq!(spare.get(4, 5), 0.005);
+        // A negative bound leaves no spare (0), and a larger one never raises it again.
+        spare.tighten(0, 0, -1.0);
+        assert_eq!(spare.get(0, 0), 0.0);
+        spare.tighten(0, 0, 0.03);
+        assert_eq!(spare.get(0, 0), 0.0);
+        assert!(
+            !spare.covers(&[0.015, 0.01, 0.0, 0.0, 0.0, 0.0]),
+            "range 0..=0 has no spare"
+        );
+        // The base and shoulder move 2.5 cm between them: every range within its spare.
+        let mut spare = JointSpare::uniform(0.03);
+        spare.tighten(4, 5, 0.005);
+        assert!(spare.covers(&[0.015, 0.01, 0.0, 0.0, 0.0, 0.0]));
+        // Past the whole chain's spare: not covered.
+        assert!(!spare.covers(&[0.015, 0.01, 0.006, 0.0, 0.0, 0.0]));
+        // The wrists move 6 mm between them: range 4..=5 fails although the sum is small.
+        assert!(!spare.covers(&[0.0, 0.0, 0.0, 0.0, 0.003, 0.003]));
+        assert!(spare.covers(&[0.0, 0.0, 0.0, 0.0, 0.002, 0.003]));
+        // Wrist 2 alone, 6 mm: range 4..=4 keeps 3 cm, but the wrists' pairs (4..=5) move by
+        // joint 4 too, 6 mm against 5 mm.
+        assert!(!spare.covers(&[0.0, 0.0, 0.0, 0.0, 0.006, 0.0]));
+        assert!(JointSpare::NONE.covers(&[0.0; 6]));
+        assert!(!JointSpare::NONE.covers(&[0.0, 0.0, 0.0, 1e-9, 0.0, 0.0]));
+    }
+
+    #[test]
+    fn the_spare_ring_keeps_the_newest_and_covers_only_within_a_spare() {
+        let arms = [1.0; 6];
+        let mut balls = Balls::new(2);
+        let at = |x: f64| [x, 0.0, 0.0, 0.0, 0.0, 0.0];
+        balls.remember(&at(0.0), JointSpare::uniform(0.01));
+        assert!(balls.cover(&at(0.009), &arms));
+        assert!(!balls.cover(&at(0.011), &arms));
+        balls.remember(&at(1.0), JointSpare::uniform(0.01));
+        balls.remember(&at(2.0), JointSpare::uniform(0.01));
+        // The oldest was replaced: two remembered at most.
+        assert!(!balls.cover(&at(0.0), &arms));
+        assert!(balls.cover(&at(1.005), &arms) && balls.cover(&at(1.995), &arms));
+    }
 }
