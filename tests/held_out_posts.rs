@@ -104,3 +104,24 @@ fn descent_ran_the_arm_into_a_post_after_the_block_slid_on() {
         r["collisions"]
     );
 }
+
+/// The last attempt's reach, a direct 4.66 rad swing to the other elbow branch with the pinch
+/// 0.64 m out, ended its trajectory 16 mm short (the stretched arm lagging), and closed in at
+/// under 0.05 rad/s: counted "at rest", it failed `blocked` ("the arm stopped 3.0 mm short of its
+/// goal") 0.3 s later while still converging. A resting arm is blocked only when its error stops
+/// halving. The same false `blocked` had cost a quarter of this cell's episodes a retry.
+#[test]
+fn a_reach_still_closing_in_on_its_goal_was_called_blocked() {
+    clean(89, 2);
+    // Scenario 2's first reach above a block stopped "2.0 mm short" and its attempt was retried;
+    // now no reach fails on the way.
+    let r = clean(2, 2);
+    let failed: Vec<&str> = r["nodes"]
+        .as_array()
+        .expect("per-node counts")
+        .iter()
+        .filter(|n| n["path"].as_str().is_some_and(|p| p.contains("reach[")) && n["failures"] != 0)
+        .filter_map(|n| n["path"].as_str())
+        .collect();
+    assert!(failed.is_empty(), "reaches that failed: {failed:?}");
+}
