@@ -62,6 +62,10 @@ pub struct Arrival {
     resting_since: Option<(f64, f64)>,
 }
 
+/// The fraction of its error an arm at rest must get down to within [`Arrival::blocked_after`]
+/// to count as still closing in on its goal, not blocked: half.
+const CLOSING_IN: f64 = 0.5;
+
 impl Default for Arrival {
     /// 2 mm, 0.05 rad/s, blocked after 0.3 s at rest short of the goal without halving the
     /// error.
@@ -124,7 +128,7 @@ impl Arrival {
             return Progress::Running;
         }
         let (since, then) = *self.resting_since.get_or_insert((time, error));
-        if error <= 0.5 * then {
+        if error <= CLOSING_IN * then {
             // Still closing in: the wait starts again from here.
             self.resting_since = Some((time, error));
             return Progress::Running;
