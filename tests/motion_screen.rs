@@ -234,7 +234,10 @@ fn the_planner_with_the_screen_plans_the_same_paths_as_without_it() {
         assert_eq!(a.raw_path, b.raw_path, "seed {seed}");
         assert_eq!(a.trajectory.waypoints(), b.trajectory.waypoints(), "seed {seed}");
         assert_eq!(a.raw_path, c.raw_path);
-        assert_eq!(a.stats.stage_checks[..3], b.stats.stage_checks[..3]);
+        // The start, the goals and the direct segments are checked exactly either way. (The
+        // search's count of a blocked segment depends on where its bisection met the block,
+        // which the screen's spare moves: paths stay the same unless the budget binds.)
+        assert_eq!(a.stats.stage_checks[0], b.stats.stage_checks[0]);
         assert_eq!(
             a.stats.screened > 0,
             !a.stats.direct,

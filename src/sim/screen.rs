@@ -20,7 +20,7 @@ use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, Unit, UnitQuaternio
 
 use super::pair_filter::PairFilter;
 use crate::motion::plan::JointSpare;
-use crate::motion::plan::shapes::{Shape, V3, clearance, near, within};
+use crate::motion::plan::shapes::{Shape, V3, apart, near, within};
 
 /// Extra distance every pair must keep beyond its margin for the screen to vouch, metres: room
 /// for MuJoCo's own tolerances (its convex-hull distances converge to about 1e-6 m).
@@ -684,17 +684,25 @@ impl Screen {
                         continue;
                     }
                 }
-                if near(&x.0, &y.0, p.gap) {
-                    if x.2 && y.2 && within(&x.0, &y.0, p.block) {
-                        return (
-                            Some(false),
-                            Some((self.geoms[a], self.geoms[b])),
-                            JointSpare::NONE,
-                        );
+                // Near, or the clearance when it is wanted (one distance for both).
+                let kept = if SPARE && ranged && !unsure {
+                    apart(&x.0, &y.0, p.gap)
+                } else {
+                    (!near(&x.0, &y.0, p.gap)).then_some(f64::INFINITY)
+                };
+                match kept {
+                    None => {
+                        if x.2 && y.2 && within(&x.0, &y.0, p.block) {
+                            return (
+                                Some(false),
+                                Some((self.geoms[a], self.geoms[b])),
+                                JointSpare::NONE,
+                            );
+                        }
+                        unsure = true;
                     }
-                    unsure = true;
-                } else if SPARE && ranged && !unsure {
-                    spare.tighten(lo, hi, clearance(&x.0, &y.0) - p.gap);
+                    Some(c) if SPARE && ranged => spare.tighten(lo, hi, c - p.gap),
+                    Some(_) => {}
                 }
             }
         }

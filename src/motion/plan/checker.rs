@@ -26,9 +26,8 @@ pub trait CollisionChecker {
     /// scene keeps the margin), `Some(false)` only when it is certainly blocked (exact shapes
     /// deeper than the margin), `None` when it cannot tell (the default: no screen). The
     /// planner searches and shortcuts with "screen, else `is_free`" (the start and the goals
-    /// with `is_free` unless certainly free), then re-checks with `is_free` alone every
-    /// configuration of the final path the screen called free, so a screen that errs towards
-    /// "free" only costs time, never a collision.
+    /// with `is_free` alone), then re-checks the final path with `is_free` alone at the edge
+    /// resolution, so a screen that errs towards "free" only costs time, never a collision.
     fn screen(&mut self, _q: &[f64; 6]) -> Option<bool> {
         None
     }
@@ -36,8 +35,8 @@ pub trait CollisionChecker {
     /// The [`screen`](Self::screen)'s verdict at `q` (radians) and, with a "free", its spare
     /// clearance by joint range ([`JointSpare`], metres, at most `cap`; none with any other
     /// verdict, and none by default). The planner vouches with it for the configurations the
-    /// joints reach within it, as with [`exact_spare`](Self::exact_spare), and re-checks them
-    /// like every configuration the screen called free.
+    /// joints reach within it, as with [`exact_spare`](Self::exact_spare), and re-checks the
+    /// final path like every path the screen helped find.
     fn screen_spare(&mut self, q: &[f64; 6], _cap: f64) -> (Option<bool>, JointSpare) {
         (self.screen(q), JointSpare::NONE)
     }
@@ -51,6 +50,26 @@ pub trait CollisionChecker {
     /// still keeps the margin.
     fn exact_spare(&mut self, _q: &[f64; 6], _cap: f64) -> Option<JointSpare> {
         None
+    }
+
+    /// The verdict at `q` (radians) with how far it reaches along a straight line: `None` when
+    /// `q` is blocked; `Some(k)` (`k ≥ 0`, a number of steps, not necessarily whole) when `q`
+    /// is free and every configuration `q + λ · step` with `|λ| ≤ k` keeps the margin too
+    /// (`step`: a joint change, radians). A reach beyond `want` steps is of no use to the
+    /// caller and need not be measured. The planner's segment check
+    /// ([`check_segment`](super::edge::check_segment)) does not ask about those configurations.
+    /// The default knows no reach: [`is_free`](Self::is_free), and `k = 0`.
+    fn free_reach(&mut self, q: &[f64; 6], _step: &[f64; 6], _want: f64) -> Option<f64> {
+        self.is_free(q).then_some(0.0)
+    }
+
+    /// Told by the segment check that `samples` configurations of a segment's resolution were
+    /// decided free without asking (within a [`free_reach`](Self::free_reach), or between two
+    /// such neighbourhoods less than a step apart): a checker that counts its checks counts
+    /// them. False refuses them (a check budget is spent), and the segment counts as blocked.
+    /// The default accepts them.
+    fn vouched(&mut self, _samples: u64) -> bool {
+        true
     }
 }
 
@@ -69,6 +88,12 @@ impl<C: CollisionChecker + ?Sized> CollisionChecker for &mut C {
     }
     fn exact_spare(&mut self, q: &[f64; 6], cap: f64) -> Option<JointSpare> {
         (**self).exact_spare(q, cap)
+    }
+    fn free_reach(&mut self, q: &[f64; 6], step: &[f64; 6], want: f64) -> Option<f64> {
+        (**self).free_reach(q, step, want)
+    }
+    fn vouched(&mut self, samples: u64) -> bool {
+        (**self).vouched(samples)
     }
 }
 
@@ -148,28 +173,64 @@ impl JointSpare {
             .fold(f64::INFINITY, f64::min)
     }
 
-    /// True when displacements `moved[j]` (metres: joint `j`'s lever arm times its change) keep
-    /// every range's sum within its spare.
-    pub fn covers(&self, moved: &[f64; 6]) -> bool {
+    /// The spare left after displacements `moved[j]` (metres: joint `j`'s lever arm times its
+    /// change): each range's spare less its sum, `None` when one falls below zero. A point of
+    /// the robot has moved at most that sum relative to its partner, so the rest still bounds
+    /// its clearance beyond the margin (the triangle inequality).
+    pub fn less(&self, moved: &[f64; 6]) -> Option<JointSpare> {
         let mut prefix = [0.0; 7];
         for j in 0..6 {
             prefix[j + 1] = prefix[j] + moved[j];
         }
-        // The wrists' ranges first: their own pairs hold the smallest spares.
-        (0..6)
-            .rev()
-            .all(|lo| (lo..6).all(|hi| prefix[hi + 1] - prefix[lo] <= self.by_range[lo][hi]))
+        let mut rest = *self;
+        for lo in 0..6 {
+            for hi in lo..6 {
+                let v = self.by_range[lo][hi] - (prefix[hi + 1] - prefix[lo]);
+                if v < 0.0 {
+                    return None;
+                }
+                rest.by_range[lo][hi] = v;
+            }
+        }
+        Some(rest)
+    }
+
+    /// How many steps of displacements `per_step[j]` (metres per step: joint `j`'s lever arm
+    /// times its change per step) every range's spare holds, not necessarily whole: the
+    /// largest `k` with `k · Σ_{j in range} per_step[j] ≤` the range's spare for every range
+    /// (infinite when nothing moves).
+    pub fn steps_within(&self, per_step: &[f64; 6]) -> f64 {
+        let mut prefix = [0.0; 7];
+        for j in 0..6 {
+            prefix[j + 1] = prefix[j] + per_step[j];
+        }
+        let mut k = f64::INFINITY;
+        for lo in 0..6 {
+            for hi in lo..6 {
+                let moved = prefix[hi + 1] - prefix[lo];
+                if moved > 0.0 {
+                    k = k.min(self.by_range[lo][hi] / moved);
+                }
+            }
+        }
+        k
+    }
+
+    /// True when displacements `moved[j]` (metres: joint `j`'s lever arm times its change) keep
+    /// every range's sum within its spare.
+    pub fn covers(&self, moved: &[f64; 6]) -> bool {
+        self.less(moved).is_some()
     }
 }
 
 /// A checker that counts the configurations it is asked about (the planner's statistics) and,
 /// while a budget is set, answers "blocked" without asking once the budget is used (a refusal
 /// never lets a collision through; it only ends the search). While `screen` is on, the inner
-/// checker's [`screen`](CollisionChecker::screen) answers first: its "free" is taken (and the
-/// configuration logged for the final re-check), its "blocked" too; each check counts once
-/// either way. With `vouch_arms` set, a configuration a remembered spare clearance covers is
-/// free without asking: the screen's while `screen` is on (logged like the screen's "free"),
-/// the exact checker's while it is off.
+/// checker's [`screen`](CollisionChecker::screen) answers first: its "free" is taken, its
+/// "blocked" too; each check counts once either way. With `vouch_arms` set, a configuration a
+/// remembered spare clearance covers is free without asking: the screen's while `screen` is
+/// on, the exact checker's while it is off; [`free_reach`](CollisionChecker::free_reach) turns
+/// the spare into the samples it vouches for along a segment.
 pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
     pub(crate) inner: &'a mut C,
     pub(crate) checks: u64,
@@ -177,12 +238,8 @@ pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
     pub(crate) budget: u64,
     /// Ask the inner checker's screen first.
     pub(crate) screen: bool,
-    /// Checks the screen answered.
+    /// Checks the screen answered (its own verdict or a remembered spare of its).
     pub(crate) screened: u64,
-    /// The configurations the screen called free, for the final re-check, at most
-    /// [`VOUCHED_LOG`]; `vouched_lost` when more were.
-    pub(crate) vouched: Vec<[f64; 6]>,
-    pub(crate) vouched_lost: bool,
     /// Lever arms (metres) to vouch with a measured spare clearance for configurations near
     /// the measured one: the exact checker's ([`CollisionChecker::exact_spare`]) while the
     /// screen is off, the screen's ([`CollisionChecker::screen_spare`]) while it is on; `None`:
@@ -190,25 +247,24 @@ pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
     pub(crate) vouch_arms: Option<[f64; 6]>,
     /// Configurations the exact checker measured, with their spare clearance.
     balls: Balls,
-    /// Configurations the screen called free, with its spare clearance (while `screen` is on;
-    /// what they vouch for is logged for the final re-check like the screen's own answers).
+    /// Configurations the screen called free, with its spare clearance (while `screen` is on).
     screen_balls: Balls,
 }
 
 /// Measured configurations [`Counting`] remembers to vouch with the exact checker's spare.
 const EXACT_BALLS: usize = 32;
 
-/// Configurations [`Counting`] remembers to vouch with the screen's spare: enough to hold the
-/// neighbours of a segment's deepest bisection level (checked up to half the segment's samples
-/// earlier) for segments of a few hundred samples.
+/// Configurations [`Counting`] remembers to vouch with the screen's spare, looked up before the
+/// screen is asked (a segment's own neighbours vouch through its bisection; these reach across
+/// segments: a search's neighbouring edges, a shortcut beside the path it shortens).
 const SCREEN_BALLS: usize = 128;
 
 /// Recently measured configurations and their spare clearance by joint range (radians;
 /// metres), a ring: a configuration the joints reach within a remembered spare keeps the margin
 /// too ([`JointSpare::covers`]).
 struct Balls {
-    /// Configuration, spare, and the spare's least range (metres).
-    ring: Vec<([f64; 6], JointSpare, f64)>,
+    /// Configuration and spare (metres).
+    ring: Vec<([f64; 6], JointSpare)>,
     next: usize,
     size: usize,
 }
@@ -222,20 +278,23 @@ impl Balls {
         }
     }
 
-    /// True when `q` lies within a remembered spare, joint `j` moving a point at most
-    /// `arms[j]` metres per radian.
-    fn cover(&self, q: &[f64; 6], arms: &[f64; 6]) -> bool {
-        self.ring.iter().rev().any(|(c, spare, least)| {
+    /// The spare left at `q` ([`JointSpare::less`]) by the newest remembered configuration
+    /// whose spare covers it, joint `j` moving a point at most `arms[j]` metres per radian;
+    /// `None` when none does.
+    fn cover(&self, q: &[f64; 6], arms: &[f64; 6]) -> Option<JointSpare> {
+        self.ring.iter().rev().find_map(|(c, spare)| {
             let moved: [f64; 6] = std::array::from_fn(|j| arms[j] * (q[j] - c[j]).abs());
-            // Within the least range's spare every range holds; beyond the whole chain's,
-            // that range fails (most configurations far away); else each range decides.
-            let total: f64 = moved.iter().sum();
-            total <= *least || (total <= spare.by_range[0][5] && spare.covers(&moved))
+            // Beyond the whole chain's spare that range fails (most configurations far away);
+            // else each range decides.
+            if moved.iter().sum::<f64>() > spare.by_range[0][5] {
+                return None;
+            }
+            spare.less(&moved)
         })
     }
 
     fn remember(&mut self, q: &[f64; 6], spare: JointSpare) {
-        let entry = (*q, spare, spare.least());
+        let entry = (*q, spare);
         if self.ring.len() < self.size {
             self.ring.push(entry);
         } else {
@@ -245,10 +304,6 @@ impl Balls {
     }
 }
 
-/// Most configurations the screen called free that a query remembers for the final re-check
-/// (48 bytes each); past it, the final path is re-checked at its own edge resolution instead.
-pub(crate) const VOUCHED_LOG: usize = 1 << 20;
-
 impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
     pub(crate) fn new(inner: &'a mut C) -> Self {
         Self {
@@ -257,47 +312,58 @@ impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
             budget: u64::MAX,
             screen: true,
             screened: 0,
-            vouched: Vec::new(),
-            vouched_lost: false,
             vouch_arms: None,
             balls: Balls::new(EXACT_BALLS),
             screen_balls: Balls::new(SCREEN_BALLS),
         }
     }
 
-    /// True when `q` (radians) is free by the exact checker's spare clearance: within the
-    /// lever-arm reach of a measured configuration's, or measured now with some to spare.
-    /// False when that cannot tell (the caller asks `is_free`).
-    fn exact_vouched(&mut self, q: &[f64; 6]) -> bool {
-        let Some(arms) = self.vouch_arms else {
-            return false;
-        };
-        if self.balls.cover(q, &arms) {
-            return true;
+    /// The verdict at `q` (radians) and, with a "free", the spare clearance by joint range that
+    /// vouches for configurations near it ([`JointSpare::NONE`] when none is known): the
+    /// screen's while `screen` is on (a remembered spare of its, else asked; unsure: the exact
+    /// checker), the exact checker's while it is off (a remembered spare, else measured, else
+    /// `is_free`). Counted as one check; `None` also once the budget is spent.
+    fn verdict(&mut self, q: &[f64; 6], cap: f64) -> Option<JointSpare> {
+        if self.spent() {
+            return None;
         }
-        match self.inner.exact_spare(q, SPARE_CAP) {
-            Some(spare) => {
-                self.balls.remember(q, spare);
-                true
+        self.checks += 1;
+        if self.screen {
+            let Some(arms) = self.vouch_arms else {
+                return match self.inner.screen(q) {
+                    Some(free) => {
+                        self.screened += 1;
+                        free.then_some(JointSpare::NONE)
+                    }
+                    None => self.inner.is_free(q).then_some(JointSpare::NONE),
+                };
+            };
+            if let Some(rest) = self.screen_balls.cover(q, &arms) {
+                self.screened += 1;
+                return Some(rest);
             }
-            None => false,
+            match self.inner.screen_spare(q, cap) {
+                (Some(true), spare) => {
+                    self.screened += 1;
+                    self.screen_balls.remember(q, spare);
+                    return Some(spare);
+                }
+                (Some(false), _) => {
+                    self.screened += 1;
+                    return None;
+                }
+                (None, _) => {}
+            }
+        } else if let Some(arms) = self.vouch_arms {
+            if let Some(rest) = self.balls.cover(q, &arms) {
+                return Some(rest);
+            }
+            if let Some(spare) = self.inner.exact_spare(q, cap) {
+                self.balls.remember(q, spare);
+                return Some(spare);
+            }
         }
-    }
-
-    /// The screen's verdict at `q` (radians): vouched free within the reach of a remembered
-    /// screen spare, else asked (its spare remembered).
-    fn screened(&mut self, q: &[f64; 6]) -> Option<bool> {
-        let Some(arms) = self.vouch_arms else {
-            return self.inner.screen(q);
-        };
-        if self.screen_balls.cover(q, &arms) {
-            return Some(true);
-        }
-        let (verdict, spare) = self.inner.screen_spare(q, SPARE_CAP);
-        if verdict == Some(true) {
-            self.screen_balls.remember(q, spare);
-        }
-        verdict
+        self.inner.is_free(q).then_some(JointSpare::NONE)
     }
 
     /// True when the budget is used.
@@ -308,34 +374,40 @@ impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
 
 impl<C: CollisionChecker + ?Sized> CollisionChecker for Counting<'_, C> {
     fn is_free(&mut self, q: &[f64; 6]) -> bool {
-        if self.spent() {
-            return false;
-        }
-        self.checks += 1;
-        if self.screen {
-            match self.screened(q) {
-                Some(true) => {
-                    self.screened += 1;
-                    if self.vouched.len() < VOUCHED_LOG {
-                        self.vouched.push(*q);
-                    } else {
-                        self.vouched_lost = true;
-                    }
-                    return true;
-                }
-                Some(false) => {
-                    self.screened += 1;
-                    return false;
-                }
-                _ => {}
-            }
-        } else if self.exact_vouched(q) {
-            return true;
-        }
-        self.inner.is_free(q)
+        self.verdict(q, SPARE_CAP).is_some()
     }
     fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
         self.inner.collisions(q)
+    }
+    /// The steps of `step` (radians per step) within the spare the verdict at `q` comes with
+    /// ([`JointSpare::steps_within`] through the vouching lever arms; none without them). The
+    /// spare is measured up to what `want` steps need ([`SPARE_CAP`] at most): a small cap lets
+    /// the checkers skip the pairs that surely keep it.
+    fn free_reach(&mut self, q: &[f64; 6], step: &[f64; 6], want: f64) -> Option<f64> {
+        let Some(arms) = self.vouch_arms else {
+            return self.verdict(q, SPARE_CAP).map(|_| 0.0);
+        };
+        let per_step: [f64; 6] = std::array::from_fn(|j| arms[j] * step[j].abs());
+        let need = want * per_step.iter().sum::<f64>();
+        let cap = if need > 0.0 {
+            need.min(SPARE_CAP)
+        } else {
+            SPARE_CAP
+        };
+        Some(self.verdict(q, cap)?.steps_within(&per_step))
+    }
+    /// Counts the samples as checks (as screened ones while the screen is on), refusing them
+    /// past the budget.
+    fn vouched(&mut self, samples: u64) -> bool {
+        if self.checks.saturating_add(samples) > self.budget {
+            self.checks = self.budget;
+            return false;
+        }
+        self.checks += samples;
+        if self.screen {
+            self.screened += samples;
+        }
+        true
     }
 }
 
@@ -394,12 +466,37 @@ mod tests {
         let mut balls = Balls::new(2);
         let at = |x: f64| [x, 0.0, 0.0, 0.0, 0.0, 0.0];
         balls.remember(&at(0.0), JointSpare::uniform(0.01));
-        assert!(balls.cover(&at(0.009), &arms));
-        assert!(!balls.cover(&at(0.011), &arms));
+        // Covered, with the spare left: 1 mm of the 1 cm.
+        let rest = balls.cover(&at(0.009), &arms).expect("within the spare");
+        assert!((rest.least() - 0.001).abs() < 1e-12, "{}", rest.least());
+        assert!(balls.cover(&at(0.011), &arms).is_none());
         balls.remember(&at(1.0), JointSpare::uniform(0.01));
         balls.remember(&at(2.0), JointSpare::uniform(0.01));
         // The oldest was replaced: two remembered at most.
-        assert!(!balls.cover(&at(0.0), &arms));
-        assert!(balls.cover(&at(1.005), &arms) && balls.cover(&at(1.995), &arms));
+        assert!(balls.cover(&at(0.0), &arms).is_none());
+        assert!(balls.cover(&at(1.005), &arms).is_some() && balls.cover(&at(1.995), &arms).is_some());
+    }
+
+    #[test]
+    fn a_spare_holds_as_many_steps_as_its_tightest_range_allows() {
+        // 3 cm everywhere but the wrists' own pairs (joints 4..=5): 5 mm.
+        let mut spare = JointSpare::uniform(0.03);
+        spare.tighten(4, 5, 0.005);
+        // The base moving 1 cm per step: 3 steps; the wrists 2 mm each per step: 1.25 steps.
+        let near = |x: f64, y: f64| (x - y).abs() < 1e-9;
+        assert!(near(spare.steps_within(&[0.01, 0.0, 0.0, 0.0, 0.0, 0.0]), 3.0));
+        assert!(near(
+            spare.steps_within(&[0.0, 0.0, 0.0, 0.0, 0.002, 0.002]),
+            1.25
+        ));
+        assert_eq!(spare.steps_within(&[0.0; 6]), f64::INFINITY);
+        assert_eq!(
+            JointSpare::NONE.steps_within(&[1e-9, 0.0, 0.0, 0.0, 0.0, 0.0]),
+            0.0
+        );
+        // The spare left after moving: each range less its own sum, none once one is exceeded.
+        let rest = spare.less(&[0.0, 0.0, 0.0, 0.0, 0.002, 0.0]).unwrap();
+        assert!((rest.get(4, 5) - 0.003).abs() < 1e-12 && (rest.get(0, 3) - 0.03).abs() < 1e-12);
+        assert!(spare.less(&[0.0, 0.0, 0.0, 0.0, 0.003, 0.003]).is_none());
     }
 }

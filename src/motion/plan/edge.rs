@@ -40,6 +40,15 @@ impl Resolution {
     }
 }
 
+/// The number of whole sample indices from `first` to `last` (whole numbers), 0 when none.
+fn samples_within(first: f64, last: f64) -> u64 {
+    if last >= first {
+        (last - first) as u64 + 1
+    } else {
+        0
+    }
+}
+
 /// Number of equal steps a segment from `a` to `b` is cut into so that no joint moves more than
 /// `res.joint` radians and no point more than `res.displacement` metres per step (at least 1).
 pub fn steps(a: &[f64; 6], b: &[f64; 6], res: &Resolution) -> usize {
@@ -64,9 +73,12 @@ pub fn lerp(a: &[f64; 6], b: &[f64; 6], k: usize, n: usize) -> [f64; 6] {
 }
 
 /// True when every configuration strictly between `a` and `b`, at [`steps`] equal steps of
-/// `res`, is free; `a` and `b` themselves are the caller's (checked before). The steps are visited in
-/// bisection order (the middle, then the quarters, …) so a blocked segment is usually found
-/// after few checks. On a hit, returns the blocked configuration in `Err`.
+/// `res`, is free; `a` and `b` themselves are the caller's (checked before). The samples are
+/// visited in bisection order (the middle, then the quarters, …) so a blocked segment is usually
+/// found after few checks; a sample the checker finds free with a reach
+/// ([`CollisionChecker::free_reach`]) vouches for its neighbours within it, which are not
+/// asked: each unvouched stretch is bisected in turn. On a hit, returns the blocked
+/// configuration in `Err`.
 pub fn check_segment<C: CollisionChecker + ?Sized>(
     checker: &mut C,
     a: &[f64; 6],
@@ -77,20 +89,42 @@ pub fn check_segment<C: CollisionChecker + ?Sized>(
     if n < 2 {
         return Ok(());
     }
-    // Breadth-first bisection of the index range: the middle, then the middles of the halves, …
+    let step: [f64; 6] = std::array::from_fn(|j| (b[j] - a[j]) / n as f64);
+    // Breadth-first bisection of the stretches not yet vouched for (open intervals in units
+    // of steps, between vouched ones): a stretch of at most one step is done (every point of
+    // it lies within half a step of a configuration that keeps the margin); else the sample
+    // nearest its middle is asked, and vouches for its reach either way. Every sample of the
+    // resolution is accounted for once: asked, or told to the checker as vouched for.
     let mut queue = std::collections::VecDeque::with_capacity(16);
-    queue.push_back((0usize, n));
+    queue.push_back((0.0f64, n as f64));
     while let Some((lo, hi)) = queue.pop_front() {
-        if hi - lo < 2 {
+        if hi - lo <= 1.0 {
+            let inside = samples_within(lo.floor() + 1.0, hi.ceil() - 1.0);
+            if inside > 0 && !checker.vouched(inside) {
+                return Err(lerp(a, b, lo.floor() as usize + 1, n));
+            }
             continue;
         }
-        let k = lo + (hi - lo) / 2;
-        let q = lerp(a, b, k, n);
-        if !checker.is_free(&q) {
+        let mut k = ((lo + hi) / 2.0).floor();
+        if k <= lo {
+            k = lo.floor() + 1.0;
+        } else if k >= hi {
+            k = hi.ceil() - 1.0;
+        }
+        let q = lerp(a, b, k as usize, n);
+        let Some(reach) = checker.free_reach(&q, &step, (k - lo).max(hi - k)) else {
+            return Err(q);
+        };
+        // The samples of the stretch within the reach, besides the one asked.
+        let within = samples_within(
+            (lo.floor() + 1.0).max((k - reach).ceil()),
+            (hi.ceil() - 1.0).min((k + reach).floor()),
+        );
+        if within > 1 && !checker.vouched(within - 1) {
             return Err(q);
         }
-        queue.push_back((lo, k));
-        queue.push_back((k, hi));
+        queue.push_back((lo, k - reach));
+        queue.push_back((k + reach, hi));
     }
     Ok(())
 }
@@ -124,6 +158,80 @@ mod tests {
         }
         // Neighbouring checked configurations differ by at most the resolution in every joint.
         assert!(xs.windows(2).all(|w| w[1] - w[0] <= 0.1 + 1e-12));
+    }
+
+    /// Free outside `blocked` (an interval of joint 0, radians), with a reach that keeps out of
+    /// it (a sound spare: the distance to it, in steps of joint 0), at most `cap` steps;
+    /// records where it is asked (joint 0).
+    struct Reach {
+        blocked: (f64, f64),
+        cap: f64,
+        asked: Vec<f64>,
+        vouched: u64,
+    }
+    impl CollisionChecker for Reach {
+        fn is_free(&mut self, q: &[f64; 6]) -> bool {
+            !(self.blocked.0..=self.blocked.1).contains(&q[0])
+        }
+        fn free_reach(&mut self, q: &[f64; 6], step: &[f64; 6], _want: f64) -> Option<f64> {
+            self.asked.push(q[0]);
+            let x = q[0];
+            if !self.is_free(q) {
+                return None;
+            }
+            let to = if x < self.blocked.0 {
+                self.blocked.0 - x
+            } else {
+                x - self.blocked.1
+            };
+            Some((to / step[0].abs()).min(self.cap))
+        }
+        fn vouched(&mut self, samples: u64) -> bool {
+            self.vouched += samples;
+            true
+        }
+    }
+
+    #[test]
+    fn a_free_reach_vouches_for_its_neighbours_and_leaves_no_gap_over_a_step() {
+        let (a, b) = ([0.0; 6], [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        let res = Resolution::joint(0.01);
+        let mut c = Reach {
+            blocked: (2.0, 2.0),
+            cap: 2.5,
+            asked: Vec::new(),
+            vouched: 0,
+        };
+        check_segment(&mut c, &a, &b, &res).unwrap();
+        // Each of the 99 samples accounted for once: asked, or told as vouched for.
+        assert_eq!(c.asked.len() as u64 + c.vouched, 99);
+        // Far fewer questions than the 99 samples, and every point of the segment within a
+        // reach of 2.5 steps of an asked one or in a stretch of at most one step between such
+        // neighbourhoods (the ends count as checked).
+        assert!(c.asked.len() < 30, "{}", c.asked.len());
+        let mut covered: Vec<(f64, f64)> = c.asked.iter().map(|x| (x - 0.025, x + 0.025)).collect();
+        covered.push((0.0, 0.0));
+        covered.push((1.0, 1.0));
+        covered.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let mut end = 0.0f64;
+        for (lo, hi) in covered {
+            assert!(lo - end <= 0.01 + 1e-12, "a gap from {end} to {lo}");
+            end = end.max(hi);
+        }
+    }
+
+    #[test]
+    fn an_obstacle_between_vouched_stretches_is_found() {
+        // Blocked over three steps in the middle of a long free stretch.
+        let (a, b) = ([0.0; 6], [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        let mut c = Reach {
+            blocked: (0.615, 0.645),
+            cap: 4.0,
+            asked: Vec::new(),
+            vouched: 0,
+        };
+        let hit = check_segment(&mut c, &a, &b, &Resolution::joint(0.01)).unwrap_err();
+        assert!((0.615..=0.645).contains(&hit[0]), "{hit:?}");
     }
 
     #[test]

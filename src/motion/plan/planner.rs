@@ -54,17 +54,16 @@ fn in_bounds(q: &[f64; 6], config: &PlannerConfig) -> bool {
 /// ([`PlannerConfig::edge_resolution`]) along segments and arcs.
 ///
 /// The search and the shortcuts ask the checker's [`screen`](CollisionChecker::screen) first
-/// and `is_free` only when it cannot tell; every configuration of the shortcut path the screen
-/// called free is then checked again with `is_free` alone (so are the corner arcs), and if one
-/// is blocked the query is planned again with `is_free` alone
-/// ([`PlanStats::screen_fallback`]). The start, the goals and the direct segments are checked
-/// with `is_free` alone. Wherever the screen is off, a configuration within the lever-arm reach
-/// of the exact checker's spare clearance at a measured one
-/// ([`exact_spare`](CollisionChecker::exact_spare)) counts as checked free without asking again
-/// (the same verdict `is_free` gives); wherever it is on, one within the reach of the screen's
-/// spare clearance by joint range at a screened one
-/// ([`screen_spare`](CollisionChecker::screen_spare)) counts as screened free (the same verdict
-/// the screen gives, re-checked like it; see `docs/motion.md`).
+/// and `is_free` only when it cannot tell; when the screen helped find the path, every vertex
+/// and every segment of the shortcut path is then checked again with the exact checker alone,
+/// at the edge resolution (so are the corner arcs), and if one is blocked the query is planned
+/// again with `is_free` alone ([`PlanStats::screen_fallback`]). The start, the goals and the
+/// direct segments are checked with `is_free` alone. Along a segment, a configuration found
+/// free with a spare clearance vouches for its neighbours within the lever-arm reach of it
+/// ([`CollisionChecker::free_reach`]): the exact checker's
+/// ([`exact_spare`](CollisionChecker::exact_spare)) wherever the screen is off, the screen's by
+/// joint range ([`screen_spare`](CollisionChecker::screen_spare)) wherever it is on (see
+/// `docs/motion.md`).
 ///
 /// # Errors
 /// A [`PlanError`]: the typed reason, and the statistics of the attempt.
@@ -104,30 +103,10 @@ enum Attempt {
     ScreenWrong { checks: u64, screened: u64 },
 }
 
-/// Joint-space distance (radians) within which a configuration counts as lying on a segment of
-/// the path: rounding of the interpolation, nothing more.
-const ON_PATH: f64 = 1e-9;
-
-/// Where `q` lies on the segment `a`–`b` (the fraction of the way, 0 to 1), if it does (within
-/// [`ON_PATH`]).
-fn on_segment(q: &[f64; 6], a: &[f64; 6], b: &[f64; 6]) -> Option<f64> {
-    let (mut dd, mut dq) = (0.0, 0.0);
-    for j in 0..6 {
-        dd += (b[j] - a[j]) * (b[j] - a[j]);
-        dq += (q[j] - a[j]) * (b[j] - a[j]);
-    }
-    let t = if dd > 0.0 { (dq / dd).clamp(0.0, 1.0) } else { 0.0 };
-    let mut e = 0.0;
-    for j in 0..6 {
-        let d = a[j] + (b[j] - a[j]) * t - q[j];
-        e += d * d;
-    }
-    (e <= ON_PATH * ON_PATH).then_some(t)
-}
-
-/// Widest spare clearance the final re-check asks the exact checker for, metres
-/// ([`CollisionChecker::exact_spare`]): a configuration measured with this much to spare vouches
-/// for those up to this far (in the lever-arm displacement bound) along the path.
+/// Widest spare clearance the planner asks a checker for, metres
+/// ([`CollisionChecker::exact_spare`], [`CollisionChecker::screen_spare`]): a configuration
+/// measured with this much to spare vouches for those up to this far (in the lever-arm
+/// displacement bound) along a segment.
 pub const SPARE_CAP: f64 = 0.05;
 
 /// The lever arms the final re-check's vouching uses, metres: the configured ones, and never
@@ -138,45 +117,20 @@ fn vouching_arms(res: &super::edge::Resolution) -> [f64; 6] {
     std::array::from_fn(|j| res.lever_arms[j].max(super::config::UR5E_LEVER_ARMS[j]))
 }
 
-/// The exact re-check of a path the screen helped find: every configuration the screen called
-/// free that lies on `path` (the configurations its segments were checked at, at the edge
-/// resolution, also where a shortcut split a checked segment) is checked again by `checker`
-/// with its screen off, in the order of the path (so the exact checker's spare clearance at one
-/// vouches for the next ones within its reach). When the log of such configurations overflowed, every vertex and
-/// every segment of `path` is checked at `res` instead. True when all are free.
+/// The exact re-check of a path the screen helped find: every vertex of `path` and every
+/// segment at the edge resolution `res`, with `checker`'s screen off, in the order of the path
+/// (the exact checker's spare clearance at one configuration vouches for the next ones within
+/// its reach). True when all are free.
 fn revalidate<C: CollisionChecker + ?Sized>(
     checker: &mut Counting<'_, C>,
     path: &[[f64; 6]],
     res: &super::edge::Resolution,
 ) -> bool {
     checker.screen = false;
-    if checker.vouched_lost {
-        return path.iter().all(|q| checker.is_free(q))
-            && path
-                .windows(2)
-                .all(|w| check_segment(checker, &w[0], &w[1], res).is_ok());
-    }
-    // Each configuration on the path once, in the order of the path (segment, fraction).
-    let mut on: Vec<(usize, f64, [f64; 6])> = std::mem::take(&mut checker.vouched)
-        .into_iter()
-        .filter_map(|q| {
-            path.windows(2)
-                .enumerate()
-                .find_map(|(i, w)| on_segment(&q, &w[0], &w[1]).map(|t| (i, t, q)))
-        })
-        .collect();
-    let order = |x: &[f64; 6], y: &[f64; 6]| {
-        x.iter()
-            .zip(y)
-            .map(|(a, b)| a.total_cmp(b))
-            .find(|o| o.is_ne())
-            .unwrap_or(std::cmp::Ordering::Equal)
-    };
-    on.sort_by(|x, y| x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)).then(order(&x.2, &y.2)));
-    on.dedup_by(|x, y| x.2 == y.2);
-    // In the order of the path, each measured configuration vouches for the next ones within its
-    // spare clearance (the checker's exact vouching, on for the re-check).
-    on.iter().all(|(_, _, q)| checker.is_free(q))
+    checker.is_free(&path[0])
+        && path
+            .windows(2)
+            .all(|w| check_segment(checker, &w[0], &w[1], res).is_ok() && checker.is_free(&w[1]))
 }
 
 /// One planning attempt, with the checker's screen asked first (`screen`) or not.

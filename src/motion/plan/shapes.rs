@@ -117,6 +117,30 @@ pub fn near(x: &Shape, y: &Shape, gap: f64) -> bool {
     }
 }
 
+/// `None` when `x` and `y` may come closer than `gap` metres ([`near`]), else their
+/// [`clearance`] (at least `gap`), computed once where the two tests share their distance
+/// (capsule pairs, capsule–box).
+pub fn apart(x: &Shape, y: &Shape, gap: f64) -> Option<f64> {
+    use Shape::*;
+    let (d2, radii) = match (x, y) {
+        (
+            Capsule { a, b, radius },
+            Capsule {
+                a: c,
+                b: e,
+                radius: r2,
+            },
+        ) => (segment_segment_dist2(a, b, c, e), radius + r2),
+        (Capsule { a, b, radius }, Box { center, axes, half })
+        | (Box { center, axes, half }, Capsule { a, b, radius }) => {
+            (segment_box_dist2(a, b, center, axes, half), *radius)
+        }
+        _ => return (!near(x, y, gap)).then(|| clearance(x, y)),
+    };
+    let t = radii + gap;
+    (d2 >= t * t).then(|| (d2.sqrt() - radii).max(0.0))
+}
+
 /// A lower bound on the distance between `x` and `y`, metres (0 when they may touch, and for
 /// two half-spaces): exact for capsule pairs, capsule–box and anything against a half-space; for
 /// two boxes the widest gap of their projections on the six face axes (every separating
