@@ -257,7 +257,7 @@ const EXACT_BALLS: usize = 32;
 /// Configurations [`Counting`] remembers to vouch with the screen's spare, looked up before the
 /// screen is asked (a segment's own neighbours vouch through its bisection; these reach across
 /// segments: a search's neighbouring edges, a shortcut beside the path it shortens).
-const SCREEN_BALLS: usize = 128;
+const SCREEN_BALLS: usize = 32;
 
 /// Recently measured configurations and their spare clearance by joint range (radians;
 /// metres), a ring: a configuration the joints reach within a remembered spare keeps the margin
