@@ -238,7 +238,8 @@ pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
     pub(crate) budget: u64,
     /// Ask the inner checker's screen first.
     pub(crate) screen: bool,
-    /// Checks the screen answered (its own verdict or a remembered spare of its).
+    /// Checks decided without the exact test while the screen is on: answered by the screen
+    /// (its own verdict or a remembered spare of its), or vouched for along a segment.
     pub(crate) screened: u64,
     /// Lever arms (metres) to vouch with a measured spare clearance for configurations near
     /// the measured one: the exact checker's ([`CollisionChecker::exact_spare`]) while the

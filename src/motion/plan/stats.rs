@@ -32,8 +32,9 @@ pub struct PlanStats {
     pub duration: f64,
     /// Wall-clock time the query took (for reports only; no decision uses it).
     pub planning_time: Duration,
-    /// Checks the checker's screen answered ([`screen`](super::CollisionChecker::screen))
-    /// without its exact test.
+    /// Checks decided without the checker's exact test while its screen was on: answered by the
+    /// screen ([`screen`](super::CollisionChecker::screen)), or vouched for along a segment by a
+    /// neighbour's spare clearance.
     pub screened: u64,
     /// True when the exact re-check of the final path found a configuration the screen had
     /// passed blocked, and the query was planned again with exact checks only (its checks
