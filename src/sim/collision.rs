@@ -28,7 +28,7 @@ use super::margin::MarginPairs;
 use super::scene::{ARM_JOINTS, Scene};
 use super::screen::{Build, Screen};
 use crate::motion::fk;
-use crate::motion::plan::config::HELD_BLOCK_REACH;
+use crate::motion::plan::config::{HELD_BLOCK_REACH, UR5E_LEVER_ARMS};
 use crate::motion::plan::{Collision, CollisionChecker, JointSpare};
 use crate::scene::OBJECT_PREFIX;
 
@@ -256,7 +256,7 @@ impl SceneChecker {
                 *m = 0.0;
             }
         }
-        self.margin_pairs = (MarginPairs::new(self.data.model()), Vec::new());
+        self.margin_pairs = (MarginPairs::new(self.data.model(), &group), Vec::new());
     }
 
     /// Takes a new snapshot from `data` (a running simulation of the same scene): every block's
@@ -280,6 +280,7 @@ impl SceneChecker {
         let ids = &self.scene.ids;
         self.snapshot_q = ids.arm_qpos.map(|a| data.qpos()[a]);
         self.screen = None;
+        self.margin_pairs.0.forget();
         if let Some(h) = self.held.clone() {
             self.hold(h.object)?;
         }
@@ -322,6 +323,7 @@ impl SceneChecker {
             within_arms,
         });
         self.screen = None;
+        self.margin_pairs.0.forget();
         if regroup {
             self.rebuild_model();
         }
@@ -388,7 +390,11 @@ impl SceneChecker {
             return None;
         }
         self.detect_pose(q);
-        Some(self.margin_pairs.0.least(&mut self.data, wide))
+        Some(
+            self.margin_pairs
+                .0
+                .least(&mut self.data, q, &UR5E_LEVER_ARMS, wide),
+        )
     }
 
     /// Poses the arm (and a held block) at `q` with `mj_kinematics`.

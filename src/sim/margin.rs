@@ -30,12 +30,23 @@ fn margin_unreliable(a: MjtGeomBase, b: MjtGeomBase) -> bool {
     matches!(other, G::mjGEOM_BOX | G::mjGEOM_CAPSULE | G::mjGEOM_PLANE)
 }
 
-/// One pair to measure: geoms `a`, `b` and the pair's margin (the larger geom margin), metres.
+/// One pair to measure: geoms `a`, `b`, the pair's margin (the larger geom margin), metres, and
+/// the arm joints `lo..=hi` that move the two relative to each other (`lo > hi`: none).
 #[derive(Clone, Copy, Debug)]
 struct Pair {
     a: usize,
     b: usize,
     margin: f64,
+    lo: u8,
+    hi: u8,
+}
+
+/// The arm joints (0-based, `lo..=hi`) that move geoms of arm groups `ga` and `gb` relative to
+/// each other (group 0: fixed; `k` in 1..=6: moved by arm joints `0..k`): a fixed geom and one
+/// of group `k`, joints `0..=k−1`; groups `a < b`, joints `a..=b−1` (`lo > hi`: none).
+fn joint_range(ga: u8, gb: u8) -> (u8, u8) {
+    let (a, b) = (ga.min(gb), ga.max(gb));
+    if b == 0 { (1, 0) } else { (a, b - 1) }
 }
 
 /// The geom pairs of a model whose margin MuJoCo's narrow phase may leave out (see the module
@@ -49,12 +60,41 @@ pub(crate) struct MarginPairs {
     /// The index in `all` of the closest pair at the last [`MarginPairs::least`], measured
     /// first the next time: the least so far then prunes most of the others.
     closest: usize,
+    /// Lower bounds on each pair's distance from earlier calls of [`MarginPairs::least`].
+    known: Known,
+}
+
+/// Lower bounds on the pairs' distances, carried from call to call of [`MarginPairs::least`]:
+/// between two calls a point moved by joints `lo..=hi` moves relative to its partner at most the
+/// lever-arm bound `Σ_{j in lo..=hi} r_j |Δq_j|`, so no pair comes closer by more than that.
+#[derive(Clone, Debug, Default)]
+struct Known {
+    /// The joints of the last call, radians (`None`: nothing known).
+    at: Option<[f64; 6]>,
+    /// `travelled[k]`: the lever-arm displacements of joints `0..k` summed over the calls since
+    /// `at` was first set, metres (a prefix sum: joints `lo..=hi` moved `travelled[hi + 1] −
+    /// travelled[lo]`).
+    travelled: [f64; 7],
+    /// Per pair of `all`: a lower bound of its distance at the call that set it plus its joints'
+    /// travel then, metres (the bound now is this less its joints' travel now).
+    lower: Vec<f64>,
+}
+
+impl Known {
+    /// How far joints `lo..=hi` have moved a point, summed over the calls, metres.
+    fn moved(&self, p: &Pair) -> f64 {
+        if p.lo > p.hi {
+            return 0.0;
+        }
+        self.travelled[p.hi as usize + 1] - self.travelled[p.lo as usize]
+    }
 }
 
 impl MarginPairs {
     /// The capsule–box, box–box and box–plane pairs MuJoCo tests in `m` (its contact bitmasks,
-    /// its body filters, `<exclude>`) with a positive margin.
-    pub(crate) fn new(m: &MjModel) -> Self {
+    /// its body filters, `<exclude>`) with a positive margin; `group` gives each geom's arm group
+    /// (0: fixed; `k` in 1..=6: moved by arm joint `k − 1`, a held block's geoms 6).
+    pub(crate) fn new(m: &MjModel, group: &[u8]) -> Self {
         let ngeom = m.ffi().ngeom as usize;
         let (types, margin) = (m.geom_type(), m.geom_margin());
         let filter = PairFilter::new(m);
@@ -63,10 +103,13 @@ impl MarginPairs {
             for g2 in g1 + 1..ngeom {
                 let pair_margin = margin[g1].max(margin[g2]);
                 if pair_margin > 0.0 && filter.tested(g1, g2) {
+                    let (lo, hi) = joint_range(group[g1], group[g2]);
                     let p = Pair {
                         a: g1,
                         b: g2,
                         margin: pair_margin,
+                        lo,
+                        hi,
                     };
                     all.push(p);
                     if margin_unreliable(types[g1], types[g2]) {
@@ -79,6 +122,7 @@ impl MarginPairs {
             pairs,
             all,
             closest: 0,
+            known: Known::default(),
         }
     }
 
@@ -115,21 +159,63 @@ impl MarginPairs {
     /// first, so the least so far prunes the others. One least for every pair, not one per
     /// joint range as the screen's spare: measured on the motion benchmark, the pruning by the
     /// least so far saves more `mj_geomDistance` calls than ranges would vouch for.
-    pub(crate) fn least<M: ModelType>(&mut self, data: &mut MjData<M>, wide: f64) -> f64 {
+    ///
+    /// `q` (radians) is the configuration `data` is posed at and `arms` the lever arms (metres)
+    /// that bound how far a point moves per radian of each joint: each pair's bound is carried
+    /// to the next calls, less how far the joints that move the pair have moved since, and a
+    /// pair still at least the least so far apart is not looked at again. The least is the same
+    /// as measured afresh; [`MarginPairs::forget`] drops the bounds when the scene changes.
+    pub(crate) fn least<M: ModelType>(
+        &mut self,
+        data: &mut MjData<M>,
+        q: &[f64; 6],
+        arms: &[f64; 6],
+        wide: f64,
+    ) -> f64 {
+        let known = &mut self.known;
+        match known.at {
+            Some(prev) => {
+                let mut sum = 0.0;
+                for j in 0..6 {
+                    sum += arms[j] * (q[j] - prev[j]).abs();
+                    known.travelled[j + 1] += sum;
+                }
+            }
+            None => {
+                known.lower.clear();
+                known.lower.resize(self.all.len(), f64::NEG_INFINITY);
+                known.travelled = [0.0; 7];
+            }
+        }
+        known.at = Some(*q);
         let mut least = wide;
         let first = self.closest.min(self.all.len().saturating_sub(1));
         let order = std::iter::once(first).chain((0..self.all.len()).filter(|&i| i != first));
         for i in order {
             let p = &self.all[i];
-            if near(data, p, least) {
-                let d = data.geom_distance(p.a, p.b, least, None);
-                if d < least {
-                    least = d;
-                    self.closest = i;
-                }
+            // Apart by at least `least` still, since the call that bounded it.
+            let moved = known.moved(p);
+            if known.lower[i] - moved >= least {
+                continue;
+            }
+            let bound = apart(data, p, least);
+            if bound >= least {
+                known.lower[i] = bound + moved;
+                continue;
+            }
+            let d = data.geom_distance(p.a, p.b, least, None);
+            known.lower[i] = d + moved;
+            if d < least {
+                least = d;
+                self.closest = i;
             }
         }
         least
+    }
+
+    /// Drops the pairs' lower bounds ([`MarginPairs::least`]): the scene or a held block moved.
+    pub(crate) fn forget(&mut self) {
+        self.known.at = None;
     }
 
     /// True when the model has no pair with a positive margin.
@@ -143,6 +229,12 @@ impl MarginPairs {
 /// half-space against the other's bounding sphere, is at least the margin; the geoms then keep
 /// it too.
 fn near<M: ModelType>(data: &MjData<M>, p: &Pair, margin: f64) -> bool {
+    apart(data, p, margin) < margin
+}
+
+/// A lower bound on the pair's distance, metres, from the bounds [`near`] uses (the bounding
+/// spheres alone when they keep `margin`).
+fn apart<M: ModelType>(data: &MjData<M>, p: &Pair, margin: f64) -> f64 {
     let m = data.model();
     let (pos, mat, rbound, types) = (data.geom_xpos(), data.geom_xmat(), m.geom_rbound(), m.geom_type());
     // A lower bound of the distance from geom `shape` (a box or a plane) to geom `other`.
@@ -165,16 +257,16 @@ fn near<M: ModelType>(data: &MjData<M>, p: &Pair, margin: f64) -> bool {
     };
     let is_box = |g: usize| types[g] == MjtGeomBase::mjGEOM_BOX;
     let plane = |g: usize| types[g] == MjtGeomBase::mjGEOM_PLANE;
+    let mut apart = f64::NEG_INFINITY;
     if !plane(p.a) && !plane(p.b) {
         // The bounding spheres first: most pairs are far apart, and the box bounds cost more.
         let (x, y) = (pos[p.a], pos[p.b]);
-        let reach = rbound[p.a] + rbound[p.b] + margin;
         let d2 = (x[0] - y[0]).powi(2) + (x[1] - y[1]).powi(2) + (x[2] - y[2]).powi(2);
-        if d2 >= reach * reach {
-            return false;
+        apart = d2.sqrt() - rbound[p.a] - rbound[p.b];
+        if apart >= margin {
+            return apart;
         }
     }
-    let mut apart = f64::NEG_INFINITY;
     // A plane is unbounded: only its own half-space bounds the distance to it.
     if plane(p.a) || (is_box(p.a) && !plane(p.b)) {
         apart = apart.max(bound(p.a, p.b));
@@ -182,5 +274,25 @@ fn near<M: ModelType>(data: &MjData<M>, p: &Pair, margin: f64) -> bool {
     if plane(p.b) || (is_box(p.b) && !plane(p.a)) {
         apart = apart.max(bound(p.b, p.a));
     }
-    apart < margin
+    apart
+}
+
+#[cfg(test)]
+mod tests {
+    use super::joint_range;
+
+    #[test]
+    fn a_pair_is_moved_by_the_joints_between_its_links() {
+        // The fixed cell against link k (group k + 1): every joint up to k.
+        assert_eq!(joint_range(0, 1), (0, 0));
+        assert_eq!(joint_range(6, 0), (0, 5));
+        // Wrist 1 (group 4) against wrist 3 or a held block (group 6): wrists 2 and 3 only.
+        assert_eq!(joint_range(4, 6), (4, 5));
+        assert_eq!(joint_range(6, 4), (4, 5));
+        // Two fixed geoms, or two of one link, never move relative to each other.
+        let (lo, hi) = joint_range(0, 0);
+        assert!(lo > hi);
+        let (lo, hi) = joint_range(3, 3);
+        assert!(lo > hi);
+    }
 }
