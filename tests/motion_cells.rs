@@ -90,6 +90,45 @@ fn a_held_block_is_carried_past_a_wall_taller_than_the_lift_without_touching_it(
     );
 }
 
+/// `go_around`'s pick, carry and release, once (no retry), the carry given `extra` parameters.
+fn carry_around(extra: &str) -> Arc<Plan> {
+    tree(&format!(
+        "main:
+  sequence:
+    children:
+      - home: {{}}
+      - release: {{width: 0.065, retreat: 0}}
+      - reach: {{target: cube, offset: [0, 0, 0.12]}}
+      - reach: {{target: cube, offset: [0, 0, 0.0], path: cartesian}}
+      - grasp: {{}}
+      - carry: {{name: around, to: bowl, lift: 0.15, place_height: 0.02, speed: 1.0{extra}}}
+      - release: {{retreat: 0.10}}
+"
+    ))
+}
+
+#[test]
+fn a_carry_with_a_small_check_budget_ends_in_no_path_naming_the_fixture() {
+    // The transfer around `go_around`'s 0.80 m fixture must be searched for (no direct segment
+    // is free): 40 collision checks do not find it, the planner's own budget does.
+    let cell = scene(&std::fs::read_to_string(Path::new(ROOT).join("scenes/go_around.yaml")).unwrap());
+    let r = run(&cell, carry_around(", max_checks: 40"));
+    assert_eq!(
+        r.failure_kind,
+        Some(FailureKind::NoPath),
+        "{:?}",
+        r.failure_reason
+    );
+    assert_eq!(r.failed_node.as_deref(), Some("main/sequence/carry[around]"));
+    let why = r.failure_reason.unwrap_or_default();
+    assert!(why.contains("fixture"), "{why}");
+    assert_eq!(r.planning.plan_failures, 1, "{:?}", r.planning);
+    assert!(r.collisions.is_empty(), "{:?}", r.collisions);
+    let r = run(&cell, carry_around(""));
+    assert!(r.success, "{:?}", r.failure_reason);
+    assert_eq!(r.planning.plan_failures, 0, "{:?}", r.planning);
+}
+
 #[test]
 fn a_low_wall_needs_no_plan_and_a_tall_one_does() {
     // The contrast that makes the test above mean something: a 5 cm wall is cleared by the
@@ -160,15 +199,58 @@ fn the_same_swing_with_the_default_budget_goes_around_the_fixture() {
     assert!(r.collisions.is_empty(), "{:?}", r.collisions);
 }
 
+/// The go-around cell with the arm on one side of the fixture, then a `reach` named `across`
+/// to the pinch point on the other side (the swing's goal), with `extra` parameters.
+fn reach_across_tree(extra: &str) -> (Scene, Arc<Plan>) {
+    let (cell, _) = swing_tree("");
+    let a = down(0.45, -0.25, 0.25, &HOME_Q);
+    let text = format!(
+        "main:\n  sequence:\n    children:\n      - move_joints: {{name: one side, joints: [{}]}}\n      - reach: {{name: across, target: [0.45, 0.25, 0.25], yaw: 0{extra}}}\n",
+        joints(&a)
+    );
+    (cell, tree(&text))
+}
+
+#[test]
+fn a_reach_with_a_small_check_budget_ends_in_no_path_naming_the_fixture() {
+    let (cell, plan) = reach_across_tree(", max_checks: 40");
+    let r = run(&cell, plan);
+    assert_eq!(
+        r.failure_kind,
+        Some(FailureKind::NoPath),
+        "{:?}",
+        r.failure_reason
+    );
+    assert_eq!(r.failed_node.as_deref(), Some("main/sequence/reach[across]"));
+    let why = r.failure_reason.unwrap_or_default();
+    assert!(why.contains("fixture"), "{why}");
+    assert!(r.planning.plan_failures >= 1, "{:?}", r.planning);
+    assert!(r.collisions.is_empty(), "{:?}", r.collisions);
+    // The same reach with the planner's own budget goes around.
+    let (cell, plan) = reach_across_tree("");
+    let r = run(&cell, plan);
+    assert!(r.success, "{:?}", r.failure_reason);
+    assert!(r.planning.plans >= 1, "{:?}", r.planning);
+    assert!(r.collisions.is_empty(), "{:?}", r.collisions);
+}
+
 #[test]
 fn max_checks_out_of_range_is_a_located_tree_error() {
-    let text = "main:\n  move_joints: {joints: [0, -1.57, 1.57, -1.57, -1.57, 0], max_checks: 0}\n";
-    let errs = Loader::default()
-        .compile_str(text, "budget.yaml")
-        .expect_err("max_checks 0 is rejected");
-    let msg = errs[0].to_string();
-    assert!(msg.contains("budget.yaml:2:"), "{msg}");
-    assert!(msg.contains("max_checks"), "{msg}");
+    for leaf in [
+        "move_joints: {joints: [0, -1.57, 1.57, -1.57, -1.57, 0], max_checks: 0}",
+        "reach: {target: cube, max_checks: 0}",
+        "carry: {to: bowl, max_checks: 0}",
+        "place: {point: [0.4, 0.1], max_checks: 0}",
+        "home: {max_checks: 10000001}",
+    ] {
+        let text = format!("main:\n  {leaf}\n");
+        let errs = Loader::default()
+            .compile_str(&text, "budget.yaml")
+            .expect_err("an out-of-range max_checks is rejected");
+        let msg = errs[0].to_string();
+        assert!(msg.contains("budget.yaml:2:"), "{leaf}: {msg}");
+        assert!(msg.contains("max_checks"), "{leaf}: {msg}");
+    }
 }
 
 #[test]

@@ -608,7 +608,8 @@ impl Carry {
         } else {
             crate::motion::plan::GoalSet::configs(free)
         };
-        let motion = super::planning::plan_motion(cell, "carry transfer", from, &goals)?;
+        let motion =
+            super::planning::plan_motion(cell, "carry transfer", from, &goals, self.spec.max_checks)?;
         let reached = crate::motion::fk(&motion.trajectory.end()).rotation;
         let k = (0..4)
             .min_by(|&a, &b| {

@@ -2,7 +2,7 @@
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
-use super::planning::{check_motion, describe, plan_motion_within};
+use super::planning::{check_motion, describe, plan_motion};
 use crate::failure::FailureKind;
 use crate::motion::plan::{GoalSet, PlannerConfig};
 use crate::motion::{JointMove, MotionLimits};
@@ -51,11 +51,11 @@ impl MacroAction for MoveJoints {
             // exactly these joint angles.
             tracing::debug!(target: "macrotree::actions", "move_joints: the direct joint move would touch {}; planning", describe(&pairs));
             let goals = GoalSet::configs(vec![self.goal_q]);
-            let motion = match plan_motion_within(cell, "move_joints", &from, &goals, self.max_checks) {
+            let motion = match plan_motion(cell, "move_joints", &from, &goals, self.max_checks) {
                 Err(e) if e.kind == FailureKind::NoPath && self.max_checks.is_none() => {
                     let budget = SECOND_SEARCH_BUDGET * PlannerConfig::default().max_checks;
                     tracing::debug!(target: "macrotree::actions", "move_joints: {e}; searching once more with {budget} checks");
-                    plan_motion_within(cell, "move_joints", &from, &goals, Some(budget))?
+                    plan_motion(cell, "move_joints", &from, &goals, Some(budget))?
                 }
                 planned => planned?,
             };

@@ -80,6 +80,7 @@ impl MacroAction for Place {
             place_height: DROP,
             speed: self.spec.speed,
             timeout: self.spec.timeout,
+            max_checks: self.spec.max_checks,
         };
         let mut carry = Carry::placing(spec, yaw);
         self.release = None;
@@ -135,6 +136,7 @@ mod tests {
             retreat: 0.1,
             speed: 0.5,
             timeout: 15.0,
+            max_checks: None,
         }
     }
 

@@ -325,26 +325,14 @@ pub(crate) fn describe(pairs: &[Collision]) -> String {
 pub(crate) const LEAF_TIME_CAP: Duration = Duration::from_secs(2);
 
 /// Plans the arm from `start` to any of `goals` in the cell, the pairs touching at `start`
-/// allowed; logs the query; counts it in the tally. The cell's `n`-th plan of the episode is
-/// seeded with `n`, so an episode replays the same plans.
+/// allowed, with the planner's collision-check budget set to `max_checks` (the leaf's
+/// `max_checks` parameter, range-checked by the tree reader; `None`: the planner's default);
+/// logs the query; counts it in the tally. The cell's `n`-th plan of the episode is seeded with
+/// `n`, so an episode replays the same plans.
 ///
 /// # Errors
 /// The planner's typed failure ([`crate::sim::planning::plan_failure`]).
 pub(crate) fn plan_motion(
-    cell: &mut Cell,
-    what: &str,
-    start: &[f64; 6],
-    goals: &GoalSet,
-) -> Result<PlannedMotion, Failure> {
-    plan_motion_within(cell, what, start, goals, None)
-}
-
-/// [`plan_motion`] with the planner's collision-check budget set to `max_checks` (the leaf's
-/// `max_checks` parameter, range-checked by the tree reader; `None`: the planner's default).
-///
-/// # Errors
-/// The planner's typed failure ([`crate::sim::planning::plan_failure`]).
-pub(crate) fn plan_motion_within(
     cell: &mut Cell,
     what: &str,
     start: &[f64; 6],

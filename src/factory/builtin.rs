@@ -28,7 +28,9 @@ fn bind(f: &mut Factory) -> Result<(), BindError> {
     f.bind_action("move_joints", |p: &MoveJoints| {
         Box::new(MoveJointsAction::new(p.joints).with_max_checks(p.max_checks))
     })?;
-    f.bind_action("home", |_: &Home| Box::new(MoveJointsAction::home()))?;
+    f.bind_action("home", |p: &Home| {
+        Box::new(MoveJointsAction::home().with_max_checks(p.max_checks))
+    })?;
     f.bind_action("grasp", |p: &Grasp| Box::new(GraspAction::new(p.clone())))?;
     f.bind_action("carry", |p: &Carry| Box::new(CarryAction::new(p.clone())))?;
     f.bind_action("release", |p: &Release| Box::new(ReleaseAction::new(p.clone())))?;

@@ -104,6 +104,12 @@ pub struct Reach {
     #[serde(default = "d_5", deserialize_with = "units::time_limit")]
     #[schemars(range(min = 0.0))]
     pub timeout: f64,
+    /// Collision checks the planner may spend when the direct motion would collide (1 to
+    /// 10 000 000); a search that uses them up fails with `no_path`. Default: the planner's
+    /// own budget (20 000).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(range(min = 1, max = 10_000_000))]
+    pub max_checks: Option<u64>,
 }
 
 #[doc = include_str!("../../docs/nodes/move_joints.md")]
@@ -134,11 +140,20 @@ pub struct Home {
     #[serde(default = "d_6", deserialize_with = "units::time_limit")]
     #[schemars(range(min = 0.0))]
     pub timeout: f64,
+    /// Collision checks the planner may spend when the direct move would collide (1 to
+    /// 10 000 000); a search that uses them up fails with `no_path`. Default: the planner's
+    /// own budget (20 000).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(range(min = 1, max = 10_000_000))]
+    pub max_checks: Option<u64>,
 }
 
 impl Default for Home {
     fn default() -> Self {
-        Self { timeout: 6.0 }
+        Self {
+            timeout: 6.0,
+            max_checks: None,
+        }
     }
 }
 
@@ -193,6 +208,12 @@ pub struct Carry {
     #[serde(default = "d_10", deserialize_with = "units::time_limit")]
     #[schemars(range(min = 0.0))]
     pub timeout: f64,
+    /// Collision checks the planner may spend when the direct transfer would collide (1 to
+    /// 10 000 000); a search that uses them up fails with `no_path`. Default: the planner's
+    /// own budget (20 000).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(range(min = 1, max = 10_000_000))]
+    pub max_checks: Option<u64>,
 }
 
 fn d_15() -> f64 {
@@ -241,6 +262,12 @@ pub struct Place {
     #[serde(default = "d_15", deserialize_with = "units::time_limit")]
     #[schemars(range(min = 0.0))]
     pub timeout: f64,
+    /// Collision checks the planner may spend when the direct transfer would collide (1 to
+    /// 10 000 000); a search that uses them up fails with `no_path`. Default: the planner's
+    /// own budget (20 000).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(range(min = 1, max = 10_000_000))]
+    pub max_checks: Option<u64>,
 }
 
 #[doc = include_str!("../../docs/nodes/release.md")]
@@ -709,7 +736,8 @@ impl Params for Reach {
         Some(self.timeout)
     }
     fn validate_fields(&self) -> Result<(), ParamError> {
-        super::approach::check_reach(self.approach, &self.target, &self.offset, &self.yaw)
+        super::approach::check_reach(self.approach, &self.target, &self.offset, &self.yaw)?;
+        check_max_checks(self.max_checks)
     }
 }
 
@@ -721,19 +749,27 @@ impl Params for MoveJoints {
         Some(self.timeout)
     }
     fn validate_fields(&self) -> Result<(), ParamError> {
-        match self.max_checks {
-            Some(n) if !(1..=10_000_000).contains(&n) => Err(ParamError::at(
-                "max_checks",
-                format!("`max_checks` must be between 1 and 10000000 collision checks, found {n}"),
-            )),
-            _ => Ok(()),
-        }
+        check_max_checks(self.max_checks)
+    }
+}
+
+/// The `max_checks` parameter of a leaf that plans: 1 to 10 000 000 collision checks.
+fn check_max_checks(max_checks: Option<u64>) -> Result<(), ParamError> {
+    match max_checks {
+        Some(n) if !(1..=10_000_000).contains(&n) => Err(ParamError::at(
+            "max_checks",
+            format!("`max_checks` must be between 1 and 10000000 collision checks, found {n}"),
+        )),
+        _ => Ok(()),
     }
 }
 
 impl Params for Home {
     fn timeout(&self) -> Option<f64> {
         Some(self.timeout)
+    }
+    fn validate_fields(&self) -> Result<(), ParamError> {
+        check_max_checks(self.max_checks)
     }
 }
 
@@ -764,6 +800,9 @@ impl Params for Carry {
     }
     fn timeout(&self) -> Option<f64> {
         Some(self.timeout)
+    }
+    fn validate_fields(&self) -> Result<(), ParamError> {
+        check_max_checks(self.max_checks)
     }
 }
 
@@ -806,7 +845,7 @@ impl Params for Place {
                 "`object` is not a place yaw: give an angle (`deg(90)`) or `keep`",
             ));
         }
-        Ok(())
+        check_max_checks(self.max_checks)
     }
 }
 
