@@ -223,16 +223,19 @@ impl Cell {
     pub fn advance(&mut self) {
         for _ in 0..self.steps_per_tick {
             let t = self.sim.time();
-            let (q, qd) = match &self.arm {
-                ArmPlan::Hold(q) => (*q, [0.0; 6]),
+            let (q, qd, qdd) = match &self.arm {
+                ArmPlan::Hold(q) => (*q, [0.0; 6], [0.0; 6]),
                 ArmPlan::Track { trajectory, t0 } if t - t0 >= trajectory.duration() => {
                     let end = trajectory.end();
                     self.arm = ArmPlan::Hold(end);
-                    (end, [0.0; 6])
+                    (end, [0.0; 6], [0.0; 6])
                 }
-                ArmPlan::Track { trajectory, t0 } => trajectory.sample(t - t0),
+                ArmPlan::Track { trajectory, t0 } => {
+                    let (q, qd) = trajectory.sample(t - t0);
+                    (q, qd, trajectory.acceleration(t - t0))
+                }
             };
-            self.sim.command_arm(&q, &qd);
+            self.sim.command_arm(&q, &qd, &qdd);
             self.sim.set_gripper_ctrl(self.gripper_ctrl);
             for obs in &mut self.observers {
                 obs.before_step(&mut self.sim);

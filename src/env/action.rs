@@ -25,7 +25,7 @@ pub enum Action {
     /// exactly one control period (`EnvConfig::control_period`, default 4 ms = 2 physics steps
     /// of 2 ms). The layout is the dataset's `action` ([`super::Observation::command`]); the
     /// arm servos track the target with the same gravity feedforward as every leaf (zero target
-    /// velocity).
+    /// velocity and acceleration).
     Ctrl([f64; 7]),
     /// A node of the environment's tree, by its `name:` (a subtree call is named after its
     /// subtree: `pick`), by its node path (`main/sequence[cube to bowl]/…`), or `main` for the

@@ -3,8 +3,8 @@
 //! cell as a controller.
 //!
 //! What differs from the reference, on purpose: motions start from the commanded set point
-//! (not the measured, gravity-sagged joints) and the servos get the same gravity feedforward as
-//! every leaf, so holding does not sag; joint and Cartesian moves follow macrotree's
+//! (not the measured, gravity-sagged joints) and the servos get the same velocity, inertia and
+//! gravity feedforward as every leaf, so holding does not sag; joint and Cartesian moves follow macrotree's
 //! minimum-jerk profiles ([`crate::motion`]) stretched to the requested duration instead of
 //! linear ramps; the gripper command steps to its target instead of ramping.
 
@@ -262,6 +262,10 @@ impl Trajectory for Retimed {
         let k = self.inner.duration() / self.duration;
         let (q, qd) = self.inner.sample(t * k);
         (q, qd.map(|v| v * k))
+    }
+    fn acceleration(&self, t: f64) -> [f64; 6] {
+        let k = self.inner.duration() / self.duration;
+        self.inner.acceleration(t * k).map(|a| a * k * k)
     }
     fn duration(&self) -> f64 {
         self.duration

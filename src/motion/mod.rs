@@ -21,7 +21,7 @@ pub mod trajectory;
 pub use gripper::{CLOSED_CTRL, OPEN_CTRL, ctrl_for_width, width_for_ctrl};
 pub use ik::{IkError, down_pose, ik, ik_all, ik_benchmark, ik_down, ik_down_with_pose};
 pub use kinematics::{ARM_JOINTS, JOINT_LIMITS, fk, jacobian};
-pub use trajectory::{CartesianMove, Hold, JointMove, MotionLimits, Trajectory};
+pub use trajectory::{ACC_DIFF_STEP, CartesianMove, Hold, JointMove, MotionLimits, Trajectory};
 
 /// Home joint angles of the UR5e (Menagerie keyframe `home`), radians — the same values as
 /// `sim::HOME_Q`, repeated here so this layer stays MuJoCo-free. At home the pinch is at

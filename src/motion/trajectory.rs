@@ -58,6 +58,10 @@ impl Default for MotionLimits {
     }
 }
 
+/// Half the interval over which [`Trajectory::acceleration`] differentiates velocities by
+/// default, seconds: half a physics step.
+pub const ACC_DIFF_STEP: f64 = 1e-3;
+
 /// A smooth motion in joint space that can be sampled at any time `t ≥ 0` (seconds since its
 /// start); after [`duration`](Trajectory::duration) it holds [`end`](Trajectory::end).
 pub trait Trajectory: Send {
@@ -65,6 +69,22 @@ pub trait Trajectory: Send {
     fn sample(&self, t: f64) -> ([f64; 6], [f64; 6]);
     /// Duration of the motion, seconds.
     fn duration(&self) -> f64;
+    /// Joint accelerations at time `t` seconds, rad/s² (the servos' inertial feedforward). The
+    /// default differentiates [`sample`](Self::sample)'s velocities over ±[`ACC_DIFF_STEP`]
+    /// (one-sided at the ends, where the motion is at rest before and after); zero after the end.
+    fn acceleration(&self, t: f64) -> [f64; 6] {
+        let d = self.duration();
+        if t.is_nan() || t >= d || d <= 0.0 {
+            return [0.0; 6];
+        }
+        let (a, b) = ((t - ACC_DIFF_STEP).max(0.0), (t + ACC_DIFF_STEP).min(d));
+        if b <= a {
+            return [0.0; 6];
+        }
+        let (_, va) = self.sample(a);
+        let (_, vb) = self.sample(b);
+        std::array::from_fn(|j| (vb[j] - va[j]) / (b - a))
+    }
     /// Final joint positions, radians (exactly what `sample(t)` returns for `t ≥ duration()`).
     fn end(&self) -> [f64; 6];
     /// What kind of motion this is, for logs ("joint move", "straight line", …).
@@ -125,6 +145,15 @@ impl Trajectory for JointMove {
 
     fn duration(&self) -> f64 {
         self.duration
+    }
+
+    fn acceleration(&self, t: f64) -> [f64; 6] {
+        if t.is_nan() || t >= self.duration {
+            return [0.0; 6];
+        }
+        let (_, _, sdd) = min_jerk(t.max(0.0) / self.duration);
+        let k = sdd / (self.duration * self.duration);
+        std::array::from_fn(|j| (self.to[j] - self.from[j]) * k)
     }
 
     fn end(&self) -> [f64; 6] {

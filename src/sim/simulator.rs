@@ -26,6 +26,10 @@ pub struct Sim {
     steps: u64,
     /// Wall-clock time spent inside `mj_step` since this simulation was created (never reset).
     physics_time: std::time::Duration,
+    /// Scratch for [`Sim::command_arm`]: the commanded joint accelerations (rad/s², `nv`).
+    accel: Vec<f64>,
+    /// Scratch for [`Sim::command_arm`]: the inertial torques `M q̈` (N·m, `nv`).
+    inertial: Vec<f64>,
 }
 
 impl Sim {
@@ -37,6 +41,8 @@ impl Sim {
             data,
             steps: 0,
             physics_time: std::time::Duration::ZERO,
+            accel: Vec::new(),
+            inertial: Vec::new(),
         };
         let placement = scene.default_placement();
         sim.reset_placement(&placement);
@@ -116,21 +122,43 @@ impl Sim {
         }
     }
 
-    /// Commands the arm to track joint angles `q` (radians) moving at `qd` (rad/s), with feedforward.
+    /// Commands the arm to track joint angles `q` (radians) moving at `qd` (rad/s) and
+    /// accelerating at `qdd` (rad/s²), with feedforward.
     ///
     /// Menagerie's UR5e servos are plain PD position actuators, `τ = kp (ctrl − q) − kv q̇`, with
     /// no gravity compensation: holding a pose they sag by about 0.6° (≈1 cm at the tool), and
-    /// tracking a moving target they lag by `kv/kp · q̇`. This command shifts the servo set point
-    /// so that `τ = kp (q − q_meas) + kv (qd − q̇_meas) + bias`, where `bias` is MuJoCo's
-    /// gravity + Coriolis torque at the current state (`qfrc_bias`) — the feedforward a real UR
-    /// controller applies. Call it before every physics step while tracking.
-    pub fn command_arm(&mut self, q: &[f64; 6], qd: &[f64; 6]) {
+    /// tracking a moving target they lag by `kv/kp · q̇`, and by `M q̈ / kp` while accelerating
+    /// (about 1 cm at the pinch at the default limits). This command shifts the servo set point
+    /// so that `τ = kp (q − q_meas) + kv (qd − q̇_meas) + M qdd + bias`, where `M` is MuJoCo's
+    /// joint-space inertia (with the gripper and the joints' armature) and `bias` its gravity +
+    /// Coriolis torque, both at the state of the last step (`qM`, `qfrc_bias`): the computed-torque
+    /// feedforward of a real UR controller. Call it before every physics step while tracking.
+    pub fn command_arm(&mut self, q: &[f64; 6], qd: &[f64; 6], qdd: &[f64; 6]) {
         let ids = &self.scene.ids;
+        let nv = self.data.model().ffi().nv as usize;
+        self.accel.clear();
+        self.accel.resize(nv, 0.0);
+        self.inertial.clear();
+        self.inertial.resize(nv, 0.0);
+        for (&dof, &a) in ids.arm_dof.iter().zip(qdd) {
+            self.accel[dof] = if a.is_finite() { a } else { 0.0 };
+        }
+        // SAFETY: `accel` and `inertial` hold exactly `nv` numbers, what mj_mulM reads and
+        // writes; the model and data are MuJoCo's own, valid for this call.
+        unsafe {
+            mujoco_rs::mujoco_c::mj_mulM(
+                self.data.model().ffi(),
+                self.data.ffi(),
+                self.inertial.as_mut_ptr(),
+                self.accel.as_ptr(),
+            );
+        }
         let bias = self.data.qfrc_bias();
         let mut set = [0.0; 6];
         for i in 0..6 {
             let (kp, kv) = self.scene.arm_gains[i];
-            let u = q[i] + (kv * qd[i] + bias[ids.arm_dof[i]]) / kp;
+            let dof = ids.arm_dof[i];
+            let u = q[i] + (kv * qd[i] + self.inertial[dof] + bias[dof]) / kp;
             let [lo, hi] = self.scene.arm_ctrlrange[i];
             set[i] = u.clamp(lo, hi);
         }
