@@ -328,11 +328,13 @@ fn carry_chose_a_free_spot_in_a_020_m_bin_that_its_own_descent_check_refused() {
 
 /// The bug: a deep bin (0.12 m walls, the scene format's maximum) holding one block "could not
 /// take" a second one held at 40° to it: the opened hand, diagonal across the bin, reached a wall
-/// or the first block from every spot. Set down square to the bin, both fit.
+/// or the first block from every spot. Set down square to the bin, both fit. (Found in a
+/// 0.21 m bin; there, since the servos' inertia feed-forward, the first block lands 0.4 mm from
+/// where it did and one diagonal spot just fits, so the test uses 0.20 m, where none does.)
 #[test]
 fn a_deep_bin_could_not_take_a_second_block_held_diagonally() {
     let objects = format!(
-        "{}{}  bin:\n    container: {{inner: [0.21, 0.21], wall_height: 0.12, color: gray}}\n    pose: [0.50, 0.14]\n",
+        "{}{}  bin:\n    container: {{inner: [0.20, 0.20], wall_height: 0.12, color: gray}}\n    pose: [0.50, 0.14]\n",
         block("a", 0.40, -0.20, 0.0),
         block("b", 0.55, -0.20, 40.0),
     );
@@ -342,7 +344,7 @@ fn a_deep_bin_could_not_take_a_second_block_held_diagonally() {
         steps += "      - carry: {to: bin, lift: 0.20}\n      - release: {width: 0.08, retreat: 0.15}\n";
     }
     let (r, cell) = run("deep_bin_square", &objects, &sequence(&steps));
-    assert_success(&r, "two blocks into a deep 0.21 m bin");
+    assert_success(&r, "two blocks into a deep 0.20 m bin");
     assert!(r.collisions.is_empty(), "{:?}", r.collisions);
     let w = cell.world();
     let bin = index(w, "bin");
