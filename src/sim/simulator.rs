@@ -140,18 +140,21 @@ impl Sim {
         self.accel.resize(nv, 0.0);
         self.inertial.clear();
         self.inertial.resize(nv, 0.0);
-        for (&dof, &a) in ids.arm_dof.iter().zip(qdd) {
-            self.accel[dof] = if a.is_finite() { a } else { 0.0 };
-        }
-        // SAFETY: `accel` and `inertial` hold exactly `nv` numbers, what mj_mulM reads and
-        // writes; the model and data are MuJoCo's own, valid for this call.
-        unsafe {
-            mujoco_rs::mujoco_c::mj_mulM(
-                self.data.model().ffi(),
-                self.data.ffi(),
-                self.inertial.as_mut_ptr(),
-                self.accel.as_ptr(),
-            );
+        // Holding (no acceleration) needs no inertial torque: M · 0 is 0.
+        if qdd.iter().any(|a| *a != 0.0 && a.is_finite()) {
+            for (&dof, &a) in ids.arm_dof.iter().zip(qdd) {
+                self.accel[dof] = if a.is_finite() { a } else { 0.0 };
+            }
+            // SAFETY: `accel` and `inertial` hold exactly `nv` numbers, what mj_mulM reads and
+            // writes; the model and data are MuJoCo's own, valid for this call.
+            unsafe {
+                mujoco_rs::mujoco_c::mj_mulM(
+                    self.data.model().ffi(),
+                    self.data.ffi(),
+                    self.inertial.as_mut_ptr(),
+                    self.accel.as_ptr(),
+                );
+            }
         }
         let bias = self.data.qfrc_bias();
         let mut set = [0.0; 6];
