@@ -254,6 +254,32 @@ fn max_checks_out_of_range_is_a_located_tree_error() {
 }
 
 #[test]
+fn plan_time_cap_out_of_range_is_a_located_tree_error() {
+    for leaf in [
+        "move_joints: {joints: [0, -1.57, 1.57, -1.57, -1.57, 0], plan_time_cap: 0}",
+        "reach: {target: cube, plan_time_cap: 0.0001}",
+        "carry: {to: bowl, plan_time_cap: 61}",
+        "place: {point: [0.4, 0.1], plan_time_cap: -1}",
+        "home: {plan_time_cap: .inf}",
+    ] {
+        // The error points at the value (line 2, after the two spaces of indentation).
+        let column = 3 + leaf.find("plan_time_cap: ").unwrap() + "plan_time_cap: ".len();
+        let text = format!("main:\n  {leaf}\n");
+        let errs = Loader::default()
+            .compile_str(&text, "cap.yaml")
+            .expect_err("an out-of-range plan_time_cap is rejected");
+        let msg = errs[0].to_string();
+        assert!(msg.contains(&format!("cap.yaml:2:{column}")), "{leaf}: {msg}");
+        assert!(msg.contains("planning time cap"), "{leaf}: {msg}");
+    }
+    // In range: accepted, and carried to the leaf's planning budget.
+    let text = "main:\n  reach: {target: cube, plan_time_cap: 0.25, max_checks: 500}\n";
+    Loader::default()
+        .compile_str(text, "cap.yaml")
+        .expect("a plan_time_cap in range is accepted");
+}
+
+#[test]
 fn goal_in_collision_through_a_tree_names_the_fixture_and_the_node() {
     // Joints that put the gripper inside the fixture.
     let (cell, _) = swing_tree("");

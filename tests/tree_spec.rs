@@ -369,7 +369,7 @@ fn diagnostic_display_is_rustc_like() {
     let d = errors("main:\n  sequence:\n    children:\n      - reach: {targt: cube}\n");
     assert_eq!(
         d[0].to_string(),
-        "error: unknown parameter `targt` in `reach`\n --> bad.yaml:4:17\n  |\n4 |       - reach: {targt: cube}\n  |                 ^^^^^ expected one of `target`, `offset`, `yaw`, `path`, `approach`, `speed`, `timeout`, `max_checks` or `name`\n  = help: did you mean `target`?"
+        "error: unknown parameter `targt` in `reach`\n --> bad.yaml:4:17\n  |\n4 |       - reach: {targt: cube}\n  |                 ^^^^^ expected one of `target`, `offset`, `yaw`, `path`, `approach`, `speed`, `timeout`, `max_checks`, `plan_time_cap` or `name`\n  = help: did you mean `target`?"
     );
 }
 

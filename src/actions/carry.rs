@@ -609,7 +609,7 @@ impl Carry {
             crate::motion::plan::GoalSet::configs(free)
         };
         let motion =
-            super::planning::plan_motion(cell, "carry transfer", from, &goals, self.spec.max_checks)?;
+            super::planning::plan_motion(cell, "carry transfer", from, &goals, self.spec.plan_budget())?;
         let reached = crate::motion::fk(&motion.trajectory.end()).rotation;
         let k = (0..4)
             .min_by(|&a, &b| {

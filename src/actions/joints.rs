@@ -4,6 +4,7 @@ use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
 use super::planning::{check_motion, describe, plan_motion};
 use crate::failure::FailureKind;
+use crate::kinds::PlanBudget;
 use crate::motion::plan::{GoalSet, PlannerConfig};
 use crate::motion::{JointMove, MotionLimits};
 
@@ -15,7 +16,7 @@ const SECOND_SEARCH_BUDGET: u64 = 3;
 /// Moves the arm in joint space to fixed joint angles (radians).
 pub struct MoveJoints {
     goal_q: [f64; 6],
-    max_checks: Option<u64>,
+    budget: PlanBudget,
     arrival: Arrival,
 }
 
@@ -24,15 +25,16 @@ impl MoveJoints {
     pub fn new(goal_q: [f64; 6]) -> Self {
         Self {
             goal_q,
-            max_checks: None,
+            budget: PlanBudget::default(),
             arrival: Arrival::default(),
         }
     }
 
-    /// The planner, when the direct move collides, may spend at most `max_checks` collision
-    /// checks (`None`: its default budget); past them the move fails with `no_path`.
-    pub fn with_max_checks(mut self, max_checks: Option<u64>) -> Self {
-        self.max_checks = max_checks;
+    /// The planner, when the direct move collides, may spend at most the `budget`'s collision
+    /// checks and wall-clock time (`None`: the defaults of the leaves); past them the move fails
+    /// with `no_path`.
+    pub fn with_budget(mut self, budget: PlanBudget) -> Self {
+        self.budget = budget;
         self
     }
 
@@ -51,11 +53,15 @@ impl MacroAction for MoveJoints {
             // exactly these joint angles.
             tracing::debug!(target: "macrotree::actions", "move_joints: the direct joint move would touch {}; planning", describe(&pairs));
             let goals = GoalSet::configs(vec![self.goal_q]);
-            let motion = match plan_motion(cell, "move_joints", &from, &goals, self.max_checks) {
-                Err(e) if e.kind == FailureKind::NoPath && self.max_checks.is_none() => {
-                    let budget = SECOND_SEARCH_BUDGET * PlannerConfig::default().max_checks;
-                    tracing::debug!(target: "macrotree::actions", "move_joints: {e}; searching once more with {budget} checks");
-                    plan_motion(cell, "move_joints", &from, &goals, Some(budget))?
+            let motion = match plan_motion(cell, "move_joints", &from, &goals, self.budget) {
+                Err(e) if e.kind == FailureKind::NoPath && self.budget.max_checks.is_none() => {
+                    let checks = SECOND_SEARCH_BUDGET * PlannerConfig::default().max_checks;
+                    tracing::debug!(target: "macrotree::actions", "move_joints: {e}; searching once more with {checks} checks");
+                    let budget = PlanBudget {
+                        max_checks: Some(checks),
+                        ..self.budget
+                    };
+                    plan_motion(cell, "move_joints", &from, &goals, budget)?
                 }
                 planned => planned?,
             };

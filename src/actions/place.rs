@@ -81,6 +81,7 @@ impl MacroAction for Place {
             speed: self.spec.speed,
             timeout: self.spec.timeout,
             max_checks: self.spec.max_checks,
+            plan_time_cap: self.spec.plan_time_cap,
         };
         let mut carry = Carry::placing(spec, yaw);
         self.release = None;
@@ -137,6 +138,7 @@ mod tests {
             speed: 0.5,
             timeout: 15.0,
             max_checks: None,
+            plan_time_cap: None,
         }
     }
 

@@ -25,6 +25,7 @@ use serde::Serialize;
 
 use super::cell::Cell;
 use crate::failure::Failure;
+use crate::kinds::PlanBudget;
 use crate::motion::Trajectory;
 use crate::motion::plan::edge::{Resolution, steps};
 use crate::motion::plan::{Collision, CollisionChecker, GoalSet, JointSpare, PlannedMotion, PlannerConfig};
@@ -318,16 +319,29 @@ pub(crate) fn describe(pairs: &[Collision]) -> String {
     s.join(", ")
 }
 
-/// Wall-clock safety cap of a plan under the leaves, seconds: the planner's deterministic
+/// The planner's settings for the `plans`-th plan of an episode under a leaf with `budget`:
+/// seeded by the count (an episode replays the same plans), the leaf's check budget and time
+/// cap where it sets them, the planner's defaults otherwise.
+pub(crate) fn leaf_config(budget: PlanBudget, plans: u32) -> PlannerConfig {
+    let defaults = PlannerConfig::default();
+    PlannerConfig {
+        seed: 0x6d61_6372_6f74_7265 ^ u64::from(plans),
+        time_cap: Some(budget.time_cap.map_or(LEAF_TIME_CAP, Duration::from_secs_f64)),
+        max_checks: budget.max_checks.unwrap_or(defaults.max_checks),
+        ..defaults
+    }
+}
+
+/// Wall-clock safety cap of a plan under the leaves unless the leaf sets `plan_time_cap`, seconds: the planner's deterministic
 /// collision-check budget ([`PlannerConfig::max_checks`], 0.1–0.2 s of checks) ends a search long
 /// before it, so the cap only fires on a machine stalled by 10× or more; it is the only
 /// outcome of a plan that depends on the machine (`no_path`, "planning stopped at its time cap").
 pub(crate) const LEAF_TIME_CAP: Duration = Duration::from_secs(2);
 
 /// Plans the arm from `start` to any of `goals` in the cell, the pairs touching at `start`
-/// allowed, with the planner's collision-check budget set to `max_checks` (the leaf's
-/// `max_checks` parameter, range-checked by the tree reader; `None`: the planner's default);
-/// logs the query; counts it in the tally. The cell's `n`-th plan of the episode is seeded with
+/// allowed, within the leaf's `budget` (its `max_checks` and `plan_time_cap` parameters,
+/// range-checked by the tree reader; `None`: the planner's check budget and
+/// [`LEAF_TIME_CAP`]); logs the query; counts it in the tally. The cell's `n`-th plan of the episode is seeded with
 /// `n`, so an episode replays the same plans.
 ///
 /// # Errors
@@ -337,16 +351,10 @@ pub(crate) fn plan_motion(
     what: &str,
     start: &[f64; 6],
     goals: &GoalSet,
-    max_checks: Option<u64>,
+    budget: PlanBudget,
 ) -> Result<PlannedMotion, Failure> {
     let t = Instant::now();
-    let defaults = PlannerConfig::default();
-    let config = PlannerConfig {
-        seed: 0x6d61_6372_6f74_7265 ^ u64::from(cell.planning().plans),
-        time_cap: Some(LEAF_TIME_CAP),
-        max_checks: max_checks.unwrap_or(defaults.max_checks),
-        ..defaults
-    };
+    let config = leaf_config(budget, cell.planning().plans);
     let sim_time = cell.sim().time();
     let Some(checker) = cell.checker() else {
         return Err(Failure::new(
@@ -371,4 +379,33 @@ pub(crate) fn plan_motion(
         }
     }
     result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_leaf_budget_sets_the_check_budget_and_the_time_cap_of_its_plans() {
+        let defaults = PlannerConfig::default();
+        let none = leaf_config(PlanBudget::default(), 0);
+        assert_eq!(none.time_cap, Some(LEAF_TIME_CAP));
+        assert_eq!(none.max_checks, defaults.max_checks);
+        let set = leaf_config(
+            PlanBudget {
+                max_checks: Some(500),
+                time_cap: Some(0.25),
+            },
+            3,
+        );
+        assert_eq!(set.time_cap, Some(Duration::from_millis(250)));
+        assert_eq!(set.max_checks, 500);
+        assert!(set.check().is_ok());
+        // Each plan of an episode has its own seed, the same in every run.
+        assert_ne!(set.seed, leaf_config(PlanBudget::default(), 4).seed);
+        assert_eq!(set.seed, leaf_config(PlanBudget::default(), 3).seed);
+        // The other settings are the planner's.
+        assert_eq!(set.resolution, defaults.resolution);
+        assert_eq!(set.shortcut_attempts, defaults.shortcut_attempts);
+    }
 }

@@ -17,6 +17,7 @@ use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vect
 use super::cell::Cell;
 use super::planning::{check_motion, check_straight, look_ahead_clear, plan_motion};
 use crate::failure::{Failure, FailureKind};
+use crate::kinds::PlanBudget;
 use crate::motion::plan::GoalSet;
 use crate::motion::{CartesianMove, JointMove, MotionLimits, Trajectory, fk};
 use crate::world::World;
@@ -221,7 +222,7 @@ pub(crate) fn start_joint(
     b: usize,
     offset: &Vector3<f64>,
     limits: &MotionLimits,
-    max_checks: Option<u64>,
+    budget: PlanBudget,
 ) -> Result<[f64; 6], Failure> {
     let from = cell.arm_setpoint();
     let w = cell.world();
@@ -238,7 +239,7 @@ pub(crate) fn start_joint(
             continue;
         }
         tracing::debug!(target: "macrotree::actions", "reach: side approach to {name} through the face ({:+.2}, {:+.2}); {} free pre-grasp configuration(s)", n.x, n.y, free.len());
-        return go_to(cell, &from, free, limits, max_checks);
+        return go_to(cell, &from, free, limits, budget);
     }
     Err(unreachable(format!(
         "unreachable: no face of {name} can be approached from the side: {}",
@@ -396,31 +397,31 @@ pub(crate) fn start(cell: &mut Cell, spec: &crate::kinds::Reach) -> Result<Optio
         Route::Top => Ok(None),
         Route::Above(free) => {
             let from = cell.arm_setpoint();
-            go_to(cell, &from, free, &limits, spec.max_checks).map(Some)
+            go_to(cell, &from, free, &limits, spec.plan_budget()).map(Some)
         }
         Route::Side(b) => match spec.path {
-            PathKind::Joint => start_joint(cell, b, &offset, &limits, spec.max_checks).map(Some),
+            PathKind::Joint => start_joint(cell, b, &offset, &limits, spec.plan_budget()).map(Some),
             PathKind::Cartesian => start_cartesian(cell, b, &offset, &limits).map(Some),
         },
     }
 }
 
 /// Moves the arm from `from` to the first of `goals` (nearest first) by a joint move when that
-/// is free, else by the planner to any of them (spending at most `max_checks` collision checks;
-/// `None`: the planner's budget); returns the configuration it goes to.
+/// is free, else by the planner to any of them within the leaf's `budget`; returns the
+/// configuration it goes to.
 fn go_to(
     cell: &mut Cell,
     from: &[f64; 6],
     goals: Vec<[f64; 6]>,
     limits: &MotionLimits,
-    max_checks: Option<u64>,
+    budget: PlanBudget,
 ) -> Result<[f64; 6], Failure> {
     let direct = JointMove::new(*from, goals[0], limits);
     if check_motion(cell, &[&direct], &[], false).is_none() {
         cell.track(Box::new(direct));
         return Ok(goals[0]);
     }
-    let motion = plan_motion(cell, "reach", from, &GoalSet::configs(goals), max_checks)?;
+    let motion = plan_motion(cell, "reach", from, &GoalSet::configs(goals), budget)?;
     let end = motion.trajectory.end();
     cell.track(Box::new(motion.trajectory));
     Ok(end)

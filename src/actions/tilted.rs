@@ -16,6 +16,7 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use super::cell::Cell;
 use super::planning::{look_ahead_clear, plan_motion};
 use crate::failure::Failure;
+use crate::kinds::PlanBudget;
 use crate::motion::plan::{GoalSet, PlannedMotion};
 use crate::motion::{CartesianMove, MotionLimits, down_pose, fk};
 
@@ -82,8 +83,7 @@ pub(crate) fn descent_clear(cell: &mut Cell, q: &[f64; 6], standoff: f64, target
 
 /// Plans from `from` to a tilted pre-grasp of the block `target` centred at `centre` whose
 /// configuration and descent are free, the smallest tilt of [`TILTS`] first; `Ok(None)` when no
-/// tilt has one. Each plan spends at most `max_checks` collision checks (`None`: the planner's
-/// budget).
+/// tilt has one. Each plan stays within the leaf's `budget`.
 ///
 /// # Errors
 /// The planner's failure for the last tilt that had free pre-grasps but no path to them.
@@ -94,7 +94,7 @@ pub(crate) fn plan(
     (yaw, quarter): (f64, bool),
     standoff: f64,
     target: &str,
-    max_checks: Option<u64>,
+    budget: PlanBudget,
 ) -> Result<Option<PlannedMotion>, Failure> {
     let mut last = None;
     for tilt in TILTS {
@@ -110,7 +110,7 @@ pub(crate) fn plan(
         if free.is_empty() {
             continue;
         }
-        match plan_motion(cell, "reach (tilted)", from, &GoalSet::configs(free), max_checks) {
+        match plan_motion(cell, "reach (tilted)", from, &GoalSet::configs(free), budget) {
             Ok(m) => return Ok(Some(m)),
             Err(e) => last = Some(e),
         }

@@ -26,10 +26,10 @@ fn bind(f: &mut Factory) -> Result<(), BindError> {
     // Actions.
     f.bind_action("reach", |p: &Reach| Box::new(ReachAction::new(p.clone())))?;
     f.bind_action("move_joints", |p: &MoveJoints| {
-        Box::new(MoveJointsAction::new(p.joints).with_max_checks(p.max_checks))
+        Box::new(MoveJointsAction::new(p.joints).with_budget(p.plan_budget()))
     })?;
     f.bind_action("home", |p: &Home| {
-        Box::new(MoveJointsAction::home().with_max_checks(p.max_checks))
+        Box::new(MoveJointsAction::home().with_budget(p.plan_budget()))
     })?;
     f.bind_action("grasp", |p: &Grasp| Box::new(GraspAction::new(p.clone())))?;
     f.bind_action("carry", |p: &Carry| Box::new(CarryAction::new(p.clone())))?;

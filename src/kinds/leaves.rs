@@ -110,6 +110,16 @@ pub struct Reach {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schemars(range(min = 1, max = 10_000_000))]
     pub max_checks: Option<u64>,
+    /// Wall-clock seconds a plan may take before it fails with `no_path` (0.001 to 60). The
+    /// only outcome that depends on the machine's speed; `max_checks` ends searches first on
+    /// any machine not stalled tenfold. Default 2.
+    #[serde(
+        default,
+        deserialize_with = "units::opt_plan_time_cap",
+        skip_serializing_if = "Option::is_none"
+    )]
+    #[schemars(range(min = 0.001, max = 60.0))]
+    pub plan_time_cap: Option<f64>,
 }
 
 #[doc = include_str!("../../docs/nodes/move_joints.md")]
@@ -130,6 +140,16 @@ pub struct MoveJoints {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schemars(range(min = 1, max = 10_000_000))]
     pub max_checks: Option<u64>,
+    /// Wall-clock seconds a plan may take before it fails with `no_path` (0.001 to 60). The
+    /// only outcome that depends on the machine's speed; `max_checks` ends searches first on
+    /// any machine not stalled tenfold. Default 2.
+    #[serde(
+        default,
+        deserialize_with = "units::opt_plan_time_cap",
+        skip_serializing_if = "Option::is_none"
+    )]
+    #[schemars(range(min = 0.001, max = 60.0))]
+    pub plan_time_cap: Option<f64>,
 }
 
 #[doc = include_str!("../../docs/nodes/home.md")]
@@ -146,6 +166,16 @@ pub struct Home {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schemars(range(min = 1, max = 10_000_000))]
     pub max_checks: Option<u64>,
+    /// Wall-clock seconds a plan may take before it fails with `no_path` (0.001 to 60). The
+    /// only outcome that depends on the machine's speed; `max_checks` ends searches first on
+    /// any machine not stalled tenfold. Default 2.
+    #[serde(
+        default,
+        deserialize_with = "units::opt_plan_time_cap",
+        skip_serializing_if = "Option::is_none"
+    )]
+    #[schemars(range(min = 0.001, max = 60.0))]
+    pub plan_time_cap: Option<f64>,
 }
 
 impl Default for Home {
@@ -153,6 +183,7 @@ impl Default for Home {
         Self {
             timeout: 6.0,
             max_checks: None,
+            plan_time_cap: None,
         }
     }
 }
@@ -214,6 +245,16 @@ pub struct Carry {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schemars(range(min = 1, max = 10_000_000))]
     pub max_checks: Option<u64>,
+    /// Wall-clock seconds a plan may take before it fails with `no_path` (0.001 to 60). The
+    /// only outcome that depends on the machine's speed; `max_checks` ends searches first on
+    /// any machine not stalled tenfold. Default 2.
+    #[serde(
+        default,
+        deserialize_with = "units::opt_plan_time_cap",
+        skip_serializing_if = "Option::is_none"
+    )]
+    #[schemars(range(min = 0.001, max = 60.0))]
+    pub plan_time_cap: Option<f64>,
 }
 
 fn d_15() -> f64 {
@@ -268,6 +309,16 @@ pub struct Place {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schemars(range(min = 1, max = 10_000_000))]
     pub max_checks: Option<u64>,
+    /// Wall-clock seconds a plan may take before it fails with `no_path` (0.001 to 60). The
+    /// only outcome that depends on the machine's speed; `max_checks` ends searches first on
+    /// any machine not stalled tenfold. Default 2.
+    #[serde(
+        default,
+        deserialize_with = "units::opt_plan_time_cap",
+        skip_serializing_if = "Option::is_none"
+    )]
+    #[schemars(range(min = 0.001, max = 60.0))]
+    pub plan_time_cap: Option<f64>,
 }
 
 #[doc = include_str!("../../docs/nodes/release.md")]
@@ -752,6 +803,31 @@ impl Params for MoveJoints {
         check_max_checks(self.max_checks)
     }
 }
+
+/// What a leaf that plans lets its plans spend: its `max_checks` and `plan_time_cap`
+/// parameters (`None`: the defaults of the leaves, 20 000 checks and 2 s).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PlanBudget {
+    /// Collision checks per plan, 1 to 10 000 000.
+    pub max_checks: Option<u64>,
+    /// Wall-clock seconds per plan, 0.001 to 60.
+    pub time_cap: Option<f64>,
+}
+
+macro_rules! plan_budget {
+    ($($leaf:ty),*) => {$(
+        impl $leaf {
+            /// The leaf's planning budget (its `max_checks` and `plan_time_cap`).
+            pub fn plan_budget(&self) -> PlanBudget {
+                PlanBudget {
+                    max_checks: self.max_checks,
+                    time_cap: self.plan_time_cap,
+                }
+            }
+        }
+    )*};
+}
+plan_budget!(Reach, MoveJoints, Home, Carry, Place);
 
 /// The `max_checks` parameter of a leaf that plans: 1 to 10 000 000 collision checks.
 fn check_max_checks(max_checks: Option<u64>) -> Result<(), ParamError> {

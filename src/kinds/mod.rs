@@ -36,7 +36,8 @@ pub use control::{
 pub use leaf_call::LeafCall;
 pub use leaves::{
     At, AtHome, Carry, CubeAt, CubeGrasped, CubeInBowl, CubeLifted, CubeOnTable, GoalMet, Grasp, Grasped,
-    GripperOpen, Home, In, Leaf, Lifted, MoveJoints, On, OnTable, Place, Reach, Release, Select, Wait,
+    GripperOpen, Home, In, Leaf, Lifted, MoveJoints, On, OnTable, Place, PlanBudget, Reach, Release, Select,
+    Wait,
 };
 pub use objects::{ObjectRef, ObjectRole};
 pub use param_error::ParamError;

@@ -111,6 +111,23 @@ pub fn time_limit<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     Ok(x)
 }
 
+/// Shortest and longest wall-clock cap of one plan a tree may set, seconds (the planner's own
+/// range for `PlannerConfig::time_cap`).
+pub const PLAN_TIME_CAP_RANGE: (f64, f64) = (0.001, 60.0);
+
+/// An optional wall-clock cap on one plan, seconds, within [`PLAN_TIME_CAP_RANGE`] (absent =
+/// `None`).
+pub fn opt_plan_time_cap<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+    let x = number(d, "a planning time cap (s)")?;
+    let (lo, hi) = PLAN_TIME_CAP_RANGE;
+    if !(lo..=hi).contains(&x) {
+        return Err(de::Error::custom(format!(
+            "a planning time cap is wall-clock seconds between {lo} and {hi}, found `{x}`"
+        )));
+    }
+    Ok(Some(x))
+}
+
 /// A finite, strictly positive speed in m/s.
 pub fn speed<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     let x = number(d, "a speed (m/s)")?;
