@@ -330,3 +330,34 @@ fn a_block_held_away_from_the_pinch_was_vouched_for_beyond_the_lever_arms() {
     let mut r = ChaCha8Rng::seed_from_u64(43);
     assert!((0..300).any(|_| c.exact_spare(&drawn(&mut r), SPARE_CAP).is_some()));
 }
+
+#[test]
+fn a_pairs_lever_ratio_bounds_how_far_its_parts_move_relative_to_each_other() {
+    // Regression for the lever-arm ratios of the screen's pairs: a clearance vouches for
+    // `1 / kappa` times the planner's lever-arm bound, so the pair's parts must never move
+    // relative to each other more than `kappa` times that bound, for any joints and any step.
+    for hold in [false, true] {
+        let mut c = checker(hold);
+        let mut r = ChaCha8Rng::seed_from_u64(77);
+        let screen = c.screen_model().expect("a screen of this cell");
+        let (mut short, mut tight) = (0, 0);
+        for i in 0..400 {
+            let q = drawn(&mut r);
+            // Small steps and whole swings.
+            let scale = if i % 2 == 0 { 0.05 } else { 2.0 };
+            let q2: [f64; 6] = std::array::from_fn(|j| q[j] + scale * r.random_range(-1.0..1.0));
+            for (kappa, moved, bound) in screen.pair_moves(&q, &q2) {
+                assert!(kappa > 0.0 && kappa <= 1.0, "{kappa}");
+                assert!(
+                    moved <= bound + 1e-9,
+                    "moved {moved} m, bound {bound} m (kappa {kappa})"
+                );
+                short += usize::from(kappa < 0.5);
+                tight += usize::from(moved > 0.5 * bound);
+            }
+        }
+        // Short chains (the forearm against wrist 2) move far less than the whole arm, and the
+        // bound is not loose everywhere.
+        assert!(short > 0 && tight > 0, "{short} {tight}");
+    }
+}

@@ -20,6 +20,7 @@ use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, Unit, UnitQuaternio
 
 use super::pair_filter::PairFilter;
 use crate::motion::plan::JointSpare;
+use crate::motion::plan::config::UR5E_LEVER_ARMS;
 use crate::motion::plan::shapes::{Shape, V3, apart, near, within};
 
 /// Extra distance every pair must keep beyond its margin for the screen to vouch, metres: room
@@ -115,6 +116,10 @@ struct Pair {
     b: u16,
     gap: f64,
     block: f64,
+    /// The pair's lever-arm ratio ([`Screen::lever_ratio`]): its parts move relative to each
+    /// other at most this fraction of the planner's lever-arm bound, so a clearance `c` beyond
+    /// the gap vouches for `c / kappa` of that bound. In (0, 1].
+    kappa: f64,
 }
 
 /// The conservative model of one snapshot of the cell (see the module docs).
@@ -161,6 +166,8 @@ struct Group {
     link: usize,
     partner: Partner,
     gap: f64,
+    /// The largest lever-arm ratio of the group's pairs.
+    kappa: f64,
     start: u32,
     end: u32,
 }
@@ -356,6 +363,44 @@ fn link_sphere<'a>(shapes: impl Iterator<Item = &'a Local> + Clone) -> (Vector3<
     (mid, r)
 }
 
+/// The lever-arm ratio of the pair of shapes `a` (moving) and `b` (moving or fixed, index past
+/// `moving`): the largest, over the joints that move the two relative to each other, of how far
+/// the distal shape's points can lie from the joint's axis over the planner's lever arm for
+/// that joint ([`UR5E_LEVER_ARMS`], an upper bound for the whole moving robot and a held
+/// block), at most 1.
+///
+/// Joint `j` moves the distal shape's points by at most their distance from its axis times the
+/// angle, and that distance is bounded through the chain, whatever the joints between: the
+/// shape lies within its reach of its centre in its link's frame, each link's origin within
+/// `|pos| + 2 |anchor|` of its parent's (the body offset, and the rotation about the anchor),
+/// and joint `j`'s axis passes within `|anchor_j|` of link `j`'s origin. A short chain (the
+/// forearm against wrist 2) then moves far less than the whole arm's lever arm allows, and a
+/// clearance vouches for proportionally more.
+fn lever_ratio(links: &[Link; 6], moving: &[(usize, Local, bool, f64)], a: usize, b: usize) -> f64 {
+    let (range, far) = if b < moving.len() {
+        let (ka, kb) = (moving[a].0, moving[b].0);
+        let far = if ka >= kb { a } else { b };
+        (ka.min(kb) + 1..=ka.max(kb), far)
+    } else {
+        (0..=moving[a].0, a)
+    };
+    let (k, local, _, reach) = &moving[far];
+    let centre = match local {
+        Local::Capsule { a, b, .. } => (a + b) / 2.0,
+        Local::Box { center, .. } => *center,
+    };
+    let mut chain = centre.norm() + reach;
+    let mut ratio: f64 = 0.0;
+    for j in (0..=*k).rev() {
+        let anchor = links[j].anchor.norm();
+        if range.contains(&j) {
+            ratio = ratio.max((chain + anchor) / UR5E_LEVER_ARMS[j]);
+        }
+        chain += links[j].pos.norm() + 2.0 * anchor;
+    }
+    if ratio > 0.0 { ratio.min(1.0) } else { 1.0 }
+}
+
 impl Screen {
     /// The screen of the private model and data in `b`; `None` when some geom that can touch
     /// the arm is of a type the screen cannot bound, or the arm is not a chain of six links.
@@ -466,6 +511,7 @@ impl Screen {
                         b: bb as u16,
                         gap: pair_margin.max(0.0) + PAD,
                         block: (pair_margin - pair_gap.max(0.0)).min(0.0) - PAD,
+                        kappa: 1.0,
                     });
                     true
                 }
@@ -501,6 +547,9 @@ impl Screen {
         // Cheapest rejections first: fixed partners before self pairs.
         pairs.sort_by_key(|p| (p.b as usize) < moving.len());
         let nm = moving.len();
+        for p in &mut pairs {
+            p.kappa = lever_ratio(&links, &moving, p.a as usize, p.b as usize);
+        }
         let partner = |p: &Pair| {
             if (p.b as usize) < nm {
                 Partner::Link(moving[p.b as usize].0)
@@ -520,18 +569,20 @@ impl Screen {
         let mut groups = Vec::with_capacity(order.len());
         for &(link, with) in &order {
             let start = grouped.len() as u32;
-            let mut gap: f64 = 0.0;
+            let (mut gap, mut kappa): (f64, f64) = (0.0, 0.0);
             for p in pairs
                 .iter()
                 .filter(|p| (moving[p.a as usize].0, partner(p)) == (link, with))
             {
                 gap = gap.max(p.gap);
+                kappa = kappa.max(p.kappa);
                 grouped.push(*p);
             }
             groups.push(Group {
                 link,
                 partner: with,
                 gap,
+                kappa,
                 start,
                 end: grouped.len() as u32,
             });
@@ -648,7 +699,7 @@ impl Screen {
                 }
                 // The link's sphere keeps more than the range's spare found so far: nothing to
                 // learn from the group's pairs; else they may keep more than the sphere does.
-                if self.group_apart(g, &spheres, g.gap + spare.get(lo, hi)) {
+                if self.group_apart(g, &spheres, g.gap + g.kappa * spare.get(lo, hi)) {
                     continue;
                 }
             }
@@ -673,12 +724,12 @@ impl Screen {
                         || (b >= nm && sphere_box_apart(&c1, r1, &y.0, p.gap))
                     {
                         if SPARE && ranged {
-                            let need = p.gap + spare.get(lo, hi);
+                            let need = p.gap + p.kappa * spare.get(lo, hi);
                             let t = r1 + r2 + need;
                             let far = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] >= t * t
                                 || (b >= nm && sphere_box_apart(&c1, r1, &y.0, need));
                             if !far {
-                                spare.tighten(lo, hi, sphere_shape_gap(&c1, r1, y) - p.gap);
+                                spare.tighten(lo, hi, (sphere_shape_gap(&c1, r1, y) - p.gap) / p.kappa);
                             }
                         }
                         continue;
@@ -701,7 +752,7 @@ impl Screen {
                         }
                         unsure = true;
                     }
-                    Some(c) if SPARE && ranged => spare.tighten(lo, hi, c - p.gap),
+                    Some(c) if SPARE && ranged => spare.tighten(lo, hi, (c - p.gap) / p.kappa),
                     Some(_) => {}
                 }
             }
@@ -736,6 +787,65 @@ impl Screen {
     /// Pairs tested per configuration.
     pub fn pairs(&self) -> usize {
         self.pairs.len()
+    }
+}
+
+#[cfg(test)]
+impl Screen {
+    /// For every pair: its lever-arm ratio, and between joints `q` and `q2` (radians) the
+    /// largest displacement of a point of its distal shape's hull (box corners; capsule ends
+    /// pushed out by the radius along each axis) relative to the frame of its partner's link
+    /// (the world for a fixed partner), with the bound `kappa · Σ_range r_j |q2_j − q_j|`
+    /// (metres) that the spare's vouching relies on.
+    pub(crate) fn pair_moves(&self, q: &[f64; 6], q2: &[f64; 6]) -> Vec<(f64, f64, f64)> {
+        let (f1, f2) = (self.link_poses(q), self.link_poses(q2));
+        let nm = self.moving.len();
+        let points = |l: &Local| -> Vec<Vector3<f64>> {
+            match l {
+                Local::Capsule { a, b, radius } => [a, b]
+                    .iter()
+                    .flat_map(|e| {
+                        (0..3).flat_map(move |i| [-1.0, 1.0].map(|sgn| *e + Vector3::ith(i, sgn * radius)))
+                    })
+                    .collect(),
+                Local::Box { center, axes, half } => (0..8)
+                    .map(|c| {
+                        let s = |i: usize| if c >> i & 1 == 1 { 1.0 } else { -1.0 };
+                        center
+                            + (0..3)
+                                .map(|i| axes.column(i) * (s(i) * half[i]))
+                                .sum::<Vector3<f64>>()
+                    })
+                    .collect(),
+            }
+        };
+        self.pairs
+            .iter()
+            .map(|p| {
+                let (a, b) = (p.a as usize, p.b as usize);
+                let (far, near_link, range) = if b < nm {
+                    let (ka, kb) = (self.moving[a].0, self.moving[b].0);
+                    let far = if ka >= kb { a } else { b };
+                    (far, Some(ka.min(kb)), ka.min(kb) + 1..=ka.max(kb))
+                } else {
+                    (a, None, 0..=self.moving[a].0)
+                };
+                let k = self.moving[far].0;
+                let in_near = |f: &[(Matrix3<f64>, Vector3<f64>); 6], x: &Vector3<f64>| {
+                    let w = f[k].0 * x + f[k].1;
+                    match near_link {
+                        Some(n) => f[n].0.transpose() * (w - f[n].1),
+                        None => w,
+                    }
+                };
+                let moved = points(&self.moving[far].1)
+                    .iter()
+                    .map(|x| (in_near(&f2, x) - in_near(&f1, x)).norm())
+                    .fold(0.0, f64::max);
+                let bound: f64 = range.map(|j| UR5E_LEVER_ARMS[j] * (q2[j] - q[j]).abs()).sum();
+                (p.kappa, moved, p.kappa * bound)
+            })
+            .collect()
     }
 }
 
