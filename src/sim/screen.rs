@@ -648,9 +648,11 @@ impl Screen {
     /// The verdict at `q` (radians), as [`Screen::classify`], and with a "free" the spare
     /// clearance by joint range ([`JointSpare`], at most `cap` metres; none with any other
     /// verdict): for each tested pair, a lower bound on how much farther apart than its margin
-    /// plus [`PAD`] its primitives are, in the range of the joints that move the pair's parts
-    /// relative to each other. Geoms lie inside their primitives, so the geoms keep the margin
-    /// wherever no point of the robot moved relative to its partner farther than that.
+    /// plus [`PAD`] its primitives are, divided by the pair's lever-arm ratio (its parts move
+    /// relative to each other at most that fraction of the planner's lever-arm bound), in the
+    /// range of the joints that move the pair's parts relative to each other. Geoms lie inside
+    /// their primitives, so the geoms keep the margin wherever the lever-arm bound of the
+    /// range's joint changes stays within its spare.
     pub fn free_spare(&mut self, q: &[f64; 6], cap: f64) -> (Option<bool>, JointSpare) {
         let (verdict, _, spare) = self.judge::<true>(q, cap.max(0.0));
         (
