@@ -149,3 +149,37 @@ fn a_reach_still_closing_in_on_its_goal_was_called_blocked() {
         .collect();
     assert!(failed.is_empty(), "reaches that failed: {failed:?}");
 }
+
+/// A wall-clock cap far below what a search needs ends the leaf with `no_path` ("planning
+/// stopped at its time cap"), before the arm moves. The way from home to the wound wrist in this
+/// cell is a long search (about 5 700 collision checks, about 50 ms on the 2-core CI machine;
+/// with a 10 s cap this test fails, the move planned and made), so a 1 ms cap is outrun on any
+/// machine this runs on.
+#[test]
+fn a_move_with_a_one_millisecond_plan_time_cap_ends_in_no_path_at_the_cap() {
+    let dir = cli::scratch("held-out-posts-cap");
+    let path = dir.join("capped.yaml");
+    let tree = format!(
+        "description: a capped search\nmain:\n  sequence:\n    children:\n      - move_joints: {{name: wind, joints: {WOUND}, plan_time_cap: 0.001}}\n"
+    );
+    std::fs::write(&path, tree).unwrap();
+    let out = cli::macrotree(&["run", cli::s(&path), "--scene", SCENE, "--json"]);
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON report");
+    assert_eq!(r["tree_status"], "failure", "{r}");
+    assert_eq!(r["failure_kind"], "no_path", "{}", r["failure_reason"]);
+    assert_eq!(r["failed_node"], "main/sequence/move_joints[wind]");
+    let why = r["failure_reason"].as_str().unwrap_or_default();
+    assert!(why.contains("time cap"), "{why}");
+    assert!(
+        r["planning"]["plan_failures"].as_u64() >= Some(1),
+        "{}",
+        r["planning"]
+    );
+    // Failed before moving: nothing was hit.
+    assert_eq!(
+        r["collisions"].as_array().map(Vec::len),
+        Some(0),
+        "{}",
+        r["collisions"]
+    );
+}
