@@ -35,7 +35,7 @@ pub struct MotionLimits {
     /// Largest joint speed, rad/s. Default 3.0 rad/s: just under the UR5e's rated π rad/s (180°/s)
     /// for every joint, so the position servos can track it.
     pub max_joint_speed: f64,
-    /// Largest joint acceleration, rad/s². Default 8 rad/s²: well inside what the Menagerie servos
+    /// Largest joint acceleration, rad/s². Default 15 rad/s²: well inside what the Menagerie servos
     /// (kp 2000 / 500, force ±150 / ±28 N·m) follow without large tracking lag.
     pub max_joint_acc: f64,
     /// Largest linear speed of the pinch along a Cartesian line, m/s. Default 0.5 m/s: a brisk
@@ -47,7 +47,7 @@ pub struct MotionLimits {
 }
 
 impl Default for MotionLimits {
-    /// 3.0 rad/s, 8 rad/s², 0.5 m/s, 0.2 s (see the field docs).
+    /// 3.0 rad/s, 15 rad/s², 0.5 m/s, 0.2 s (see the field docs).
     fn default() -> Self {
         Self {
             max_joint_speed: 3.0,
