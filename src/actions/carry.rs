@@ -608,8 +608,14 @@ impl Carry {
         } else {
             crate::motion::plan::GoalSet::configs(free)
         };
-        let motion =
-            super::planning::plan_motion(cell, "carry transfer", from, &goals, self.spec.plan_budget())?;
+        let motion = super::planning::plan_motion(
+            cell,
+            "carry transfer",
+            from,
+            &goals,
+            self.spec.plan_budget(),
+            Some(self.spec.speed),
+        )?;
         let reached = crate::motion::fk(&motion.trajectory.end()).rotation;
         let k = (0..4)
             .min_by(|&a, &b| {

@@ -53,7 +53,7 @@ impl MacroAction for MoveJoints {
             // exactly these joint angles.
             tracing::debug!(target: "macrotree::actions", "move_joints: the direct joint move would touch {}; planning", describe(&pairs));
             let goals = GoalSet::configs(vec![self.goal_q]);
-            let motion = match plan_motion(cell, "move_joints", &from, &goals, self.budget) {
+            let motion = match plan_motion(cell, "move_joints", &from, &goals, self.budget, None) {
                 Err(e) if e.kind == FailureKind::NoPath && self.budget.max_checks.is_none() => {
                     let checks = SECOND_SEARCH_BUDGET * PlannerConfig::default().max_checks;
                     tracing::debug!(target: "macrotree::actions", "move_joints: {e}; searching once more with {checks} checks");
@@ -61,7 +61,7 @@ impl MacroAction for MoveJoints {
                         max_checks: Some(checks),
                         ..self.budget
                     };
-                    plan_motion(cell, "move_joints", &from, &goals, budget)?
+                    plan_motion(cell, "move_joints", &from, &goals, budget, None)?
                 }
                 planned => planned?,
             };

@@ -341,7 +341,8 @@ pub(crate) const LEAF_TIME_CAP: Duration = Duration::from_secs(2);
 /// Plans the arm from `start` to any of `goals` in the cell, the pairs touching at `start`
 /// allowed, within the leaf's `budget` (its `max_checks` and `plan_time_cap` parameters,
 /// range-checked by the tree reader; `None`: the planner's check budget and
-/// [`LEAF_TIME_CAP`]); logs the query; counts it in the tally. The cell's `n`-th plan of the episode is seeded with
+/// [`LEAF_TIME_CAP`]), the pinch at most `tool_speed` m/s along the timed path (`None`: the
+/// joint limits alone; a carry passes its `speed`, the held block's); logs the query; counts it in the tally. The cell's `n`-th plan of the episode is seeded with
 /// `n`, so an episode replays the same plans.
 ///
 /// # Errors
@@ -352,9 +353,13 @@ pub(crate) fn plan_motion(
     start: &[f64; 6],
     goals: &GoalSet,
     budget: PlanBudget,
+    tool_speed: Option<f64>,
 ) -> Result<PlannedMotion, Failure> {
     let t = Instant::now();
-    let config = leaf_config(budget, cell.planning().plans);
+    let config = PlannerConfig {
+        tool_speed: tool_speed.unwrap_or(f64::INFINITY),
+        ..leaf_config(budget, cell.planning().plans)
+    };
     let sim_time = cell.sim().time();
     let Some(checker) = cell.checker() else {
         return Err(Failure::new(

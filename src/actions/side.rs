@@ -421,7 +421,7 @@ fn go_to(
         cell.track(Box::new(direct));
         return Ok(goals[0]);
     }
-    let motion = plan_motion(cell, "reach", from, &GoalSet::configs(goals), budget)?;
+    let motion = plan_motion(cell, "reach", from, &GoalSet::configs(goals), budget, None)?;
     let end = motion.trajectory.end();
     cell.track(Box::new(motion.trajectory));
     Ok(end)

@@ -110,7 +110,14 @@ pub(crate) fn plan(
         if free.is_empty() {
             continue;
         }
-        match plan_motion(cell, "reach (tilted)", from, &GoalSet::configs(free), budget) {
+        match plan_motion(
+            cell,
+            "reach (tilted)",
+            from,
+            &GoalSet::configs(free),
+            budget,
+            None,
+        ) {
             Ok(m) => return Ok(Some(m)),
             Err(e) => last = Some(e),
         }

@@ -123,6 +123,12 @@ pub struct PlannerConfig {
     pub bounds: [(f64, f64); 6],
     /// Speed and acceleration limits of the timed trajectory.
     pub limits: JointLimits,
+    /// Largest speed of the pinch point along the timed trajectory, m/s (a held block moves
+    /// with it): the path speed is capped at every cell boundary of the timing
+    /// ([`CELL`](super::timing::CELL) apart) by this over the pinch's displacement per radian
+    /// of path there. `f64::INFINITY` (the default) leaves the joint limits alone; any other
+    /// value must be positive.
+    pub tool_speed: f64,
     /// Optional wall-clock safety cap on the search, 1 ms to 60 s; reaching it ends the plan
     /// with [`PlanFailure::TimeCap`](super::PlanFailure::TimeCap), the only outcome that depends
     /// on the machine's speed. Default none (the budgets `max_iterations`, `max_nodes` and
@@ -132,7 +138,8 @@ pub struct PlannerConfig {
 
 impl Default for PlannerConfig {
     /// Seed 0, 0.05 rad and 0.01 m resolution with [`UR5E_LEVER_ARMS`], 1.0 rad range, 2000 iterations, 20 000 nodes, 20 000 checks, 16 shortcuts,
-    /// 0.1 rad blends, the joint limits as bounds, [`JointLimits::default`], no time cap.
+    /// 0.1 rad blends, the joint limits as bounds, [`JointLimits::default`], no tool speed
+    /// bound, no time cap.
     fn default() -> Self {
         Self {
             seed: 0,
@@ -147,6 +154,7 @@ impl Default for PlannerConfig {
             blend_deviation: 0.1,
             bounds: JOINT_LIMITS,
             limits: JointLimits::default(),
+            tool_speed: f64::INFINITY,
             time_cap: None,
         }
     }
@@ -225,6 +233,12 @@ impl PlannerConfig {
             return Err(format!(
                 "blend_deviation {} rad: use a value in [0, 1]",
                 self.blend_deviation
+            ));
+        }
+        if self.tool_speed.is_nan() || self.tool_speed <= 0.0 {
+            return Err(format!(
+                "tool_speed {} m/s: use a positive value (or infinity for no bound)",
+                self.tool_speed
             ));
         }
         for (j, &(lo, hi)) in self.bounds.iter().enumerate() {

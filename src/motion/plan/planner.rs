@@ -304,7 +304,7 @@ fn attempt<C: CollisionChecker + ?Sized>(
     checker.screen = false;
     let smoothed = smooth(&mut checker, &path, config.blend_deviation, &res);
     stats.blends = smoothed.blends;
-    let trajectory = PathTrajectory::new(smoothed, path, &config.limits);
+    let trajectory = PathTrajectory::new(smoothed, path, &config.limits, config.tool_speed);
     stats.duration = crate::motion::trajectory::Trajectory::duration(&trajectory);
     stats.collision_checks = checker.checks;
     stats.stage_checks[3] = checker.checks - stats.stage_checks[..3].iter().sum::<u64>();

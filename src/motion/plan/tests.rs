@@ -349,6 +349,62 @@ fn a_malformed_query_is_refused_before_any_check() {
     assert_eq!(c.checks, 0);
 }
 
+/// The peak speed of the pinch point along `t`, m/s: forward kinematics every 1 ms.
+fn peak_pinch_speed(t: &PathTrajectory) -> f64 {
+    let dt = 1e-3;
+    let n = (t.duration() / dt).ceil() as usize;
+    let mut prev = crate::motion::fk(&t.sample(0.0).0).translation.vector;
+    let mut peak: f64 = 0.0;
+    for k in 1..=n {
+        let p = crate::motion::fk(&t.sample(k as f64 * dt).0).translation.vector;
+        peak = peak.max((p - prev).norm() / dt);
+        prev = p;
+    }
+    peak
+}
+
+/// A carry's planned transfer swung the held block at up to 3.3 m/s (`go_around`, seed 1),
+/// timed by the joint limits alone, while the carry's `speed` (0.5 m/s) bounded only its straight
+/// lines. A tool speed now caps the pinch along the whole timed path: the same path, slower where
+/// the arm reaches far, and only there.
+#[test]
+fn a_planned_carry_swung_the_held_block_far_faster_than_the_carrys_tool_speed() {
+    let mut c = JointBoxes::new(vec![wall("post", (-0.3, 0.3), (-1.0, 1.0))]).with_margin(HALF_RES);
+    let start = [-1.0, -1.2, 1.5, -1.9, -1.57, 0.0];
+    let goal = [1.2, -1.0, 1.2, -1.7, -1.57, 0.5];
+    let plan_at = |c: &mut JointBoxes, tool_speed: f64| {
+        let config = PlannerConfig {
+            seed: 5,
+            tool_speed,
+            ..PlannerConfig::default()
+        };
+        plan(c, &start, &GoalSet::configs(vec![goal]), &config).unwrap()
+    };
+    let free = plan_at(&mut c, f64::INFINITY);
+    let capped = plan_at(&mut c, 0.5);
+    assert_eq!(
+        free.raw_path, capped.raw_path,
+        "the cap changes the timing, not the path"
+    );
+    assert_eq!(free.trajectory.waypoints(), capped.trajectory.waypoints());
+    let (fast, slow) = (
+        peak_pinch_speed(&free.trajectory),
+        peak_pinch_speed(&capped.trajectory),
+    );
+    assert!(fast > 1.0, "without the cap the pinch swings fast: {fast} m/s");
+    // Capped at the timing's cell boundaries (0.01 rad of path apart): a hair over between them.
+    assert!(slow <= 0.5 * 1.02, "{slow} m/s");
+    assert!(slow > 0.45, "the cap is reached, not undershot: {slow} m/s");
+    assert!(capped.trajectory.duration() > free.trajectory.duration());
+    assert_eq!(capped.trajectory.sample(capped.trajectory.duration()).0, goal);
+    // A non-positive tool speed is an invalid query.
+    let bad = PlannerConfig {
+        tool_speed: 0.0,
+        ..PlannerConfig::default()
+    };
+    assert!(bad.check().unwrap_err().contains("tool_speed"));
+}
+
 #[test]
 fn the_timed_trajectory_keeps_every_joint_within_its_speed_and_acceleration() {
     let mut c = JointBoxes::new(vec![

@@ -9,6 +9,9 @@
 //! forward pass (accelerate as allowed) and a backward pass (brake as needed) over the cell
 //! boundaries give a speed with constant acceleration inside each cell, so every limit holds
 //! everywhere, not only at samples. The arm stops at the start, the end and every unblended corner.
+//! With a tool speed (a carry's, for the held block), the speed at each cell boundary is also
+//! capped so the pinch point moves at most that fast (by the pinch's displacement per radian of
+//! path over the cell, through forward kinematics).
 
 use super::blend::{Piece, Smoothed};
 use crate::motion::trajectory::Trajectory;
@@ -70,9 +73,34 @@ fn caps(piece: &Piece, limits: &JointLimits) -> (f64, f64) {
     (v, a)
 }
 
+/// Caps `cap` (the path speed at each cell boundary, rad/s) so the pinch point moves at most
+/// `tool_speed` m/s: over each cell, the pinch's displacement per radian of path (the chord
+/// between its ends, by forward kinematics) bounds the speed at both ends.
+fn cap_tool_speed(pieces: &[Piece], cells: &[(u32, f64, f64, f64)], cap: &mut [f64], tool_speed: f64) {
+    let pinch = |piece: u32, s: f64| {
+        crate::motion::fk(&pieces[piece as usize].eval(s).0)
+            .translation
+            .vector
+    };
+    for (k, &(piece, s0, ds, _)) in cells.iter().enumerate() {
+        let gain = (pinch(piece, s0 + ds) - pinch(piece, s0)).norm() / ds;
+        if gain > 0.0 {
+            let v = tool_speed / gain;
+            cap[k] = cap[k].min(v);
+            cap[k + 1] = cap[k + 1].min(v);
+        }
+    }
+}
+
 impl PathTrajectory {
-    /// Times `smoothed` (the path through `waypoints`, radians) within `limits`.
-    pub(crate) fn new(smoothed: Smoothed, waypoints: Vec<[f64; 6]>, limits: &JointLimits) -> Self {
+    /// Times `smoothed` (the path through `waypoints`, radians) within `limits`, the pinch
+    /// point at most `tool_speed` m/s (`f64::INFINITY`: no such bound).
+    pub(crate) fn new(
+        smoothed: Smoothed,
+        waypoints: Vec<[f64; 6]>,
+        limits: &JointLimits,
+        tool_speed: f64,
+    ) -> Self {
         let start = waypoints[0];
         let end = waypoints[waypoints.len() - 1];
         let pieces: Vec<Piece> = smoothed.pieces.iter().map(|(p, _)| p.clone()).collect();
@@ -93,6 +121,9 @@ impl PathTrajectory {
         }
         let last = cap.len() - 1;
         cap[last] = 0.0;
+        if tool_speed.is_finite() {
+            cap_tool_speed(&pieces, &cells, &mut cap, tool_speed);
+        }
         // Forward then backward pass.
         let mut vel = cap.clone();
         vel[0] = 0.0;
