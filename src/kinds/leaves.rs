@@ -96,7 +96,8 @@ pub struct Reach {
     /// descent are free, else `side`); see docs/motion.md "Side grasps".
     #[serde(default, skip_serializing_if = "Approach::is_top")]
     pub approach: Approach,
-    /// Tool speed, m/s (> 0). Default 0.5.
+    /// Tool speed along straight lines (`cartesian`, the descent), m/s (> 0); a joint move or a
+    /// planned path keeps the joint limits. Default 0.5.
     #[serde(default = "d_speed", deserialize_with = "units::speed")]
     #[schemars(range(min = 0.0))]
     pub speed: f64,
@@ -231,7 +232,9 @@ pub struct Carry {
     #[serde(default = "d_place_height", deserialize_with = "units::distance")]
     #[schemars(range(min = 0.0, max = units::MAX_REACH))]
     pub place_height: f64,
-    /// Tool speed, m/s (> 0). Default 0.5.
+    /// Speed of the held block, m/s (> 0), along the lift, the set-down and the transfer,
+    /// straight or planned (the joint move a transfer falls back to where no straight line can
+    /// be made keeps the joint limits). Default 0.5.
     #[serde(default = "d_speed", deserialize_with = "units::speed")]
     #[schemars(range(min = 0.0))]
     pub speed: f64,
@@ -295,7 +298,9 @@ pub struct Place {
     #[serde(default = "d_retreat", deserialize_with = "units::distance")]
     #[schemars(range(min = 0.0, max = units::MAX_REACH))]
     pub retreat: f64,
-    /// Tool speed, m/s (> 0). Default 0.5.
+    /// Speed of the held block, m/s (> 0), along the lift, the set-down and the transfer,
+    /// straight or planned (the joint move a transfer falls back to where no straight line can
+    /// be made keeps the joint limits). Default 0.5.
     #[serde(default = "d_speed", deserialize_with = "units::speed")]
     #[schemars(range(min = 0.0))]
     pub speed: f64,
