@@ -65,6 +65,22 @@ fn pick_beside_a_post_was_blocked_from_every_straight_down_pre_grasp() {
     );
 }
 
+/// The second block's carry went straight (in joint space) to a goal on the other elbow branch,
+/// swinging the forearm through the stretched arm with the tool far from pointing down, and the
+/// block fell out of the fingers on the way (scenario 81 of sweep seed 1: a fifth grasp; once
+/// the planned transfer kept the carry's speed, the slower swing dropped it where picking it
+/// again brushed the bin wall, `fingers-container` at `reach[descend]` of a successful episode).
+/// A transfer now stays on the elbow branch the block was picked on when a goal there is free.
+#[test]
+fn a_transfer_across_the_elbow_branch_dropped_the_block() {
+    let r = clean(81, 1);
+    assert_eq!(
+        r["grasp_attempts"], 4,
+        "one grasp per block: {}",
+        r["grasp_attempts"]
+    );
+}
+
 /// The look-ahead at a pick's descent counted only penetration, so a descent whose wrist passed
 /// a post within a millimetre in the kinematic check was taken, and in physics (the arm lagging
 /// its setpoint) the wrist touched the post (`arm-obstacle` at `reach[descend]` of a successful

@@ -594,6 +594,12 @@ impl Carry {
                 free.push(*q);
             }
         }
+        // The block stays on the elbow branch it was picked on when a goal there is free: a
+        // transfer across the branches swings the forearm through the stretched arm with the
+        // tool far from pointing down, and the block falls out of the fingers.
+        if free.iter().any(|q| same_elbow(q, from)) {
+            free.retain(|q| same_elbow(q, from));
+        }
         let goals = if free.is_empty() {
             // Every pre-place configuration's set-down touches: plan to any (the goal's own
             // reasons, if any, name why) and let the set-down run as the leaf asks.
@@ -811,6 +817,12 @@ impl MacroAction for Carry {
         }
         self.arrival.progress(cell, &self.goal_q)
     }
+}
+
+/// True when joints `a` and `b` (radians) put the elbow on the same side: the elbow joint's
+/// sign, which changes only through the stretched arm.
+fn same_elbow(a: &[f64; 6], b: &[f64; 6]) -> bool {
+    (a[2] >= 0.0) == (b[2] >= 0.0)
 }
 
 #[cfg(test)]
