@@ -342,8 +342,9 @@ pub(crate) const LEAF_TIME_CAP: Duration = Duration::from_secs(2);
 /// allowed, within the leaf's `budget` (its `max_checks` and `plan_time_cap` parameters,
 /// range-checked by the tree reader; `None`: the planner's check budget and
 /// [`LEAF_TIME_CAP`]), the pinch at most `tool_speed` m/s along the timed path (`None`: the
-/// joint limits alone; a carry passes its `speed`, the held block's); logs the query; counts it in the tally. The cell's `n`-th plan of the episode is seeded with
-/// `n`, so an episode replays the same plans.
+/// joint limits alone; a carry passes its `speed`, the held block's); logs the query; counts
+/// it in the tally. The cell's `n`-th plan of the episode is seeded with `n`, so an episode
+/// replays the same plans.
 ///
 /// # Errors
 /// The planner's typed failure ([`crate::sim::planning::plan_failure`]).

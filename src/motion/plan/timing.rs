@@ -82,8 +82,16 @@ fn cap_tool_speed(pieces: &[Piece], cells: &[(u32, f64, f64, f64)], cap: &mut [f
             .translation
             .vector
     };
+    // The end of a cell is usually the next one's start: its pinch is computed once.
+    let mut last: Option<(u32, f64, nalgebra::Vector3<f64>)> = None;
     for (k, &(piece, s0, ds, _)) in cells.iter().enumerate() {
-        let gain = (pinch(piece, s0 + ds) - pinch(piece, s0)).norm() / ds;
+        let start = match last {
+            Some((p, s, at)) if p == piece && s.to_bits() == s0.to_bits() => at,
+            _ => pinch(piece, s0),
+        };
+        let end = pinch(piece, s0 + ds);
+        last = Some((piece, s0 + ds, end));
+        let gain = (end - start).norm() / ds;
         if gain > 0.0 {
             let v = tool_speed / gain;
             cap[k] = cap[k].min(v);
