@@ -7,7 +7,9 @@
 //! of 73 box–box and 44 of 81 box–plane pairs 0–5 mm apart were not reported, while every
 //! mesh and cylinder pair was. A planned path could then pass 1.5 mm from the fixture (the
 //! forearm's capsule) although the planner keeps 5 mm, and the servos' few millimetres of
-//! tracking error put the forearm on the fixture.
+//! tracking error put the forearm on the fixture. (Part of those omissions was the broad
+//! phase, which grows each body's box by the body's compiled margin: the checker now writes the
+//! bodies' margins with the geoms'. The colliders' own omissions remain.)
 //!
 //! [`MarginPairs`] lists the pairs of those types that MuJoCo tests in a model (contact bitmasks,
 //! body filters, `<exclude>`) and, after `mj_collision`, measures each one that MuJoCo did not

@@ -16,8 +16,9 @@
 //! configurations near obstacles.
 
 use mujoco_rs::prelude::*;
-use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, Unit, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Vector3};
 
+use super::chain::{ArmChain, Link, mat};
 use super::pair_filter::PairFilter;
 use crate::motion::plan::JointSpare;
 use crate::motion::plan::config::UR5E_LEVER_ARMS;
@@ -78,33 +79,6 @@ impl Local {
     }
 }
 
-/// One arm link: its body's offset from its parent (rotation, translation) and its hinge.
-#[derive(Clone, Copy, Debug)]
-struct Link {
-    rot: Matrix3<f64>,
-    pos: Vector3<f64>,
-    axis: Vector3<f64>,
-    anchor: Vector3<f64>,
-    qpos0: f64,
-}
-
-/// Rotation by `angle` radians about the unit `axis` (Rodrigues).
-fn axis_angle(a: &Vector3<f64>, angle: f64) -> Matrix3<f64> {
-    let (s, c) = angle.sin_cos();
-    let t = 1.0 - c;
-    Matrix3::new(
-        c + t * a.x * a.x,
-        t * a.x * a.y - s * a.z,
-        t * a.x * a.z + s * a.y,
-        t * a.x * a.y + s * a.z,
-        c + t * a.y * a.y,
-        t * a.y * a.z - s * a.x,
-        t * a.x * a.z - s * a.y,
-        t * a.y * a.z + s * a.x,
-        c + t * a.z * a.z,
-    )
-}
-
 /// One pair to test: two shape indices (moving shapes first, then fixed ones), the distance
 /// they must keep for "free" (the pair's margin plus [`PAD`], metres), and the distance below
 /// which exact shapes are "blocked": [`PAD`] of penetration (MuJoCo reports every
@@ -125,9 +99,8 @@ struct Pair {
 /// The conservative model of one snapshot of the cell (see the module docs).
 #[derive(Clone, Debug)]
 pub struct Screen {
-    /// World pose of the first arm link's parent body (rotation, translation).
-    base: (Matrix3<f64>, Vector3<f64>),
-    links: [Link; 6],
+    /// The arm's link frames at any joints.
+    chain: ArmChain,
     /// Shapes moved by the arm: (link index 0..6, shape in the link's frame, whether the
     /// shape is the geom itself rather than a bound of it).
     moving: Vec<(usize, Local, bool, f64)>,
@@ -142,10 +115,28 @@ pub struct Screen {
     link_spheres: [(Vector3<f64>, f64); 6],
     /// Geom id of each shape (moving ones, then fixed ones).
     geoms: Vec<usize>,
+    /// The pairs the last [`Screen::free_spare`] could not decide.
+    undecided: Vec<Undecided>,
     /// Scratch: the moving shapes posed, when `stamp` matches `call`.
     posed: Vec<Posed>,
     stamp: Vec<u32>,
     call: u32,
+}
+
+/// A pair whose primitives come within its margin plus [`PAD`] but that the screen cannot call
+/// blocked: only the geoms' exact distance decides it ([`Screen::undecided`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Undecided {
+    /// The two geom ids.
+    pub geoms: (usize, usize),
+    /// The distance the geoms must keep beyond the margin for the screen's vouching, metres:
+    /// the pair's margin plus [`PAD`].
+    pub gap: f64,
+    /// The pair's lever-arm ratio, in (0, 1].
+    pub kappa: f64,
+    /// The joints `lo..=hi` that move the pair's parts relative to each other (`lo > hi`:
+    /// none).
+    pub range: (usize, usize),
 }
 
 /// The partner of an arm link in a [`Group`].
@@ -174,11 +165,6 @@ struct Group {
 
 /// A shape in the world, its bounding sphere, and whether it is the geom itself.
 type Posed = (Shape, Option<(V3, f64)>, bool);
-
-/// Rotation matrix of MuJoCo's row-major `xmat`.
-fn mat(x: &[f64; 9]) -> Matrix3<f64> {
-    Matrix3::new(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], x[8])
-}
 
 /// The geom's bounding primitive in its own frame; `None` for a type the screen cannot bound
 /// (a height field, an SDF).
@@ -408,41 +394,10 @@ impl Screen {
         let m: &MjModel = b.data.model();
         let d = b.data;
         let ngeom = m.ffi().ngeom as usize;
-        let parent = m.body_parentid();
-        for k in 1..6 {
-            if parent[b.link_bodies[k]] as usize != b.link_bodies[k - 1] {
-                return None;
-            }
-        }
-        let iso = |pos: &[f64; 3], xmat: &[f64; 9]| {
-            let r = nalgebra::Rotation3::from_matrix_unchecked(mat(xmat));
-            Isometry3::from_parts(
-                Translation3::new(pos[0], pos[1], pos[2]),
-                UnitQuaternion::from_rotation_matrix(&r),
-            )
-        };
-        let p0 = parent[b.link_bodies[0]] as usize;
-        let base = (mat(&d.xmat()[p0]), Vector3::from(d.xpos()[p0]));
-        let links: [Link; 6] = std::array::from_fn(|k| {
-            let body = b.link_bodies[k];
-            let j = b.joints[k];
-            let (p, q) = (m.body_pos()[body], m.body_quat()[body]);
-            let ax = m.jnt_axis()[j];
-            let an = m.jnt_pos()[j];
-            let offset = UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]));
-            Link {
-                rot: offset.to_rotation_matrix().into_inner(),
-                pos: Vector3::new(p[0], p[1], p[2]),
-                axis: Unit::new_normalize(Vector3::new(ax[0], ax[1], ax[2])).into_inner(),
-                anchor: Vector3::new(an[0], an[1], an[2]),
-                qpos0: m.qpos0()[m.jnt_qposadr()[j] as usize],
-            }
-        });
-        let link_pose: Vec<Isometry3<f64>> = b
+        let chain = ArmChain::new(d, b.link_bodies, b.joints)?;
+        let link_pose: [(Matrix3<f64>, Vector3<f64>); 6] = b
             .link_bodies
-            .iter()
-            .map(|&l| iso(&d.xpos()[l], &d.xmat()[l]))
-            .collect();
+            .map(|l| (mat(&d.xmat()[l]), Vector3::from(d.xpos()[l])));
         let (ct, ca) = (m.geom_contype(), m.geom_conaffinity());
         let collidable = |g: usize| ct[g] != 0 || ca[g] != 0;
         // Index of each geom's shape: moving ones first, then fixed ones.
@@ -478,9 +433,9 @@ impl Screen {
                     return None;
                 };
                 let link = &link_pose[k as usize - 1];
-                let lr = link.rotation.to_rotation_matrix().into_inner().transpose();
+                let lr = link.0.transpose();
                 let rel_r = lr * gr;
-                let rel_t = lr * (gt - link.translation.vector);
+                let rel_t = lr * (gt - link.1);
                 *slot = Some(moving.len());
                 let local = moved(&l, &rel_r, &rel_t);
                 moving.push((k as usize - 1, local, exact(m, g), local.reach()));
@@ -548,7 +503,7 @@ impl Screen {
         pairs.sort_by_key(|p| (p.b as usize) < moving.len());
         let nm = moving.len();
         for p in &mut pairs {
-            p.kappa = lever_ratio(&links, &moving, p.a as usize, p.b as usize);
+            p.kappa = lever_ratio(&chain.links, &moving, p.a as usize, p.b as usize);
         }
         let partner = |p: &Pair| {
             if (p.b as usize) < nm {
@@ -601,33 +556,17 @@ impl Screen {
             nm
         ];
         Some(Self {
-            base,
-            links,
+            chain,
             moving,
             fixed,
             pairs: grouped,
             groups,
             link_spheres,
             geoms,
+            undecided: Vec::new(),
             posed,
             stamp: vec![0; nm],
             call: 0,
-        })
-    }
-
-    /// World poses of the six arm links at joints `q` (radians), as `mj_kinematics` computes
-    /// them: parent pose · body offset · rotation about the joint axis through its anchor.
-    pub fn link_poses(&self, q: &[f64; 6]) -> [(Matrix3<f64>, Vector3<f64>); 6] {
-        let (mut r, mut t) = self.base;
-        std::array::from_fn(|k| {
-            let l = &self.links[k];
-            t += r * l.pos;
-            r *= l.rot;
-            let j = axis_angle(&l.axis, q[k] - l.qpos0);
-            // Rotation about the axis through the anchor: x ↦ anchor + J (x − anchor).
-            t += r * (l.anchor - j * l.anchor);
-            r *= j;
-            (r, t)
         })
     }
 
@@ -653,16 +592,25 @@ impl Screen {
     /// range of the joints that move the pair's parts relative to each other. Geoms lie inside
     /// their primitives, so the geoms keep the margin wherever the lever-arm bound of the
     /// range's joint changes stays within its spare.
+    ///
+    /// With no verdict (`None`), the spare is that of the pairs the screen decided, and
+    /// [`Screen::undecided`] lists the others: a checker that measures them exactly can settle
+    /// the verdict and the spare ([`Undecided`]).
     pub fn free_spare(&mut self, q: &[f64; 6], cap: f64) -> (Option<bool>, JointSpare) {
         let (verdict, _, spare) = self.judge::<true>(q, cap.max(0.0));
         (
             verdict,
-            if verdict == Some(true) {
-                spare
-            } else {
+            if verdict == Some(false) {
                 JointSpare::NONE
+            } else {
+                spare
             },
         )
+    }
+
+    /// The pairs the last [`Screen::free_spare`] could not decide (none after a verdict).
+    pub fn undecided(&self) -> &[Undecided] {
+        &self.undecided
     }
 
     /// The verdict, the pair that decided a "blocked", and with `SPARE` the spare clearance by
@@ -672,7 +620,7 @@ impl Screen {
         q: &[f64; 6],
         cap: f64,
     ) -> (Option<bool>, Option<(usize, usize)>, JointSpare) {
-        let frames = self.link_poses(q);
+        let frames = self.chain.link_poses(q);
         // A new stamp: every moving shape is posed again when first needed.
         self.call = self.call.wrapping_add(1);
         if self.call == 0 {
@@ -687,6 +635,7 @@ impl Screen {
         let nm = self.moving.len();
         let mut unsure = false;
         let mut spare = JointSpare::uniform(cap);
+        self.undecided.clear();
         for g in &self.groups {
             // The joints that move the group's pair relative to each other (none: the pair
             // never moves apart or closer, and limits no spare).
@@ -738,7 +687,7 @@ impl Screen {
                     }
                 }
                 // Near, or the clearance when it is wanted (one distance for both).
-                let kept = if SPARE && ranged && !unsure {
+                let kept = if SPARE && ranged {
                     apart(&x.0, &y.0, p.gap)
                 } else {
                     (!near(&x.0, &y.0, p.gap)).then_some(f64::INFINITY)
@@ -746,6 +695,7 @@ impl Screen {
                 match kept {
                     None => {
                         if x.2 && y.2 && within(&x.0, &y.0, p.block) {
+                            self.undecided.clear();
                             return (
                                 Some(false),
                                 Some((self.geoms[a], self.geoms[b])),
@@ -753,11 +703,22 @@ impl Screen {
                             );
                         }
                         unsure = true;
+                        if SPARE {
+                            self.undecided.push(Undecided {
+                                geoms: (self.geoms[a], self.geoms[b]),
+                                gap: p.gap,
+                                kappa: p.kappa,
+                                range: (lo, hi),
+                            });
+                        }
                     }
                     Some(c) if SPARE && ranged => spare.tighten(lo, hi, (c - p.gap) / p.kappa),
                     Some(_) => {}
                 }
             }
+        }
+        if !unsure {
+            self.undecided.clear();
         }
         ((!unsure).then_some(true), None, spare)
     }
@@ -800,7 +761,7 @@ impl Screen {
     /// (the world for a fixed partner), with the bound `kappa · Σ_range r_j |q2_j − q_j|`
     /// (metres) that the spare's vouching relies on.
     pub(crate) fn pair_moves(&self, q: &[f64; 6], q2: &[f64; 6]) -> Vec<(f64, f64, f64)> {
-        let (f1, f2) = (self.link_poses(q), self.link_poses(q2));
+        let (f1, f2) = (self.chain.link_poses(q), self.chain.link_poses(q2));
         let nm = self.moving.len();
         let points = |l: &Local| -> Vec<Vector3<f64>> {
             match l {

@@ -1,0 +1,161 @@
+//! [`ArmChain`]: the six arm link frames at any joints, computed from the model's own body
+//! offsets and joint axes (the same products as `mj_kinematics`, without posing the rest of the
+//! cell); [`MovingGeoms`]: the geoms the arm moves, posed from those frames into an `MjData`.
+
+use mujoco_rs::prelude::*;
+use mujoco_rs::wrappers::mj_model::traits::ModelType;
+use nalgebra::{Matrix3, Quaternion, Unit, UnitQuaternion, Vector3};
+
+/// A rotation (row-major `xmat` read as a matrix) and a translation, metres.
+pub(crate) type Frame = (Matrix3<f64>, Vector3<f64>);
+
+/// One arm link: its body's offset from its parent (rotation, translation, metres) and its
+/// hinge (unit axis and anchor in the body frame, the joint's reference angle in radians).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Link {
+    pub(crate) rot: Matrix3<f64>,
+    pub(crate) pos: Vector3<f64>,
+    pub(crate) axis: Vector3<f64>,
+    pub(crate) anchor: Vector3<f64>,
+    pub(crate) qpos0: f64,
+}
+
+/// Rotation by `angle` radians about the unit `axis` (Rodrigues).
+fn axis_angle(a: &Vector3<f64>, angle: f64) -> Matrix3<f64> {
+    let (s, c) = angle.sin_cos();
+    let t = 1.0 - c;
+    Matrix3::new(
+        c + t * a.x * a.x,
+        t * a.x * a.y - s * a.z,
+        t * a.x * a.z + s * a.y,
+        t * a.x * a.y + s * a.z,
+        c + t * a.y * a.y,
+        t * a.y * a.z - s * a.x,
+        t * a.x * a.z - s * a.y,
+        t * a.y * a.z + s * a.x,
+        c + t * a.z * a.z,
+    )
+}
+
+/// Rotation matrix of MuJoCo's row-major `xmat`.
+pub(crate) fn mat(x: &[f64; 9]) -> Matrix3<f64> {
+    Matrix3::new(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], x[8])
+}
+
+/// The six arm links as a kinematic chain from the first link's parent body.
+#[derive(Clone, Debug)]
+pub struct ArmChain {
+    /// World pose of the first arm link's parent body.
+    base: Frame,
+    pub(crate) links: [Link; 6],
+}
+
+impl ArmChain {
+    /// The chain of `link_bodies` (base to wrist 3, each the parent of the next) and their
+    /// hinges `joints`, its base posed as in `data` (posed by `mj_kinematics`); `None` when the
+    /// bodies are not a chain.
+    pub(crate) fn new<M: ModelType>(
+        data: &MjData<M>,
+        link_bodies: [usize; 6],
+        joints: [usize; 6],
+    ) -> Option<Self> {
+        let m = data.model();
+        let parent = m.body_parentid();
+        for k in 1..6 {
+            if parent[link_bodies[k]] as usize != link_bodies[k - 1] {
+                return None;
+            }
+        }
+        let p0 = parent[link_bodies[0]] as usize;
+        let base = (mat(&data.xmat()[p0]), Vector3::from(data.xpos()[p0]));
+        let links = std::array::from_fn(|k| {
+            let (body, j) = (link_bodies[k], joints[k]);
+            let (p, q) = (m.body_pos()[body], m.body_quat()[body]);
+            let (ax, an) = (m.jnt_axis()[j], m.jnt_pos()[j]);
+            let offset = UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]));
+            Link {
+                rot: offset.to_rotation_matrix().into_inner(),
+                pos: Vector3::new(p[0], p[1], p[2]),
+                axis: Unit::new_normalize(Vector3::new(ax[0], ax[1], ax[2])).into_inner(),
+                anchor: Vector3::new(an[0], an[1], an[2]),
+                qpos0: m.qpos0()[m.jnt_qposadr()[j] as usize],
+            }
+        });
+        Some(Self { base, links })
+    }
+
+    /// World poses of the six arm links at joints `q` (radians), as `mj_kinematics` computes
+    /// them: parent pose · body offset · rotation about the joint axis through its anchor.
+    pub fn link_poses(&self, q: &[f64; 6]) -> [Frame; 6] {
+        let (mut r, mut t) = self.base;
+        std::array::from_fn(|k| {
+            let l = &self.links[k];
+            t += r * l.pos;
+            r *= l.rot;
+            let j = axis_angle(&l.axis, q[k] - l.qpos0);
+            // Rotation about the axis through the anchor: x ↦ anchor + J (x − anchor).
+            t += r * (l.anchor - j * l.anchor);
+            r *= j;
+            (r, t)
+        })
+    }
+}
+
+/// The geoms the arm moves (every geom of arm group 1..=6: on a link, the gripper at its
+/// opening, a held block), each fixed in its link's frame, posed at any joints without
+/// `mj_kinematics`: what `mj_geomDistance` reads of them is their world pose alone.
+#[derive(Clone, Debug)]
+pub(crate) struct MovingGeoms {
+    chain: ArmChain,
+    /// Geom id, link index (0..6), and the geom's pose in the link's frame.
+    geoms: Vec<(usize, usize, Frame)>,
+}
+
+impl MovingGeoms {
+    /// The moving geoms of `data` (posed by `mj_kinematics` at any joints), `group` giving each
+    /// geom's arm group (0 fixed, `k` in 1..=6 moved by arm joint `k − 1`).
+    pub(crate) fn new<M: ModelType>(
+        data: &MjData<M>,
+        chain: ArmChain,
+        link_bodies: [usize; 6],
+        group: &[u8],
+    ) -> Self {
+        let geoms = group
+            .iter()
+            .enumerate()
+            .filter(|&(_, &k)| k != 0)
+            .map(|(g, &k)| {
+                let link = k as usize - 1;
+                let body = link_bodies[link];
+                let lr = mat(&data.xmat()[body]).transpose();
+                let lt = Vector3::from(data.xpos()[body]);
+                let (gr, gt) = (mat(&data.geom_xmat()[g]), Vector3::from(data.geom_xpos()[g]));
+                (g, link, (lr * gr, lr * (gt - lt)))
+            })
+            .collect();
+        Self { chain, geoms }
+    }
+
+    /// Writes the world pose of every moving geom at joints `q` (radians) into `data`'s
+    /// `geom_xpos` and `geom_xmat`; nothing else of `data` changes.
+    pub(crate) fn pose<M: ModelType>(&self, q: &[f64; 6], data: &mut MjData<M>) {
+        let frames = self.chain.link_poses(q);
+        for &(g, link, (rel_r, rel_t)) in &self.geoms {
+            let (r, t) = &frames[link];
+            let (x, p) = (r * rel_r, r * rel_t + t);
+            data.geom_xpos_mut()[g] = [p.x, p.y, p.z];
+            // `geom_xmat` is row-major.
+            data.geom_xmat_mut()[g] = [
+                x[(0, 0)],
+                x[(0, 1)],
+                x[(0, 2)],
+                x[(1, 0)],
+                x[(1, 1)],
+                x[(1, 2)],
+                x[(2, 0)],
+                x[(2, 1)],
+                x[(2, 2)],
+            ];
+        }
+    }
+}
