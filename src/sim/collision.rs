@@ -40,7 +40,7 @@ pub const DEFAULT_MARGIN: f64 = 0.005;
 /// What the spare clearance ([`CollisionChecker::exact_spare`]) leaves for MuJoCo's own
 /// tolerances, metres: its `mj_geomDistance` and `mj_collision`'s contact distances of the same
 /// pair differ by the convex-hull iterations' tolerance (about 1e-6 m); the screen's
-/// [`PAD`](super::screen::PAD) again.
+/// [`PAD`] again.
 pub const SPARE_TOLERANCE: f64 = 5e-4;
 
 /// Largest clearance margin accepted, metres.
@@ -501,8 +501,8 @@ impl CollisionChecker for SceneChecker {
 
     /// The [`Screen`]'s verdict and spare clearance ([`Screen::free_spare`]), settled where the
     /// screen cannot tell by measuring its undecided pairs alone with `mj_geomDistance` (the
-    /// moving geoms posed from the arm's link frames, [`MovingGeoms`]): blocked when one is
-    /// closer than the margin, else free with their exact clearances in the spare. Every other
+    /// moving geoms posed from the arm's link frames, `sim::chain::MovingGeoms`): blocked when
+    /// one is closer than the margin, else free with their exact clearances in the spare. Every other
     /// pair keeps the margin by the screen's bound, so the verdict is the one a full MuJoCo pass
     /// gives (up to MuJoCo's own tolerances, about 1e-6 m), at a few pairs' cost instead of
     /// the whole cell's. With a held block beyond [`HELD_BLOCK_REACH`] of the pinch, the
