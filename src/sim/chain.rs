@@ -101,9 +101,10 @@ impl ArmChain {
     }
 }
 
-/// The geoms the arm moves (every geom of arm group 1..=6: on a link, the gripper at its
-/// opening, a held block), each fixed in its link's frame, posed at any joints without
-/// `mj_kinematics`: what `mj_geomDistance` reads of them is their world pose alone.
+/// The collidable geoms the arm moves (every one of arm group 1..=6: on a link, the gripper at
+/// its opening, a held block), each fixed in its link's frame, posed at any joints without
+/// `mj_kinematics`: what `mj_geomDistance` reads of them is their world pose alone, and it is
+/// asked of no other geom.
 #[derive(Clone, Debug)]
 pub(crate) struct MovingGeoms {
     chain: ArmChain,
@@ -112,18 +113,20 @@ pub(crate) struct MovingGeoms {
 }
 
 impl MovingGeoms {
-    /// The moving geoms of `data` (posed by `mj_kinematics` at any joints), `group` giving each
-    /// geom's arm group (0 fixed, `k` in 1..=6 moved by arm joint `k − 1`).
+    /// The moving collidable geoms of `data` (posed by `mj_kinematics` at any joints; a geom
+    /// with a contact type or affinity), `group` giving each geom's arm group (0 fixed, `k` in
+    /// 1..=6 moved by arm joint `k − 1`).
     pub(crate) fn new<M: ModelType>(
         data: &MjData<M>,
         chain: ArmChain,
         link_bodies: [usize; 6],
         group: &[u8],
     ) -> Self {
+        let (ct, ca) = (data.model().geom_contype(), data.model().geom_conaffinity());
         let geoms = group
             .iter()
             .enumerate()
-            .filter(|&(_, &k)| k != 0)
+            .filter(|&(g, &k)| k != 0 && (ct[g] != 0 || ca[g] != 0))
             .map(|(g, &k)| {
                 let link = k as usize - 1;
                 let body = link_bodies[link];

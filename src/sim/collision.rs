@@ -609,17 +609,19 @@ impl SceneChecker {
                 }
             }
             let (bodies, joints) = self.arm_links;
-            let screen = Screen::build(&Build {
-                data: &self.data,
-                group: &group,
-                link_bodies: bodies,
-                joints,
+            let chain = ArmChain::new(&self.data, bodies, joints);
+            let screen = chain.as_ref().and_then(|chain| {
+                Screen::build(&Build {
+                    data: &self.data,
+                    group: &group,
+                    link_bodies: bodies,
+                    chain,
+                })
             });
             if screen.is_none() {
                 tracing::debug!(target: "macrotree::plan", "no collision screen for this cell: MuJoCo checks every configuration");
             }
-            let moving = ArmChain::new(&self.data, bodies, joints)
-                .map(|chain| MovingGeoms::new(&self.data, chain, bodies, &group));
+            let moving = chain.map(|chain| MovingGeoms::new(&self.data, chain, bodies, &group));
             self.derived = Some(Derived { screen, moving });
         }
         self.derived.as_mut().expect("derived above")

@@ -18,7 +18,7 @@
 use mujoco_rs::prelude::*;
 use nalgebra::{Matrix3, Vector3};
 
-use super::chain::{ArmChain, Link, mat};
+use super::chain::{ArmChain, Frame, Link, mat};
 use super::pair_filter::PairFilter;
 use crate::motion::plan::JointSpare;
 use crate::motion::plan::config::UR5E_LEVER_ARMS;
@@ -239,12 +239,12 @@ pub(crate) struct Build<'a> {
     pub(crate) group: &'a [u8],
     /// Body ids of the six arm links, base to wrist 3.
     pub(crate) link_bodies: [usize; 6],
-    /// Joint ids of the six arm joints.
-    pub(crate) joints: [usize; 6],
+    /// The six arm links as a chain (their frames at any joints).
+    pub(crate) chain: &'a ArmChain,
 }
 
 /// A moving shape posed at the link frames, with its bounding sphere and exactness.
-fn pose(m: &(usize, Local, bool, f64), frames: &[(Matrix3<f64>, Vector3<f64>); 6]) -> Posed {
+fn pose(m: &(usize, Local, bool, f64), frames: &[Frame; 6]) -> Posed {
     let (k, l, e, reach) = m;
     let (r, t) = &frames[*k];
     let s = l.posed(r, t);
@@ -394,8 +394,8 @@ impl Screen {
         let m: &MjModel = b.data.model();
         let d = b.data;
         let ngeom = m.ffi().ngeom as usize;
-        let chain = ArmChain::new(d, b.link_bodies, b.joints)?;
-        let link_pose: [(Matrix3<f64>, Vector3<f64>); 6] = b
+        let chain = b.chain.clone();
+        let link_pose: [Frame; 6] = b
             .link_bodies
             .map(|l| (mat(&d.xmat()[l]), Vector3::from(d.xpos()[l])));
         let (ct, ca) = (m.geom_contype(), m.geom_conaffinity());
@@ -794,7 +794,7 @@ impl Screen {
                     (a, None, 0..=self.moving[a].0)
                 };
                 let k = self.moving[far].0;
-                let in_near = |f: &[(Matrix3<f64>, Vector3<f64>); 6], x: &Vector3<f64>| {
+                let in_near = |f: &[Frame; 6], x: &Vector3<f64>| {
                     let w = f[k].0 * x + f[k].1;
                     match near_link {
                         Some(n) => f[n].0.transpose() * (w - f[n].1),
