@@ -99,6 +99,28 @@ impl ArmChain {
             (r, t)
         })
     }
+
+    /// How far `spheres` reach from each joint's axis at the link frames `frames`
+    /// ([`ArmChain::link_poses`]), metres: for joint `j`, the largest distance from its axis of a
+    /// point of the spheres of links `j..6` (world centre and radius, metres; a negative radius:
+    /// no sphere). Those links are all joint `j` turns, so no point of theirs inside a sphere is
+    /// farther from the axis.
+    pub(crate) fn axis_reach(&self, frames: &[Frame; 6], spheres: &[([f64; 3], f64); 6]) -> [f64; 6] {
+        let mut reach = [0.0f64; 6];
+        for (j, (link, (r, t))) in self.links.iter().zip(frames).enumerate() {
+            // The axis is fixed in link j's frame: through the anchor, along the axis.
+            let u = r * link.axis;
+            let a = r * link.anchor + t;
+            for (c, radius) in &spheres[j..] {
+                if *radius < 0.0 {
+                    continue;
+                }
+                let d = Vector3::new(c[0] - a.x, c[1] - a.y, c[2] - a.z);
+                reach[j] = reach[j].max(d.cross(&u).norm() + radius);
+            }
+        }
+        reach
+    }
 }
 
 /// The collidable geoms the arm moves (every one of arm group 1..=6: on a link, the gripper at
@@ -142,7 +164,16 @@ impl MovingGeoms {
     /// Writes the world pose of every moving geom at joints `q` (radians) into `data`'s
     /// `geom_xpos` and `geom_xmat`; nothing else of `data` changes.
     pub(crate) fn pose<M: ModelType>(&self, q: &[f64; 6], data: &mut MjData<M>) {
-        let frames = self.chain.link_poses(q);
+        self.pose_at(&self.frames(q), data);
+    }
+
+    /// The six link frames at joints `q` (radians).
+    pub(crate) fn frames(&self, q: &[f64; 6]) -> [Frame; 6] {
+        self.chain.link_poses(q)
+    }
+
+    /// [`MovingGeoms::pose`] at the link frames `frames` ([`MovingGeoms::frames`]).
+    pub(crate) fn pose_at<M: ModelType>(&self, frames: &[Frame; 6], data: &mut MjData<M>) {
         for &(g, link, (rel_r, rel_t)) in &self.geoms {
             let (r, t) = &frames[link];
             let (x, p) = (r * rel_r, r * rel_t + t);

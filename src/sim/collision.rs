@@ -444,18 +444,20 @@ impl SceneChecker {
     }
 
     /// The least distance at `q` (radians) of every pair the checker tests, metres, at most
-    /// `wide`: `mj_geomDistance` of each pair that may be closer ([`MarginPairs::least`]).
-    /// `None` when the margin is zero (no pairs listed).
-    fn least_distance(&mut self, q: &[f64; 6], wide: f64) -> Option<f64> {
+    /// `wide`: `mj_geomDistance` of each pair that may be closer ([`MarginPairs::least`]); with
+    /// how far the moving parts reach from each joint's axis there (metres, infinite when
+    /// unknown: see [`SceneChecker::pose_moving`]). `None` when the margin is zero (no pairs
+    /// listed).
+    fn least_distance(&mut self, q: &[f64; 6], wide: f64) -> Option<(f64, [f64; 6])> {
         if self.margin_pairs.0.is_empty() {
             return None;
         }
-        self.pose_moving(q);
-        Some(
-            self.margin_pairs
-                .0
-                .least(&mut self.data, q, &UR5E_LEVER_ARMS, wide),
-        )
+        let reach = self.pose_moving(q);
+        let least = self
+            .margin_pairs
+            .0
+            .least(&mut self.data, q, &UR5E_LEVER_ARMS, wide);
+        Some((least, reach))
     }
 
     /// Poses the arm (and a held block) at `q` with `mj_kinematics`.
@@ -554,8 +556,9 @@ impl CollisionChecker for SceneChecker {
             return None;
         }
         let wide = self.margin + cap.min(MAX_MARGIN);
-        let spare = self.least_distance(q, wide)? - self.margin - SPARE_TOLERANCE;
-        (spare >= 0.0).then(|| JointSpare::uniform(spare.min(cap)))
+        let (least, reach) = self.least_distance(q, wide)?;
+        let spare = least - self.margin - SPARE_TOLERANCE;
+        (spare >= 0.0).then(|| JointSpare::uniform(spare.min(cap)).with_reach(reach))
     }
 
     fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
@@ -628,12 +631,24 @@ impl SceneChecker {
     }
 
     /// Poses the moving geoms at `q` (radians) for `mj_geomDistance`: from the arm's link
-    /// frames ([`MovingGeoms`]), or by `mj_kinematics` when the arm is not a chain.
-    fn pose_moving(&mut self, q: &[f64; 6]) {
+    /// frames ([`MovingGeoms`]), or by `mj_kinematics` when the arm is not a chain. Returns how
+    /// far the moving geoms reach from each joint's axis there, metres, through the screen's
+    /// link spheres ([`Screen::reach`]); infinite when the cell has no screen.
+    fn pose_moving(&mut self, q: &[f64; 6]) -> [f64; 6] {
         self.derive();
-        match self.derived.as_ref().and_then(|d| d.moving.as_ref()) {
-            Some(moving) => moving.pose(q, &mut self.data),
-            None => self.detect_pose(q),
+        match self.derived.as_ref() {
+            Some(Derived {
+                moving: Some(moving),
+                screen,
+            }) => {
+                let frames = moving.frames(q);
+                moving.pose_at(&frames, &mut self.data);
+                screen.as_ref().map_or([f64::INFINITY; 6], |s| s.reach(&frames))
+            }
+            _ => {
+                self.detect_pose(q);
+                [f64::INFINITY; 6]
+            }
         }
     }
 

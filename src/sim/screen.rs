@@ -627,11 +627,7 @@ impl Screen {
             self.stamp.iter_mut().for_each(|s| *s = u32::MAX);
             self.call = 1;
         }
-        let spheres: [(V3, f64); 6] = std::array::from_fn(|k| {
-            let (c, r) = &self.link_spheres[k];
-            let w = frames[k].0 * c + frames[k].1;
-            ([w.x, w.y, w.z], *r)
-        });
+        let spheres = self.world_spheres(&frames);
         let nm = self.moving.len();
         let mut unsure = false;
         let mut spare = JointSpare::uniform(cap);
@@ -721,6 +717,23 @@ impl Screen {
             self.undecided.clear();
         }
         ((!unsure).then_some(true), None, spare)
+    }
+
+    /// How far the moving shapes reach from each joint's axis at the link frames `frames`
+    /// ([`ArmChain::link_poses`]), metres, through each link's bounding sphere
+    /// ([`ArmChain::axis_reach`]): every moving collidable geom lies inside them.
+    pub(crate) fn reach(&self, frames: &[Frame; 6]) -> [f64; 6] {
+        self.chain.axis_reach(frames, &self.world_spheres(frames))
+    }
+
+    /// Each link's bounding sphere in the world at the link frames `frames` (centre, radius,
+    /// metres; radius negative for a link without shapes).
+    fn world_spheres(&self, frames: &[Frame; 6]) -> [(V3, f64); 6] {
+        std::array::from_fn(|k| {
+            let (c, r) = &self.link_spheres[k];
+            let w = frames[k].0 * c + frames[k].1;
+            ([w.x, w.y, w.z], *r)
+        })
     }
 
     /// True when the sphere of group `g`'s link (`spheres`: each link's, world frame) keeps

@@ -3,6 +3,7 @@
 use std::fmt;
 
 use super::planner::SPARE_CAP;
+use super::spare::JointSpare;
 
 /// A collision model of the arm in its cell, queried one joint configuration at a time.
 ///
@@ -126,103 +127,6 @@ impl fmt::Display for Collision {
     }
 }
 
-/// Spare clearance by joint range, metres: for each range of arm joints `lo..=hi` (0 = base …
-/// 5 = wrist 3), a lower bound on how much farther than the clearance margin every pair of
-/// parts that only those joints move relative to each other is. The fixed cell and a part of
-/// link `k` (moved by joints `0..=k`) form a pair of range `0..=k`; parts of links `a < b`, a pair
-/// of range `a+1..=b`. A point of a part moves relative to its partner at most
-/// `Σ_{j in range} r_j |Δq_j|` (lever arms `r_j`), so a configuration whose joint changes keep
-/// every range's sum within its spare keeps the margin too. Self pairs of the wrist links change
-/// only with the wrist joints: a single spare for all joints would be held down by them.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct JointSpare {
-    /// `by_range[lo][hi]` for `lo ≤ hi`, metres; unused below the diagonal.
-    by_range: [[f64; 6]; 6],
-}
-
-impl JointSpare {
-    /// No spare anywhere: vouches for nothing.
-    pub const NONE: JointSpare = JointSpare {
-        by_range: [[0.0; 6]; 6],
-    };
-
-    /// The same spare `s` (metres) for every range.
-    pub fn uniform(s: f64) -> Self {
-        Self {
-            by_range: [[s; 6]; 6],
-        }
-    }
-
-    /// The spare of the range `lo..=hi` (joint indices, `lo ≤ hi ≤ 5`), metres.
-    pub fn get(&self, lo: usize, hi: usize) -> f64 {
-        self.by_range[lo][hi]
-    }
-
-    /// Lowers the spare of the range `lo..=hi` to `s` metres (to 0 for a negative `s`: a bound
-    /// too weak to vouch) if it is less.
-    pub fn tighten(&mut self, lo: usize, hi: usize, s: f64) {
-        let v = &mut self.by_range[lo][hi];
-        *v = v.min(s.max(0.0));
-    }
-
-    /// The least spare of any range, metres.
-    pub fn least(&self) -> f64 {
-        (0..6)
-            .flat_map(|lo| (lo..6).map(move |hi| (lo, hi)))
-            .map(|(lo, hi)| self.by_range[lo][hi])
-            .fold(f64::INFINITY, f64::min)
-    }
-
-    /// The spare left after displacements `moved[j]` (metres: joint `j`'s lever arm times its
-    /// change): each range's spare less its sum, `None` when one falls below zero. A point of
-    /// the robot has moved at most that sum relative to its partner, so the rest still bounds
-    /// its clearance beyond the margin (the triangle inequality).
-    pub fn less(&self, moved: &[f64; 6]) -> Option<JointSpare> {
-        let mut prefix = [0.0; 7];
-        for j in 0..6 {
-            prefix[j + 1] = prefix[j] + moved[j];
-        }
-        let mut rest = *self;
-        for lo in 0..6 {
-            for hi in lo..6 {
-                let v = self.by_range[lo][hi] - (prefix[hi + 1] - prefix[lo]);
-                if v < 0.0 {
-                    return None;
-                }
-                rest.by_range[lo][hi] = v;
-            }
-        }
-        Some(rest)
-    }
-
-    /// How many steps of displacements `per_step[j]` (metres per step: joint `j`'s lever arm
-    /// times its change per step) every range's spare holds, not necessarily whole: the
-    /// largest `k` with `k · Σ_{j in range} per_step[j] ≤` the range's spare for every range
-    /// (infinite when nothing moves).
-    pub fn steps_within(&self, per_step: &[f64; 6]) -> f64 {
-        let mut prefix = [0.0; 7];
-        for j in 0..6 {
-            prefix[j + 1] = prefix[j] + per_step[j];
-        }
-        let mut k = f64::INFINITY;
-        for lo in 0..6 {
-            for hi in lo..6 {
-                let moved = prefix[hi + 1] - prefix[lo];
-                if moved > 0.0 {
-                    k = k.min(self.by_range[lo][hi] / moved);
-                }
-            }
-        }
-        k
-    }
-
-    /// True when displacements `moved[j]` (metres: joint `j`'s lever arm times its change) keep
-    /// every range's sum within its spare.
-    pub fn covers(&self, moved: &[f64; 6]) -> bool {
-        self.less(moved).is_some()
-    }
-}
-
 /// A checker that counts the configurations it is asked about (the planner's statistics) and,
 /// while a budget is set, answers "blocked" without asking once the budget is used (a refusal
 /// never lets a collision through; it only ends the search). While `screen` is on, the inner
@@ -279,18 +183,17 @@ impl Balls {
         }
     }
 
-    /// The spare left at `q` ([`JointSpare::less`]) by the newest remembered configuration
-    /// whose spare covers it, joint `j` moving a point at most `arms[j]` metres per radian;
-    /// `None` when none does.
+    /// The spare left at `q` ([`JointSpare::after`]) by the newest remembered configuration
+    /// whose spare covers it, joint `j` turning a point at most `arms[j]` metres per radian
+    /// (less where the spare's reach is nearer the axis); `None` when none does.
     fn cover(&self, q: &[f64; 6], arms: &[f64; 6]) -> Option<JointSpare> {
         self.ring.iter().rev().find_map(|(c, spare)| {
-            let moved: [f64; 6] = std::array::from_fn(|j| arms[j] * (q[j] - c[j]).abs());
-            // Beyond the whole chain's spare that range fails (most configurations far away);
-            // else each range decides.
-            if moved.iter().sum::<f64>() > spare.by_range[0][5] {
+            let dq: [f64; 6] = std::array::from_fn(|j| q[j] - c[j]);
+            // Most remembered configurations are far: rejected without the ranges.
+            if spare.surely_beyond(arms, &dq) {
                 return None;
             }
-            spare.less(&moved)
+            spare.after(arms, &dq)
         })
     }
 
@@ -381,21 +284,20 @@ impl<C: CollisionChecker + ?Sized> CollisionChecker for Counting<'_, C> {
         self.inner.collisions(q)
     }
     /// The steps of `step` (radians per step) within the spare the verdict at `q` comes with
-    /// ([`JointSpare::steps_within`] through the vouching lever arms; none without them). The
+    /// ([`JointSpare::steps_along`] through the vouching lever arms; none without them). The
     /// spare is measured up to what `want` steps need ([`SPARE_CAP`] at most): a small cap lets
     /// the checkers skip the pairs that surely keep it.
     fn free_reach(&mut self, q: &[f64; 6], step: &[f64; 6], want: f64) -> Option<f64> {
         let Some(arms) = self.vouch_arms else {
             return self.verdict(q, SPARE_CAP).map(|_| 0.0);
         };
-        let per_step: [f64; 6] = std::array::from_fn(|j| arms[j] * step[j].abs());
-        let need = want * per_step.iter().sum::<f64>();
+        let need = want * (0..6).map(|j| arms[j] * step[j].abs()).sum::<f64>();
         let cap = if need > 0.0 {
             need.min(SPARE_CAP)
         } else {
             SPARE_CAP
         };
-        Some(self.verdict(q, cap)?.steps_within(&per_step))
+        Some(self.verdict(q, cap)?.steps_along(&arms, step))
     }
     /// Counts the samples as checks (as screened ones while the screen is on), refusing them
     /// past the budget.
@@ -430,38 +332,6 @@ mod tests {
     }
 
     #[test]
-    fn a_joint_spare_bounds_each_range_by_its_own_joints() {
-        // 3 cm everywhere but the wrists' own pairs (joints 4..=5): 5 mm.
-        let mut spare = JointSpare::uniform(0.03);
-        spare.tighten(4, 5, 0.005);
-        assert_eq!(spare.least(), 0.005);
-        assert_eq!(spare.get(4, 5), 0.005);
-        // A negative bound leaves no spare (0), and a larger one never raises it again.
-        spare.tighten(0, 0, -1.0);
-        assert_eq!(spare.get(0, 0), 0.0);
-        spare.tighten(0, 0, 0.03);
-        assert_eq!(spare.get(0, 0), 0.0);
-        assert!(
-            !spare.covers(&[0.015, 0.01, 0.0, 0.0, 0.0, 0.0]),
-            "range 0..=0 has no spare"
-        );
-        // The base and shoulder move 2.5 cm between them: every range within its spare.
-        let mut spare = JointSpare::uniform(0.03);
-        spare.tighten(4, 5, 0.005);
-        assert!(spare.covers(&[0.015, 0.01, 0.0, 0.0, 0.0, 0.0]));
-        // Past the whole chain's spare: not covered.
-        assert!(!spare.covers(&[0.015, 0.01, 0.006, 0.0, 0.0, 0.0]));
-        // The wrists move 6 mm between them: range 4..=5 fails although the sum is small.
-        assert!(!spare.covers(&[0.0, 0.0, 0.0, 0.0, 0.003, 0.003]));
-        assert!(spare.covers(&[0.0, 0.0, 0.0, 0.0, 0.002, 0.003]));
-        // Wrist 2 alone, 6 mm: range 4..=4 keeps 3 cm, but the wrists' pairs (4..=5) move by
-        // joint 4 too, 6 mm against 5 mm.
-        assert!(!spare.covers(&[0.0, 0.0, 0.0, 0.0, 0.006, 0.0]));
-        assert!(JointSpare::NONE.covers(&[0.0; 6]));
-        assert!(!JointSpare::NONE.covers(&[0.0, 0.0, 0.0, 1e-9, 0.0, 0.0]));
-    }
-
-    #[test]
     fn the_spare_ring_keeps_the_newest_and_covers_only_within_a_spare() {
         let arms = [1.0; 6];
         let mut balls = Balls::new(2);
@@ -476,28 +346,5 @@ mod tests {
         // The oldest was replaced: two remembered at most.
         assert!(balls.cover(&at(0.0), &arms).is_none());
         assert!(balls.cover(&at(1.005), &arms).is_some() && balls.cover(&at(1.995), &arms).is_some());
-    }
-
-    #[test]
-    fn a_spare_holds_as_many_steps_as_its_tightest_range_allows() {
-        // 3 cm everywhere but the wrists' own pairs (joints 4..=5): 5 mm.
-        let mut spare = JointSpare::uniform(0.03);
-        spare.tighten(4, 5, 0.005);
-        // The base moving 1 cm per step: 3 steps; the wrists 2 mm each per step: 1.25 steps.
-        let near = |x: f64, y: f64| (x - y).abs() < 1e-9;
-        assert!(near(spare.steps_within(&[0.01, 0.0, 0.0, 0.0, 0.0, 0.0]), 3.0));
-        assert!(near(
-            spare.steps_within(&[0.0, 0.0, 0.0, 0.0, 0.002, 0.002]),
-            1.25
-        ));
-        assert_eq!(spare.steps_within(&[0.0; 6]), f64::INFINITY);
-        assert_eq!(
-            JointSpare::NONE.steps_within(&[1e-9, 0.0, 0.0, 0.0, 0.0, 0.0]),
-            0.0
-        );
-        // The spare left after moving: each range less its own sum, none once one is exceeded.
-        let rest = spare.less(&[0.0, 0.0, 0.0, 0.0, 0.002, 0.0]).unwrap();
-        assert!((rest.get(4, 5) - 0.003).abs() < 1e-12 && (rest.get(0, 3) - 0.03).abs() < 1e-12);
-        assert!(spare.less(&[0.0, 0.0, 0.0, 0.0, 0.003, 0.003]).is_none());
     }
 }

@@ -114,6 +114,14 @@ pub struct PlannerConfig {
     /// Random shortcut attempts on the found path, after its greedy pass. Default 16 (48 gave
     /// paths 2–4 % shorter for about twice the planning time: `cargo bench --bench motion`).
     pub shortcut_attempts: usize,
+    /// Least share of the stretch of path a random shortcut replaces that it must save to be
+    /// checked, in [0, 1): an attempt whose straight segment is not shorter than
+    /// `(1 − shortcut_min_gain)` times the path between its ends is skipped unchecked (its
+    /// segment would cost a full check of a stretch that is almost straight already). Default
+    /// 0.02: on the shelf family 18 % fewer instructions per plan than with 0, paths 0.1–0.4 %
+    /// longer and trajectories as long within 0.6 % (`cargo bench --bench motion`); 0.05 saved
+    /// 19 % but lengthened `go_around`'s episodes by 48 ms on average (0.02: 20 ms).
+    pub shortcut_min_gain: f64,
     /// Largest joint-space deviation of a corner blend from the path's corner, radians. Blends
     /// are collision-checked at `resolution` and halved (down to none: the arm stops at the
     /// corner) until free. Default 0.1 rad; 0 turns blending off.
@@ -137,8 +145,9 @@ pub struct PlannerConfig {
 }
 
 impl Default for PlannerConfig {
-    /// Seed 0, 0.05 rad and 0.01 m resolution with [`UR5E_LEVER_ARMS`], 1.0 rad range, 2000 iterations, 20 000 nodes, 20 000 checks, 16 shortcuts,
-    /// 0.1 rad blends, the joint limits as bounds, [`JointLimits::default`], no tool speed
+    /// Seed 0, 0.05 rad and 0.01 m resolution with [`UR5E_LEVER_ARMS`], 1.0 rad range, 2000
+    /// iterations, 20 000 nodes, 20 000 checks, 16 shortcuts that save at least 2 %, 0.1 rad
+    /// blends, the joint limits as bounds, [`JointLimits::default`], no tool speed
     /// bound, no time cap.
     fn default() -> Self {
         Self {
@@ -151,6 +160,7 @@ impl Default for PlannerConfig {
             max_nodes: 20_000,
             max_checks: 20_000,
             shortcut_attempts: 16,
+            shortcut_min_gain: 0.02,
             blend_deviation: 0.1,
             bounds: JOINT_LIMITS,
             limits: JointLimits::default(),
@@ -229,6 +239,12 @@ impl PlannerConfig {
                 self.shortcut_attempts
             ));
         }
+        if !(self.shortcut_min_gain.is_finite() && (0.0..1.0).contains(&self.shortcut_min_gain)) {
+            return Err(format!(
+                "shortcut_min_gain {}: use a share in [0, 1)",
+                self.shortcut_min_gain
+            ));
+        }
         if !(self.blend_deviation.is_finite() && (0.0..=1.0).contains(&self.blend_deviation)) {
             return Err(format!(
                 "blend_deviation {} rad: use a value in [0, 1]",
@@ -272,5 +288,12 @@ mod tests {
         let mut c = PlannerConfig::default();
         c.bounds[0] = (1.0, f64::NAN);
         assert!(c.check().unwrap_err().contains("joint 1"));
+        for gain in [-0.1, 1.0, f64::NAN] {
+            let c = PlannerConfig {
+                shortcut_min_gain: gain,
+                ..PlannerConfig::default()
+            };
+            assert!(c.check().unwrap_err().contains("shortcut_min_gain"), "{gain}");
+        }
     }
 }

@@ -22,6 +22,7 @@
 //! | [`blend`] | corner arcs within a deviation, collision-checked |
 //! | [`timing`] | [`PathTrajectory`]: the smoothed path timed within the joint limits |
 //! | [`reason`] | [`PlanFailure`], [`PlanError`] |
+//! | [`spare`] | [`JointSpare`]: spare clearance by joint range, and how far it reaches |
 //! | [`stats`] | [`PlanStats`] and joint-space distances |
 //! | [`planner`] | [`plan`]: one query, stage by stage |
 //! | [`boxes`] | [`JointBoxes`]: obstacles as boxes in joint space, for tests and benchmarks |
@@ -39,6 +40,7 @@ mod rng;
 pub mod rrt;
 pub mod shapes;
 pub mod shortcut;
+pub mod spare;
 pub mod stats;
 pub mod timing;
 
@@ -46,10 +48,11 @@ pub mod timing;
 mod tests;
 
 pub use boxes::{JointBox, JointBoxes};
-pub use checker::{Collision, CollisionChecker, JointSpare};
+pub use checker::{Collision, CollisionChecker};
 pub use config::{JointLimits, PlannerConfig, UR5E_RATED_JOINT_SPEED};
 pub use goal::GoalSet;
 pub use planner::{PlannedMotion, SPARE_CAP, plan};
 pub use reason::{PlanError, PlanFailure};
+pub use spare::JointSpare;
 pub use stats::PlanStats;
 pub use timing::PathTrajectory;

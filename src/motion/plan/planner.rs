@@ -284,6 +284,7 @@ fn attempt<C: CollisionChecker + ?Sized>(
             &mut checker,
             raw_path.clone(),
             config.shortcut_attempts,
+            config.shortcut_min_gain,
             &res,
             config.seed,
         )

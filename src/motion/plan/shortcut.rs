@@ -61,12 +61,15 @@ fn greedy<C: CollisionChecker + ?Sized>(
 }
 
 /// Shortens `path` (start and end kept exactly): a greedy pass over its vertices, then
-/// `attempts` seeded random shortcuts and a final vertex-dropping sweep. Every segment of the result is free at `res`, given the
-/// input's segments were.
+/// `attempts` seeded random shortcuts and a final vertex-dropping sweep. A random shortcut is
+/// checked only when its segment is shorter than `1 − min_gain` times the path between its ends
+/// (radians); the others are skipped, their draws spent all the same. Every segment of the
+/// result is free at `res`, given the input's segments were.
 pub(crate) fn shortcut<C: CollisionChecker + ?Sized>(
     checker: &mut C,
     path: Vec<[f64; 6]>,
     attempts: usize,
+    min_gain: f64,
     res: &Resolution,
     seed: u64,
 ) -> Vec<[f64; 6]> {
@@ -86,6 +89,9 @@ pub(crate) fn shortcut<C: CollisionChecker + ?Sized>(
         let (i2, p2) = at(&path, &cum, s2);
         if i1 == i2 {
             continue; // one straight segment already
+        }
+        if distance(&p1, &p2) >= (1.0 - min_gain) * (s2 - s1) {
+            continue; // too little to gain for a check of the whole stretch
         }
         // p1 and p2 lie on checked segments; check them exactly too, then the new segment.
         if !checker.is_free(&p1) || !checker.is_free(&p2) {
