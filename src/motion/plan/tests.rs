@@ -562,3 +562,29 @@ fn a_screen_that_lies_is_caught_by_the_recheck_and_the_query_planned_exactly() {
     assert!(m.stats.collision_checks > exact.stats.collision_checks);
     assert_trajectory_free(&post(), &m.trajectory);
 }
+
+#[test]
+fn a_shortcut_that_would_save_little_is_not_checked() {
+    // A path bent by 0.05 rad around a small box on its chord: the straight segment from the
+    // start to the end is blocked, and every random shortcut between its two legs saves under
+    // 0.2 % of the stretch it would replace.
+    let mut c = JointBoxes::new(vec![wall("peg", (0.99, 1.01), (-0.01, 0.01))]);
+    let path = vec![q(0.0, 0.0), q(1.0, 0.05), q(2.0, 0.0)];
+    let res = PlannerConfig::default().edge_resolution();
+    let run = |c: &mut JointBoxes, gain: f64| {
+        c.checks = 0;
+        let out = super::shortcut::shortcut(c, path.clone(), 16, gain, &res, 7);
+        (out, c.checks)
+    };
+    let (skipped, few) = run(&mut c, 0.02);
+    let (checked, many) = run(&mut c, 0.0);
+    // Skipped: only the greedy pass and the final sweep asked (the blocked chord, twice).
+    assert_eq!(skipped, path);
+    assert!(
+        few > 0 && many > few + 16,
+        "{few} checks with the threshold, {many} without"
+    );
+    // Checked, the shortcuts that pass beside the peg were taken: shorter, by under 0.2 %.
+    let (a, b) = (stats::path_length(&skipped), stats::path_length(&checked));
+    assert!(b < a && b > a * 0.998, "{a} → {b}");
+}
