@@ -86,14 +86,8 @@ impl JointSpare {
     /// measured configuration, metres: `min(arms[j], reach[j] + Σ_{k>j} arms[k] |dq_k|) |dq_j|`
     /// (`arms`: lever arms bounding every configuration, metres per radian).
     pub fn levers(&self, arms: &[f64; 6], dq: &[f64; 6]) -> [f64; 6] {
-        let mut out = [0.0; 6];
-        let mut after = 0.0;
-        for j in (0..6).rev() {
-            let turn = dq[j].abs();
-            out[j] = arms[j].min(self.reach[j] + after) * turn;
-            after += arms[j] * turn;
-        }
-        out
+        let later = later_turns(arms, dq);
+        std::array::from_fn(|j| arms[j].min(self.reach[j] + later[j]) * dq[j].abs())
     }
 
     /// True when the straight move `dq` (radians) from the measured configuration surely uses up
@@ -114,11 +108,8 @@ impl JointSpare {
     /// the move can add to it; `None` when a range's spare is used up.
     pub fn after(&self, arms: &[f64; 6], dq: &[f64; 6]) -> Option<JointSpare> {
         let mut rest = self.less(&self.levers(arms, dq))?;
-        let mut after = 0.0;
-        for j in (0..6).rev() {
-            rest.reach[j] = self.reach[j] + after;
-            after += arms[j] * dq[j].abs();
-        }
+        let later = later_turns(arms, dq);
+        rest.reach = std::array::from_fn(|j| self.reach[j] + later[j]);
         Some(rest)
     }
 
@@ -131,10 +122,6 @@ impl JointSpare {
         let mut prefix = [0.0; 7];
         for j in 0..6 {
             prefix[j + 1] = prefix[j] + moved[j];
-        }
-        // The whole chain's range first: most far moves fail there.
-        if prefix[6] > self.by_range[0][5] {
-            return None;
         }
         let mut rest = *self;
         for lo in 0..6 {
@@ -160,12 +147,7 @@ impl JointSpare {
         let mut arm = [0.0; 7];
         let mut near = [0.0; 7];
         let mut grow = [0.0; 7];
-        let mut after = 0.0;
-        let mut tail = [0.0; 6];
-        for j in (0..6).rev() {
-            tail[j] = after;
-            after += arms[j] * step[j].abs();
-        }
+        let tail = later_turns(arms, step);
         for j in 0..6 {
             let turn = step[j].abs();
             arm[j + 1] = arm[j] + arms[j] * turn;
@@ -204,6 +186,19 @@ impl JointSpare {
     pub fn covers(&self, moved: &[f64; 6]) -> bool {
         self.less(moved).is_some()
     }
+}
+
+/// For each joint `j`, how far the joints after it turn the parts over the move `dq` (radians)
+/// by the lever arms `arms` (metres per radian): `Σ_{k>j} arms[k] |dq_k|`, metres; what the move
+/// can add to the parts' distance from joint `j`'s axis.
+fn later_turns(arms: &[f64; 6], dq: &[f64; 6]) -> [f64; 6] {
+    let mut out = [0.0; 6];
+    let mut sum = 0.0;
+    for j in (0..6).rev() {
+        out[j] = sum;
+        sum += arms[j] * dq[j].abs();
+    }
+    out
 }
 
 #[cfg(test)]
