@@ -320,6 +320,43 @@ fn the_screen_spare_by_joint_range_is_conservative_with_a_held_block() {
 }
 
 #[test]
+fn a_wrist_pair_inside_its_bounding_spheres_limited_the_spare_to_their_gap() {
+    // The wrist 1 housing and the flange cylinder, 2–4 cm apart, sit well inside each other's
+    // bounding spheres: where the spheres kept the pair's gap but not the spare wanted, the
+    // spheres' gap (a few millimetres) was the spare of joints 5–6, and the bisection of a
+    // wrist move asked twice as many configurations. The spare now takes each such pair's
+    // primitive clearance: no range's spare is below its pairs' clearances, nor above them.
+    for hold in [false, true] {
+        let mut c = checker(hold);
+        let mut r = ChaCha8Rng::seed_from_u64(43);
+        let (mut free, mut beyond_spheres) = (0, 0);
+        for _ in 0..600 {
+            let q = drawn(&mut r);
+            let screen = c.screen_model().expect("a screen");
+            let (verdict, spare) = screen.free_spare(&q, SPARE_CAP);
+            if verdict != Some(true) {
+                continue;
+            }
+            free += 1;
+            let (low, high) = screen.pair_spares(&q, SPARE_CAP);
+            for lo in 0..6 {
+                for hi in lo..6 {
+                    let s = spare.get(lo, hi);
+                    assert!(
+                        low.get(lo, hi) <= s + 1e-12 && s <= high.get(lo, hi) + 1e-12,
+                        "{q:?}: range {lo}..={hi} spare {s} outside [{}, {}]",
+                        low.get(lo, hi),
+                        high.get(lo, hi)
+                    );
+                }
+            }
+            beyond_spheres += usize::from(spare.get(4, 5) > 0.02);
+        }
+        assert!(free > 200 && beyond_spheres > 50, "{free} {beyond_spheres}");
+    }
+}
+
+#[test]
 fn a_block_held_away_from_the_pinch_was_vouched_for_beyond_the_lever_arms() {
     // Held 30 cm from the pinch, the cube's points lie farther from the joint axes than the
     // lever arms bound: a move within a measured spare carried it from 6.7 cm above the table

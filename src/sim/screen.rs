@@ -676,7 +676,12 @@ impl Screen {
                             let far = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] >= t * t
                                 || (b >= nm && sphere_box_apart(&c1, r1, &y.0, need));
                             if !far {
-                                spare.tighten(lo, hi, (sphere_shape_gap(&c1, r1, y) - p.gap) / p.kappa);
+                                // The spheres may lie far inside each other's reach (a wrist
+                                // housing and the flange): the primitives' own clearance,
+                                // which the spheres' gap only bounds from below.
+                                let bound = sphere_shape_gap(&c1, r1, y);
+                                let c = apart(&x.0, &y.0, p.gap).map_or(bound, |c| c.max(bound));
+                                spare.tighten(lo, hi, (c - p.gap) / p.kappa);
                             }
                         }
                         continue;
@@ -768,6 +773,41 @@ impl Screen {
 
 #[cfg(test)]
 impl Screen {
+    /// Bounds on the spare [`Screen::free_spare`] finds at `q` (radians), pair by pair and
+    /// without its shortcuts: for each joint range, the least over the range's pairs of
+    /// `(c − gap) / kappa`, at most `cap` (metres), with `c` each pair's primitive clearance
+    /// ([`clearance`](crate::motion::plan::shapes::clearance)) in the first spare, and the
+    /// larger of that and its bounding-sphere bound in the second.
+    pub(crate) fn pair_spares(&self, q: &[f64; 6], cap: f64) -> (JointSpare, JointSpare) {
+        let frames = self.chain.link_poses(q);
+        let nm = self.moving.len();
+        let (mut low, mut high) = (JointSpare::uniform(cap), JointSpare::uniform(cap));
+        for g in &self.groups {
+            let (lo, hi) = match g.partner {
+                Partner::Fixed(_) => (0, g.link),
+                Partner::Link(m) => (g.link.min(m) + 1, g.link.max(m)),
+            };
+            if lo > hi {
+                continue;
+            }
+            for p in &self.pairs[g.start as usize..g.end as usize] {
+                let (a, b) = (p.a as usize, p.b as usize);
+                let x = pose(&self.moving[a], &frames);
+                let y = if b < nm {
+                    pose(&self.moving[b], &frames)
+                } else {
+                    self.fixed[b - nm]
+                };
+                let c = crate::motion::plan::shapes::clearance(&x.0, &y.0);
+                let (c1, r1) = x.1.expect("a moving shape has a sphere");
+                let spheres = sphere_shape_gap(&c1, r1, &y);
+                low.tighten(lo, hi, (c - p.gap) / p.kappa);
+                high.tighten(lo, hi, (c.max(spheres) - p.gap) / p.kappa);
+            }
+        }
+        (low, high)
+    }
+
     /// For every pair: its lever-arm ratio, and between joints `q` and `q2` (radians) the
     /// largest displacement of a point of its distal shape's hull (box corners; capsule ends
     /// pushed out by the radius along each axis) relative to the frame of its partner's link

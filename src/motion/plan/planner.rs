@@ -107,7 +107,7 @@ enum Attempt {
 /// ([`CollisionChecker::exact_spare`], [`CollisionChecker::screen_spare`]): a configuration
 /// measured with this much to spare vouches for those up to this far (in the lever-arm
 /// displacement bound) along a segment.
-pub const SPARE_CAP: f64 = 0.10;
+pub const SPARE_CAP: f64 = 0.15;
 
 /// The lever arms the final re-check's vouching uses, metres: the configured ones, and never
 /// less than [`UR5E_LEVER_ARMS`](super::config::UR5E_LEVER_ARMS) (a setting that bounds fewer
