@@ -453,10 +453,21 @@ impl SceneChecker {
             return None;
         }
         let reach = self.pose_moving(q);
+        // The screen's primitives, posed at `q` too where the moving geoms were posed from the
+        // link frames, bound a pair before `mj_geomDistance`.
+        let mut screen = self
+            .derived
+            .as_mut()
+            .filter(|d| d.moving.is_some())
+            .and_then(|d| d.screen.as_mut());
         let least = self
             .margin_pairs
             .0
-            .least(&mut self.data, q, &UR5E_LEVER_ARMS, wide);
+            .least(&mut self.data, q, &UR5E_LEVER_ARMS, wide, |a, b| {
+                screen
+                    .as_mut()
+                    .map_or(f64::NEG_INFINITY, |s| s.geom_clearance(a, b))
+            });
         Some((least, reach))
     }
 
@@ -631,19 +642,23 @@ impl SceneChecker {
     }
 
     /// Poses the moving geoms at `q` (radians) for `mj_geomDistance`: from the arm's link
-    /// frames ([`MovingGeoms`]), or by `mj_kinematics` when the arm is not a chain. Returns how
+    /// frames ([`MovingGeoms`]), the screen's primitives with them ([`Screen::bound_at`]), or by
+    /// `mj_kinematics` when the arm is not a chain. Returns how
     /// far the moving geoms reach from each joint's axis there, metres, through the screen's
     /// link spheres ([`Screen::reach`]); infinite when the cell has no screen.
     fn pose_moving(&mut self, q: &[f64; 6]) -> [f64; 6] {
         self.derive();
-        match self.derived.as_ref() {
+        match self.derived.as_mut() {
             Some(Derived {
                 moving: Some(moving),
                 screen,
             }) => {
                 let frames = moving.frames(q);
                 moving.pose_at(&frames, &mut self.data);
-                screen.as_ref().map_or([f64::INFINITY; 6], |s| s.reach(&frames))
+                screen.as_mut().map_or([f64::INFINITY; 6], |s| {
+                    s.bound_at(&frames);
+                    s.reach(&frames)
+                })
             }
             _ => {
                 self.detect_pose(q);

@@ -156,9 +156,12 @@ impl MarginPairs {
 impl MarginPairs {
     /// The least distance of every pair MuJoCo tests in the model (with a positive margin) at
     /// `data` (posed), metres, at most `wide`: each pair that may be closer (bounding spheres,
-    /// a box's or a plane's own bound) measured with `mj_geomDistance`, the exact distance of
-    /// the shapes MuJoCo collides (a mesh's convex hull); the pair closest at the last call
-    /// first, so the least so far prunes the others. One least for every pair, not one per
+    /// a box's or a plane's own bound, then `tighter(a, b)`: any lower bound on the distance
+    /// of geoms `a` and `b` as posed, such as the screen's primitives'; `−∞` for none) measured
+    /// with `mj_geomDistance`, the exact distance of the shapes MuJoCo collides (a mesh's
+    /// convex hull); the pair closest at the last call first, so the least so far prunes the
+    /// others. A pair left out by a bound is at least the least so far apart, so the least is
+    /// the one every pair's `mj_geomDistance` gives. One least for every pair, not one per
     /// joint range as the screen's spare: measured on the motion benchmark, the pruning by the
     /// least so far saves more `mj_geomDistance` calls than ranges would vouch for.
     ///
@@ -173,6 +176,7 @@ impl MarginPairs {
         q: &[f64; 6],
         arms: &[f64; 6],
         wide: f64,
+        mut tighter: impl FnMut(usize, usize) -> f64,
     ) -> f64 {
         let known = &mut self.known;
         match known.at {
@@ -201,6 +205,11 @@ impl MarginPairs {
                 continue;
             }
             let bound = apart(data, p, least);
+            if bound >= least {
+                known.lower[i] = bound + moved;
+                continue;
+            }
+            let bound = bound.max(tighter(p.a, p.b));
             if bound >= least {
                 known.lower[i] = bound + moved;
                 continue;

@@ -22,7 +22,7 @@ use super::chain::{ArmChain, Frame, Link, mat};
 use super::pair_filter::PairFilter;
 use crate::motion::plan::JointSpare;
 use crate::motion::plan::config::UR5E_LEVER_ARMS;
-use crate::motion::plan::shapes::{Shape, V3, apart, near, within};
+use crate::motion::plan::shapes::{Shape, V3, apart, clearance, near, within};
 
 /// Extra distance every pair must keep beyond its margin for the screen to vouch, metres: room
 /// for MuJoCo's own tolerances (its convex-hull distances converge to about 1e-6 m).
@@ -117,10 +117,59 @@ pub struct Screen {
     geoms: Vec<usize>,
     /// The pairs the last [`Screen::free_spare`] could not decide.
     undecided: Vec<Undecided>,
-    /// Scratch: the moving shapes posed, when `stamp` matches `call`.
+    /// The moving shapes posed for the verdicts ([`Screen::free_spare`]).
+    posed: Posing,
+    /// Index of each geom's shape (`u32::MAX`: none), for [`Screen::geom_clearance`].
+    shape_of: Vec<u32>,
+    /// The moving shapes posed for [`Screen::geom_clearance`], at `bound_frames`.
+    bound_posed: Posing,
+    bound_frames: [Frame; 6],
+}
+
+/// Scratch of the moving shapes posed at one set of link frames, each when first needed: shape
+/// `i` is posed while `stamp[i]` matches `call`.
+#[derive(Clone, Debug)]
+struct Posing {
     posed: Vec<Posed>,
     stamp: Vec<u32>,
     call: u32,
+}
+
+impl Posing {
+    fn new(n: usize) -> Self {
+        let none = (
+            Shape::HalfSpace {
+                normal: [0.0; 3],
+                offset: 0.0,
+            },
+            None,
+            false,
+        );
+        Self {
+            posed: vec![none; n],
+            stamp: vec![0; n],
+            call: 0,
+        }
+    }
+
+    /// Forgets every posed shape (new link frames).
+    fn renew(&mut self) {
+        self.call = self.call.wrapping_add(1);
+        if self.call == 0 {
+            self.stamp.iter_mut().for_each(|s| *s = u32::MAX);
+            self.call = 1;
+        }
+    }
+
+    /// Poses moving shape `i` at `frames` unless it is posed already (`i` past the moving
+    /// shapes: a fixed one, nothing to do).
+    #[inline]
+    fn ensure(&mut self, i: usize, moving: &[(usize, Local, bool, f64)], frames: &[Frame; 6]) {
+        if i < moving.len() && self.stamp[i] != self.call {
+            self.posed[i] = pose(&moving[i], frames);
+            self.stamp[i] = self.call;
+        }
+    }
 }
 
 /// A pair whose primitives come within its margin plus [`PAD`] but that the screen cannot call
@@ -544,17 +593,6 @@ impl Screen {
         }
         let link_spheres =
             std::array::from_fn(|k| link_sphere(moving.iter().filter(|m| m.0 == k).map(|m| &m.1)));
-        let posed = vec![
-            (
-                Shape::HalfSpace {
-                    normal: [0.0; 3],
-                    offset: 0.0
-                },
-                None,
-                false
-            );
-            nm
-        ];
         Some(Self {
             chain,
             moving,
@@ -564,9 +602,10 @@ impl Screen {
             link_spheres,
             geoms,
             undecided: Vec::new(),
-            posed,
-            stamp: vec![0; nm],
-            call: 0,
+            posed: Posing::new(nm),
+            shape_of: index.iter().map(|i| i.map_or(u32::MAX, |i| i as u32)).collect(),
+            bound_posed: Posing::new(nm),
+            bound_frames: link_pose,
         })
     }
 
@@ -621,12 +660,8 @@ impl Screen {
         cap: f64,
     ) -> (Option<bool>, Option<(usize, usize)>, JointSpare) {
         let frames = self.chain.link_poses(q);
-        // A new stamp: every moving shape is posed again when first needed.
-        self.call = self.call.wrapping_add(1);
-        if self.call == 0 {
-            self.stamp.iter_mut().for_each(|s| *s = u32::MAX);
-            self.call = 1;
-        }
+        // Every moving shape posed again when first needed.
+        self.posed.renew();
         let spheres = self.world_spheres(&frames);
         let nm = self.moving.len();
         let mut unsure = false;
@@ -652,15 +687,11 @@ impl Screen {
             }
             for p in &self.pairs[g.start as usize..g.end as usize] {
                 let (a, b) = (p.a as usize, p.b as usize);
-                for i in [a, b] {
-                    if i < nm && self.stamp[i] != self.call {
-                        self.posed[i] = pose(&self.moving[i], &frames);
-                        self.stamp[i] = self.call;
-                    }
-                }
-                let x = &self.posed[a];
+                self.posed.ensure(a, &self.moving, &frames);
+                self.posed.ensure(b, &self.moving, &frames);
+                let x = &self.posed.posed[a];
                 let y = if b < nm {
-                    &self.posed[b]
+                    &self.posed.posed[b]
                 } else {
                     &self.fixed[b - nm]
                 };
@@ -760,6 +791,35 @@ impl Screen {
         }
     }
 
+    /// Sets the link frames (`ArmChain::link_poses`) at which [`Screen::geom_clearance`]
+    /// bounds the distances of geoms.
+    pub(crate) fn bound_at(&mut self, frames: &[Frame; 6]) {
+        self.bound_frames = *frames;
+        self.bound_posed.renew();
+    }
+
+    /// A lower bound on the distance between geoms `g1` and `g2` at the frames of the last
+    /// [`Screen::bound_at`], metres: the clearance of their primitives, which contain them
+    /// (`shapes::clearance`; 0 where they may touch); `−∞` when either has no primitive.
+    pub(crate) fn geom_clearance(&mut self, g1: usize, g2: usize) -> f64 {
+        let shape = |g: usize| self.shape_of.get(g).copied().filter(|&i| i != u32::MAX);
+        let (Some(a), Some(b)) = (shape(g1), shape(g2)) else {
+            return f64::NEG_INFINITY;
+        };
+        let (a, b) = (a as usize, b as usize);
+        let nm = self.moving.len();
+        self.bound_posed.ensure(a, &self.moving, &self.bound_frames);
+        self.bound_posed.ensure(b, &self.moving, &self.bound_frames);
+        let at = |i: usize| {
+            if i < nm {
+                &self.bound_posed.posed[i].0
+            } else {
+                &self.fixed[i - nm].0
+            }
+        };
+        clearance(at(a), at(b))
+    }
+
     /// True when the screen vouches that `q` (radians) is free ([`Screen::classify`]).
     pub fn free(&mut self, q: &[f64; 6]) -> bool {
         self.classify(q) == Some(true)
@@ -798,7 +858,7 @@ impl Screen {
                 } else {
                     self.fixed[b - nm]
                 };
-                let c = crate::motion::plan::shapes::clearance(&x.0, &y.0);
+                let c = clearance(&x.0, &y.0);
                 let (c1, r1) = x.1.expect("a moving shape has a sphere");
                 let spheres = sphere_shape_gap(&c1, r1, &y);
                 low.tighten(lo, hi, (c - p.gap) / p.kappa);
