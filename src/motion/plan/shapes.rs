@@ -311,43 +311,45 @@ fn point_box_dist2(x: &V3, h: &V3) -> f64 {
     d
 }
 
-/// Squared distance between the segment `p`–`q` and an oriented box, metres². Exact: the
-/// squared distance along the segment is a convex piecewise quadratic whose pieces change where
-/// a coordinate crosses a face plane; each piece's minimum is found in closed form.
+/// Squared distance between the segment `p`–`q` and an oriented box, metres². Exact: along the
+/// segment the squared distance is a convex piecewise quadratic whose pieces change where a
+/// coordinate crosses a face plane. The pieces are walked from `p`: the first whose own
+/// minimiser does not lie past its end holds the minimum (the function cannot fall again after
+/// it), found in closed form.
 pub fn segment_box_dist2(p: &V3, q: &V3, center: &V3, axes: &[V3; 3], half: &V3) -> f64 {
     let rp = sub(p, center);
     let rq = sub(q, center);
     let a = [dot(&axes[0], &rp), dot(&axes[1], &rp), dot(&axes[2], &rp)];
     let b = [dot(&axes[0], &rq), dot(&axes[1], &rq), dot(&axes[2], &rq)];
     let d = sub(&b, &a);
-    // Break points: where a coordinate crosses ±h.
-    let mut ts = [0.0f64; 8];
+    // The interior break points, where a coordinate crosses ±h, in order (insertion).
+    let mut ts = [0.0f64; 6];
     let mut n = 0;
-    ts[n] = 0.0;
-    n += 1;
     for i in 0..3 {
         if d[i] != 0.0 {
             for s in [-half[i], half[i]] {
                 let t = (s - a[i]) / d[i];
                 if t > 0.0 && t < 1.0 {
-                    ts[n] = t;
+                    let mut k = n;
+                    while k > 0 && ts[k - 1] > t {
+                        ts[k] = ts[k - 1];
+                        k -= 1;
+                    }
+                    ts[k] = t;
                     n += 1;
                 }
             }
         }
     }
-    ts[n] = 1.0;
-    n += 1;
-    ts[..n].sort_by(f64::total_cmp);
     let at = |t: f64| [a[0] + d[0] * t, a[1] + d[1] * t, a[2] + d[2] * t];
-    let mut best = point_box_dist2(&a, half).min(point_box_dist2(&b, half));
-    for w in ts[..n].windows(2) {
-        let (t0, t1) = (w[0], w[1]);
+    let mut t0 = 0.0;
+    for &t1 in ts[..n].iter().chain(&[1.0]) {
         if t1 <= t0 {
             continue;
         }
         let m = at(0.5 * (t0 + t1));
-        // On this piece, coordinate i contributes (x_i − c_i)² where c_i = ±h_i outside, none inside.
+        // On this piece coordinate i adds (x_i − c_i)², c_i = ±h_i outside the slab, none inside:
+        // the piece's quadratic has its minimum at num / den.
         let (mut num, mut den) = (0.0, 0.0);
         for i in 0..3 {
             let c = if m[i] > half[i] {
@@ -360,10 +362,14 @@ pub fn segment_box_dist2(p: &V3, q: &V3, center: &V3, axes: &[V3; 3], half: &V3)
             num -= (a[i] - c) * d[i];
             den += d[i] * d[i];
         }
-        let t = if den > 0.0 { (num / den).clamp(t0, t1) } else { t0 };
-        best = best.min(point_box_dist2(&at(t), half));
+        // Flat (den 0), or rising by the piece's end: the minimum is on this piece.
+        if den == 0.0 || num <= t1 * den {
+            let t = if den > 0.0 { (num / den).clamp(t0, t1) } else { t0 };
+            return point_box_dist2(&at(t), half);
+        }
+        t0 = t1;
     }
-    best
+    point_box_dist2(&b, half)
 }
 
 /// True when two oriented boxes overlap (the separating axis test over the 15 candidate axes;
@@ -491,6 +497,78 @@ mod tests {
             assert!(exact <= sampled + 1e-12, "{exact} > {sampled}");
             assert!(sampled - exact < 1e-3, "{exact} vs {sampled}");
         }
+    }
+
+    /// The squared segment–box distance as the least of every piece's minimum (closed form)
+    /// and both ends: the walk's reference, without its early stop.
+    fn every_piece(p: &V3, q: &V3, center: &V3, axes: &[V3; 3], half: &V3) -> f64 {
+        let (rp, rq) = (sub(p, center), sub(q, center));
+        let a = [dot(&axes[0], &rp), dot(&axes[1], &rp), dot(&axes[2], &rp)];
+        let b = [dot(&axes[0], &rq), dot(&axes[1], &rq), dot(&axes[2], &rq)];
+        let d = sub(&b, &a);
+        let mut ts = vec![0.0, 1.0];
+        for i in 0..3 {
+            if d[i] != 0.0 {
+                for s in [-half[i], half[i]] {
+                    let t = (s - a[i]) / d[i];
+                    if t > 0.0 && t < 1.0 {
+                        ts.push(t);
+                    }
+                }
+            }
+        }
+        ts.sort_by(f64::total_cmp);
+        let at = |t: f64| [a[0] + d[0] * t, a[1] + d[1] * t, a[2] + d[2] * t];
+        let mut best = point_box_dist2(&a, half).min(point_box_dist2(&b, half));
+        for w in ts.windows(2) {
+            let (t0, t1) = (w[0], w[1]);
+            if t1 <= t0 {
+                continue;
+            }
+            let m = at(0.5 * (t0 + t1));
+            let (mut num, mut den) = (0.0, 0.0);
+            for i in 0..3 {
+                if m[i].abs() > half[i] {
+                    let c = half[i].copysign(m[i]);
+                    num -= (a[i] - c) * d[i];
+                    den += d[i] * d[i];
+                }
+            }
+            let t = if den > 0.0 { (num / den).clamp(t0, t1) } else { t0 };
+            best = best.min(point_box_dist2(&at(t), half));
+        }
+        best
+    }
+
+    #[test]
+    fn the_segment_box_walk_stops_at_the_global_minimum() {
+        // Segments through, along and beside boxes, some parallel to a face (flat pieces).
+        let mut r = ChaCha8Rng::seed_from_u64(9);
+        let mut flat = 0;
+        for k in 0..2000 {
+            let axes = rot(&mut r);
+            let h = [
+                r.random_range(0.01..0.2),
+                r.random_range(0.01..0.2),
+                r.random_range(0.01..0.2),
+            ];
+            let c = v(&mut r, 0.1);
+            let p = v(&mut r, 0.4);
+            let mut q = v(&mut r, 0.4);
+            if k % 4 == 0 {
+                // Parallel to the box's first face: the same first local coordinate.
+                let along = dot(&axes[0], &sub(&q, &p));
+                q = axpy(-along, &axes[0], &q);
+                flat += 1;
+            }
+            let walked = segment_box_dist2(&p, &q, &c, &axes, &h);
+            let reference = every_piece(&p, &q, &c, &axes, &h);
+            assert!(
+                (walked - reference).abs() <= 1e-15,
+                "{walked} against {reference}"
+            );
+        }
+        assert_eq!(flat, 500);
     }
 
     #[test]
