@@ -161,6 +161,15 @@ impl Posing {
         }
     }
 
+    /// Shape `i` (moving ones first, then `fixed`), posed by [`Posing::ensure`] if moving.
+    #[inline]
+    fn get<'a>(&'a self, i: usize, fixed: &'a [Posed]) -> &'a Posed {
+        match self.posed.get(i) {
+            Some(p) => p,
+            None => &fixed[i - self.posed.len()],
+        }
+    }
+
     /// Poses moving shape `i` at `frames` unless it is posed already (`i` past the moving
     /// shapes: a fixed one, nothing to do).
     #[inline]
@@ -210,6 +219,18 @@ struct Group {
     kappa: f64,
     start: u32,
     end: u32,
+}
+
+impl Group {
+    /// The joints `lo..=hi` that move the group's pairs relative to each other: every joint up
+    /// to the link against a fixed shape, those after the nearer link up to the farther one
+    /// against another link (`lo > hi`: none).
+    fn joints(&self) -> (usize, usize) {
+        match self.partner {
+            Partner::Fixed(_) => (0, self.link),
+            Partner::Link(m) => (self.link.min(m) + 1, self.link.max(m)),
+        }
+    }
 }
 
 /// A shape in the world, its bounding sphere, and whether it is the geom itself.
@@ -670,10 +691,7 @@ impl Screen {
         for g in &self.groups {
             // The joints that move the group's pair relative to each other (none: the pair
             // never moves apart or closer, and limits no spare).
-            let (lo, hi) = match g.partner {
-                Partner::Fixed(_) => (0, g.link),
-                Partner::Link(m) => (g.link.min(m) + 1, g.link.max(m)),
-            };
+            let (lo, hi) = g.joints();
             let ranged = lo <= hi;
             if self.group_apart(g, &spheres, g.gap) {
                 if !SPARE || !ranged {
@@ -689,12 +707,7 @@ impl Screen {
                 let (a, b) = (p.a as usize, p.b as usize);
                 self.posed.ensure(a, &self.moving, &frames);
                 self.posed.ensure(b, &self.moving, &frames);
-                let x = &self.posed.posed[a];
-                let y = if b < nm {
-                    &self.posed.posed[b]
-                } else {
-                    &self.fixed[b - nm]
-                };
+                let (x, y) = (self.posed.get(a, &self.fixed), self.posed.get(b, &self.fixed));
                 if let (Some((c1, r1)), Some((c2, r2))) = (x.1, y.1) {
                     let t = r1 + r2 + p.gap;
                     let d = [c1[0] - c2[0], c1[1] - c2[1], c1[2] - c2[2]];
@@ -807,16 +820,9 @@ impl Screen {
             return f64::NEG_INFINITY;
         };
         let (a, b) = (a as usize, b as usize);
-        let nm = self.moving.len();
         self.bound_posed.ensure(a, &self.moving, &self.bound_frames);
         self.bound_posed.ensure(b, &self.moving, &self.bound_frames);
-        let at = |i: usize| {
-            if i < nm {
-                &self.bound_posed.posed[i].0
-            } else {
-                &self.fixed[i - nm].0
-            }
-        };
+        let at = |i: usize| &self.bound_posed.get(i, &self.fixed).0;
         clearance(at(a), at(b))
     }
 
@@ -843,10 +849,7 @@ impl Screen {
         let nm = self.moving.len();
         let (mut low, mut high) = (JointSpare::uniform(cap), JointSpare::uniform(cap));
         for g in &self.groups {
-            let (lo, hi) = match g.partner {
-                Partner::Fixed(_) => (0, g.link),
-                Partner::Link(m) => (g.link.min(m) + 1, g.link.max(m)),
-            };
+            let (lo, hi) = g.joints();
             if lo > hi {
                 continue;
             }

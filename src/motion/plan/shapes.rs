@@ -311,6 +311,25 @@ fn point_box_dist2(x: &V3, h: &V3) -> f64 {
     d
 }
 
+/// The piece of the segment–box squared distance around the point `m` (box coordinates) of the
+/// segment `a + t d`: coordinate i adds `(x_i − c_i)²`, `c_i = ±h_i` outside the slab and
+/// nothing inside, so the piece's quadratic has its minimum at `t = num / den` (`den` 0: flat).
+fn piece_minimum(a: &V3, d: &V3, half: &V3, m: &V3) -> (f64, f64) {
+    let (mut num, mut den) = (0.0, 0.0);
+    for i in 0..3 {
+        let c = if m[i] > half[i] {
+            half[i]
+        } else if m[i] < -half[i] {
+            -half[i]
+        } else {
+            continue;
+        };
+        num -= (a[i] - c) * d[i];
+        den += d[i] * d[i];
+    }
+    (num, den)
+}
+
 /// Squared distance between the segment `p`–`q` and an oriented box, metres². Exact: along the
 /// segment the squared distance is a convex piecewise quadratic whose pieces change where a
 /// coordinate crosses a face plane. The pieces are walked from `p`: the first whose own
@@ -347,21 +366,7 @@ pub fn segment_box_dist2(p: &V3, q: &V3, center: &V3, axes: &[V3; 3], half: &V3)
         if t1 <= t0 {
             continue;
         }
-        let m = at(0.5 * (t0 + t1));
-        // On this piece coordinate i adds (x_i − c_i)², c_i = ±h_i outside the slab, none inside:
-        // the piece's quadratic has its minimum at num / den.
-        let (mut num, mut den) = (0.0, 0.0);
-        for i in 0..3 {
-            let c = if m[i] > half[i] {
-                half[i]
-            } else if m[i] < -half[i] {
-                -half[i]
-            } else {
-                continue;
-            };
-            num -= (a[i] - c) * d[i];
-            den += d[i] * d[i];
-        }
+        let (num, den) = piece_minimum(&a, &d, half, &at(0.5 * (t0 + t1)));
         // Flat (den 0), or rising by the piece's end: the minimum is on this piece.
         if den == 0.0 || num <= t1 * den {
             let t = if den > 0.0 { (num / den).clamp(t0, t1) } else { t0 };
@@ -472,17 +477,22 @@ mod tests {
         out
     }
 
+    /// A seeded oriented box: axes, half extents 1–20 cm, centre within 10 cm of the origin.
+    fn random_box(r: &mut ChaCha8Rng) -> ([V3; 3], V3, V3) {
+        let axes = rot(r);
+        let h = [
+            r.random_range(0.01..0.2),
+            r.random_range(0.01..0.2),
+            r.random_range(0.01..0.2),
+        ];
+        (axes, h, v(r, 0.1))
+    }
+
     #[test]
     fn segment_box_distance_is_exact_against_dense_sampling() {
         let mut r = ChaCha8Rng::seed_from_u64(7);
         for _ in 0..300 {
-            let axes = rot(&mut r);
-            let h = [
-                r.random_range(0.01..0.2),
-                r.random_range(0.01..0.2),
-                r.random_range(0.01..0.2),
-            ];
-            let c = v(&mut r, 0.1);
+            let (axes, h, c) = random_box(&mut r);
             let p = v(&mut r, 0.4);
             let q = v(&mut r, 0.4);
             let exact = segment_box_dist2(&p, &q, &c, &axes, &h).sqrt();
@@ -525,15 +535,7 @@ mod tests {
             if t1 <= t0 {
                 continue;
             }
-            let m = at(0.5 * (t0 + t1));
-            let (mut num, mut den) = (0.0, 0.0);
-            for i in 0..3 {
-                if m[i].abs() > half[i] {
-                    let c = half[i].copysign(m[i]);
-                    num -= (a[i] - c) * d[i];
-                    den += d[i] * d[i];
-                }
-            }
+            let (num, den) = piece_minimum(&a, &d, half, &at(0.5 * (t0 + t1)));
             let t = if den > 0.0 { (num / den).clamp(t0, t1) } else { t0 };
             best = best.min(point_box_dist2(&at(t), half));
         }
@@ -546,13 +548,7 @@ mod tests {
         let mut r = ChaCha8Rng::seed_from_u64(9);
         let mut flat = 0;
         for k in 0..2000 {
-            let axes = rot(&mut r);
-            let h = [
-                r.random_range(0.01..0.2),
-                r.random_range(0.01..0.2),
-                r.random_range(0.01..0.2),
-            ];
-            let c = v(&mut r, 0.1);
+            let (axes, h, c) = random_box(&mut r);
             let p = v(&mut r, 0.4);
             let mut q = v(&mut r, 0.4);
             if k % 4 == 0 {
