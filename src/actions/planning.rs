@@ -180,8 +180,8 @@ impl CollisionChecker for Allowing<'_> {
 
     /// The inner checker's "certainly free" and its spare (what keeps the margin and more from
     /// everything is free whatever is allowed). Counted as a check.
-    fn screen_spare(&mut self, q: &[f64; 6], cap: f64) -> (Option<bool>, JointSpare) {
-        let (verdict, spare) = self.inner.screen_spare(q, cap);
+    fn screen_spare(&mut self, q: &[f64; 6], caps: &JointSpare) -> (Option<bool>, JointSpare) {
+        let (verdict, spare) = self.inner.screen_spare(q, caps);
         let free = verdict == Some(true);
         self.checks += u64::from(free);
         (free.then_some(true), if free { spare } else { JointSpare::NONE })

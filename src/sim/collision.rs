@@ -520,7 +520,7 @@ impl CollisionChecker for SceneChecker {
     /// gives (up to MuJoCo's own tolerances, about 1e-6 m), at a few pairs' cost instead of
     /// the whole cell's. With a held block beyond [`HELD_BLOCK_REACH`] of the pinch, the
     /// screen's verdict alone.
-    fn screen_spare(&mut self, q: &[f64; 6], cap: f64) -> (Option<bool>, JointSpare) {
+    fn screen_spare(&mut self, q: &[f64; 6], caps: &JointSpare) -> (Option<bool>, JointSpare) {
         if !self.screen_on || !q.iter().all(|v| v.is_finite()) {
             return (None, JointSpare::NONE);
         }
@@ -535,7 +535,7 @@ impl CollisionChecker for SceneChecker {
         else {
             return (None, JointSpare::NONE);
         };
-        let (verdict, mut spare) = screen.free_spare(q, cap);
+        let (verdict, mut spare) = screen.free_spare(q, caps);
         if verdict.is_some() {
             return (verdict, spare);
         }
@@ -544,13 +544,14 @@ impl CollisionChecker for SceneChecker {
         moving.pose(q, &mut self.data);
         for u in screen.undecided() {
             let counts = self.margin.min(u.gap - PAD);
+            let (lo, hi) = u.range;
+            let wanted = if lo <= hi { caps.get(lo, hi) } else { 0.0 };
             let d = self
                 .data
-                .geom_distance(u.geoms.0, u.geoms.1, u.gap + u.kappa * cap, None);
+                .geom_distance(u.geoms.0, u.geoms.1, u.gap + u.kappa * wanted, None);
             if d < counts {
                 return (Some(false), JointSpare::NONE);
             }
-            let (lo, hi) = u.range;
             if lo <= hi {
                 spare.tighten(lo, hi, (d - u.gap) / u.kappa);
             }

@@ -264,7 +264,7 @@ fn screen_spare_is_conservative(hold: bool, seed: u64) {
     let (mut settled_free, mut settled_blocked) = (0, 0);
     for _ in 0..1500 {
         let q = drawn(&mut r);
-        let (verdict, spare) = c.screen_spare(&q, SPARE_CAP);
+        let (verdict, spare) = c.screen_spare(&q, &JointSpare::uniform(SPARE_CAP));
         match c.screen(&q) {
             Some(v) => assert_eq!(verdict, Some(v), "{q:?}: the spare changes no verdict"),
             None => {
@@ -333,7 +333,7 @@ fn a_wrist_pair_inside_its_bounding_spheres_limited_the_spare_to_their_gap() {
         for _ in 0..600 {
             let q = drawn(&mut r);
             let screen = c.screen_model().expect("a screen");
-            let (verdict, spare) = screen.free_spare(&q, SPARE_CAP);
+            let (verdict, spare) = screen.free_spare(&q, &JointSpare::uniform(SPARE_CAP));
             if verdict != Some(true) {
                 continue;
             }
@@ -357,6 +357,45 @@ fn a_wrist_pair_inside_its_bounding_spheres_limited_the_spare_to_their_gap() {
 }
 
 #[test]
+fn the_screen_spare_measured_up_to_what_a_move_wants_is_the_whole_spare_capped() {
+    // A checker asked for the spare a move wants skips the pairs that surely keep it: the
+    // verdict is the same, and every range's spare is the whole spare's, capped at what the
+    // move wants of that range (so it holds the move wherever the whole spare does).
+    for hold in [false, true] {
+        let mut c = checker(hold);
+        let mut r = ChaCha8Rng::seed_from_u64(44);
+        let (mut free, mut capped) = (0, 0);
+        for _ in 0..600 {
+            let q = drawn(&mut r);
+            let step: [f64; 6] = std::array::from_fn(|_| r.random_range(-0.01..0.01));
+            let want = r.random_range(0.5..20.0);
+            let caps = JointSpare::wanted(&UR5E_LEVER_ARMS, &step, want, SPARE_CAP);
+            let (whole_verdict, whole) = c.screen_spare(&q, &JointSpare::uniform(SPARE_CAP));
+            let (verdict, spare) = c.screen_spare(&q, &caps);
+            assert_eq!(verdict, whole_verdict, "{q:?}");
+            if verdict != Some(true) {
+                continue;
+            }
+            free += 1;
+            for lo in 0..6 {
+                for hi in lo..6 {
+                    let expected = whole.get(lo, hi).min(caps.get(lo, hi));
+                    assert!(
+                        (spare.get(lo, hi) - expected).abs() < 1e-12,
+                        "{q:?}: range {lo}..={hi} {} against {expected}",
+                        spare.get(lo, hi)
+                    );
+                    capped += usize::from(caps.get(lo, hi) < whole.get(lo, hi));
+                }
+            }
+            let k = spare.steps_along(&UR5E_LEVER_ARMS, &step);
+            assert!(k >= want.min(whole.steps_along(&UR5E_LEVER_ARMS, &step)) * (1.0 - 1e-9));
+        }
+        assert!(free > 200 && capped > 1000, "{free} {capped}");
+    }
+}
+
+#[test]
 fn a_block_held_away_from_the_pinch_was_vouched_for_beyond_the_lever_arms() {
     // Held 30 cm from the pinch, the cube's points lie farther from the joint axes than the
     // lever arms bound: a move within a measured spare carried it from 6.7 cm above the table
@@ -372,7 +411,7 @@ fn a_block_held_away_from_the_pinch_was_vouched_for_beyond_the_lever_arms() {
     for _ in 0..300 {
         let q = drawn(&mut r);
         assert!(c.exact_spare(&q, SPARE_CAP).is_none(), "{q:?}");
-        let (verdict, spare) = c.screen_spare(&q, SPARE_CAP);
+        let (verdict, spare) = c.screen_spare(&q, &JointSpare::uniform(SPARE_CAP));
         assert_eq!(verdict, c.screen(&q));
         assert_eq!(spare, JointSpare::NONE);
         free += usize::from(c.is_free(&q));

@@ -22,7 +22,7 @@ use super::chain::{ArmChain, Frame, Link, mat};
 use super::pair_filter::PairFilter;
 use crate::motion::plan::JointSpare;
 use crate::motion::plan::config::UR5E_LEVER_ARMS;
-use crate::motion::plan::shapes::{Shape, V3, apart, clearance, near, within};
+use crate::motion::plan::shapes::{Shape, V3, apart, beyond, clearance, near, within};
 
 /// Extra distance every pair must keep beyond its margin for the screen to vouch, metres: room
 /// for MuJoCo's own tolerances (its convex-hull distances converge to about 1e-6 m).
@@ -640,13 +640,13 @@ impl Screen {
 
     /// The verdict at `q` and the geom pair that decided a "blocked" (geom ids).
     pub fn decide(&mut self, q: &[f64; 6]) -> (Option<bool>, Option<(usize, usize)>) {
-        let (verdict, hit, _) = self.judge::<false>(q, 0.0);
+        let (verdict, hit, _) = self.judge::<false>(q, &JointSpare::NONE);
         (verdict, hit)
     }
 
     /// The verdict at `q` (radians), as [`Screen::classify`], and with a "free" the spare
-    /// clearance by joint range ([`JointSpare`], at most `cap` metres; none with any other
-    /// verdict): for each tested pair, a lower bound on how much farther apart than its margin
+    /// clearance by joint range ([`JointSpare`], in each range at most `caps`' (metres: the
+    /// spare worth measuring, [`JointSpare::wanted`]); none with any other verdict): for each tested pair, a lower bound on how much farther apart than its margin
     /// plus [`PAD`] its primitives are, divided by the pair's lever-arm ratio (its parts move
     /// relative to each other at most that fraction of the planner's lever-arm bound), in the
     /// range of the joints that move the pair's parts relative to each other. Geoms lie inside
@@ -656,8 +656,8 @@ impl Screen {
     /// With no verdict (`None`), the spare is that of the pairs the screen decided, and
     /// [`Screen::undecided`] lists the others: a checker that measures them exactly can settle
     /// the verdict and the spare ([`Undecided`]).
-    pub fn free_spare(&mut self, q: &[f64; 6], cap: f64) -> (Option<bool>, JointSpare) {
-        let (verdict, _, spare) = self.judge::<true>(q, cap.max(0.0));
+    pub fn free_spare(&mut self, q: &[f64; 6], caps: &JointSpare) -> (Option<bool>, JointSpare) {
+        let (verdict, _, spare) = self.judge::<true>(q, caps);
         (
             verdict,
             if verdict == Some(false) {
@@ -674,11 +674,11 @@ impl Screen {
     }
 
     /// The verdict, the pair that decided a "blocked", and with `SPARE` the spare clearance by
-    /// joint range up to `cap` (metres; only meaningful with a "free").
+    /// joint range up to `caps`' (metres; only meaningful with a "free").
     fn judge<const SPARE: bool>(
         &mut self,
         q: &[f64; 6],
-        cap: f64,
+        caps: &JointSpare,
     ) -> (Option<bool>, Option<(usize, usize)>, JointSpare) {
         let frames = self.chain.link_poses(q);
         // Every moving shape posed again when first needed.
@@ -686,7 +686,7 @@ impl Screen {
         let spheres = self.world_spheres(&frames);
         let nm = self.moving.len();
         let mut unsure = false;
-        let mut spare = JointSpare::uniform(cap);
+        let mut spare = *caps;
         self.undecided.clear();
         for g in &self.groups {
             // The joints that move the group's pair relative to each other (none: the pair
@@ -719,7 +719,7 @@ impl Screen {
                             let t = r1 + r2 + need;
                             let far = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] >= t * t
                                 || (b >= nm && sphere_box_apart(&c1, r1, &y.0, need));
-                            if !far {
+                            if !far && !beyond(&x.0, &y.0, need) {
                                 // The spheres may lie far inside each other's reach (a wrist
                                 // housing and the flange): the primitives' own clearance,
                                 // which the spheres' gap only bounds from below.
@@ -731,7 +731,16 @@ impl Screen {
                         continue;
                     }
                 }
-                // Near, or the clearance when it is wanted (one distance for both).
+                // Near, or the clearance when it is wanted (one distance for both); nothing
+                // to learn from a pair the quick bound keeps beyond what it could tighten.
+                let quick = if SPARE && ranged {
+                    p.gap + p.kappa * spare.get(lo, hi)
+                } else {
+                    p.gap
+                };
+                if beyond(&x.0, &y.0, quick) {
+                    continue;
+                }
                 let kept = if SPARE && ranged {
                     apart(&x.0, &y.0, p.gap)
                 } else {

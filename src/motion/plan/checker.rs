@@ -34,11 +34,13 @@ pub trait CollisionChecker {
     }
 
     /// The [`screen`](Self::screen)'s verdict at `q` (radians) and, with a "free", its spare
-    /// clearance by joint range ([`JointSpare`], metres, at most `cap`; none with any other
-    /// verdict, and none by default). The planner vouches with it for the configurations the
-    /// joints reach within it, as with [`exact_spare`](Self::exact_spare), and re-checks the
-    /// final path like every path the screen helped find.
-    fn screen_spare(&mut self, q: &[f64; 6], _cap: f64) -> (Option<bool>, JointSpare) {
+    /// clearance by joint range ([`JointSpare`], metres; none with any other verdict, and none
+    /// by default). In each range the spare is at most `caps`': the spare worth measuring
+    /// ([`JointSpare::wanted`]), so a pair that surely keeps more need not be measured. The
+    /// planner vouches with it for the configurations the joints reach within it, as with
+    /// [`exact_spare`](Self::exact_spare), and re-checks the final path like every path the
+    /// screen helped find.
+    fn screen_spare(&mut self, q: &[f64; 6], _caps: &JointSpare) -> (Option<bool>, JointSpare) {
         (self.screen(q), JointSpare::NONE)
     }
 
@@ -84,8 +86,8 @@ impl<C: CollisionChecker + ?Sized> CollisionChecker for &mut C {
     fn screen(&mut self, q: &[f64; 6]) -> Option<bool> {
         (**self).screen(q)
     }
-    fn screen_spare(&mut self, q: &[f64; 6], cap: f64) -> (Option<bool>, JointSpare) {
-        (**self).screen_spare(q, cap)
+    fn screen_spare(&mut self, q: &[f64; 6], caps: &JointSpare) -> (Option<bool>, JointSpare) {
+        (**self).screen_spare(q, caps)
     }
     fn exact_spare(&mut self, q: &[f64; 6], cap: f64) -> Option<JointSpare> {
         (**self).exact_spare(q, cap)
@@ -227,7 +229,7 @@ impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
     /// screen's while `screen` is on (a remembered spare of its, else asked; unsure: the exact
     /// checker), the exact checker's while it is off (a remembered spare, else measured, else
     /// `is_free`). Counted as one check; `None` also once the budget is spent.
-    fn verdict(&mut self, q: &[f64; 6], cap: f64) -> Option<JointSpare> {
+    fn verdict(&mut self, q: &[f64; 6], caps: &JointSpare) -> Option<JointSpare> {
         if self.spent() {
             return None;
         }
@@ -246,7 +248,7 @@ impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
                 self.screened += 1;
                 return Some(rest);
             }
-            match self.inner.screen_spare(q, cap) {
+            match self.inner.screen_spare(q, caps) {
                 (Some(true), spare) => {
                     self.screened += 1;
                     self.screen_balls.remember(q, spare);
@@ -262,7 +264,8 @@ impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
             if let Some(rest) = self.balls.cover(q, &arms) {
                 return Some(rest);
             }
-            if let Some(spare) = self.inner.exact_spare(q, cap) {
+            // The exact spare is one for every range: the whole chain's cap, the widest.
+            if let Some(spare) = self.inner.exact_spare(q, caps.get(0, 5)) {
                 self.balls.remember(q, spare);
                 return Some(spare);
             }
@@ -278,26 +281,21 @@ impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
 
 impl<C: CollisionChecker + ?Sized> CollisionChecker for Counting<'_, C> {
     fn is_free(&mut self, q: &[f64; 6]) -> bool {
-        self.verdict(q, SPARE_CAP).is_some()
+        self.verdict(q, &JointSpare::uniform(SPARE_CAP)).is_some()
     }
     fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
         self.inner.collisions(q)
     }
     /// The steps of `step` (radians per step) within the spare the verdict at `q` comes with
-    /// ([`JointSpare::steps_along`] through the vouching lever arms; none without them). The
-    /// spare is measured up to what `want` steps need ([`SPARE_CAP`] at most): a small cap lets
-    /// the checkers skip the pairs that surely keep it.
+    /// ([`JointSpare::steps_along`] through the vouching lever arms; none without them). Each
+    /// range's spare is measured up to what `want` steps need of it ([`JointSpare::wanted`],
+    /// [`SPARE_CAP`] at most): a small cap lets the checkers skip the pairs that surely keep it.
     fn free_reach(&mut self, q: &[f64; 6], step: &[f64; 6], want: f64) -> Option<f64> {
         let Some(arms) = self.vouch_arms else {
-            return self.verdict(q, SPARE_CAP).map(|_| 0.0);
+            return self.verdict(q, &JointSpare::uniform(SPARE_CAP)).map(|_| 0.0);
         };
-        let need = want * (0..6).map(|j| arms[j] * step[j].abs()).sum::<f64>();
-        let cap = if need > 0.0 {
-            need.min(SPARE_CAP)
-        } else {
-            SPARE_CAP
-        };
-        Some(self.verdict(q, cap)?.steps_along(&arms, step))
+        let caps = JointSpare::wanted(&arms, step, want, SPARE_CAP);
+        Some(self.verdict(q, &caps)?.steps_along(&arms, step))
     }
     /// Counts the samples as checks (as screened ones while the screen is on), refusing them
     /// past the budget.

@@ -117,6 +117,32 @@ pub fn near(x: &Shape, y: &Shape, gap: f64) -> bool {
     }
 }
 
+/// True when `x` and `y` surely lie more than `d` metres apart by a quick bound, false when it
+/// cannot tell: for a capsule against a box, the distance from the box of the capsule axis's
+/// bounding box in the box's frame, less the radius (the axis lies inside that bounding box,
+/// so it is never farther from the box). A lower bound on [`clearance`]; a few products
+/// against the exact distance's walk.
+pub fn beyond(x: &Shape, y: &Shape, d: f64) -> bool {
+    use Shape::*;
+    match (x, y) {
+        (Capsule { a, b, radius }, Box { center, axes, half })
+        | (Box { center, axes, half }, Capsule { a, b, radius }) => {
+            let (ra, rb) = (sub(a, center), sub(b, center));
+            let mut out2 = 0.0;
+            for i in 0..3 {
+                let (u, v) = (dot(&axes[i], &ra), dot(&axes[i], &rb));
+                let e = (u.min(v) - half[i]).max(-half[i] - u.max(v));
+                if e > 0.0 {
+                    out2 += e * e;
+                }
+            }
+            let t = radius + d;
+            t < 0.0 || out2 > t * t
+        }
+        _ => false,
+    }
+}
+
 /// `None` when `x` and `y` may come closer than `gap` metres ([`near`]), else their
 /// [`clearance`] (at least `gap`), computed once where the two tests share their distance
 /// (capsule pairs, capsule–box).
@@ -565,6 +591,45 @@ mod tests {
             );
         }
         assert_eq!(flat, 500);
+    }
+
+    #[test]
+    fn the_quick_capsule_box_bound_never_exceeds_the_clearance() {
+        // Capsules through, beside and far from boxes: `beyond` only says "farther than d"
+        // where the exact clearance is, and it says so for most pairs well apart.
+        let mut r = ChaCha8Rng::seed_from_u64(10);
+        let (mut said, mut apart) = (0, 0);
+        for _ in 0..4000 {
+            let (axes, half, center) = random_box(&mut r);
+            let capsule = Shape::Capsule {
+                a: v(&mut r, 0.5),
+                b: v(&mut r, 0.5),
+                radius: r.random_range(0.0..0.05),
+            };
+            let boxed = Shape::Box { center, axes, half };
+            let c = clearance(&capsule, &boxed);
+            let d = r.random_range(0.0..0.1);
+            for (x, y) in [(&capsule, &boxed), (&boxed, &capsule)] {
+                if beyond(x, y, d) {
+                    assert!(c > d, "beyond {d} m but {c} m apart: {capsule:?} {boxed:?}");
+                    said += 1;
+                }
+            }
+            apart += usize::from(c > d + 0.1);
+        }
+        assert!(apart > 200 && said > apart, "{said} {apart}");
+        // Other pairs: no quick bound.
+        let ball = Shape::Capsule {
+            a: [0.0; 3],
+            b: [0.0; 3],
+            radius: 0.01,
+        };
+        let far = Shape::Capsule {
+            a: [5.0, 0.0, 0.0],
+            b: [5.0, 0.0, 0.0],
+            radius: 0.01,
+        };
+        assert!(!beyond(&ball, &far, 0.0));
     }
 
     #[test]

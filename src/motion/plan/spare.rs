@@ -56,6 +56,29 @@ impl JointSpare {
         self
     }
 
+    /// The spare worth measuring for a move of `want` steps of `step` (radians per step) from
+    /// the measured configuration: in each range, what the move's lever-arm displacement
+    /// `want · Σ_{j in range} arms[j] |step_j|` uses (metres; `arms`: metres per radian), at most
+    /// `cap`; `cap` in every range when nothing moves. A spare measured up to it holds the
+    /// move by the lever arms alone ([`JointSpare::steps_along`]); a checker need not measure a
+    /// pair that surely keeps more.
+    pub fn wanted(arms: &[f64; 6], step: &[f64; 6], want: f64, cap: f64) -> Self {
+        let mut arm = [0.0; 7];
+        for j in 0..6 {
+            arm[j + 1] = arm[j] + arms[j] * step[j].abs();
+        }
+        if want * arm[6] <= 0.0 {
+            return Self::uniform(cap);
+        }
+        let mut caps = Self::uniform(cap);
+        for lo in 0..6 {
+            for hi in lo..6 {
+                caps.by_range[lo][hi] = (want * (arm[hi + 1] - arm[lo])).min(cap);
+            }
+        }
+        caps
+    }
+
     /// The reach from each joint's axis at the measured configuration, metres (infinite:
     /// unknown).
     pub fn reach(&self) -> [f64; 6] {
@@ -262,6 +285,35 @@ mod tests {
         let rest = spare.less(&[0.0, 0.0, 0.0, 0.0, 0.002, 0.0]).unwrap();
         assert!((rest.get(4, 5) - 0.003).abs() < 1e-12 && (rest.get(0, 3) - 0.03).abs() < 1e-12);
         assert!(spare.less(&[0.0, 0.0, 0.0, 0.0, 0.003, 0.003]).is_none());
+    }
+
+    #[test]
+    fn the_spare_wanted_is_what_the_move_uses_of_each_range() {
+        let arms = [1.0, 1.0, 0.5, 0.4, 0.3, 0.1];
+        // Ten steps of the base (1 mm per step) and of wrist 3 (0.2 mm per step).
+        let step = [0.001, 0.0, 0.0, 0.0, 0.0, 0.002];
+        let caps = JointSpare::wanted(&arms, &step, 10.0, 0.15);
+        let near = |x: f64, y: f64| (x - y).abs() < 1e-12;
+        assert!(near(caps.get(0, 5), 0.012) && near(caps.get(0, 0), 0.01));
+        assert!(near(caps.get(5, 5), 0.002) && near(caps.get(1, 4), 0.0));
+        // A spare measured up to it holds the ten steps in every range, and no more than a
+        // larger spare would.
+        let mut full = JointSpare::uniform(0.15);
+        full.tighten(0, 5, 0.03);
+        let mut capped = caps;
+        for lo in 0..6 {
+            for hi in lo..6 {
+                capped.tighten(lo, hi, full.get(lo, hi));
+            }
+        }
+        assert!(near(capped.steps_along(&arms, &step), 10.0));
+        assert!(full.steps_along(&arms, &step) > 10.0);
+        // Capped at `cap`, and the cap everywhere when nothing moves.
+        assert!(near(JointSpare::wanted(&arms, &step, 1e6, 0.15).get(0, 5), 0.15));
+        assert_eq!(
+            JointSpare::wanted(&arms, &[0.0; 6], 10.0, 0.15),
+            JointSpare::uniform(0.15)
+        );
     }
 
     #[test]
