@@ -8,6 +8,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::{SPARE_TOLERANCE, SceneChecker};
 use crate::motion::plan::config::UR5E_LEVER_ARMS;
+use crate::motion::plan::shapes::{Shape, clearance};
 use crate::motion::plan::{CollisionChecker, JointSpare, SPARE_CAP};
 use crate::motion::{HOME_Q, JOINT_LIMITS, down_pose, fk, ik};
 use crate::scene::SceneSpec;
@@ -392,6 +393,63 @@ fn the_screen_spare_measured_up_to_what_a_move_wants_is_the_whole_spare_capped()
             assert!(k >= want.min(whole.steps_along(&UR5E_LEVER_ARMS, &step)) * (1.0 - 1e-9));
         }
         assert!(free > 200 && capped > 1000, "{free} {capped}");
+    }
+}
+
+/// An upper bound on the distance between two primitives, metres: exact where one is a
+/// capsule; between two boxes, the least distance from a grid of points on the first box's
+/// surface to the second box (every point of it is at least the distance away).
+fn distance_at_most(x: &Shape, y: &Shape) -> f64 {
+    let (Shape::Box { center, axes, half }, Shape::Box { .. }) = (x, y) else {
+        return clearance(x, y);
+    };
+    let mut least = f64::INFINITY;
+    for face in 0..6 {
+        let (i, sign) = (face / 2, if face % 2 == 0 { -1.0 } else { 1.0 });
+        for u in 0..=8 {
+            for v in 0..=8 {
+                let mut s = [0.0; 3];
+                s[i] = sign * half[i];
+                s[(i + 1) % 3] = half[(i + 1) % 3] * (u as f64 / 4.0 - 1.0);
+                s[(i + 2) % 3] = half[(i + 2) % 3] * (v as f64 / 4.0 - 1.0);
+                let p: [f64; 3] = std::array::from_fn(|k| {
+                    center[k] + axes[0][k] * s[0] + axes[1][k] * s[1] + axes[2][k] * s[2]
+                });
+                let point = Shape::Capsule {
+                    a: p,
+                    b: p,
+                    radius: 0.0,
+                };
+                least = least.min(clearance(&point, y));
+            }
+        }
+    }
+    least
+}
+
+#[test]
+fn the_arms_own_pairs_keep_their_turned_bound_at_any_joints() {
+    // The screen leaves out the arm's own pairs that keep their gap at any angles of the joints
+    // between them (`turned_apart`): the bound taken at one configuration must hold at every
+    // other. Whole swings of every joint, with and without a held block.
+    for hold in [false, true] {
+        let mut c = checker(hold);
+        let mut r = ChaCha8Rng::seed_from_u64(45);
+        let screen = c.screen_model().expect("a screen of this cell");
+        let (mut bounded, mut tight) = (0, 0);
+        for _ in 0..60 {
+            let (q, q2) = (drawn(&mut r), drawn(&mut r));
+            for (bound, x, y) in screen.turned_bounds(&q, &q2) {
+                if bound <= 0.0 {
+                    continue;
+                }
+                bounded += 1;
+                let d = distance_at_most(&x, &y);
+                assert!(d >= bound - 1e-9, "{bound} m bound, {d} m apart: {x:?} {y:?}");
+                tight += usize::from(d < bound + 0.01);
+            }
+        }
+        assert!(bounded > 1000 && tight > 50, "{bounded} {tight}");
     }
 }
 

@@ -22,7 +22,9 @@ use super::chain::{ArmChain, Frame, Link, mat};
 use super::pair_filter::PairFilter;
 use crate::motion::plan::JointSpare;
 use crate::motion::plan::config::UR5E_LEVER_ARMS;
-use crate::motion::plan::shapes::{Shape, V3, apart, beyond, clearance, near, within};
+use crate::motion::plan::shapes::{
+    Shape, V3, apart, beyond, clearance, near, segment_box_dist2, segment_segment_dist2, within,
+};
 
 /// Extra distance every pair must keep beyond its margin for the screen to vouch, metres: room
 /// for MuJoCo's own tolerances (its convex-hull distances converge to about 1e-6 m).
@@ -113,6 +115,10 @@ pub struct Screen {
     /// Bounding sphere of each link's moving shapes in the link's frame (centre, radius,
     /// metres); radius negative for a link without shapes.
     link_spheres: [(Vector3<f64>, f64); 6],
+    /// A capsule around each link's moving shapes in the link's frame ([`link_capsule`]; `None`
+    /// for a link without shapes): tighter than the sphere around a long link (the forearm) or
+    /// the gripper, it culls a group the spheres cannot.
+    link_capsules: [Option<Local>; 6],
     /// Geom id of each shape (moving ones, then fixed ones).
     geoms: Vec<usize>,
     /// The pairs the last [`Screen::free_spare`] could not decide.
@@ -419,6 +425,139 @@ fn link_sphere<'a>(shapes: impl Iterator<Item = &'a Local> + Clone) -> (Vector3<
     (mid, r)
 }
 
+/// Where `shape` (world frame, metres) lies about the axis through `o` along the unit `u`: the
+/// ranges of its points' heights along the axis and of their distances from it (metres).
+fn about_axis(shape: &Shape, o: &Vector3<f64>, u: &Vector3<f64>) -> ([f64; 2], [f64; 2]) {
+    let height = |p: &V3| (Vector3::from(*p) - o).dot(u);
+    let off = |p: &V3| {
+        let d = Vector3::from(*p) - o;
+        (d - u * d.dot(u)).norm()
+    };
+    // The axis as a segment far longer than the cell, for the distance from the line.
+    let (l0, l1) = (o - u * 100.0, o + u * 100.0);
+    let (l0, l1) = ([l0.x, l0.y, l0.z], [l1.x, l1.y, l1.z]);
+    match shape {
+        Shape::Capsule { a, b, radius } => {
+            let (ha, hb) = (height(a), height(b));
+            let near = segment_segment_dist2(a, b, &l0, &l1).sqrt();
+            (
+                [ha.min(hb) - radius, ha.max(hb) + radius],
+                [(near - radius).max(0.0), off(a).max(off(b)) + radius],
+            )
+        }
+        Shape::Box { center, axes, half } => {
+            let (mut h, mut r) = ([f64::INFINITY, f64::NEG_INFINITY], 0.0f64);
+            for k in 0..8 {
+                let s = |i: usize| if k >> i & 1 == 0 { -half[i] } else { half[i] };
+                let c: V3 = std::array::from_fn(|x| {
+                    center[x] + axes[0][x] * s(0) + axes[1][x] * s(1) + axes[2][x] * s(2)
+                });
+                h = [h[0].min(height(&c)), h[1].max(height(&c))];
+                r = r.max(off(&c));
+            }
+            let near = segment_box_dist2(&l0, &l1, center, axes, half).sqrt();
+            (h, [near, r])
+        }
+        Shape::HalfSpace { .. } => ([f64::NEG_INFINITY, f64::INFINITY], [0.0, f64::INFINITY]),
+    }
+}
+
+/// The gap between two ranges, 0 where they overlap.
+fn range_gap(x: [f64; 2], y: [f64; 2]) -> f64 {
+    (x[0] - y[1]).max(y[0] - x[1]).max(0.0)
+}
+
+/// A lower bound on the distance between moving shapes `x` and `y` (metres) at any angles of the
+/// joints between their links, when those are one or two joints (`−∞` otherwise), from the
+/// links' frames `frames` at one configuration. The farther shape turns about the next joint's
+/// axis, which is fixed to the nearer link: heights along that axis and distances from it do
+/// not change, and two points are at least as far apart as those differ (the axial and radial
+/// parts of their offset). Across two joints the farther shape, turned about the last axis,
+/// stays within a ball about a point of that axis, and the ball turns about the axis before.
+fn turned_apart(
+    links: &[Link; 6],
+    frames: &[Frame; 6],
+    x: &(usize, Local, bool, f64),
+    y: &(usize, Local, bool, f64),
+) -> f64 {
+    let (near, far) = if x.0 < y.0 { (x, y) } else { (y, x) };
+    let axis = |j: usize| {
+        let (r, t) = &frames[j];
+        (r * links[j].anchor + t, r * links[j].axis)
+    };
+    if far.0 == near.0 {
+        return f64::NEG_INFINITY;
+    }
+    let (o, u) = axis(far.0);
+    let (mut h, mut r) = about_axis(&pose(far, frames).0, &o, &u);
+    // Joint by joint towards the nearer link: the ball about the last axis's point at
+    // mid-height holds every turn of what lies beyond it, and turns about the axis before.
+    for j in (near.0 + 1..far.0).rev() {
+        let (o, u) = axis(j + 1);
+        let centre = o + u * ((h[0] + h[1]) / 2.0);
+        let radius = ((h[1] - h[0]) / 2.0).hypot(r[1]);
+        let (o, u) = axis(j);
+        let d = centre - o;
+        let (hc, rc) = (d.dot(&u), (d - u * d.dot(&u)).norm());
+        h = [hc - radius, hc + radius];
+        r = [(rc - radius).max(0.0), rc + radius];
+    }
+    let (o, u) = axis(near.0 + 1);
+    let (nh, nr) = about_axis(&pose(near, frames).0, &o, &u);
+    range_gap(h, nh).hypot(range_gap(r, nr))
+}
+
+/// A capsule (in the link's frame, metres) containing every one of `shapes`, `None` when there
+/// are none: its axis along whichever of the frame's three
+/// axes and the direction between the two farthest shape points gives the least volume, through
+/// the shapes' mean point, from the least to the largest projection of a shape's point on it; its
+/// radius the largest distance of a shape from that line. Every point of a capsule or a box lies
+/// within its ends' (corners') largest distance from the axis segment, plus the capsule's radius
+/// (the distance to a segment is convex), and every such point projects inside the segment.
+fn link_capsule<'a>(shapes: impl Iterator<Item = &'a Local>) -> Option<Local> {
+    // Each shape's extreme points, with how far the shape reaches beyond them.
+    let mut points: Vec<(Vector3<f64>, f64)> = Vec::new();
+    for l in shapes {
+        match l {
+            Local::Capsule { a, b, radius } => points.extend([(*a, *radius), (*b, *radius)]),
+            Local::Box { center, axes, half } => {
+                for k in 0..8 {
+                    let s = |i: usize| if k >> i & 1 == 0 { -half[i] } else { half[i] };
+                    points.push((center + axes * Vector3::new(s(0), s(1), s(2)), 0.0));
+                }
+            }
+        }
+    }
+    if points.is_empty() {
+        return None;
+    }
+    let mean = points.iter().map(|p| p.0).sum::<Vector3<f64>>() / points.len() as f64;
+    let mut far = (0.0, Vector3::x());
+    for (i, (p, _)) in points.iter().enumerate() {
+        for (r, _) in &points[i + 1..] {
+            let d = (r - p).norm();
+            if d > far.0 {
+                far = (d, (r - p) / d);
+            }
+        }
+    }
+    let mut best: Option<(f64, Vector3<f64>, Vector3<f64>, f64)> = None;
+    for u in [Vector3::x(), Vector3::y(), Vector3::z(), far.1] {
+        let (mut lo, mut hi, mut radius) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
+        for (p, extra) in &points {
+            let t = (p - mean).dot(&u);
+            lo = lo.min(t);
+            hi = hi.max(t);
+            radius = radius.max((p - mean - u * t).norm() + extra);
+        }
+        let volume = std::f64::consts::PI * radius * radius * (hi - lo + 4.0 / 3.0 * radius);
+        if best.is_none_or(|b| volume < b.0) {
+            best = Some((volume, mean + u * lo, mean + u * hi, radius));
+        }
+    }
+    best.map(|(_, a, b, radius)| Local::Capsule { a, b, radius })
+}
+
 /// The lever-arm ratio of the pair of shapes `a` (moving) and `b` (moving or fixed, index past
 /// `moving`): the largest, over the joints that move the two relative to each other, of how far
 /// the distal shape's points can lie from the joint's axis over the planner's lever arm for
@@ -575,6 +714,17 @@ impl Screen {
         for p in &mut pairs {
             p.kappa = lever_ratio(&chain.links, &moving, p.a as usize, p.b as usize);
         }
+        // The arm's own pairs across one or two joints that keep their gap at any angles of
+        // those joints: never tested.
+        pairs.retain(|p| {
+            (p.b as usize) >= nm
+                || turned_apart(
+                    &chain.links,
+                    &link_pose,
+                    &moving[p.a as usize],
+                    &moving[p.b as usize],
+                ) < p.gap
+        });
         let partner = |p: &Pair| {
             if (p.b as usize) < nm {
                 Partner::Link(moving[p.b as usize].0)
@@ -612,6 +762,8 @@ impl Screen {
                 end: grouped.len() as u32,
             });
         }
+        let link_capsules =
+            std::array::from_fn(|k| link_capsule(moving.iter().filter(|m| m.0 == k).map(|m| &m.1)));
         let link_spheres =
             std::array::from_fn(|k| link_sphere(moving.iter().filter(|m| m.0 == k).map(|m| &m.1)));
         Some(Self {
@@ -621,6 +773,7 @@ impl Screen {
             pairs: grouped,
             groups,
             link_spheres,
+            link_capsules,
             geoms,
             undecided: Vec::new(),
             posed: Posing::new(nm),
@@ -684,6 +837,7 @@ impl Screen {
         // Every moving shape posed again when first needed.
         self.posed.renew();
         let spheres = self.world_spheres(&frames);
+        let capsules = self.world_capsules(&frames);
         let nm = self.moving.len();
         let mut unsure = false;
         let mut spare = *caps;
@@ -693,13 +847,13 @@ impl Screen {
             // never moves apart or closer, and limits no spare).
             let (lo, hi) = g.joints();
             let ranged = lo <= hi;
-            if self.group_apart(g, &spheres, g.gap) {
+            if self.group_apart(g, &spheres, &capsules, g.gap) {
                 if !SPARE || !ranged {
                     continue;
                 }
                 // The link's sphere keeps more than the range's spare found so far: nothing to
                 // learn from the group's pairs; else they may keep more than the sphere does.
-                if self.group_apart(g, &spheres, g.gap + g.kappa * spare.get(lo, hi)) {
+                if self.group_apart(g, &spheres, &capsules, g.gap + g.kappa * spare.get(lo, hi)) {
                     continue;
                 }
             }
@@ -794,12 +948,29 @@ impl Screen {
         })
     }
 
-    /// True when the sphere of group `g`'s link (`spheres`: each link's, world frame) keeps
-    /// `gap` metres from the group's partner: the other link's sphere, or a fixed shape's
-    /// bounding sphere, its box or its half-space.
-    fn group_apart(&self, g: &Group, spheres: &[(V3, f64); 6], gap: f64) -> bool {
+    /// Each link's bounding capsule in the world at the link frames `frames` (`None`: a link
+    /// without shapes).
+    fn world_capsules(&self, frames: &[Frame; 6]) -> [Option<Shape>; 6] {
+        std::array::from_fn(|k| {
+            self.link_capsules[k]
+                .as_ref()
+                .map(|l| l.posed(&frames[k].0, &frames[k].1))
+        })
+    }
+
+    /// True when group `g`'s link keeps `gap` metres from the group's partner: its sphere
+    /// (`spheres`: each link's, world frame) from the other link's sphere, or from a fixed
+    /// shape's bounding sphere, its box or its half-space; else its capsule (`capsules`) from
+    /// the other link's capsule, or from the fixed shape (a box by [`beyond`]).
+    fn group_apart(
+        &self,
+        g: &Group,
+        spheres: &[(V3, f64); 6],
+        capsules: &[Option<Shape>; 6],
+        gap: f64,
+    ) -> bool {
         let (c1, r1) = spheres[g.link];
-        match g.partner {
+        let by_spheres = match g.partner {
             Partner::Link(m) => sphere_apart(&c1, r1, &spheres[m].0, spheres[m].1, gap),
             Partner::Fixed(f) => match &self.fixed[f] {
                 (y, Some((c2, r2)), _) => {
@@ -810,6 +981,24 @@ impl Screen {
                 }
                 _ => false,
             },
+        };
+        if by_spheres {
+            return true;
+        }
+        let Some(capsule) = &capsules[g.link] else {
+            return true;
+        };
+        match g.partner {
+            Partner::Link(m) => capsules[m]
+                .as_ref()
+                .is_none_or(|other| !near(capsule, other, gap)),
+            Partner::Fixed(f) => {
+                let y = &self.fixed[f].0;
+                match y {
+                    Shape::Box { .. } => beyond(capsule, y, gap),
+                    _ => !near(capsule, y, gap),
+                }
+            }
         }
     }
 
@@ -878,6 +1067,23 @@ impl Screen {
             }
         }
         (low, high)
+    }
+
+    /// For every two moving shapes on different links: the bound on their distance at any
+    /// angles of the joints between them ([`turned_apart`]) from the link frames at `q`, and
+    /// the two primitives posed at `q2` (radians, metres).
+    pub(crate) fn turned_bounds(&self, q: &[f64; 6], q2: &[f64; 6]) -> Vec<(f64, Shape, Shape)> {
+        let (f1, f2) = (self.chain.link_poses(q), self.chain.link_poses(q2));
+        let mut out = Vec::new();
+        for (i, x) in self.moving.iter().enumerate() {
+            for y in &self.moving[i + 1..] {
+                if x.0 != y.0 {
+                    let bound = turned_apart(&self.chain.links, &f1, x, y);
+                    out.push((bound, pose(x, &f2).0, pose(y, &f2).0));
+                }
+            }
+        }
+        out
     }
 
     /// For every pair: its lever-arm ratio, and between joints `q` and `q2` (radians) the
@@ -971,6 +1177,47 @@ mod tests {
         let (_, none) = link_sphere(std::iter::empty());
         assert!(none < 0.0);
         assert!(sphere_apart(&[0.0; 3], none, &[0.0; 3], 1.0, 0.01));
+    }
+
+    #[test]
+    fn a_link_capsule_contains_every_shape_of_the_link() {
+        let shapes = [
+            Local::Capsule {
+                a: Vector3::new(0.0, 0.0, -0.1),
+                b: Vector3::new(0.02, 0.0, 0.3),
+                radius: 0.05,
+            },
+            Local::Box {
+                center: Vector3::new(0.05, -0.04, 0.2),
+                axes: Matrix3::new(0.8, -0.6, 0.0, 0.6, 0.8, 0.0, 0.0, 0.0, 1.0),
+                half: [0.02, 0.03, 0.04],
+            },
+        ];
+        let Some(Local::Capsule { a, b, radius }) = link_capsule(shapes.iter()) else {
+            panic!("a capsule");
+        };
+        let (a, b) = ([a.x, a.y, a.z], [b.x, b.y, b.z]);
+        // Every shape's extreme points, and the capsule's surface points around its ends.
+        let to_axis =
+            |p: &Vector3<f64>| segment_segment_dist2(&a, &b, &[p.x, p.y, p.z], &[p.x, p.y, p.z]).sqrt();
+        let mut points: Vec<(Vector3<f64>, f64)> = Vec::new();
+        if let Local::Capsule { a, b, radius } = &shapes[0] {
+            for k in 0..=20 {
+                points.push((a + (b - a) * (k as f64 / 20.0), *radius));
+            }
+        }
+        if let Local::Box { center, axes, half } = &shapes[1] {
+            for k in 0..8 {
+                let s = |i: usize| if k >> i & 1 == 0 { -half[i] } else { half[i] };
+                points.push((center + axes * Vector3::new(s(0), s(1), s(2)), 0.0));
+            }
+        }
+        for (p, r) in &points {
+            assert!(to_axis(p) + r <= radius + 1e-12, "{p} ({r}) outside the capsule");
+        }
+        // Tighter than the sphere around the same shapes, and none for no shape.
+        assert!(radius < link_sphere(shapes.iter()).1);
+        assert!(link_capsule(std::iter::empty()).is_none());
     }
 
     #[test]

@@ -133,10 +133,13 @@ impl fmt::Display for Collision {
 /// while a budget is set, answers "blocked" without asking once the budget is used (a refusal
 /// never lets a collision through; it only ends the search). While `screen` is on, the inner
 /// checker's [`screen`](CollisionChecker::screen) answers first: its "free" is taken, its
-/// "blocked" too; each check counts once either way. With `vouch_arms` set, a configuration a
-/// remembered spare clearance covers is free without asking: the screen's while `screen` is
-/// on, the exact checker's while it is off; [`free_reach`](CollisionChecker::free_reach) turns
-/// the spare into the samples it vouches for along a segment.
+/// "blocked" too; each check counts once either way. With `vouch_arms` set, the verdicts come
+/// with a spare clearance (the screen's while `screen` is on, the exact checker's while it is
+/// off), [`free_reach`](CollisionChecker::free_reach) turns it into the samples it vouches for
+/// along a segment, and while the screen is off a configuration a remembered exact spare covers
+/// is free without asking. (The screen's spares are not remembered: asked only up to what a
+/// move wants of each range, they seldom cover another segment's configurations, and looking
+/// them up cost more than it saved.)
 pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
     pub(crate) inner: &'a mut C,
     pub(crate) checks: u64,
@@ -144,8 +147,8 @@ pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
     pub(crate) budget: u64,
     /// Ask the inner checker's screen first.
     pub(crate) screen: bool,
-    /// Checks decided without the exact test while the screen is on: answered by the screen
-    /// (its own verdict or a remembered spare of its), or vouched for along a segment.
+    /// Checks decided without the exact test while the screen is on: answered by the screen,
+    /// or vouched for along a segment.
     pub(crate) screened: u64,
     /// Lever arms (metres) to vouch with a measured spare clearance for configurations near
     /// the measured one: the exact checker's ([`CollisionChecker::exact_spare`]) while the
@@ -154,17 +157,10 @@ pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
     pub(crate) vouch_arms: Option<[f64; 6]>,
     /// Configurations the exact checker measured, with their spare clearance.
     balls: Balls,
-    /// Configurations the screen called free, with its spare clearance (while `screen` is on).
-    screen_balls: Balls,
 }
 
 /// Measured configurations [`Counting`] remembers to vouch with the exact checker's spare.
 const EXACT_BALLS: usize = 32;
-
-/// Configurations [`Counting`] remembers to vouch with the screen's spare, looked up before the
-/// screen is asked (a segment's own neighbours vouch through its bisection; these reach across
-/// segments: a search's neighbouring edges, a shortcut beside the path it shortens).
-const SCREEN_BALLS: usize = 32;
 
 /// Recently measured configurations and their spare clearance by joint range (radians;
 /// metres), a ring: a configuration the joints reach within a remembered spare keeps the margin
@@ -220,14 +216,13 @@ impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
             screened: 0,
             vouch_arms: None,
             balls: Balls::new(EXACT_BALLS),
-            screen_balls: Balls::new(SCREEN_BALLS),
         }
     }
 
     /// The verdict at `q` (radians) and, with a "free", the spare clearance by joint range that
     /// vouches for configurations near it ([`JointSpare::NONE`] when none is known): the
-    /// screen's while `screen` is on (a remembered spare of its, else asked; unsure: the exact
-    /// checker), the exact checker's while it is off (a remembered spare, else measured, else
+    /// screen's while `screen` is on (unsure: the exact checker's verdict), the exact checker's
+    /// while it is off (a remembered spare, else measured, else
     /// `is_free`). Counted as one check; `None` also once the budget is spent.
     fn verdict(&mut self, q: &[f64; 6], caps: &JointSpare) -> Option<JointSpare> {
         if self.spent() {
@@ -235,7 +230,7 @@ impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
         }
         self.checks += 1;
         if self.screen {
-            let Some(arms) = self.vouch_arms else {
+            if self.vouch_arms.is_none() {
                 return match self.inner.screen(q) {
                     Some(free) => {
                         self.screened += 1;
@@ -243,15 +238,10 @@ impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
                     }
                     None => self.inner.is_free(q).then_some(JointSpare::NONE),
                 };
-            };
-            if let Some(rest) = self.screen_balls.cover(q, &arms) {
-                self.screened += 1;
-                return Some(rest);
             }
             match self.inner.screen_spare(q, caps) {
                 (Some(true), spare) => {
                     self.screened += 1;
-                    self.screen_balls.remember(q, spare);
                     return Some(spare);
                 }
                 (Some(false), _) => {
