@@ -18,6 +18,38 @@ pub(crate) struct Link {
     pub(crate) axis: Vector3<f64>,
     pub(crate) anchor: Vector3<f64>,
     pub(crate) qpos0: f64,
+    /// The hinge's axis when it is a coordinate axis of the body frame (index, and the sign
+    /// of the turn), as for every UR5e joint: a turn then mixes two columns of the frame.
+    coordinate: Option<(usize, f64)>,
+}
+
+impl Link {
+    /// This link's frame from its parent's (`r`, `t`: rotation and origin, world) with the
+    /// joint `angle` radians past its reference.
+    #[inline]
+    fn frame(&self, r: &mut Matrix3<f64>, t: &mut Vector3<f64>, angle: f64) {
+        *t += *r * self.pos;
+        if self.rot != Matrix3::identity() {
+            *r *= self.rot;
+        }
+        match self.coordinate {
+            Some((i, sign)) if self.anchor == Vector3::zeros() => {
+                // r · R_i(angle): columns a and b turn into each other.
+                let (s, c) = angle.sin_cos();
+                let s = sign * s;
+                let (a, b) = ((i + 1) % 3, (i + 2) % 3);
+                let (ca, cb) = (r.column(a).into_owned(), r.column(b).into_owned());
+                r.set_column(a, &(ca * c + cb * s));
+                r.set_column(b, &(cb * c - ca * s));
+            }
+            _ => {
+                let j = axis_angle(&self.axis, angle);
+                // Rotation about the axis through the anchor: x ↦ anchor + J (x − anchor).
+                *t += *r * (self.anchor - j * self.anchor);
+                *r *= j;
+            }
+        }
+    }
 }
 
 /// Rotation by `angle` radians about the unit `axis` (Rodrigues).
@@ -73,12 +105,19 @@ impl ArmChain {
             let (p, q) = (m.body_pos()[body], m.body_quat()[body]);
             let (ax, an) = (m.jnt_axis()[j], m.jnt_pos()[j]);
             let offset = UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]));
+            let axis = Unit::new_normalize(Vector3::new(ax[0], ax[1], ax[2])).into_inner();
+            let coordinate = (0..3).find_map(|i| {
+                let along = axis[i];
+                let unit = along.abs() == 1.0 && (0..3).all(|k| k == i || axis[k] == 0.0);
+                unit.then_some((i, along))
+            });
             Link {
                 rot: offset.to_rotation_matrix().into_inner(),
                 pos: Vector3::new(p[0], p[1], p[2]),
-                axis: Unit::new_normalize(Vector3::new(ax[0], ax[1], ax[2])).into_inner(),
+                axis,
                 anchor: Vector3::new(an[0], an[1], an[2]),
                 qpos0: m.qpos0()[m.jnt_qposadr()[j] as usize],
+                coordinate,
             }
         });
         Some(Self { base, links })
@@ -90,12 +129,7 @@ impl ArmChain {
         let (mut r, mut t) = self.base;
         std::array::from_fn(|k| {
             let l = &self.links[k];
-            t += r * l.pos;
-            r *= l.rot;
-            let j = axis_angle(&l.axis, q[k] - l.qpos0);
-            // Rotation about the axis through the anchor: x ↦ anchor + J (x − anchor).
-            t += r * (l.anchor - j * l.anchor);
-            r *= j;
+            l.frame(&mut r, &mut t, q[k] - l.qpos0);
             (r, t)
         })
     }

@@ -12,6 +12,7 @@ use crate::motion::plan::shapes::{Shape, clearance};
 use crate::motion::plan::{CollisionChecker, JointSpare, SPARE_CAP};
 use crate::motion::{HOME_Q, JOINT_LIMITS, down_pose, fk, ik};
 use crate::scene::SceneSpec;
+use crate::sim::chain::ArmChain;
 use crate::sim::pair_filter::PairFilter;
 use crate::sim::{Scene, Sim};
 
@@ -393,6 +394,36 @@ fn the_screen_spare_measured_up_to_what_a_move_wants_is_the_whole_spare_capped()
             assert!(k >= want.min(whole.steps_along(&UR5E_LEVER_ARMS, &step)) * (1.0 - 1e-9));
         }
         assert!(free > 200 && capped > 1000, "{free} {capped}");
+    }
+}
+
+#[test]
+fn the_chain_poses_the_links_as_mujoco_does() {
+    // `ArmChain::link_poses` (each UR5e hinge a coordinate axis of its body: a turn mixes two
+    // columns) against `mj_kinematics`, over whole swings of every joint.
+    let mut c = checker(false);
+    let (bodies, joints) = c.arm_links;
+    c.detect_pose(&HOME_Q);
+    let chain = ArmChain::new(&c.data, bodies, joints).expect("the arm is a chain");
+    let mut r = ChaCha8Rng::seed_from_u64(46);
+    for _ in 0..300 {
+        let q = drawn(&mut r);
+        c.detect_pose(&q);
+        for (k, (rot, t)) in chain.link_poses(&q).iter().enumerate() {
+            let (xpos, xmat) = (c.data.xpos()[bodies[k]], c.data.xmat()[bodies[k]]);
+            for i in 0..3 {
+                assert!(
+                    (t[i] - xpos[i]).abs() < 1e-12,
+                    "{q:?} link {k}: {t} against {xpos:?}"
+                );
+                for j in 0..3 {
+                    assert!(
+                        (rot[(i, j)] - xmat[3 * i + j]).abs() < 1e-12,
+                        "{q:?} link {k}: {rot} against {xmat:?}"
+                    );
+                }
+            }
+        }
     }
 }
 
