@@ -847,15 +847,16 @@ impl Screen {
             // never moves apart or closer, and limits no spare).
             let (lo, hi) = g.joints();
             let ranged = lo <= hi;
-            if self.group_apart(g, &spheres, &capsules, g.gap) {
-                if !SPARE || !ranged {
-                    continue;
-                }
-                // The link's sphere keeps more than the range's spare found so far: nothing to
-                // learn from the group's pairs; else they may keep more than the sphere does.
-                if self.group_apart(g, &spheres, &capsules, g.gap + g.kappa * spare.get(lo, hi)) {
-                    continue;
-                }
+            // The link keeps the group's gap, and with a spare wanted the range's spare found so
+            // far too: nothing to learn from the group's pairs (else they may keep more than
+            // the link's bound does, or not their gap).
+            let keep = if SPARE && ranged {
+                g.gap + g.kappa * spare.get(lo, hi)
+            } else {
+                g.gap
+            };
+            if self.group_apart(g, &spheres, &capsules, keep) {
+                continue;
             }
             for p in &self.pairs[g.start as usize..g.end as usize] {
                 let (a, b) = (p.a as usize, p.b as usize);
