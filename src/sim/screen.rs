@@ -467,49 +467,63 @@ fn range_gap(x: [f64; 2], y: [f64; 2]) -> f64 {
     (x[0] - y[1]).max(y[0] - x[1]).max(0.0)
 }
 
-/// A lower bound on the distance between moving shapes `x` and `y` (metres) at any angles of the
-/// joints between their links, when those are one or two joints (`−∞` otherwise), from the
-/// links' frames `frames` at one configuration. The farther shape turns about the next joint's
-/// axis, which is fixed to the nearer link: heights along that axis and distances from it do
-/// not change, and two points are at least as far apart as those differ (the axial and radial
-/// parts of their offset). Across two joints the farther shape, turned about the last axis,
-/// stays within a ball about a point of that axis, and the ball turns about the axis before.
+/// Where a moving shape lies, heights along and distances from an axis ([`about_axis`]):
+/// about its own link's joint axis, and about the next link's (none past the last link).
+type Places = (([f64; 2], [f64; 2]), Option<([f64; 2], [f64; 2])>);
+
+/// The axis of joint `j` at the link frames `frames`: a point and the unit direction, world.
+fn joint_axis(links: &[Link; 6], frames: &[Frame; 6], j: usize) -> (Vector3<f64>, Vector3<f64>) {
+    let (r, t) = &frames[j];
+    (r * links[j].anchor + t, r * links[j].axis)
+}
+
+/// The [`Places`] of moving shape `m` at the link frames `frames`.
+fn axial_places(links: &[Link; 6], frames: &[Frame; 6], m: &(usize, Local, bool, f64)) -> Places {
+    let shape = pose(m, frames).0;
+    let about = |j: usize| {
+        let (o, u) = joint_axis(links, frames, j);
+        about_axis(&shape, &o, &u)
+    };
+    (about(m.0), (m.0 + 1 < 6).then(|| about(m.0 + 1)))
+}
+
+/// A lower bound on the distance between a moving shape of link `near.0` and one of link
+/// `far.0` (metres; their [`Places`] at the link frames `frames`) at any angles of the joints
+/// between the links (`−∞` for two shapes of one link). The farther shape turns about the next
+/// joint's axis, which is fixed to the nearer link: heights along that axis and distances from
+/// it do not change, and two points are at least as far apart as those differ (the axial and
+/// radial parts of their offset). Across more joints the farther shape, turned about the last
+/// axis, stays within a ball about a point of that axis, and the ball turns about the axis
+/// before.
 fn turned_apart(
     links: &[Link; 6],
     frames: &[Frame; 6],
-    x: &(usize, Local, bool, f64),
-    y: &(usize, Local, bool, f64),
+    near: (usize, &Places),
+    far: (usize, &Places),
 ) -> f64 {
-    let (near, far) = if x.0 < y.0 { (x, y) } else { (y, x) };
-    let axis = |j: usize| {
-        let (r, t) = &frames[j];
-        (r * links[j].anchor + t, r * links[j].axis)
-    };
-    if far.0 == near.0 {
+    let (near, far) = if near.0 < far.0 { (near, far) } else { (far, near) };
+    let Some((nh, nr)) = near.1.1.filter(|_| far.0 > near.0) else {
         return f64::NEG_INFINITY;
-    }
-    let (o, u) = axis(far.0);
-    let (mut h, mut r) = about_axis(&pose(far, frames).0, &o, &u);
+    };
+    let (mut h, mut r) = far.1.0;
     // Joint by joint towards the nearer link: the ball about the last axis's point at
     // mid-height holds every turn of what lies beyond it, and turns about the axis before.
     for j in (near.0 + 1..far.0).rev() {
-        let (o, u) = axis(j + 1);
+        let (o, u) = joint_axis(links, frames, j + 1);
         let centre = o + u * ((h[0] + h[1]) / 2.0);
         let radius = ((h[1] - h[0]) / 2.0).hypot(r[1]);
-        let (o, u) = axis(j);
+        let (o, u) = joint_axis(links, frames, j);
         let d = centre - o;
         let (hc, rc) = (d.dot(&u), (d - u * d.dot(&u)).norm());
         h = [hc - radius, hc + radius];
         r = [(rc - radius).max(0.0), rc + radius];
     }
-    let (o, u) = axis(near.0 + 1);
-    let (nh, nr) = about_axis(&pose(near, frames).0, &o, &u);
     range_gap(h, nh).hypot(range_gap(r, nr))
 }
 
 /// A capsule (in the link's frame, metres) containing every one of `shapes`, `None` when there
 /// are none: its axis along whichever of the frame's three
-/// axes and the direction between the two farthest shape points gives the least volume, through
+/// axes and the direction between the two farthest shape centres gives the least volume, through
 /// the shapes' mean point, from the least to the largest projection of a shape's point on it; its
 /// radius the largest distance of a shape from that line. Every point of a capsule or a box lies
 /// within its ends' (corners') largest distance from the axis segment, plus the capsule's radius
@@ -517,10 +531,15 @@ fn turned_apart(
 fn link_capsule<'a>(shapes: impl Iterator<Item = &'a Local>) -> Option<Local> {
     // Each shape's extreme points, with how far the shape reaches beyond them.
     let mut points: Vec<(Vector3<f64>, f64)> = Vec::new();
+    let mut centres: Vec<Vector3<f64>> = Vec::new();
     for l in shapes {
         match l {
-            Local::Capsule { a, b, radius } => points.extend([(*a, *radius), (*b, *radius)]),
+            Local::Capsule { a, b, radius } => {
+                points.extend([(*a, *radius), (*b, *radius)]);
+                centres.push((a + b) / 2.0);
+            }
             Local::Box { center, axes, half } => {
+                centres.push(*center);
                 for k in 0..8 {
                     let s = |i: usize| if k >> i & 1 == 0 { -half[i] } else { half[i] };
                     points.push((center + axes * Vector3::new(s(0), s(1), s(2)), 0.0));
@@ -533,8 +552,8 @@ fn link_capsule<'a>(shapes: impl Iterator<Item = &'a Local>) -> Option<Local> {
     }
     let mean = points.iter().map(|p| p.0).sum::<Vector3<f64>>() / points.len() as f64;
     let mut far = (0.0, Vector3::x());
-    for (i, (p, _)) in points.iter().enumerate() {
-        for (r, _) in &points[i + 1..] {
+    for (i, p) in centres.iter().enumerate() {
+        for r in &centres[i + 1..] {
             let d = (r - p).norm();
             if d > far.0 {
                 far = (d, (r - p) / d);
@@ -716,13 +735,18 @@ impl Screen {
         }
         // The arm's own pairs across one or two joints that keep their gap at any angles of
         // those joints: never tested.
+        let places: Vec<Places> = moving
+            .iter()
+            .map(|m| axial_places(&chain.links, &link_pose, m))
+            .collect();
         pairs.retain(|p| {
-            (p.b as usize) >= nm
+            let (a, bb) = (p.a as usize, p.b as usize);
+            bb >= nm
                 || turned_apart(
                     &chain.links,
                     &link_pose,
-                    &moving[p.a as usize],
-                    &moving[p.b as usize],
+                    (moving[a].0, &places[a]),
+                    (moving[bb].0, &places[bb]),
                 ) < p.gap
         });
         let partner = |p: &Pair| {
@@ -1076,10 +1100,12 @@ impl Screen {
     pub(crate) fn turned_bounds(&self, q: &[f64; 6], q2: &[f64; 6]) -> Vec<(f64, Shape, Shape)> {
         let (f1, f2) = (self.chain.link_poses(q), self.chain.link_poses(q2));
         let mut out = Vec::new();
+        let links = &self.chain.links;
+        let places: Vec<Places> = self.moving.iter().map(|m| axial_places(links, &f1, m)).collect();
         for (i, x) in self.moving.iter().enumerate() {
-            for y in &self.moving[i + 1..] {
+            for (k, y) in self.moving.iter().enumerate().skip(i + 1) {
                 if x.0 != y.0 {
-                    let bound = turned_apart(&self.chain.links, &f1, x, y);
+                    let bound = turned_apart(links, &f1, (x.0, &places[i]), (y.0, &places[k]));
                     out.push((bound, pose(x, &f2).0, pose(y, &f2).0));
                 }
             }
