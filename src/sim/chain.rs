@@ -134,6 +134,14 @@ impl ArmChain {
         })
     }
 
+    /// The axis of joint `j` at the link frames `frames` ([`ArmChain::link_poses`]): a point on
+    /// it and its unit direction, world frame (metres).
+    pub(crate) fn joint_axis(&self, frames: &[Frame; 6], j: usize) -> (Vector3<f64>, Vector3<f64>) {
+        // The axis is fixed in link j's frame: through the anchor, along the axis.
+        let (r, t) = &frames[j];
+        (r * self.links[j].anchor + t, r * self.links[j].axis)
+    }
+
     /// How far `spheres` reach from each joint's axis at the link frames `frames`
     /// ([`ArmChain::link_poses`]), metres: for joint `j`, the largest distance from its axis of a
     /// point of the spheres of links `j..6` (world centre and radius, metres; a negative radius:
@@ -141,10 +149,8 @@ impl ArmChain {
     /// farther from the axis.
     pub(crate) fn axis_reach(&self, frames: &[Frame; 6], spheres: &[([f64; 3], f64); 6]) -> [f64; 6] {
         let mut reach = [0.0f64; 6];
-        for (j, (link, (r, t))) in self.links.iter().zip(frames).enumerate() {
-            // The axis is fixed in link j's frame: through the anchor, along the axis.
-            let u = r * link.axis;
-            let a = r * link.anchor + t;
+        for j in 0..6 {
+            let (a, u) = self.joint_axis(frames, j);
             for (c, radius) in &spheres[j..] {
                 if *radius < 0.0 {
                     continue;

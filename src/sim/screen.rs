@@ -471,17 +471,11 @@ fn range_gap(x: [f64; 2], y: [f64; 2]) -> f64 {
 /// about its own link's joint axis, and about the next link's (none past the last link).
 type Places = (([f64; 2], [f64; 2]), Option<([f64; 2], [f64; 2])>);
 
-/// The axis of joint `j` at the link frames `frames`: a point and the unit direction, world.
-fn joint_axis(links: &[Link; 6], frames: &[Frame; 6], j: usize) -> (Vector3<f64>, Vector3<f64>) {
-    let (r, t) = &frames[j];
-    (r * links[j].anchor + t, r * links[j].axis)
-}
-
 /// The [`Places`] of moving shape `m` at the link frames `frames`.
-fn axial_places(links: &[Link; 6], frames: &[Frame; 6], m: &(usize, Local, bool, f64)) -> Places {
+fn axial_places(chain: &ArmChain, frames: &[Frame; 6], m: &(usize, Local, bool, f64)) -> Places {
     let shape = pose(m, frames).0;
     let about = |j: usize| {
-        let (o, u) = joint_axis(links, frames, j);
+        let (o, u) = chain.joint_axis(frames, j);
         about_axis(&shape, &o, &u)
     };
     (about(m.0), (m.0 + 1 < 6).then(|| about(m.0 + 1)))
@@ -495,12 +489,7 @@ fn axial_places(links: &[Link; 6], frames: &[Frame; 6], m: &(usize, Local, bool,
 /// radial parts of their offset). Across more joints the farther shape, turned about the last
 /// axis, stays within a ball about a point of that axis, and the ball turns about the axis
 /// before.
-fn turned_apart(
-    links: &[Link; 6],
-    frames: &[Frame; 6],
-    near: (usize, &Places),
-    far: (usize, &Places),
-) -> f64 {
+fn turned_apart(chain: &ArmChain, frames: &[Frame; 6], near: (usize, &Places), far: (usize, &Places)) -> f64 {
     let (near, far) = if near.0 < far.0 { (near, far) } else { (far, near) };
     let Some((nh, nr)) = near.1.1.filter(|_| far.0 > near.0) else {
         return f64::NEG_INFINITY;
@@ -509,10 +498,10 @@ fn turned_apart(
     // Joint by joint towards the nearer link: the ball about the last axis's point at
     // mid-height holds every turn of what lies beyond it, and turns about the axis before.
     for j in (near.0 + 1..far.0).rev() {
-        let (o, u) = joint_axis(links, frames, j + 1);
+        let (o, u) = chain.joint_axis(frames, j + 1);
         let centre = o + u * ((h[0] + h[1]) / 2.0);
         let radius = ((h[1] - h[0]) / 2.0).hypot(r[1]);
-        let (o, u) = joint_axis(links, frames, j);
+        let (o, u) = chain.joint_axis(frames, j);
         let d = centre - o;
         let (hc, rc) = (d.dot(&u), (d - u * d.dot(&u)).norm());
         h = [hc - radius, hc + radius];
@@ -733,17 +722,17 @@ impl Screen {
         for p in &mut pairs {
             p.kappa = lever_ratio(&chain.links, &moving, p.a as usize, p.b as usize);
         }
-        // The arm's own pairs across one or two joints that keep their gap at any angles of
-        // those joints: never tested.
+        // The arm's own pairs that keep their gap at any angles of the joints between their
+        // links: never tested.
         let places: Vec<Places> = moving
             .iter()
-            .map(|m| axial_places(&chain.links, &link_pose, m))
+            .map(|m| axial_places(&chain, &link_pose, m))
             .collect();
         pairs.retain(|p| {
             let (a, bb) = (p.a as usize, p.b as usize);
             bb >= nm
                 || turned_apart(
-                    &chain.links,
+                    &chain,
                     &link_pose,
                     (moving[a].0, &places[a]),
                     (moving[bb].0, &places[bb]),
@@ -1100,12 +1089,12 @@ impl Screen {
     pub(crate) fn turned_bounds(&self, q: &[f64; 6], q2: &[f64; 6]) -> Vec<(f64, Shape, Shape)> {
         let (f1, f2) = (self.chain.link_poses(q), self.chain.link_poses(q2));
         let mut out = Vec::new();
-        let links = &self.chain.links;
-        let places: Vec<Places> = self.moving.iter().map(|m| axial_places(links, &f1, m)).collect();
+        let chain = &self.chain;
+        let places: Vec<Places> = self.moving.iter().map(|m| axial_places(chain, &f1, m)).collect();
         for (i, x) in self.moving.iter().enumerate() {
             for (k, y) in self.moving.iter().enumerate().skip(i + 1) {
                 if x.0 != y.0 {
-                    let bound = turned_apart(links, &f1, (x.0, &places[i]), (y.0, &places[k]));
+                    let bound = turned_apart(chain, &f1, (x.0, &places[i]), (y.0, &places[k]));
                     out.push((bound, pose(x, &f2).0, pose(y, &f2).0));
                 }
             }
