@@ -1,7 +1,7 @@
 //! How much the step-wise environment costs over bare physics, measured in one run:
 //! `cargo run --release --example env_speed`.
 //!
-//! 1. `ctrl` mode: 5000 `Action::Ctrl` steps (one 4 ms control period = 2 physics steps each)
+//! 1. `setpoint` mode: 5000 `Action::Setpoint` steps (one 4 ms control period = 2 physics steps each)
 //!    against the same joint targets written straight into `ctrl` and `mj_step` in a loop.
 //! 2. `VecEnv` of 2 environments on 2 threads, 2000 synchronous `ctrl` steps, against one
 //!    environment's steps per second.
@@ -42,7 +42,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         env.reset(&Reset::Default)?;
         let t = Instant::now();
         for k in 0..CTRL_STEPS {
-            env.step(&Action::Ctrl(target(k)))?;
+            env.step(&Action::Setpoint(target(k)))?;
         }
         env_t.push(t.elapsed().as_secs_f64());
         let mut sim = Sim::new(&scene);
@@ -75,7 +75,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         v.reset(&[Reset::Default, Reset::Default])?;
         let t = Instant::now();
         for k in 0..2000 {
-            for r in v.step(&[Action::Ctrl(target(k)), Action::Ctrl(target(k + 1))])? {
+            for r in v.step(&[Action::Setpoint(target(k)), Action::Setpoint(target(k + 1))])? {
                 r?;
             }
         }

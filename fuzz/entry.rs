@@ -1,5 +1,5 @@
 //! The fuzzed entry point, shared by the fuzz target (`fuzz/fuzz_targets/load_tree.rs`) and its
-//! replay in `tests/tree_fuzz_regressions.rs`, so both exercise exactly the same code.
+//! replay in `tests/tree/fuzz_regressions.rs`, so both exercise exactly the same code.
 
 use std::path::{Path, PathBuf};
 

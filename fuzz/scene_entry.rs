@@ -1,5 +1,5 @@
 //! The fuzzed entry point of the scene loader, shared by the fuzz target
-//! (`fuzz/fuzz_targets/load_scene.rs`) and its replay in `tests/scene_fuzz_regressions.rs`, so
+//! (`fuzz/fuzz_targets/load_scene.rs`) and its replay in `tests/tree/scene_fuzz_regressions.rs`, so
 //! both exercise exactly the same code.
 
 use macrotree::scene::{Placement, SceneSpec, sample_placement};

@@ -4,7 +4,7 @@
 //! arm with a Robotiq 2F-85 gripper through pick-and-place macro actions.
 //!
 //! The crate is layered the way the data flows. A module uses only modules of lower layers
-//! (`tests/module_layers.rs` reads this table and fails on any `use crate::` that goes sideways
+//! (`tests/system/module_layers.rs` reads this table and fails on any `use crate::` that goes sideways
 //! or up, so the table stays true):
 //!
 //! | layer | module | what it holds | MuJoCo? |

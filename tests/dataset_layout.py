@@ -4,7 +4,7 @@ pyarrow (no LeRobot needed) and ffmpeg.
     PYTHONPATH=third_party/pyarrow python3 tests/dataset_layout.py DIR FFMPEG
 
 Exits non-zero with a message on the first problem; prints a one-line summary otherwise.
-Run by tests/dataset.rs.
+Run by tests/cli/dataset.rs.
 """
 
 import json

@@ -7,7 +7,7 @@ DIR is the dataset; FRAMES_DIR holds `scenario-K.jsonl` files written by
 its scenarios (the dataset's episode i is scenario K per meta/macrotree.json). Exits non-zero with
 a message on the first mismatch; prints a short report otherwise.
 
-Run by tests/dataset.rs when MACROTREE_LEROBOT_PYTHON names a Python with `lerobot[dataset]`
+Run by tests/cli/dataset.rs when MACROTREE_LEROBOT_PYTHON names a Python with `lerobot[dataset]`
 installed (see docs/datasets.md).
 """
 

@@ -2,7 +2,7 @@
 
 1. The flagship task driven leaf by leaf from Python (``step_leaf``) against a bare ``mj_step``
    replay of the same controls (``replay_recorded``: the same physics, bit for bit).
-2. ``ctrl`` mode: ``env.step`` of 7-D targets (10 ms = 5 physics steps each) against the bare
+2. ``setpoint`` mode: ``env.step`` of 7-D targets (10 ms = 5 physics steps each) against the bare
    replay of the same controls.
 3. Vector environments, envpool-style: N single environments in a Python loop, Gymnasium's
    ``SyncVectorEnv`` and ``AsyncVectorEnv``, and ``macrotree.VectorEnv``, in ``ctrl`` steps per
@@ -28,7 +28,8 @@ import macrotree
 from macrotree._library import data_dir
 
 #: The action leaves the flagship tree (``trees/cube_to_bowl.yaml``) starts, in order, when its
-#: first attempt succeeds (``tests/env_replay.rs`` checks these give ``run_episode``'s physics).
+#: first attempt succeeds (``tests/physics/env_replay.rs`` checks these give ``run_episode``'s
+#: physics).
 FLAGSHIP_LEAVES: list[dict[str, Any]] = [
     {"home": {}},
     {"release": {"width": 0.065, "retreat": 0}},
@@ -82,7 +83,7 @@ def flagship(repeat: int) -> dict[str, float]:
 
 
 def ctrl(repeat: int) -> dict[str, float]:
-    env = macrotree.MacroEnv(scene(), action_mode="ctrl")
+    env = macrotree.MacroEnv(scene(), action_mode="setpoint")
     home = env.home
     ratios, walls = [], []
     for _ in range(repeat):
@@ -118,11 +119,11 @@ def vector(n: int, repeat: int) -> dict[str, float]:
     batch = np.stack([np.stack([wave(k, home)] * n) for k in range(CTRL_STEPS // 4)])
     out: dict[str, float] = {}
 
-    one = macrotree.MacroEnv(scene(), action_mode="ctrl")
+    one = macrotree.MacroEnv(scene(), action_mode="setpoint")
     one.reset(seed=0)
     out["single_env"] = steps_per_second(lambda k: one.step(batch[k][0]), 1, repeat)
 
-    loop = [macrotree.MacroEnv(scene(), action_mode="ctrl") for _ in range(n)]
+    loop = [macrotree.MacroEnv(scene(), action_mode="setpoint") for _ in range(n)]
     for e in loop:
         e.reset(seed=0)
 
@@ -133,7 +134,7 @@ def vector(n: int, repeat: int) -> dict[str, float]:
     out["python_loop"] = steps_per_second(python_loop, n, repeat)
 
     def make() -> gym.Env[Any, Any]:
-        return macrotree.MacroEnv(scene(), action_mode="ctrl")
+        return macrotree.MacroEnv(scene(), action_mode="setpoint")
 
     kinds: list[tuple[str, Any]] = [
         ("sync_vector_env", gym.vector.SyncVectorEnv),
@@ -149,7 +150,7 @@ def vector(n: int, repeat: int) -> dict[str, float]:
         out[name] = steps_per_second(step, n, repeat)
         envs.close()
 
-    native = macrotree.VectorEnv(scene(), num_envs=n, action_mode="ctrl", threads=n)
+    native = macrotree.VectorEnv(scene(), num_envs=n, action_mode="setpoint", threads=n)
     native.reset(seed=0)
     out["macrotree_vector_env"] = steps_per_second(lambda k: native.step(batch[k]), n, repeat)
     native.close()

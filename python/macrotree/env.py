@@ -1,10 +1,11 @@
 """``MacroEnv``: a ``gymnasium.Env`` over the Rust ``macrotree`` environment.
 
 One ``step`` runs one macro action to completion on simulated time, closed loop inside the action
-(``action_mode="macro"``), or holds a 7-D joint + gripper target for one control period
-(``action_mode="ctrl"``). Any registered leaf runs through :meth:`MacroEnv.step_leaf`, a named
-subtree through :meth:`MacroEnv.step_subtree`. Everything heavy happens in Rust with the GIL
-released; this class converts arguments and results.
+(``action_mode="macro"``), or commands the arm and gripper for one control period: the 19-D
+command every leaf gives and a dataset's ``action`` records (``action_mode="ctrl"``), or plain
+7-D set points (``action_mode="setpoint"``). Any registered leaf runs through
+:meth:`MacroEnv.step_leaf`, a named subtree through :meth:`MacroEnv.step_subtree`. Everything
+heavy happens in Rust with the GIL released; this class converts arguments and results.
 """
 
 from __future__ import annotations
@@ -23,9 +24,13 @@ from macrotree.spaces import (
     macro_action_space,
     macro_to_native,
     observation_space,
+    setpoint_action_space,
 )
 
-ActionMode = Literal["macro", "ctrl"]
+ActionMode = Literal["macro", "ctrl", "setpoint"]
+
+#: Every action mode, and the shape of its array actions (``None`` for the macro ``Dict``).
+ACTION_MODES: dict[str, tuple[int, ...] | None] = {"macro": None, "ctrl": (19,), "setpoint": (7,)}
 Observation = dict[str, Any]
 StepReturn = tuple[Observation, SupportsFloat, bool, bool, dict[str, Any]]
 
@@ -44,8 +49,10 @@ class MacroEnv(gym.Env[Observation, Any]):
         scene: a scene file (``scenes/*.yaml``); ``None`` takes the tree's ``scene:``.
         tree: a tree file, for :meth:`step_subtree` and a scene goal of the tree; optional.
         action_mode: ``"macro"`` (a ``Dict`` mirroring TorchRL's ``RobotMacroAction``) or
-            ``"ctrl"`` (``Box(7)``: six joint targets in radians and the gripper command 0…255,
-            held for one control period).
+            ``"ctrl"`` (``Box(19)``: six joint set points in radians, six velocities in rad/s,
+            six accelerations in rad/s² and the gripper command 0…255 for one control period —
+            what every leaf commands and a dataset's ``action`` column records) or
+            ``"setpoint"`` (``Box(7)``: six set points and the gripper command, zero velocity).
         render_mode: ``None``, ``"rgb_array"`` (``render()`` gives an H×W×3 ``uint8`` image of
             ``render_camera`` now) or ``"rgb_array_list"`` (``render()`` gives the frames sampled
             at ``render_fps`` of simulated time during the steps since the last call).
@@ -79,8 +86,10 @@ class MacroEnv(gym.Env[Observation, Any]):
         fault: str | None = None,
         render_fps: int = 30,
     ) -> None:
-        if action_mode not in ("macro", "ctrl"):
-            raise ValueError(f"action_mode must be 'macro' or 'ctrl', got {action_mode!r}")
+        if action_mode not in ACTION_MODES:
+            raise ValueError(
+                f"action_mode must be 'macro', 'ctrl' or 'setpoint', got {action_mode!r}"
+            )
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
                 f"render_mode must be None or one of {self.metadata['render_modes']}, "
@@ -109,7 +118,7 @@ class MacroEnv(gym.Env[Observation, Any]):
         self.observation_space = observation_space(
             len(self.object_names), self.cameras, self.image_size
         )
-        self.action_space = macro_action_space() if action_mode == "macro" else ctrl_action_space()
+        self.action_space = action_space(action_mode)
         # LeRobot's environment contract.
         self.task = str(self._native.task)
         self.task_description = str(self._native.task_description)
@@ -154,10 +163,16 @@ class MacroEnv(gym.Env[Observation, Any]):
         if self.action_mode == "macro":
             result = self._native.step_macro(macro_to_native(action))
         else:
-            ctrl = np.asarray(action, dtype=np.float64).reshape(-1)
-            if ctrl.shape != (7,):
-                raise ValueError(f"a ctrl action has 7 values, got shape {ctrl.shape}")
-            result = self._native.step_ctrl(ctrl)
+            values = np.asarray(action, dtype=np.float64).reshape(-1)
+            shape = ACTION_MODES[self.action_mode]
+            if values.shape != shape:
+                raise ValueError(
+                    f"a {self.action_mode} action has {shape} values, got shape {values.shape}"
+                )
+            if self.action_mode == "ctrl":
+                result = self._native.step_ctrl(values)
+            else:
+                result = self._native.step_setpoint(values)
         return self._unpack(result)
 
     def render(self) -> Any:
@@ -227,3 +242,12 @@ class MacroEnv(gym.Env[Observation, Any]):
             bool(result["truncated"]),
             info,
         )
+
+
+def action_space(action_mode: str) -> gym.Space[Any]:
+    """The action space of ``action_mode`` (see :class:`MacroEnv`)."""
+    if action_mode == "ctrl":
+        return ctrl_action_space()
+    if action_mode == "setpoint":
+        return setpoint_action_space()
+    return macro_action_space()

@@ -1,8 +1,11 @@
 """The action and observation spaces, and the conversion of a Gymnasium action to a native one.
 
 The ``macro`` action mirrors TorchRL's ``RobotMacroAction`` as a ``Dict`` (TorchRL converts ``Dict``
-to a ``Composite``; it has no converter for ``OneOf``). The ``ctrl`` action is a ``Box(7)``: six arm
-joint targets and the gripper command, held for one control period.
+to a ``Composite``; it has no converter for ``OneOf``). The ``ctrl`` action is a ``Box(19)``: the
+command every leaf gives and a dataset's ``action`` records — six joint set points (rad), six
+joint velocities (rad/s), six joint accelerations (rad/s²) and the gripper command — for one
+control period. The ``setpoint`` action is a ``Box(7)``: six set points and the gripper command,
+with zero velocity and acceleration.
 """
 
 from __future__ import annotations
@@ -13,7 +16,7 @@ from typing import Any
 import numpy as np
 from gymnasium import spaces
 
-from macrotree._native import JOINT_LIMITS
+from macrotree._native import CTRL_HIGH, CTRL_LOW, JOINT_LIMITS
 
 #: Largest ``steps`` or ``settle_steps`` of one macro (control periods; 6000 = 60 s at 10 ms).
 #: ``steps = 0`` runs the macro closed loop: until its motion is done and the arm has settled.
@@ -93,8 +96,19 @@ def macro_action_space() -> spaces.Dict:
 
 
 def ctrl_action_space() -> spaces.Box:
-    """The ``ctrl`` action space: six arm joint targets (radians) and the gripper command
-    (0…255)."""
+    """The ``ctrl`` action space, from the extension's bounds: six joint set points (radians),
+    six velocities (rad/s), six accelerations (rad/s²), the gripper command (0…255). Velocities
+    and accelerations outside it, and set points further than the largest speed allows in one
+    period, are clamped (``info["ctrl_clamped"]`` counts them)."""
+    bounds = [_inside_f32(lo, hi) for lo, hi in zip(CTRL_LOW, CTRL_HIGH, strict=True)]
+    low = np.array([lo for lo, _ in bounds], dtype=np.float32)
+    high = np.array([hi for _, hi in bounds], dtype=np.float32)
+    return spaces.Box(low, high, dtype=np.float32)
+
+
+def setpoint_action_space() -> spaces.Box:
+    """The ``setpoint`` action space: six arm joint set points (radians) and the gripper
+    command (0…255)."""
     low = np.array([lo for lo, _ in JOINT_BOUNDS] + [GRIPPER_COMMAND_RANGE[0]], dtype=np.float32)
     high = np.array([hi for _, hi in JOINT_BOUNDS] + [GRIPPER_COMMAND_RANGE[1]], dtype=np.float32)
     return spaces.Box(low, high, dtype=np.float32)

@@ -20,10 +20,8 @@ from gymnasium.vector import VectorEnv as GymVectorEnv
 from gymnasium.vector.utils import batch_space
 
 from macrotree import _native
-from macrotree.env import RESET_OPTIONS, ActionMode, MacroEnv, _path
+from macrotree.env import ACTION_MODES, RESET_OPTIONS, ActionMode, MacroEnv, _path, action_space
 from macrotree.spaces import (
-    ctrl_action_space,
-    macro_action_space,
     macro_to_native,
     observation_space,
 )
@@ -105,8 +103,10 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
                 "autoreset_mode must be SAME_STEP or DISABLED (TorchRL refuses NEXT_STEP), "
                 f"got {mode}"
             )
-        if action_mode not in ("macro", "ctrl"):
-            raise ValueError(f"action_mode must be 'macro' or 'ctrl', got {action_mode!r}")
+        if action_mode not in ACTION_MODES:
+            raise ValueError(
+                f"action_mode must be 'macro', 'ctrl' or 'setpoint', got {action_mode!r}"
+            )
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         if scene is None and tree is None:
@@ -132,9 +132,7 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         self.single_observation_space = observation_space(
             len(self.object_names), list(cameras), self.image_size
         )
-        self.single_action_space = (
-            macro_action_space() if action_mode == "macro" else ctrl_action_space()
-        )
+        self.single_action_space = action_space(action_mode)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self._pending: set[int] = set()
@@ -233,10 +231,14 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
     # --- helpers ------------------------------------------------------------------------------
 
     def _native_actions(self, actions: Any, n: int) -> list[Any]:
-        if self.action_mode == "ctrl":
+        shape = ACTION_MODES[self.action_mode]
+        if shape is not None:
             array = np.asarray(actions, dtype=np.float64)
-            if array.shape != (n, 7):
-                raise ValueError(f"ctrl actions must have shape ({n}, 7), got {array.shape}")
+            if array.shape != (n, *shape):
+                raise ValueError(
+                    f"{self.action_mode} actions must have shape ({n}, {shape[0]}), "
+                    f"got {array.shape}"
+                )
             return [row for row in array]
         if isinstance(actions, dict):
             return [

@@ -127,6 +127,7 @@ pub fn step_result<'py>(
     info.set_item("failure_node", f.and_then(|f| f.node.as_deref()))?;
     info.set_item("sim_time", r.sim_time)?;
     info.set_item("physics_steps", r.physics_steps)?;
+    info.set_item("ctrl_clamped", r.ctrl_clamped)?;
     info.set_item("goal_steps", r.goal_ticks)?;
     let collisions: Vec<&str> = r.collisions.iter().map(|c| c.what.as_str()).collect();
     info.set_item("collisions", collisions)?;

@@ -267,11 +267,19 @@ impl Env {
     }
 
     fn step_ctrl(&self, py: Python<'_>, ctrl: PyReadonlyArray1<'_, f64>) -> PyResult<Py<PyDict>> {
-        let u: [f64; 7] = ctrl
+        let u: [f64; macrotree::motion::COMMAND_LEN] = ctrl
             .as_slice()?
             .try_into()
-            .map_err(|_| value("a ctrl action has 7 values"))?;
+            .map_err(|_| value("a ctrl action has 19 values"))?;
         self.step(py, Action::Ctrl(u))
+    }
+
+    fn step_setpoint(&self, py: Python<'_>, setpoint: PyReadonlyArray1<'_, f64>) -> PyResult<Py<PyDict>> {
+        let u: [f64; 7] = setpoint
+            .as_slice()?
+            .try_into()
+            .map_err(|_| value("a setpoint action has 7 values"))?;
+        self.step(py, Action::Setpoint(u))
     }
 
     fn step_leaf(&self, py: Python<'_>, text: String) -> PyResult<Py<PyDict>> {

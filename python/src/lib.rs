@@ -25,11 +25,34 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
             .collect::<Vec<_>>(),
     )?;
     m.add("HOME", macrotree::motion::HOME_Q.to_vec())?;
+    m.add("CTRL_NAMES", macrotree::motion::COMMAND_NAMES.to_vec())?;
+    let (low, high) = ctrl_bounds();
+    m.add("CTRL_LOW", low)?;
+    m.add("CTRL_HIGH", high)?;
     m.add_function(wrap_pyfunction!(gripper_command_for_width, m)?)?;
     m.add_function(wrap_pyfunction!(video::write_mp4, m)?)?;
     m.add_class::<env::Env>()?;
     m.add_class::<vector::VecEnv>()?;
     Ok(())
+}
+
+/// The bounds of a `ctrl` action, value by value: joint limits (rad), ± the largest joint speed
+/// (rad/s) and acceleration (rad/s²), the gripper's range — `macrotree::env::CTRL_LIMITS`.
+fn ctrl_bounds() -> (Vec<f64>, Vec<f64>) {
+    use macrotree::env::CTRL_LIMITS;
+    let (mut low, mut high) = (Vec::new(), Vec::new());
+    for &(lo, hi) in &macrotree::motion::JOINT_LIMITS {
+        low.push(lo);
+        high.push(hi);
+    }
+    for bound in [CTRL_LIMITS.max_joint_speed, CTRL_LIMITS.max_joint_acc] {
+        low.extend([-bound; 6]);
+        high.extend([bound; 6]);
+    }
+    let (g_lo, g_hi) = macrotree::motion::CellCommand::GRIPPER_RANGE;
+    low.push(g_lo);
+    high.push(g_hi);
+    (low, high)
 }
 
 /// The 2F-85 command (0 … 255) that closes the pads to `width` metres (the gripper calibration).

@@ -23,19 +23,22 @@ pub struct VecEnv {
     image: (u32, u32),
 }
 
-/// An action from Python: a macro dict or a 7-value ctrl array.
+/// An action from Python: a macro dict, a 19-value `ctrl` array or a 7-value `setpoint` array.
 fn action_of(a: &Bound<'_, PyAny>) -> PyResult<Action> {
     if let Ok(d) = a.cast::<PyDict>() {
         return Ok(Action::Primitive(macro_action::primitive(d)?));
     }
-    let ctrl: PyReadonlyArray1<'_, f64> = a
+    let array: PyReadonlyArray1<'_, f64> = a
         .extract()
-        .map_err(|_| value("an action is a macro dict or 7 float64 ctrl values"))?;
-    let u: [f64; 7] = ctrl
-        .as_slice()?
+        .map_err(|_| value("an action is a macro dict, 19 float64 ctrl values or 7 setpoint values"))?;
+    let u = array.as_slice()?;
+    if let Ok(ctrl) = <[f64; macrotree::motion::COMMAND_LEN]>::try_from(u) {
+        return Ok(Action::Ctrl(ctrl));
+    }
+    let setpoint: [f64; 7] = u
         .try_into()
-        .map_err(|_| value("a ctrl action has 7 values"))?;
-    Ok(Action::Ctrl(u))
+        .map_err(|_| value("a ctrl action has 19 values and a setpoint action 7"))?;
+    Ok(Action::Setpoint(setpoint))
 }
 
 type Guard<'a> = std::sync::MutexGuard<'a, macrotree::env::VecEnv>;

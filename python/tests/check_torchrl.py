@@ -1,9 +1,9 @@
 """TorchRL's own checker on macrotree: ``check_env_specs(GymWrapper(env))`` for the single
 environment in both action modes and for the vector environment.
 
-torch is too heavy for CI, so this is not a pytest module: ``tests/python_package.rs`` runs it when
-``MACROTREE_TORCHRL_PYTHON`` names a Python with torchrl 0.14.1 (it installs the package there
-first). By hand: ``python python/tests/check_torchrl.py``.
+torch is too heavy for CI, so this is not a pytest module: ``tests/system/python_package.rs``
+runs it when ``MACROTREE_TORCHRL_PYTHON`` names a Python with torchrl 0.14.1 (it installs the
+package there first). By hand: ``python python/tests/check_torchrl.py``.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import macrotree
 
 def main() -> None:
     print(f"macrotree {macrotree.__version__}")
-    for mode in ("macro", "ctrl"):
+    for mode in ("macro", "ctrl", "setpoint"):
         env = gym.make("macrotree/CubeToBowl-v0", action_mode=mode).unwrapped
         check_env_specs(GymWrapper(env, categorical_action_encoding=True), seed=0)
         print(f"check_env_specs(GymWrapper(MacroEnv, action_mode={mode!r})): passed")

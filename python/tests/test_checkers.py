@@ -14,7 +14,7 @@ import macrotree
 from macrotree.registration import GENERIC_ID, SHIPPED
 
 
-@pytest.mark.parametrize("action_mode", ["macro", "ctrl"])
+@pytest.mark.parametrize("action_mode", ["macro", "ctrl", "setpoint"])
 @pytest.mark.parametrize("env_id", [*SHIPPED, GENERIC_ID])
 def test_check_env_passes(env_id: str, action_mode: str, data: Path) -> None:
     kwargs: dict[str, Any] = {"action_mode": action_mode}

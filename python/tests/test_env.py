@@ -62,10 +62,34 @@ def test_reach_pose_ends_at_the_pose(cube_env: macrotree.MacroEnv) -> None:
 def test_ctrl_step_is_one_control_period(cube_env: macrotree.MacroEnv) -> None:
     ctrl_env = macrotree.MacroEnv(cube_env_scene(cube_env), action_mode="ctrl")
     ctrl_env.reset(seed=0)
-    target = np.concatenate([ctrl_env.home, [0.0]])
+    assert ctrl_env.action_space.shape == (19,)
+    target = np.concatenate([ctrl_env.home, np.zeros(12), [0.0]])
     _, _, _, _, info = ctrl_env.step(target)
     assert info["physics_steps"] == 5
     assert info["sim_time"] == pytest.approx(0.01)
+    assert info["ctrl_clamped"] == 0
+
+
+def test_a_ctrl_jump_is_clamped_to_the_largest_joint_speed(cube_env: macrotree.MacroEnv) -> None:
+    ctrl_env = macrotree.MacroEnv(cube_env_scene(cube_env), action_mode="ctrl")
+    ctrl_env.reset(seed=0)
+    target = np.concatenate([ctrl_env.home, np.zeros(12), [0.0]])
+    target[0] += 1.0  # 1 rad in one 10 ms period: 100 rad/s asked for
+    target[6] = 50.0  # rad/s
+    _, _, _, _, info = ctrl_env.step(target)
+    assert info["ctrl_clamped"] == 2
+    speed = abs(ctrl_env.observation()["joint_vel"][0])
+    assert speed < 4.0, speed
+
+
+def test_setpoint_action_holds_seven_values(cube_env: macrotree.MacroEnv) -> None:
+    env = macrotree.MacroEnv(cube_env_scene(cube_env), action_mode="setpoint")
+    env.reset(seed=0)
+    assert env.action_space.shape == (7,)
+    _, _, _, _, info = env.step(np.concatenate([env.home, [0.0]]))
+    assert info["physics_steps"] == 5
+    with pytest.raises(ValueError, match="setpoint action"):
+        env.step(np.zeros(19))
 
 
 def cube_env_scene(env: macrotree.MacroEnv) -> Path:

@@ -2,7 +2,7 @@
 //! trajectory tracker, the gripper command and the latest [`World`] snapshot.
 
 use crate::kinds::ActionRole;
-use crate::motion::Trajectory;
+use crate::motion::{ArmCommand, CellCommand, Trajectory};
 use crate::sim::collision::{DEFAULT_MARGIN, SceneChecker};
 use crate::sim::{Layout, Scene, Sim, TIMESTEP};
 use crate::world::World;
@@ -16,6 +16,9 @@ pub const CONTROL_PERIOD: f64 = 0.004;
 enum ArmPlan {
     /// Hold these joint angles (radians).
     Hold([f64; 6]),
+    /// One period of an explicit command given at `t0` (simulated seconds), as the step-wise
+    /// environment's `ctrl` action gives it; afterwards the arm holds where the command ended.
+    Command { command: ArmCommand, t0: f64 },
     /// Follow a trajectory that started at `t0` (simulated seconds).
     Track {
         trajectory: Box<dyn Trajectory>,
@@ -41,6 +44,11 @@ pub struct Cell {
     world: World,
     arm: ArmPlan,
     gripper_ctrl: f64,
+    /// The command of the period starting now, once computed ([`Cell::period_command`]);
+    /// cleared when the arm or gripper is told something new and after the period.
+    pending: Option<CellCommand>,
+    /// The command of the last period the physics ran.
+    last_command: Option<CellCommand>,
     steps_per_tick: u32,
     /// The motion planner's collision checker of this cell (built with the cell, synced from the
     /// simulation before each check), `None` when it could not be built (then motions run
@@ -71,6 +79,8 @@ impl Cell {
             world,
             arm: ArmPlan::Hold(crate::sim::HOME_Q),
             gripper_ctrl: 0.0,
+            pending: None,
+            last_command: None,
             steps_per_tick,
             checker,
             tally: PlanningTally::default(),
@@ -91,6 +101,8 @@ impl Cell {
         self.sim.reset_placement(placement);
         self.arm = ArmPlan::Hold(crate::sim::HOME_Q);
         self.gripper_ctrl = 0.0;
+        self.pending = None;
+        self.last_command = None;
         self.world = self.sim.observe();
         if let Some(c) = &mut self.checker {
             c.release();
@@ -162,6 +174,7 @@ impl Cell {
     pub fn arm_setpoint(&self) -> [f64; 6] {
         match &self.arm {
             ArmPlan::Hold(q) => *q,
+            ArmPlan::Command { command, t0 } => command.at(self.sim.time() - t0).q,
             ArmPlan::Track { trajectory, t0 } => trajectory.sample(self.sim.time() - t0).0,
         }
     }
@@ -193,17 +206,29 @@ impl Cell {
             trajectory,
             t0: self.sim.time(),
         };
+        self.pending = None;
+    }
+
+    /// Commands the arm with `command` for the coming control period (the environment's `ctrl`
+    /// action); after it the arm holds where the command ended.
+    pub fn command_arm(&mut self, command: ArmCommand) {
+        self.arm = ArmPlan::Command {
+            command,
+            t0: self.sim.time(),
+        };
+        self.pending = None;
     }
 
     /// Stops where the arm is commanded to be now and holds there (a halt).
     pub fn hold(&mut self) {
         self.arm = ArmPlan::Hold(self.arm_setpoint());
+        self.pending = None;
     }
 
     /// The current trajectory has reached its end (or the arm is holding).
     pub fn arm_motion_finished(&self) -> bool {
         match &self.arm {
-            ArmPlan::Hold(_) => true,
+            ArmPlan::Hold(_) | ArmPlan::Command { .. } => true,
             ArmPlan::Track { trajectory, t0 } => self.sim.time() - t0 >= trajectory.duration(),
         }
     }
@@ -211,6 +236,7 @@ impl Cell {
     /// Commands the gripper actuator (0 = open … 255 = closed).
     pub fn set_gripper(&mut self, ctrl: f64) {
         self.gripper_ctrl = ctrl.clamp(0.0, 255.0);
+        self.pending = None;
     }
 
     /// The gripper actuator command.
@@ -218,30 +244,65 @@ impl Cell {
         self.gripper_ctrl
     }
 
-    /// Advances the physics by one control period, commanding the arm at every physics step,
-    /// then refreshes the world snapshot.
+    /// The command of the control period starting now: the arm's trajectory sampled now (set
+    /// point, velocity, acceleration) or its hold, and the gripper command. What the physics
+    /// runs in [`Cell::advance`] and what a dataset records as the frame's `action`.
+    pub fn period_command(&mut self) -> CellCommand {
+        if let Some(c) = self.pending {
+            return c;
+        }
+        let t = self.sim.time();
+        let arm = match &self.arm {
+            ArmPlan::Hold(q) => ArmCommand::hold(*q),
+            ArmPlan::Command { command, t0 } if t == *t0 => *command,
+            ArmPlan::Command { command, t0 } => {
+                let q = command.at(t - t0).q;
+                self.arm = ArmPlan::Hold(q);
+                ArmCommand::hold(q)
+            }
+            ArmPlan::Track { trajectory, t0 } if t - t0 >= trajectory.duration() => {
+                let end = trajectory.end();
+                self.arm = ArmPlan::Hold(end);
+                ArmCommand::hold(end)
+            }
+            ArmPlan::Track { trajectory, t0 } => {
+                let (q, qd) = trajectory.sample(t - t0);
+                ArmCommand {
+                    q,
+                    qd,
+                    qdd: trajectory.acceleration(t - t0),
+                }
+            }
+        };
+        let command = CellCommand {
+            arm,
+            gripper: self.gripper_ctrl,
+        };
+        self.pending = Some(command);
+        command
+    }
+
+    /// The command of the last control period the physics ran, `None` before the first.
+    pub fn last_command(&self) -> Option<CellCommand> {
+        self.last_command
+    }
+
+    /// Advances the physics by one control period under [`Cell::period_command`] (held over
+    /// the period as [`ArmCommand::at`] says, applied at every physics step), then refreshes the
+    /// world snapshot.
     pub fn advance(&mut self) {
-        for _ in 0..self.steps_per_tick {
-            let t = self.sim.time();
-            let (q, qd, qdd) = match &self.arm {
-                ArmPlan::Hold(q) => (*q, [0.0; 6], [0.0; 6]),
-                ArmPlan::Track { trajectory, t0 } if t - t0 >= trajectory.duration() => {
-                    let end = trajectory.end();
-                    self.arm = ArmPlan::Hold(end);
-                    (end, [0.0; 6], [0.0; 6])
-                }
-                ArmPlan::Track { trajectory, t0 } => {
-                    let (q, qd) = trajectory.sample(t - t0);
-                    (q, qd, trajectory.acceleration(t - t0))
-                }
-            };
-            self.sim.command_arm(&q, &qd, &qdd);
-            self.sim.set_gripper_ctrl(self.gripper_ctrl);
+        let command = self.period_command();
+        for step in 0..self.steps_per_tick {
+            let arm = command.arm.at(step as f64 * TIMESTEP);
+            self.sim.command_arm(&arm.q, &arm.qd, &arm.qdd);
+            self.sim.set_gripper_ctrl(command.gripper);
             for obs in &mut self.observers {
                 obs.before_step(&mut self.sim);
             }
             self.sim.step();
         }
+        self.pending = None;
+        self.last_command = Some(command);
         self.world = self.sim.observe();
     }
 }

@@ -1,5 +1,5 @@
 //! The checks the reference tutorial asserts on every pick-and-place
-//! (../shared/notes/torchrl_anchor.md §5.1), measured the same way on our episodes, on the
+//! (TorchRL's CubeBowlEnv macro-action tutorial), measured the same way on our episodes, on the
 //! scene's cube and bowl ([`World::cube`], [`World::bowl`]). A scene without a cube measures
 //! nothing (no grasp distance, no motion or lift, not in the bowl); without a bowl, nothing is in
 //! it.

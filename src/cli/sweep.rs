@@ -83,8 +83,9 @@ pub struct SweepArgs {
         requires = "dataset"
     )]
     pub cameras: String,
-    /// Frames per second of simulated time of --dataset (1…250).
-    #[arg(long, value_name = "N", default_value_t = 15, requires = "dataset", value_parser = crate::video::parse_fps)]
+    /// Frames per second of simulated time of --dataset: a whole number of 4 ms control periods
+    /// per frame (1, 2, 5, 10, 25, 50, 125 or 250), so a policy can act at the data's rate.
+    #[arg(long, value_name = "N", default_value_t = crate::dataset::DEFAULT_FRAME_RATE, requires = "dataset", value_parser = crate::dataset::parse_frame_rate)]
     pub fps: u32,
     /// Image size of --dataset's cameras, WxH pixels (even, at most 1280x960).
     #[arg(long, value_name = "WxH", default_value = "320x240", requires = "dataset")]

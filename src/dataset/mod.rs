@@ -11,7 +11,10 @@ pub mod table;
 #[cfg(feature = "dataset")]
 mod writer;
 
-pub use record::{EpisodeRecorder, FrameRecord, Recording, STATE_NAMES};
+pub use record::{
+    CONTROL_RATE, DEFAULT_FRAME_RATE, EpisodeRecorder, FRAME_RATES, FrameRecord, Recording, STATE_NAMES,
+    parse_frame_rate,
+};
 #[cfg(feature = "dataset")]
 pub use writer::{
     CHUNKS_SIZE, CODEBASE_VERSION, DatasetError, DatasetOptions, DatasetWriter, MARKER, ROBOT_TYPE,

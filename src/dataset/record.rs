@@ -1,6 +1,13 @@
 //! [`EpisodeRecorder`]: an episode observer that samples the episode at a fixed frame rate —
 //! robot state, commanded action, object poses, the running leaf — and renders camera images
 //! into video encoders. `run --video`, `run --frames` and `sweep --dataset` use it.
+//!
+//! Frame k is taken at the start of the first control period at or after `k / fps` seconds:
+//! its state is the period's first (frame 0 is the state at reset) and its action the command
+//! the cell holds over that period (LeRobot's convention: the action of frame k acts from
+//! frame k to frame k + 1). At a frame rate that is a whole number of control periods
+//! ([`FRAME_RATES`]) the frames fall on period starts exactly, and a policy acting at that rate
+//! in the step-wise environment (`control_period = 1 / fps`) takes the dataset's actions.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -10,6 +17,7 @@ use serde::Serialize;
 
 use crate::actions::Cell;
 use crate::episode::{EpisodeObserver, vectors};
+use crate::motion::CellCommand;
 use crate::plan::Plan;
 use crate::render::{FrameSize, font, with_thread_renderer};
 use crate::runtime::TreeRunner;
@@ -18,6 +26,37 @@ use crate::video::VideoEncoder;
 /// Names of the 7 values of `observation.state` (and `action`): the UR5e's joints, then the
 /// gripper. One definition with the environment's observation ([`crate::episode::vectors`]).
 pub use crate::episode::vectors::STATE_NAMES;
+
+/// The control rate of every tree, frames per second: one frame per control period.
+pub const CONTROL_RATE: u32 = 250;
+const _: () = assert!((1.0 / crate::actions::CONTROL_PERIOD) as u32 == CONTROL_RATE);
+
+/// The frame rates a dataset may have: the whole fractions of the [`CONTROL_RATE`], so that a
+/// frame is a whole number of control periods (1, 2, 5, 10, 25, 50, 125 and 250 frames per
+/// second).
+pub const FRAME_RATES: [u32; 8] = [1, 2, 5, 10, 25, 50, 125, 250];
+const _: () = {
+    let mut i = 0;
+    while i < FRAME_RATES.len() {
+        assert!(CONTROL_RATE.is_multiple_of(FRAME_RATES[i]));
+        i += 1;
+    }
+};
+
+/// The default frame rate of a dataset, frames per second (20 ms frames: 5 control periods).
+pub const DEFAULT_FRAME_RATE: u32 = 50;
+
+/// Parses a dataset's frame rate: one of [`FRAME_RATES`].
+pub fn parse_frame_rate(s: &str) -> Result<u32, String> {
+    match s.trim().parse::<u32>() {
+        Ok(n) if FRAME_RATES.contains(&n) => Ok(n),
+        _ => Err(format!(
+            "must be a whole number of 4 ms control periods per frame: one of {} frames per second, got {}",
+            FRAME_RATES.map(|r| r.to_string()).join(", "),
+            s.chars().take(40).collect::<String>()
+        )),
+    }
+}
 
 /// One sampled frame of an episode.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -33,9 +72,10 @@ pub struct FrameRecord {
     /// radians: 0 open … about 0.8 closed).
     #[serde(rename = "observation.state")]
     pub state: [f32; 7],
-    /// Commanded arm joint set points (radians, the trajectory's target at this instant) and
-    /// gripper command (actuator units: 0 open … 255 closed).
-    pub action: [f32; 7],
+    /// The command held from this frame to the next: joint set points (radians), velocities
+    /// (rad/s), accelerations (rad/s²) and the gripper command (0 open … 255 closed)
+    /// ([`crate::motion::CellCommand::to_vector`]; names [`crate::motion::COMMAND_NAMES`]).
+    pub action: [f32; crate::motion::COMMAND_LEN],
     /// Every scene object's pose, scene order: x, y, z (metres), qw, qx, qy, qz.
     #[serde(rename = "observation.environment_state")]
     pub environment: Vec<f32>,
@@ -172,13 +212,13 @@ impl EpisodeRecorder {
         })
     }
 
-    fn sample(&self, cell: &Cell, runner: &TreeRunner, sim_time: f64) -> FrameRecord {
+    fn sample(&self, cell: &Cell, command: &CellCommand, runner: &TreeRunner, sim_time: f64) -> FrameRecord {
         // The flat vectors are the environment's observation's: one definition for both.
         let world = cell.world();
         let sim = cell.sim();
         let gripper_joint = sim.data().qpos()[sim.scene().ids.gripper_driver_qpos];
         let state = vectors::state_vector(&world.arm_q, gripper_joint);
-        let action = vectors::command_vector(&cell.arm_setpoint(), cell.gripper_command());
+        let action = vectors::command_vector(&command.to_vector());
         let mut environment = Vec::with_capacity(world.objects.len() * vectors::VALUES_PER_OBJECT);
         for o in &world.objects {
             let q = o.quat.quaternion();
@@ -257,16 +297,16 @@ impl EpisodeRecorder {
 }
 
 impl EpisodeObserver for EpisodeRecorder {
-    fn on_tick(&mut self, cell: &Cell, runner: &mut TreeRunner) {
+    fn on_period_start(&mut self, cell: &Cell, command: &CellCommand, runner: &mut TreeRunner) {
         if self.error.is_some() {
             return;
         }
         let t = cell.world().time;
-        // Frame k is sampled at the first control tick at or after k / fps.
+        // Frame k is sampled at the start of the first control period at or after k / fps.
         if t + 1e-9 < self.next as f64 / self.fps as f64 {
             return;
         }
-        let record = self.sample(cell, runner, t);
+        let record = self.sample(cell, command, runner, t);
         if !self.cameras.is_empty()
             && let Err(e) = self.render(cell, &record)
         {

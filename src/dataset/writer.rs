@@ -14,6 +14,7 @@ use serde_json::{Value, json};
 use super::record::{FrameRecord, Recording, STATE_NAMES};
 use super::stats::{QUANTILES, VecStats, image_stats_json};
 use super::table::{Column, ParquetFile, Table};
+use crate::motion::{COMMAND_LEN, COMMAND_NAMES};
 use crate::render::FrameSize;
 use crate::sweep::ScenarioResult;
 
@@ -197,7 +198,7 @@ impl DatasetWriter {
         let stage_lock = std::fs::File::open(&stage).ok().filter(crate::cleanup::try_lock);
         std::fs::create_dir(stage.join(CLIPS))
             .map_err(io_err(format!("cannot create a folder in {}", stage.display())))?;
-        let row_bytes = 8 * 5 + 4 * (14 + 7 * opts.objects.len() as u64) + 64;
+        let row_bytes = 8 * 5 + 4 * ((7 + COMMAND_LEN) as u64 + 7 * opts.objects.len() as u64) + 64;
         let cams = opts.cameras.len();
         Ok(Self {
             dir: dir.to_path_buf(),
@@ -366,7 +367,7 @@ impl DatasetWriter {
             "action",
             Column::ListF32 {
                 values: flat(&|r| &r.action),
-                width: 7,
+                width: COMMAND_LEN,
             },
         );
         if !self.opts.objects.is_empty() {
@@ -418,7 +419,7 @@ impl DatasetWriter {
         );
         f.insert(
             "action".into(),
-            json!({"dtype": "float32", "shape": [7], "names": names}),
+            json!({"dtype": "float32", "shape": [COMMAND_LEN], "names": COMMAND_NAMES.to_vec()}),
         );
         if !self.opts.objects.is_empty() {
             let env: Vec<String> = self
@@ -481,7 +482,7 @@ impl DatasetWriter {
         let value = |d: &str| json!({"dtype": d, "_type": "Value"});
         let mut f = serde_json::Map::new();
         f.insert("observation.state".into(), list(7));
-        f.insert("action".into(), list(7));
+        f.insert("action".into(), list(COMMAND_LEN));
         if !self.opts.objects.is_empty() {
             f.insert(
                 "observation.environment_state".into(),

@@ -4,7 +4,7 @@
 
 use super::primitive::Primitive;
 use crate::error::Error;
-use crate::motion::{CLOSED_CTRL, JOINT_LIMITS, OPEN_CTRL};
+use crate::motion::{ArmCommand, CLOSED_CTRL, COMMAND_LEN, CellCommand, JOINT_LIMITS, OPEN_CTRL};
 
 /// One step's action. Every action runs to completion on simulated time, closed loop inside
 /// (the leaf's or primitive's controller acts every control period); the caller decides again
@@ -20,13 +20,20 @@ pub enum Action {
     Leaf(String),
     /// One of the reference tutorial's macro primitives ([`Primitive`]).
     Primitive(Primitive),
-    /// Low-level control: six arm joint targets (radians, within
-    /// [`crate::motion::JOINT_LIMITS`]) and the gripper command (0 open … 255 closed), held for
-    /// exactly one control period (`EnvConfig::control_period`, default 4 ms = 2 physics steps
-    /// of 2 ms). The layout is the dataset's `action` ([`super::Observation::command`]); the
-    /// arm servos track the target with the same gravity feedforward as every leaf (zero target
-    /// velocity and acceleration).
-    Ctrl([f64; 7]),
+    /// Low-level control, the one action every leaf commands and a dataset's `action` column
+    /// records ([`CellCommand::to_vector`]): six arm joint set points (radians, within
+    /// [`crate::motion::JOINT_LIMITS`]), six joint velocities (rad/s), six joint accelerations
+    /// (rad/s²) and the gripper command (0 open … 255 closed), for exactly one control period
+    /// (`EnvConfig::control_period`, default 4 ms = 2 physics steps of 2 ms), held over it as
+    /// [`ArmCommand::at`] says, with the servos' feedforward of every leaf. Velocities and
+    /// accelerations beyond [`CTRL_LIMITS`], and set points further from the arm's current set
+    /// point than the largest speed allows in one period, are clamped
+    /// ([`super::StepResult::ctrl_clamped`] counts them); values that are not finite, set
+    /// points outside the joint limits and gripper commands outside 0 … 255 are refused.
+    Ctrl([f64; COMMAND_LEN]),
+    /// Plain set points: six arm joint targets (radians) and the gripper command, with zero
+    /// velocity and acceleration — [`Action::Ctrl`] with its velocities and accelerations zero.
+    Setpoint([f64; 7]),
     /// A node of the environment's tree, by its `name:` (a subtree call is named after its
     /// subtree: `pick`), by its node path (`main/sequence[cube to bowl]/…`), or `main` for the
     /// whole tree: it runs until it finishes, ticked exactly as inside the whole tree.
@@ -40,35 +47,83 @@ impl Action {
             Action::Leaf(_) => "leaf",
             Action::Primitive(p) => p.name(),
             Action::Ctrl(_) => "ctrl",
+            Action::Setpoint(_) => "setpoint",
             Action::Subtree(_) => "subtree",
         }
     }
 }
 
-/// The arm targets and gripper command of a `Ctrl`, checked: finite, joints within their
-/// limits, the command within 0 … 255.
-pub(super) fn check_ctrl(u: &[f64; 7]) -> Result<([f64; 6], f64), Error> {
-    let mut q = [0.0; 6];
-    for (i, (&v, (lo, hi))) in u.iter().zip(JOINT_LIMITS).enumerate() {
-        if !(v.is_finite() && (lo..=hi).contains(&v)) {
-            return Err(Error::Action {
-                message: format!(
-                    "ctrl[{i}] ({} target) is {v}; expected radians within {lo} … {hi}",
-                    crate::motion::ARM_JOINTS[i]
-                ),
-            });
+/// The bounds a `ctrl` action's velocities and accelerations are clamped to.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CtrlLimits {
+    /// Largest joint speed, rad/s: the UR5e's rated π rad/s, which no leaf exceeds.
+    pub max_joint_speed: f64,
+    /// Largest joint acceleration, rad/s².
+    pub max_joint_acc: f64,
+}
+
+/// The limits of every `ctrl` action (see [`CtrlLimits`]'s fields).
+pub const CTRL_LIMITS: CtrlLimits = CtrlLimits {
+    max_joint_speed: crate::motion::plan::UR5E_RATED_JOINT_SPEED,
+    max_joint_acc: 40.0,
+};
+
+/// A checked `ctrl` command and how many of its values were clamped.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CheckedCtrl {
+    /// The command the physics runs.
+    pub command: CellCommand,
+    /// Values clamped to [`CTRL_LIMITS`] or to the largest step from `from`.
+    pub clamped: u32,
+}
+
+/// A `ctrl` vector checked: finite, set points within the joint limits, the gripper command
+/// within 0 … 255 (else refused, naming the index and the range); velocities and accelerations
+/// clamped to [`CTRL_LIMITS`]; set points clamped to within `max_joint_speed × period` of the
+/// arm's current set point `from` (radians), so no command asks for a faster motion.
+pub(super) fn check_ctrl(u: &[f64; COMMAND_LEN], from: &[f64; 6], period: f64) -> Result<CheckedCtrl, Error> {
+    let bad = |message: String| Error::Action { message };
+    if let Some(i) = u.iter().position(|v| !v.is_finite()) {
+        return Err(bad(format!("ctrl[{i}] is {}; every value must be finite", u[i])));
+    }
+    let mut command = CellCommand::from_vector(u);
+    let mut clamped = 0;
+    let mut clamp = |v: &mut f64, lo: f64, hi: f64| {
+        let c = v.clamp(lo, hi);
+        if c != *v {
+            clamped += 1;
+            *v = c;
         }
-        q[i] = v;
+    };
+    let step = CTRL_LIMITS.max_joint_speed * period * (1.0 + 1e-9);
+    for i in 0..6 {
+        let (lo, hi) = JOINT_LIMITS[i];
+        let q = command.arm.q[i];
+        if !(lo..=hi).contains(&q) {
+            return Err(bad(format!(
+                "ctrl[{i}] ({} set point) is {q}; expected radians within {lo} … {hi}",
+                crate::motion::ARM_JOINTS[i]
+            )));
+        }
+        clamp(&mut command.arm.q[i], from[i] - step, from[i] + step);
+        let v = CTRL_LIMITS.max_joint_speed;
+        clamp(&mut command.arm.qd[i], -v, v);
+        let a = CTRL_LIMITS.max_joint_acc;
+        clamp(&mut command.arm.qdd[i], -a, a);
     }
-    let g = u[6];
-    if !(g.is_finite() && (OPEN_CTRL..=CLOSED_CTRL).contains(&g)) {
-        return Err(Error::Action {
-            message: format!(
-                "ctrl[6] (gripper command) is {g}; expected {OPEN_CTRL} (open) … {CLOSED_CTRL} (closed)"
-            ),
-        });
+    let g = command.gripper;
+    if !(OPEN_CTRL..=CLOSED_CTRL).contains(&g) {
+        return Err(bad(format!(
+            "ctrl[18] (gripper command) is {g}; expected {OPEN_CTRL} (open) … {CLOSED_CTRL} (closed)"
+        )));
     }
-    Ok((q, g))
+    Ok(CheckedCtrl { command, clamped })
+}
+
+/// A `setpoint` action as the `ctrl` vector it stands for (velocities and accelerations zero).
+pub(super) fn setpoint_ctrl(u: &[f64; 7]) -> [f64; COMMAND_LEN] {
+    let arm = ArmCommand::hold([u[0], u[1], u[2], u[3], u[4], u[5]]);
+    CellCommand { arm, gripper: u[6] }.to_vector()
 }
 
 #[cfg(test)]
@@ -78,21 +133,39 @@ mod tests {
     #[test]
     fn ctrl_values_out_of_range_are_refused_with_the_index_and_the_range() {
         let home = crate::motion::HOME_Q;
-        let ok = [home[0], home[1], home[2], home[3], home[4], home[5], 100.0];
-        assert_eq!(check_ctrl(&ok).unwrap(), (home, 100.0));
+        let ok = setpoint_ctrl(&[home[0], home[1], home[2], home[3], home[4], home[5], 100.0]);
+        let checked = check_ctrl(&ok, &home, 0.004).unwrap();
+        assert_eq!(checked.command.arm.q, home);
+        assert_eq!(checked.command.gripper, 100.0);
+        assert_eq!(checked.clamped, 0);
         for (i, bad) in [
             (0, f64::NAN),
             (2, 3.5),
             (5, f64::INFINITY),
-            (6, -1.0),
-            (6, 256.0),
-            (6, f64::NAN),
+            (7, f64::NAN),
+            (18, -1.0),
+            (18, 256.0),
+            (18, f64::NAN),
         ] {
             let mut u = ok;
             u[i] = bad;
-            let e = check_ctrl(&u).unwrap_err();
+            let e = check_ctrl(&u, &home, 0.004).unwrap_err();
             assert_eq!(e.kind(), "invalid_action");
             assert!(e.to_string().contains(&format!("ctrl[{i}]")), "{e}");
         }
+    }
+
+    #[test]
+    fn ctrl_speeds_accelerations_and_jumps_are_clamped_and_counted() {
+        let home = crate::motion::HOME_Q;
+        let mut u = setpoint_ctrl(&[home[0] + 0.5, home[1], home[2], home[3], home[4], home[5], 0.0]);
+        u[6] = 30.0;
+        u[13] = -1000.0;
+        let c = check_ctrl(&u, &home, 0.004).unwrap();
+        assert_eq!(c.clamped, 3);
+        let step = CTRL_LIMITS.max_joint_speed * 0.004;
+        assert!((c.command.arm.q[0] - (home[0] + step)).abs() < 1e-9);
+        assert_eq!(c.command.arm.qd[0], CTRL_LIMITS.max_joint_speed);
+        assert_eq!(c.command.arm.qdd[1], -CTRL_LIMITS.max_joint_acc);
     }
 }

@@ -30,7 +30,7 @@
 //!   up to the control period `run_episode` still simulates after the tree has finished — as
 //!   long as no leaf was halted (a guard or a race preempting a running leaf) and no loop
 //!   started a new iteration (a `retry` attempt after the first, a `repeat`: each starts on a
-//!   fresh tick). `tests/env_replay.rs` checks this on the flagship tree.
+//!   fresh tick). `tests/physics/env_replay.rs` checks this on the flagship tree.
 
 mod action;
 mod config;
@@ -48,7 +48,7 @@ mod vector;
 
 use std::sync::Arc;
 
-pub use action::Action;
+pub use action::{Action, CTRL_LIMITS, CtrlLimits};
 pub use config::{EnvConfig, MAX_CONTROL_PERIOD};
 pub use leaf::{LEAF_SOURCE_NAME, MAX_LEAF_TEXT, compile_leaf};
 pub use observation::{Contact, ENVIRONMENT_VALUES_PER_OBJECT, ObjectObservation, Observation, STATE_NAMES};
@@ -181,6 +181,7 @@ impl MacroEnv {
             });
         }
         let dt = self.cell.control_period();
+        let mut clamped = 0;
         let mut stepper: Box<dyn Stepper> = match action {
             Action::Leaf(text) => {
                 let plan = self
@@ -205,8 +206,17 @@ impl MacroEnv {
                 ))
             }
             Action::Ctrl(u) => {
-                let (q, g) = action::check_ctrl(u)?;
-                Box::new(ControllerStepper::new(Box::new(CtrlRun { q, g }), "ctrl"))
+                let checked = action::check_ctrl(u, &self.cell.arm_setpoint(), dt)?;
+                clamped = checked.clamped;
+                Box::new(ControllerStepper::new(Box::new(CtrlRun(checked.command)), "ctrl"))
+            }
+            Action::Setpoint(u) => {
+                let checked = action::check_ctrl(&action::setpoint_ctrl(u), &self.cell.arm_setpoint(), dt)?;
+                clamped = checked.clamped;
+                Box::new(ControllerStepper::new(
+                    Box::new(CtrlRun(checked.command)),
+                    "setpoint",
+                ))
             }
         };
         let t0 = self.cell.world().time;
@@ -254,6 +264,7 @@ impl MacroEnv {
             collisions: ran.collisions,
             goal,
             faults_fired: self.faults_fired(),
+            ctrl_clamped: clamped,
         })
     }
 
@@ -356,16 +367,13 @@ impl MacroEnv {
     }
 }
 
-/// `Action::Ctrl`: hold the targets for one control period.
-struct CtrlRun {
-    q: [f64; 6],
-    g: f64,
-}
+/// `Action::Ctrl` and `Action::Setpoint`: one control period of a checked command.
+struct CtrlRun(crate::motion::CellCommand);
 
 impl crate::actions::MacroAction for CtrlRun {
     fn start(&mut self, cell: &mut Cell) -> Result<(), crate::Failure> {
-        cell.track(Box::new(crate::motion::Hold::new(self.q, 0.0)));
-        cell.set_gripper(self.g);
+        cell.command_arm(self.0.arm);
+        cell.set_gripper(self.0.gripper);
         Ok(())
     }
     fn update(&mut self, _cell: &mut Cell) -> crate::actions::Progress {

@@ -30,6 +30,9 @@ pub struct Observation {
     pub gripper_width: f64,
     /// Gripper actuator command (0 open … 255 closed).
     pub gripper_command: f64,
+    /// The command of the last control period ([`crate::motion::CellCommand::to_vector`]: set
+    /// points, velocities, accelerations, gripper); holding at the set point before the first.
+    pub last_command: [f64; crate::motion::COMMAND_LEN],
     /// Pinch point (between the fingertips) position, metres.
     pub pinch_pos: [f64; 3],
     /// Pinch frame orientation `[w, x, y, z]` (its z axis points out of the fingers).
@@ -113,6 +116,13 @@ impl Observation {
             gripper_joint: sim.data().qpos()[sim.scene().ids.gripper_driver_qpos],
             gripper_width: w.gripper_width,
             gripper_command: cell.gripper_command(),
+            last_command: cell
+                .last_command()
+                .unwrap_or(crate::motion::CellCommand {
+                    arm: crate::motion::ArmCommand::hold(cell.arm_setpoint()),
+                    gripper: cell.gripper_command(),
+                })
+                .to_vector(),
             pinch_pos: v3(&w.pinch_pos),
             pinch_quat: wxyz(&pinch),
             left_pad_pos: v3(&w.left_pad_pos),
@@ -129,10 +139,10 @@ impl Observation {
         state_vector(&self.joint_pos, self.gripper_joint)
     }
 
-    /// The dataset's `action`: the six commanded arm joint set points (radians), then the
-    /// gripper command (0 … 255), as `f32` — the layout `env::Action::Ctrl` takes.
-    pub fn command(&self) -> [f32; 7] {
-        command_vector(&self.joint_target, self.gripper_command)
+    /// The dataset's `action` of the last control period, as `f32` — the layout
+    /// `env::Action::Ctrl` takes ([`Self::last_command`]).
+    pub fn command(&self) -> [f32; crate::motion::COMMAND_LEN] {
+        command_vector(&self.last_command)
     }
 
     /// The dataset's `observation.environment_state`: every object's pose in scene order, each

@@ -65,6 +65,9 @@ pub struct StepResult {
     pub goal: Vec<GoalValue>,
     /// Faults that fired during this step, each as `kind: what it did`.
     pub faults_fired: Vec<String>,
+    /// Values of a `ctrl` or `setpoint` action clamped to the limits ([`super::CTRL_LIMITS`]);
+    /// 0 for other actions.
+    pub ctrl_clamped: u32,
 }
 
 impl StepResult {

@@ -19,6 +19,7 @@ pub use report::{EpisodeReport, LayoutJson, NodeReport, ObjectReport};
 use crate::actions::Cell;
 use crate::factory::Factory;
 use crate::failure::{Failure, FailureKind};
+use crate::motion::CellCommand;
 use crate::plan::Plan;
 use crate::runtime::substitute::Resolved;
 use crate::runtime::{TreeRunner, TreeStatus};
@@ -141,6 +142,9 @@ impl Default for EpisodeConfig {
 
 /// Called after every control period (viewer, recorder, progress).
 pub trait EpisodeObserver {
+    /// A control period starts: the tree was ticked, the physics has not advanced yet, and
+    /// `command` is what the cell will hold over the period (the state is the period's first).
+    fn on_period_start(&mut self, _cell: &Cell, _command: &CellCommand, _runner: &mut TreeRunner) {}
     /// The tree was ticked and the physics advanced by one control period.
     fn on_tick(&mut self, _cell: &Cell, _runner: &mut TreeRunner) {}
 }
@@ -213,6 +217,8 @@ pub fn run_in_cell(
             break;
         }
         status = runner.tick(now, dt, &mut driver);
+        let command = driver.cell().period_command();
+        observer.on_period_start(driver.cell(), &command, &mut runner);
         driver.advance();
         observer.on_tick(driver.cell(), &mut runner);
         // MuJoCo resets an unstable simulation and carries on: the episode is no longer physics.

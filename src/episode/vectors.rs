@@ -2,8 +2,8 @@
 //! LeRobot dataset (`observation.state`, `action`, `observation.environment_state`) and the
 //! step-wise environment's observation.
 
-/// Names of the 7 values of a state or command vector ([`state_vector`], [`command_vector`]):
-/// the UR5e's joints, then the gripper.
+/// Names of the 7 values of a state vector ([`state_vector`]): the UR5e's joints, then the
+/// gripper. A command vector's are [`crate::motion::COMMAND_NAMES`].
 pub const STATE_NAMES: [&str; 7] = [
     "shoulder_pan",
     "shoulder_lift",
@@ -23,10 +23,11 @@ pub fn state_vector(joint_pos: &[f64; 6], gripper_joint: f64) -> [f32; 7] {
     seven(joint_pos, gripper_joint)
 }
 
-/// `action`: the six commanded arm joint set points (radians), then the gripper command
-/// (0 open … 255 closed), as `f32`.
-pub fn command_vector(joint_target: &[f64; 6], gripper_command: f64) -> [f32; 7] {
-    seven(joint_target, gripper_command)
+/// `action`: one control period's command ([`crate::motion::CellCommand::to_vector`]: six
+/// joint set points in radians, six velocities in rad/s, six accelerations in rad/s², the
+/// gripper command 0 open … 255 closed), as `f32`.
+pub fn command_vector(command: &[f64; crate::motion::COMMAND_LEN]) -> [f32; crate::motion::COMMAND_LEN] {
+    command.map(|v| v as f32)
 }
 
 /// One object's part of `observation.environment_state`: x, y, z (metres), then the

@@ -2,7 +2,7 @@
 //! (0 … 255) ↔ pad-face opening (metres).
 //!
 //! ## How the table was measured
-//! `tests/motion_gripper.rs::calibration_table_matches_the_simulator` (which re-measures and
+//! `tests/physics/motion_gripper.rs::calibration_table_matches_the_simulator` (which re-measures and
 //! checks this table): in the task scene (arm holding home, nothing between the fingers), starting
 //! from open, the command is raised through the table's commands (0, 15, …, 240, 246, 255) and each command is held for
 //! 2 s (1000 physics steps of 2 ms); the opening is then read as `World::gripper_width` =

@@ -163,7 +163,7 @@ pub fn fk_parts(q: &[f64; 6]) -> (Vector3<f64>, Matrix3<f64>) {
 
 /// FK of the pinch site in the world frame for arm joints `q` (radians, shoulder pan … wrist 3).
 /// Exact for the Menagerie chain (analytic, no MuJoCo); translation in metres. Matches MuJoCo's
-/// `site_xpos` / `site_xmat` of `gripper/pinch` to ~1e-15 m (see `tests/motion_fk.rs`).
+/// `site_xpos` / `site_xmat` of `gripper/pinch` to ~1e-15 m (see `tests/physics/motion_fk.rs`).
 pub fn fk(q: &[f64; 6]) -> Isometry3<f64> {
     let (p, r) = fk_parts(q);
     Isometry3::from_parts(

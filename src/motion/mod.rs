@@ -11,13 +11,16 @@
 //! | [`mod@plan`] | collision-aware joint-space planning: RRT-Connect to goal sets, shortcutting, blends, timing, typed failure reasons |
 //! | [`trajectory`] | the [`Trajectory`] trait, [`JointMove`], [`CartesianMove`], [`Hold`], [`MotionLimits`] |
 //! | [`gripper`] | command ↔ opening calibration of the simulated 2F-85 |
+//! | [`command`] | [`ArmCommand`] and [`CellCommand`]: one control period's command, the one action |
 
+pub mod command;
 pub mod gripper;
 pub mod ik;
 pub mod kinematics;
 pub mod plan;
 pub mod trajectory;
 
+pub use command::{ArmCommand, COMMAND_LEN, COMMAND_NAMES, CellCommand};
 pub use gripper::{CLOSED_CTRL, OPEN_CTRL, ctrl_for_width, width_for_ctrl};
 pub use ik::{IkError, down_pose, ik, ik_all, ik_benchmark, ik_down, ik_down_with_pose};
 pub use kinematics::{ARM_JOINTS, JOINT_LIMITS, fk, jacobian};

@@ -12,7 +12,7 @@
 //! weld parent and child unless disabled, `<exclude>`), plus explicit `<pair>`s. A configuration
 //! is certainly free when every pair's primitives are at least the pair's margin plus
 //! [`PAD`] apart: the geoms inside them are then farther apart than the margin, so MuJoCo
-//! reports no contact. `tests/motion_screen.rs` checks this against MuJoCo over thousands of
+//! reports no contact. `tests/physics/motion_screen.rs` checks this against MuJoCo over thousands of
 //! configurations near obstacles.
 
 use mujoco_rs::prelude::*;
@@ -85,7 +85,7 @@ impl Local {
 /// they must keep for "free" (the pair's margin plus [`PAD`], metres), and the distance below
 /// which exact shapes are "blocked": [`PAD`] of penetration (MuJoCo reports every
 /// penetration, but not every pair closer than a margin: its plane–box and capsule–box
-/// contacts within a margin were found missing in `tests/motion_screen.rs`).
+/// contacts within a margin were found missing in `tests/physics/motion_screen.rs`).
 #[derive(Clone, Copy, Debug)]
 struct Pair {
     a: u16,

@@ -13,7 +13,7 @@ pub const UR5E_RATED_JOINT_SPEED: f64 = std::f64::consts::PI;
 
 /// Lever arms of the UR5e with the 2F-85 and a held block of up to 7 cm, metres: an upper bound
 /// on the distance of any point of the moving robot from each joint's axis, base to wrist 3.
-/// Measured on the Menagerie models (`tests/motion_collision.rs`: the largest distance of a
+/// Measured on the Menagerie models (`tests/physics/motion_collision.rs`: the largest distance of a
 /// collision geom's bounding sphere from each axis, over the stretched arm and random joints,
 /// is 1.08, 1.11, 0.70, 0.31, 0.27, 0.10 m), plus a held block's 6.1 cm half diagonal.
 pub const UR5E_LEVER_ARMS: [f64; 6] = [1.16, 1.19, 0.77, 0.38, 0.34, 0.12];

@@ -1,0 +1,281 @@
+//! Scene files and what trees say about them: loading with located diagnostics, the committed
+//! JSON Schema, seeded placements, and the checks of object names and blackboard variables.
+
+use std::path::{Path, PathBuf};
+
+use macrotree::scene::{Placement, SceneSpec, sample_placement};
+use macrotree::spec::Diagnostic;
+
+use crate::support::cli;
+use crate::support::files;
+
+use cli::macrotree;
+
+const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+const SCHEMA: &str = "schema/scene.schema.json";
+
+fn scene_files() -> Vec<PathBuf> {
+    files::yaml_files(&Path::new(ROOT).join("scenes"))
+}
+
+fn scene_errors(text: &str) -> Vec<Diagnostic> {
+    SceneSpec::from_str(text, "cell.yaml").expect_err("the scene is invalid")
+}
+
+/// The one diagnostic whose message contains `needle`.
+fn find<'a>(diags: &'a [Diagnostic], needle: &str) -> &'a Diagnostic {
+    diags
+        .iter()
+        .find(|d| d.message.contains(needle))
+        .unwrap_or_else(|| panic!("no diagnostic with {needle:?} in {diags:#?}"))
+}
+
+#[test]
+fn the_committed_scene_schema_is_what_the_binary_prints() {
+    let out = macrotree(&["schema", "--scene"]);
+    assert_eq!(out.status.code(), Some(0));
+    let printed = String::from_utf8(out.stdout).unwrap();
+    let path = Path::new(ROOT).join(SCHEMA);
+    if std::env::var_os("UPDATE_SCHEMA").is_some() {
+        std::fs::write(&path, &printed).unwrap();
+    }
+    let committed = std::fs::read_to_string(&path).unwrap_or_default();
+    assert!(
+        printed == committed,
+        "`macrotree schema --scene` differs from {SCHEMA}: run `UPDATE_SCHEMA=1 cargo test --release --test tree scene_spec`"
+    );
+}
+
+#[test]
+fn every_shipped_scene_loads_and_passes_the_schema() {
+    let schema: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(Path::new(ROOT).join(SCHEMA)).unwrap()).unwrap();
+    let validator = jsonschema::validator_for(&schema).expect("a valid JSON Schema");
+    let scenes = scene_files();
+    assert!(scenes.len() >= 4, "{scenes:?}");
+    for path in scenes {
+        let text = std::fs::read_to_string(&path).unwrap();
+        // `../schema/…` from `scenes/`, `../../schema/…` from `scenes/held_out/`.
+        let depth = path
+            .strip_prefix(Path::new(ROOT).join("scenes"))
+            .map_or(1, |p| p.components().count());
+        let header = format!(
+            "# yaml-language-server: $schema={}schema/scene.schema.json",
+            "../".repeat(depth)
+        );
+        assert!(
+            text.starts_with(&header),
+            "{}: starts with {header}",
+            path.display()
+        );
+        let scene = macrotree::scene::load_scene_file(&path)
+            .unwrap_or_else(|d| panic!("{}: {}", path.display(), d[0]));
+        assert!(
+            !scene.goal.is_empty(),
+            "{}: every shipped scene has a goal",
+            path.display()
+        );
+        let data: serde_json::Value = serde_saphyr::from_str(&text).unwrap();
+        let errors: Vec<String> = validator.iter_errors(&data).map(|e| e.to_string()).collect();
+        assert!(errors.is_empty(), "{}: {errors:?}", path.display());
+        let out = macrotree(&["validate", path.to_str().unwrap()]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(String::from_utf8_lossy(&out.stdout).contains("ok (scene:"));
+    }
+}
+
+#[test]
+fn scene_mistakes_are_located_and_explained() {
+    let d = scene_errors("objects:\n  red: {blok: {size: 0.04}, pose: [0.4, 0]}\n");
+    let e = find(&d, "unknown parameter `blok`");
+    assert_eq!((e.line, e.column), (2, 9));
+    assert_eq!(e.help.as_deref(), Some("did you mean `block`?"));
+
+    let d = scene_errors("objects:\n  red: {block: {size: 0.4}, pose: [0.4, 0]}\n");
+    let e = find(&d, "a block's edge (m) must be within 0.02 … 0.07, found 0.4");
+    assert_eq!((e.line, e.column), (2, 23));
+
+    let d = scene_errors(
+        "objects:\n  red: {block: {size: 0.04}, pose: [0.4, 0]}\n  bin: {container: {inner: [0.1, 0.1]}, pose: [0.4, 0.3]}\ngoal:\n  - in: {object: red, container: bni}\n",
+    );
+    let e = find(&d, "unknown object `bni`");
+    assert_eq!((e.line, e.column), (5, 34));
+    assert_eq!(e.help.as_deref(), Some("did you mean `bin`?"));
+
+    let d = scene_errors(
+        "objects:\n  red: {block: {size: 0.04}, pose: [0.4, 0]}\n  bin: {container: {inner: [0.1, 0.1]}, pose: [0.4, 0.3]}\ngoal:\n  - in: {object: bin, container: red}\n",
+    );
+    find(&d, "`bin` is a container, not a block");
+    find(&d, "`red` is a block, not a container");
+
+    // Two fixed objects on top of each other.
+    let d = scene_errors(
+        "objects:\n  red: {block: {size: 0.04}, pose: [0.4, 0]}\n  bin: {container: {inner: [0.1, 0.1]}, pose: [0.42, 0.0]}\n",
+    );
+    let e = find(&d, "`red` and `bin` overlap");
+    assert!(e.help.as_deref().unwrap().contains("on: bin"), "{e}");
+
+    // A block inside the robot's base, and one out of reach.
+    find(
+        &scene_errors("objects:\n  red: {block: {size: 0.04}, pose: [0.05, 0]}\n"),
+        "robot's base",
+    );
+    find(
+        &scene_errors("objects:\n  red: {block: {size: 0.04}, pose: [0.9, 0]}\n"),
+        "picked from above",
+    );
+
+    // Randomization that cannot be met: six bins in a 10 cm square.
+    let mut text = String::from("objects:\n");
+    for i in 0..6 {
+        text += &format!(
+            "  b{i}: {{container: {{inner: [0.2, 0.2]}}, random: {{x: [0.4, 0.5], y: [0.0, 0.1]}}}}\n"
+        );
+    }
+    let d = scene_errors(&text);
+    let e = find(&d, "the randomization cannot be met");
+    assert!(e.message.contains("no placement found"), "{e}");
+}
+
+#[test]
+fn sorted_by_color_needs_one_bin_per_block_colour() {
+    let d = scene_errors(
+        "objects:\n  red: {block: {size: 0.04, color: red}, pose: [0.4, 0]}\n  bin: {container: {inner: [0.1, 0.1], color: blue}, pose: [0.4, 0.3]}\ngoal:\n  - sorted_by_color: {}\n",
+    );
+    find(&d, "exactly one container of block `red`'s colour (red), found 0");
+}
+
+#[test]
+fn placements_are_seeded_and_keep_every_constraint() {
+    let scene = macrotree::scene::load_scene_file(&Path::new(ROOT).join("scenes/clear_table.yaml")).unwrap();
+    let (seed_a, a) = sample_placement(&scene, 5, 17).unwrap();
+    let (seed_b, b) = sample_placement(&scene, 5, 17).unwrap();
+    assert_eq!(
+        (seed_a, &a),
+        (seed_b, &b),
+        "a scenario depends only on (seed, index)"
+    );
+    assert_ne!(sample_placement(&scene, 5, 18).unwrap().1, a);
+    for k in 0..200 {
+        let (_, p) = sample_placement(&scene, 1, k).unwrap();
+        p.check(&scene).unwrap_or_else(|e| panic!("scenario {k}: {e}"));
+        for (o, pose) in scene.objects.iter().zip(&p.poses) {
+            let r = o.random.as_ref().unwrap();
+            assert!((r.x[0]..=r.x[1]).contains(&pose.x) && (r.y[0]..=r.y[1]).contains(&pose.y));
+        }
+    }
+    // A hand-made placement that overlaps is refused by name.
+    let mut bad: Placement = sample_placement(&scene, 1, 0).unwrap().1;
+    bad.poses[1] = bad.poses[0];
+    let e = bad.check(&scene).unwrap_err().to_string();
+    assert!(e.contains("`a` and `b`"), "{e}");
+}
+
+fn tree_errors(text: &str) -> Vec<Diagnostic> {
+    let path = Path::new(ROOT).join("trees").join("check_test.yaml");
+    macrotree::plan::Loader::default()
+        .compile_str(text, path.to_str().unwrap())
+        .expect_err("the tree is invalid")
+}
+
+#[test]
+fn trees_name_objects_of_their_scene() {
+    let d = tree_errors(
+        "scene: ../scenes/sort_three.yaml\nmain:\n  sequence:\n    children:\n      - reach: {target: gren}\n      - in: {object: red, container: green}\n      - grasp: {}\n      - cube_grasped: {}\n",
+    );
+    let e = find(&d, "unknown target `gren` in `reach` (did you mean `green`?)");
+    assert_eq!((e.line, e.column), (5, 25));
+    find(&d, "`green` is a block, but `in` needs a container here");
+    // The legacy `cube` condition needs a scene with exactly one block.
+    let e = find(&d, "refers to the scene's only block (`cube`)");
+    assert!(e.message.contains("it has 3 blocks: red, green, blue"), "{e}");
+    // The built-in scene (no `scene:`) has `cube` and `bowl` and nothing else.
+    let d = tree_errors("main: {reach: {target: red}}\n");
+    find(&d, "unknown target `red`");
+}
+
+#[test]
+fn blackboard_variables_are_checked_when_the_tree_is_loaded() {
+    let d = tree_errors(
+        "scene: ../scenes/sort_three.yaml\nmain:\n  sequence:\n    children:\n      - select: {as: block, kind: block}\n      - reach: {target: \"{blok}\"}\n      - in: {object: \"{block}\", container: \"{block}\"}\n",
+    );
+    let e = find(&d, "undefined variable `{blok}` in `reach`");
+    assert_eq!((e.line, e.column), (6, 25));
+    assert_eq!(e.help.as_deref(), Some("did you mean `{block}`?"));
+    find(&d, "`{block}` holds a block, but `in` needs a container here");
+    // One variable, two types.
+    let d = tree_errors(
+        "scene: ../scenes/sort_three.yaml\nmain:\n  sequence:\n    children:\n      - select: {as: x, kind: block}\n      - select: {as: x, kind: container}\n",
+    );
+    find(&d, "variable `x` is written as a container here");
+    // Bare `{var}` in YAML flow style reads as the variable too.
+    let ok = macrotree::plan::Loader::default().compile_str(
+        "scene: ../scenes/sort_three.yaml\nmain:\n  sequence:\n    children:\n      - select: {as: block}\n      - reach: {target: {block}, offset: [0, 0, 0.1]}\n",
+        Path::new(ROOT).join("trees/x.yaml").to_str().unwrap(),
+    );
+    assert!(ok.is_ok(), "{:?}", ok.err());
+}
+
+#[test]
+fn a_scene_override_rechecks_the_tree() {
+    // sort_by_color names no object directly (it selects them), so it runs on any scene with a
+    // goal; the cube-to-bowl tree does not fit a scene with three blocks.
+    let out = macrotree(&[
+        "validate",
+        "trees/cube_to_bowl.yaml",
+        "--scene",
+        "scenes/sort_three.yaml",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("scene `sort_three` is ambiguous"), "{err}");
+    let out = macrotree(&[
+        "validate",
+        "trees/sort_by_color.yaml",
+        "--scene",
+        "scenes/clear_table.yaml",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// Issue 18: the reference tutorial's sampler is a setting of the scene file (`sampler:
+/// tutorial`), not a comparison with the built-in scene; it needs the scene's one randomized cube
+/// and bowl, and a wrong value is located.
+#[test]
+fn the_tutorial_sampler_is_a_scene_setting_that_needs_a_cube_and_a_bowl() {
+    let builtin = SceneSpec::builtin();
+    assert_eq!(builtin.sampler, macrotree::scene::Sampler::Tutorial);
+    let shipped = std::fs::read_to_string(Path::new(ROOT).join("scenes/cube_bowl.yaml")).unwrap();
+    assert!(shipped.contains("\nsampler: tutorial\n"));
+    // Without the line, the same cell samples its objects one by one.
+    let plain =
+        SceneSpec::from_str(&shipped.replace("\nsampler: tutorial\n", "\n"), "cube_bowl.yaml").unwrap();
+    assert_eq!(plain.sampler, macrotree::scene::Sampler::Objects);
+    // A copy under another name keeps the setting.
+    let copy = SceneSpec::from_str(&shipped, "my_cell.yaml").unwrap();
+    assert_eq!(copy.sampler, macrotree::scene::Sampler::Tutorial);
+    let d = scene_errors(
+        "sampler: tutorial\nobjects:\n  a: {block: {size: 0.04}, random: {x: [0.3, 0.6], y: [-0.3, -0.1]}}\n  b: {block: {size: 0.04}, random: {x: [0.3, 0.6], y: [0.1, 0.3]}}\n",
+    );
+    let text = d[0].to_string();
+    assert!(
+        text.contains("sampler: tutorial") && text.contains("cell.yaml:1:10"),
+        "{text}"
+    );
+    let d = scene_errors("sampler: tutorail\nobjects:\n  a: {block: {size: 0.04}, pose: [0.45, 0.1]}\n");
+    let text = d[0].to_string();
+    assert!(
+        text.contains("unknown sampler `tutorail`") && text.contains("did you mean `tutorial`?"),
+        "{text}"
+    );
+}

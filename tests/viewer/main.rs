@@ -1,0 +1,13 @@
+//! The viewer: encoding, the websocket hub, the replay page and a real headless Chromium.
+//!
+//! One test binary (`cargo test --release --test viewer`); one file per subject.
+
+#[path = "../support/mod.rs"]
+mod support;
+
+mod bundle;
+mod cli_view;
+mod encoding;
+mod real_browser;
+mod replay_ui;
+mod websocket;
