@@ -49,9 +49,8 @@ fn ctrl_bounds() -> (Vec<f64>, Vec<f64>) {
         low.extend([-bound; 6]);
         high.extend([bound; 6]);
     }
-    let (g_lo, g_hi) = macrotree::motion::CellCommand::GRIPPER_RANGE;
-    low.push(g_lo);
-    high.push(g_hi);
+    low.push(macrotree::motion::OPEN_CTRL);
+    high.push(macrotree::motion::CLOSED_CTRL);
     (low, high)
 }
 

@@ -7,8 +7,6 @@
 //! servos track `q + q̇ τ + ½ q̈ τ²` at `q̇ + q̈ τ` with feedforward `q̈`
 //! ([`ArmCommand::at`]). Units: radians, rad/s, rad/s²; the gripper in actuator units.
 
-use super::gripper::{CLOSED_CTRL, OPEN_CTRL};
-
 /// The arm's command at the start of a control period: joint set points, velocities and
 /// accelerations (the servos' feedforward).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -77,7 +75,8 @@ pub const COMMAND_NAMES: [&str; COMMAND_LEN] = [
 pub struct CellCommand {
     /// The arm's command at the start of the period.
     pub arm: ArmCommand,
-    /// The gripper actuator command, [`OPEN_CTRL`] (0, open) … [`CLOSED_CTRL`] (255, closed).
+    /// The gripper actuator command, [`super::OPEN_CTRL`] (0, open) … [`super::CLOSED_CTRL`]
+    /// (255, closed).
     pub gripper: f64,
 }
 
@@ -100,9 +99,6 @@ impl CellCommand {
         arm.qdd.copy_from_slice(&v[12..18]);
         Self { arm, gripper: v[18] }
     }
-
-    /// The gripper command's range, actuator units.
-    pub const GRIPPER_RANGE: (f64, f64) = (OPEN_CTRL, CLOSED_CTRL);
 }
 
 #[cfg(test)]
