@@ -77,14 +77,49 @@ pub struct CheckedCtrl {
     pub clamped: u32,
 }
 
+/// The `ctrl` vector a `ctrl` or `setpoint` action stands for, unchecked.
+#[derive(Clone, Copy)]
+pub(super) struct CtrlValues {
+    /// The values, laid out as [`CellCommand::to_vector`] (a set point's velocities and
+    /// accelerations zero).
+    pub vector: [f64; COMMAND_LEN],
+    /// The name of value `i` of `vector` in messages, as the caller wrote it (`ctrl[18]`,
+    /// `setpoint[6]`).
+    pub name: fn(usize) -> String,
+}
+
+/// The `ctrl` values of a `ctrl` or `setpoint` action; `None` for other actions.
+pub(super) fn ctrl_of(action: &Action) -> Option<CtrlValues> {
+    match action {
+        Action::Ctrl(u) => Some(CtrlValues {
+            vector: *u,
+            name: |i| format!("ctrl[{i}]"),
+        }),
+        Action::Setpoint(u) => {
+            let arm = ArmCommand::hold([u[0], u[1], u[2], u[3], u[4], u[5]]);
+            Some(CtrlValues {
+                vector: CellCommand { arm, gripper: u[6] }.to_vector(),
+                name: |i| format!("setpoint[{}]", if i == COMMAND_LEN - 1 { 6 } else { i }),
+            })
+        }
+        _ => None,
+    }
+}
+
 /// A `ctrl` vector checked: finite, set points within the joint limits, the gripper command
-/// within 0 … 255 (else refused, naming the index and the range); velocities and accelerations
-/// clamped to [`CTRL_LIMITS`]; set points clamped to within `max_joint_speed × period` of the
-/// arm's current set point `from` (radians), so no command asks for a faster motion.
-pub(super) fn check_ctrl(u: &[f64; COMMAND_LEN], from: &[f64; 6], period: f64) -> Result<CheckedCtrl, Error> {
+/// within 0 … 255 (else refused, naming the value as `name` does and the range); velocities and
+/// accelerations clamped to [`CTRL_LIMITS`]; set points clamped to within
+/// `max_joint_speed × period` of the arm's current set point `from` (radians), so no command
+/// asks for a faster motion.
+pub(super) fn check_ctrl(values: &CtrlValues, from: &[f64; 6], period: f64) -> Result<CheckedCtrl, Error> {
+    let CtrlValues { vector: u, name } = values;
     let bad = |message: String| Error::Action { message };
     if let Some(i) = u.iter().position(|v| !v.is_finite()) {
-        return Err(bad(format!("ctrl[{i}] is {}; every value must be finite", u[i])));
+        return Err(bad(format!(
+            "{} is {}; every value must be finite",
+            name(i),
+            u[i]
+        )));
     }
     let mut command = CellCommand::from_vector(u);
     let mut clamped = 0;
@@ -101,7 +136,8 @@ pub(super) fn check_ctrl(u: &[f64; COMMAND_LEN], from: &[f64; 6], period: f64) -
         let q = command.arm.q[i];
         if !(lo..=hi).contains(&q) {
             return Err(bad(format!(
-                "ctrl[{i}] ({} set point) is {q}; expected radians within {lo} … {hi}",
+                "{} ({} set point) is {q}; expected radians within {lo} … {hi}",
+                name(i),
                 crate::motion::ARM_JOINTS[i]
             )));
         }
@@ -114,16 +150,11 @@ pub(super) fn check_ctrl(u: &[f64; COMMAND_LEN], from: &[f64; 6], period: f64) -
     let g = command.gripper;
     if !(OPEN_CTRL..=CLOSED_CTRL).contains(&g) {
         return Err(bad(format!(
-            "ctrl[18] (gripper command) is {g}; expected {OPEN_CTRL} (open) … {CLOSED_CTRL} (closed)"
+            "{} (gripper command) is {g}; expected {OPEN_CTRL} (open) … {CLOSED_CTRL} (closed)",
+            name(COMMAND_LEN - 1)
         )));
     }
     Ok(CheckedCtrl { command, clamped })
-}
-
-/// A `setpoint` action as the `ctrl` vector it stands for (velocities and accelerations zero).
-pub(super) fn setpoint_ctrl(u: &[f64; 7]) -> [f64; COMMAND_LEN] {
-    let arm = ArmCommand::hold([u[0], u[1], u[2], u[3], u[4], u[5]]);
-    CellCommand { arm, gripper: u[6] }.to_vector()
 }
 
 #[cfg(test)]
@@ -133,8 +164,10 @@ mod tests {
     #[test]
     fn ctrl_values_out_of_range_are_refused_with_the_index_and_the_range() {
         let home = crate::motion::HOME_Q;
-        let ok = setpoint_ctrl(&[home[0], home[1], home[2], home[3], home[4], home[5], 100.0]);
-        let checked = check_ctrl(&ok, &home, 0.004).unwrap();
+        let setpoint = Action::Setpoint([home[0], home[1], home[2], home[3], home[4], home[5], 100.0]);
+        let values = ctrl_of(&setpoint).unwrap();
+        let checked = check_ctrl(&values, &home, 0.004).unwrap();
+        let ok = values.vector;
         assert_eq!(checked.command.arm.q, home);
         assert_eq!(checked.command.gripper, 100.0);
         assert_eq!(checked.clamped, 0);
@@ -149,19 +182,30 @@ mod tests {
         ] {
             let mut u = ok;
             u[i] = bad;
-            let e = check_ctrl(&u, &home, 0.004).unwrap_err();
+            let e = check_ctrl(&ctrl_of(&Action::Ctrl(u)).unwrap(), &home, 0.004).unwrap_err();
             assert_eq!(e.kind(), "invalid_action");
             assert!(e.to_string().contains(&format!("ctrl[{i}]")), "{e}");
         }
+        // A set point's values are named as the caller wrote them.
+        let mut u = ok;
+        u[18] = 300.0;
+        let e = check_ctrl(&CtrlValues { vector: u, ..values }, &home, 0.004).unwrap_err();
+        assert!(e.to_string().contains("setpoint[6] (gripper command)"), "{e}");
+        u[18] = 0.0;
+        u[2] = 9.0;
+        let e = check_ctrl(&CtrlValues { vector: u, ..values }, &home, 0.004).unwrap_err();
+        assert!(e.to_string().contains("setpoint[2] (elbow"), "{e}");
     }
 
     #[test]
     fn ctrl_speeds_accelerations_and_jumps_are_clamped_and_counted() {
         let home = crate::motion::HOME_Q;
-        let mut u = setpoint_ctrl(&[home[0] + 0.5, home[1], home[2], home[3], home[4], home[5], 0.0]);
+        let setpoint = Action::Setpoint([home[0] + 0.5, home[1], home[2], home[3], home[4], home[5], 0.0]);
+        let mut values = ctrl_of(&setpoint).unwrap();
+        let u = &mut values.vector;
         u[6] = 30.0;
         u[13] = -1000.0;
-        let c = check_ctrl(&u, &home, 0.004).unwrap();
+        let c = check_ctrl(&values, &home, 0.004).unwrap();
         assert_eq!(c.clamped, 3);
         let step = CTRL_LIMITS.max_joint_speed * 0.004;
         assert!((c.command.arm.q[0] - (home[0] + step)).abs() < 1e-9);

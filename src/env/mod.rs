@@ -205,17 +205,13 @@ impl MacroEnv {
                     p.name(),
                 ))
             }
-            Action::Ctrl(u) => {
-                let checked = action::check_ctrl(u, &self.cell.arm_setpoint(), dt)?;
-                clamped = checked.clamped;
-                Box::new(ControllerStepper::new(Box::new(CtrlRun(checked.command)), "ctrl"))
-            }
-            Action::Setpoint(u) => {
-                let checked = action::check_ctrl(&action::setpoint_ctrl(u), &self.cell.arm_setpoint(), dt)?;
+            Action::Ctrl(_) | Action::Setpoint(_) => {
+                let values = action::ctrl_of(action).expect("a ctrl or setpoint action");
+                let checked = action::check_ctrl(&values, &self.cell.arm_setpoint(), dt)?;
                 clamped = checked.clamped;
                 Box::new(ControllerStepper::new(
                     Box::new(CtrlRun(checked.command)),
-                    "setpoint",
+                    action.name(),
                 ))
             }
         };
