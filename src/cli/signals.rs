@@ -5,6 +5,11 @@
 //!
 //! The handler itself only records the signal (an atomic store, safe in a signal handler); a
 //! watcher thread does the clean-up and the exit.
+//!
+//! SIGPIPE keeps its default action (Rust programs start with it ignored): output to a closed
+//! pipe (`macrotree run … | head -0`) ends the command quietly with that signal, as the shell's
+//! 141 reports, instead of a panic on the failed write. Temporary files it leaves are reclaimed
+//! by the next run ([`crate::cleanup::reclaim`]).
 
 use std::sync::atomic::{AtomicI32, Ordering};
 use std::time::Duration;
@@ -15,8 +20,14 @@ extern "C" fn on_signal(sig: libc::c_int) {
     SIGNALLED.store(sig, Ordering::SeqCst);
 }
 
-/// Installs the handlers of SIGINT and SIGTERM and starts the watcher thread.
+/// Installs the handlers of SIGINT and SIGTERM, gives SIGPIPE its default action and starts the
+/// watcher thread.
 pub(super) fn install() {
+    // SAFETY: setting a signal's disposition to its default is async-signal-safe and has no
+    // other effect on this process's state.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     for sig in [libc::SIGINT, libc::SIGTERM] {
         // SAFETY: `sigaction` with a zeroed struct, an empty mask and a handler that only does
         // an atomic store (async-signal-safe); SA_RESTART keeps system calls going.

@@ -7,6 +7,7 @@ mod support;
 
 mod authoring;
 mod bench;
+mod closed_pipe;
 mod collision_policy;
 mod custom_leaf_example;
 mod dataset;
