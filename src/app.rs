@@ -13,7 +13,7 @@ use crate::factory::Factory;
 use crate::failure::Failure;
 use crate::kinds::{ActionRole, Params, Registry};
 use crate::plan::{Loader, Plan};
-use crate::sim::{Scene, TIMESTEP};
+use crate::sim::Scene;
 use crate::world::World;
 
 /// The name, one-line description and version a `macrotree`-like program shows in `--help`,
@@ -280,20 +280,7 @@ fn check_config(c: &EpisodeConfig) -> Result<(), Error> {
             ),
         });
     }
-    let steps = c.control_period / TIMESTEP;
-    if !(c.control_period.is_finite()
-        && c.control_period > 0.0
-        && c.control_period <= 0.1
-        && (steps - steps.round()).abs() < 1e-9)
-    {
-        return Err(Error::Config {
-            message: format!(
-                "control_period must be a whole number of 2 ms physics steps, at most 0.1 s, got {}",
-                c.control_period
-            ),
-        });
-    }
-    Ok(())
+    crate::actions::check_control_period(c.control_period)
 }
 
 #[cfg(test)]

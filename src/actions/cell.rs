@@ -12,6 +12,31 @@ pub use super::planning::{PlanCounts, PlanningTally};
 /// Default control period: the tree is ticked every 4 ms of simulated time (2 physics steps).
 pub const CONTROL_PERIOD: f64 = 0.004;
 
+/// Longest control period accepted, seconds.
+pub const MAX_CONTROL_PERIOD: f64 = 0.1;
+
+/// Checks a control period: a whole number, at least one, of 2 ms physics steps
+/// ([`TIMESTEP`]), at most [`MAX_CONTROL_PERIOD`] seconds.
+///
+/// # Errors
+/// [`crate::Error::Config`] stating the rule and the value given.
+pub fn check_control_period(period: f64) -> Result<(), crate::Error> {
+    let steps = period / TIMESTEP;
+    if period.is_finite()
+        && period > 0.0
+        && period <= MAX_CONTROL_PERIOD
+        && steps.round() >= 1.0
+        && (steps - steps.round()).abs() < 1e-9
+    {
+        return Ok(());
+    }
+    Err(crate::Error::Config {
+        message: format!(
+            "control_period must be a whole number (at least 1) of 2 ms physics steps, at most {MAX_CONTROL_PERIOD} s, got {period}"
+        ),
+    })
+}
+
 /// What the arm is doing between ticks.
 enum ArmPlan {
     /// Hold these joint angles (radians).
@@ -29,6 +54,8 @@ enum ArmPlan {
 /// Sees every physics step and every macro action that starts: fault injection acts on the
 /// physics through it, benchmarks record the controls.
 pub trait StepObserver: Send {
+    /// A control period starts under `command` (what the cell holds over it).
+    fn on_period(&mut self, _command: &CellCommand) {}
     /// Called after the controls for the coming physics step are set; may act on the physics
     /// (fault injection) or record the controls.
     fn before_step(&mut self, sim: &mut Sim);
@@ -292,6 +319,9 @@ impl Cell {
     /// world snapshot.
     pub fn advance(&mut self) {
         let command = self.period_command();
+        for obs in &mut self.observers {
+            obs.on_period(&command);
+        }
         for step in 0..self.steps_per_tick {
             let arm = command.arm.at(step as f64 * TIMESTEP);
             self.sim.command_arm(&arm.q, &arm.qd, &arm.qdd);

@@ -25,7 +25,9 @@ mod targets;
 mod tilted;
 
 pub(crate) use carry::Carry as CarryAction;
-pub use cell::{CONTROL_PERIOD, Cell, PlanCounts, PlanningTally, StepObserver};
+pub use cell::{
+    CONTROL_PERIOD, Cell, MAX_CONTROL_PERIOD, PlanCounts, PlanningTally, StepObserver, check_control_period,
+};
 pub use checks::{Checks, ChecksRecorder, pad_block_distance};
 pub(crate) use grasp::Grasp as GraspAction;
 pub(crate) use joints::MoveJoints as MoveJointsAction;

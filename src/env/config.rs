@@ -7,8 +7,7 @@ use crate::error::Error;
 use crate::faults::FaultKind;
 use crate::sim::TIMESTEP;
 
-/// Longest control period accepted, seconds.
-pub const MAX_CONTROL_PERIOD: f64 = 0.1;
+pub use crate::actions::MAX_CONTROL_PERIOD;
 
 /// How a [`super::MacroEnv`] runs.
 #[derive(Debug, Clone, PartialEq)]
@@ -60,19 +59,7 @@ impl EnvConfig {
     /// # Errors
     /// [`Error::Config`] naming the setting and the accepted range.
     pub fn check(&self) -> Result<(), Error> {
-        let steps = self.control_period / TIMESTEP;
-        if !(self.control_period.is_finite()
-            && self.control_period > 0.0
-            && self.control_period <= MAX_CONTROL_PERIOD
-            && (steps - steps.round()).abs() < 1e-9)
-        {
-            return Err(Error::Config {
-                message: format!(
-                    "control_period must be a whole number of 2 ms physics steps, at most {MAX_CONTROL_PERIOD} s, got {}",
-                    self.control_period
-                ),
-            });
-        }
+        crate::actions::check_control_period(self.control_period)?;
         if !(self.max_sim_time.is_finite() && self.max_sim_time > 0.0 && self.max_sim_time <= MAX_SIM_TIME_S)
         {
             return Err(Error::Config {
@@ -94,7 +81,7 @@ mod tests {
     fn out_of_range_settings_are_config_errors() {
         assert!(EnvConfig::default().check().is_ok());
         assert_eq!(EnvConfig::default().steps_per_tick(), 2);
-        for bad in [0.0, -0.004, 0.003, f64::NAN, f64::INFINITY, 0.2] {
+        for bad in [0.0, 1e-300, -0.004, 0.003, f64::NAN, f64::INFINITY, 0.2] {
             let c = EnvConfig {
                 control_period: bad,
                 ..EnvConfig::default()
