@@ -125,6 +125,12 @@ pub(super) fn start(
             "scenarios": config.scenarios,
             "shard": config.shard.map(|s| s.to_string()),
             "fault": config.fault,
+            "action_noise": config.noise.map(|n| serde_json::json!({
+                "joint_sigma_rad": n.joint_sigma,
+                "gripper_sigma": n.gripper_sigma,
+                "hold_s": crate::faults::NOISE_HOLD_S,
+                "labels": "the clean commands; the noise is in what was executed",
+            })),
             "goal": config.goal,
             "max_sim_time_s": config.max_sim_time,
             "fps": args.fps,

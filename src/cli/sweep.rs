@@ -96,6 +96,11 @@ pub struct SweepArgs {
     /// Replace the dataset macrotree wrote earlier at --dataset DIR.
     #[arg(long, requires = "dataset")]
     pub overwrite: bool,
+    /// Noise added to what --dataset's episodes execute, the recorded actions staying the clean
+    /// commands (DART): `JOINT_SIGMA[,GRIPPER_SIGMA]`, radians (at most 0.2) and gripper actuator
+    /// units (at most 100), redrawn every 0.1 s from the episode seed (see docs/datasets.md).
+    #[arg(long, value_name = "SIGMA[,G]", requires = "dataset", conflicts_with = "out", allow_hyphen_values = true, value_parser = crate::faults::ActionNoise::parse)]
+    pub noise: Option<crate::faults::ActionNoise>,
 }
 
 /// Runs `macrotree sweep`.
@@ -119,6 +124,7 @@ pub fn sweep(app: &crate::App, args: SweepArgs) -> Result<(), CliError> {
         seed: args.seed,
         jobs: args.jobs.map_or(0, |j| j as usize),
         fault: args.fault,
+        noise: args.noise,
         goal: args.goal,
         shard,
         max_sim_time: args.max_sim_time,

@@ -48,6 +48,9 @@ pub struct EpisodeConfig {
     pub control_period: f64,
     /// A fault to inject through physics, if any.
     pub fault: Option<crate::faults::FaultKind>,
+    /// Noise added to what the arm and gripper execute, the recorded commands staying clean
+    /// ([`crate::faults::ActionNoise`]); `None`: none.
+    pub noise: Option<crate::faults::ActionNoise>,
     /// What counts as success.
     pub goal: Goal,
     /// Leaves replaced by scripted outcomes (test doubles, see
@@ -132,6 +135,7 @@ impl Default for EpisodeConfig {
             max_sim_time: DEFAULT_MAX_SIM_TIME_S,
             control_period: crate::actions::CONTROL_PERIOD,
             fault: None,
+            noise: None,
             goal: Goal::Scene,
             substitutions: Vec::new(),
             resolved: None,
@@ -185,6 +189,9 @@ pub fn run_in_cell(
     let observers_before = cell.observers.len();
     if let Some(kind) = config.fault {
         cell.observers.push(crate::faults::injector(kind, config.seed));
+    }
+    if let Some(noise) = config.noise {
+        cell.observers.push(noise.injector(config.seed));
     }
     let dt = cell.control_period();
     let resolved = match &config.resolved {

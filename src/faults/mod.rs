@@ -9,6 +9,7 @@
 
 mod bump;
 mod late_bowl;
+mod noise;
 mod nudge;
 mod push;
 mod slip;
@@ -25,6 +26,7 @@ use crate::world::World;
 
 pub use bump::Bump;
 pub use late_bowl::LateBowl;
+pub use noise::{ActionNoise, MAX_GRIPPER_SIGMA, MAX_JOINT_SIGMA, NOISE_HOLD_S};
 pub use nudge::Nudge;
 pub use slip::Slip;
 

@@ -23,6 +23,9 @@ pub struct SweepConfig {
     pub jobs: usize,
     /// A fault injected in every scenario.
     pub fault: Option<FaultKind>,
+    /// Noise added to what every scenario's arm and gripper execute (`sweep --dataset --noise`);
+    /// the recorded commands stay clean.
+    pub noise: Option<crate::faults::ActionNoise>,
     /// What counts as success.
     pub goal: Goal,
     /// Only this shard's scenarios.
@@ -59,6 +62,7 @@ impl Default for SweepConfig {
             seed: 0,
             jobs: 0,
             fault: None,
+            noise: None,
             goal: Goal::default(),
             shard: None,
             max_sim_time: EpisodeConfig::default().max_sim_time,
@@ -105,6 +109,7 @@ impl SweepConfig {
             max_sim_time: self.max_sim_time,
             control_period: CONTROL_PERIOD,
             fault: self.fault,
+            noise: self.noise,
             goal: self.goal,
             substitutions: self.substitutions.clone(),
             resolved: self.resolved.clone(),
@@ -122,6 +127,7 @@ impl SweepConfig {
             max_sim_time: self.max_sim_time,
             control_period: CONTROL_PERIOD,
             fault: self.fault,
+            noise: self.noise,
             goal: self.goal,
             substitutions: self.substitutions.clone(),
             resolved: self.resolved.clone(),

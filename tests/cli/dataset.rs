@@ -273,3 +273,59 @@ fn a_dataset_frame_rate_that_is_not_a_whole_number_of_control_periods_is_refused
         assert!(!out.exists(), "--fps {fps}: nothing is written");
     }
 }
+
+#[test]
+fn a_noisy_dataset_records_its_noise_and_is_the_same_bytes_for_any_jobs() {
+    let dir = scratch("dataset-noise");
+    let (a, b) = (dir.join("a"), dir.join("b"));
+    for (out, jobs) in [(&a, "1"), (&b, "2")] {
+        let o = sweep(&[
+            "--scenarios",
+            "3",
+            "--seed",
+            "2",
+            "--jobs",
+            jobs,
+            "--dataset",
+            s(out),
+            "--cameras",
+            "none",
+            "--noise",
+            "0.02,10",
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    assert_eq!(files(&a), files(&b), "--jobs 1 and --jobs 2 wrote the same bytes");
+    let meta: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(a.join("meta/macrotree.json")).unwrap()).unwrap();
+    let noise = &meta["action_noise"];
+    assert_eq!(noise["joint_sigma_rad"], 0.02, "{meta}");
+    assert_eq!(noise["gripper_sigma"], 10.0, "{meta}");
+}
+
+#[test]
+fn noise_out_of_range_or_without_a_dataset_is_refused() {
+    let dir = scratch("dataset-noise-bad");
+    let out = dir.join("ds");
+    for noise in ["0.5", "-0.01", "0.02,300", "nan", "0.01,1,2"] {
+        let o = sweep(&[
+            "--scenarios",
+            "1",
+            "--dataset",
+            s(&out),
+            "--cameras",
+            "none",
+            "--noise",
+            noise,
+        ]);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "--noise {noise}: {stderr}");
+        assert!(
+            stderr.contains("JOINT_SIGMA[,GRIPPER_SIGMA]"),
+            "--noise {noise}: {stderr}"
+        );
+        assert!(!out.exists());
+    }
+    let o = sweep(&["--scenarios", "1", "--noise", "0.02"]);
+    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+}

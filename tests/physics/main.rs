@@ -5,6 +5,7 @@
 #[path = "../support/mod.rs"]
 mod support;
 
+mod action_noise;
 mod action_roles;
 mod container_packing;
 mod ctrl_replay;
