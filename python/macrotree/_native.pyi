@@ -7,6 +7,7 @@ import numpy as np
 __version__: str
 JOINT_LIMITS: list[tuple[float, float]]
 HOME: list[float]
+MAX_ENVS: int
 CTRL_NAMES: list[str]
 CTRL_LOW: list[float]
 CTRL_HIGH: list[float]

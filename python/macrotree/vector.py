@@ -26,8 +26,8 @@ from macrotree.spaces import (
     observation_space,
 )
 
-#: Most sub-environments one ``VectorEnv`` takes.
-MAX_ENVS = 1024
+#: Most sub-environments one ``VectorEnv`` takes (the extension's ``MAX_ENVS``).
+MAX_ENVS: int = _native.MAX_ENVS
 
 
 def _stack(items: Sequence[dict[str, Any]]) -> dict[str, Any]:

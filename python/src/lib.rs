@@ -25,6 +25,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
             .collect::<Vec<_>>(),
     )?;
     m.add("HOME", macrotree::motion::HOME_Q.to_vec())?;
+    m.add("MAX_ENVS", macrotree::env::MAX_ENVS)?;
     m.add("CTRL_NAMES", macrotree::motion::COMMAND_NAMES.to_vec())?;
     let (low, high) = ctrl_bounds();
     m.add("CTRL_LOW", low)?;

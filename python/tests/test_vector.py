@@ -10,7 +10,8 @@ import pytest
 from gymnasium.vector import AutoresetMode
 
 import macrotree
-from macrotree import MacroMode
+import macrotree.vector
+from macrotree import MacroMode, _native
 
 
 def scene(data: Path) -> str:
@@ -75,3 +76,10 @@ def test_disabled_autoreset_takes_a_reset_mask(data: Path) -> None:
     assert np.array_equal(again["agent_pos"][1], stepped["agent_pos"][1])
     assert list(info["_is_success"]) == [True, False]
     vec.close()
+
+
+def test_num_envs_is_bounded_by_the_extensions_maximum(data: Path) -> None:
+    assert macrotree.vector.MAX_ENVS == _native.MAX_ENVS == 1024
+    for bad in (0, _native.MAX_ENVS + 1):
+        with pytest.raises(ValueError, match="num_envs"):
+            macrotree.VectorEnv(scene(data), num_envs=bad)

@@ -17,7 +17,7 @@ use crate::plan::Plan;
 use crate::sim::Scene;
 
 /// Most environments in one [`VecEnv`].
-pub const MAX_ENVS: usize = 4096;
+pub const MAX_ENVS: usize = 1024;
 
 /// A step to run: the environment and its action.
 type Job = (usize, Action);
