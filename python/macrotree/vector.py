@@ -287,8 +287,11 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
             self._last_obs[i] = o
         info = _batch_infos(infos)
         if ended and self.autoreset_mode == AutoresetMode.SAME_STEP:
+            # Gymnasium 1.x: ``final_obs`` an object array, ``final_info`` the ended
+            # sub-environments' infos batched like any info (``final_info["is_success"]`` and its
+            # mask ``final_info["_is_success"]``), each with its ``_key`` mask.
             info["final_obs"] = np.array(final_obs, dtype=object)
-            info["final_info"] = np.array(final_info, dtype=object)
+            info["final_info"] = _batch_infos(final_info)
             info["_final_obs"] = np.array([x is not None for x in final_obs], dtype=bool)
             info["_final_info"] = info["_final_obs"].copy()
         return _stack(observations), rewards, terminated, truncated, info

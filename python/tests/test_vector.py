@@ -63,6 +63,11 @@ def test_same_step_autoreset_returns_the_final_observation(data: Path) -> None:
     _, _, _, truncated, info = vec.step([{"mode": int(MacroMode.WAIT), "steps": [10]}] * 2)
     assert truncated.all()
     assert info["_final_obs"].all()
+    # Gymnasium 1.x's layout, which LeRobot's evaluation reads: a dict of arrays with masks.
+    final = info["final_info"]
+    assert isinstance(final, dict)
+    assert final["is_success"].dtype == bool and final["_is_success"].all()
+    assert not final["is_success"].any()
     vec.close()
 
 
