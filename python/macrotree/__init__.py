@@ -1,7 +1,7 @@
 """macrotree from Python: a step-wise macro-action environment for a MuJoCo UR5e + Robotiq 2F-85.
 
 * :class:`MacroEnv`: a ``gymnasium.Env``; one ``step`` runs one macro action (the reference
-  tutorial's ``RobotMacroAction``), one control period of a 7-D joint + gripper target, any
+  tutorial's ``RobotMacroAction``), one control period of the 19-D command every leaf gives, any
   registered leaf (:meth:`MacroEnv.step_leaf`), or a named subtree (:meth:`MacroEnv.step_subtree`).
 * :class:`VectorEnv`: N cells stepped on Rust threads, with envpool-style ``send``/``recv``.
 * Gymnasium ids (registered on import): ``macrotree/CubeToBowl-v0``, ``macrotree/SortByColor-v0``,
@@ -16,7 +16,7 @@ from macrotree._library import SetupError, prepare
 
 prepare()
 
-from macrotree._native import MacrotreeError, __version__  # noqa: E402
+from macrotree._native import CTRL_NAMES, STATE_NAMES, MacrotreeError, __version__  # noqa: E402
 from macrotree.env import MacroEnv  # noqa: E402
 from macrotree.registration import register_envs  # noqa: E402
 from macrotree.spaces import Gripper, MacroMode  # noqa: E402
@@ -25,6 +25,8 @@ from macrotree.vector import VectorEnv  # noqa: E402
 register_envs()
 
 __all__ = [
+    "CTRL_NAMES",
+    "STATE_NAMES",
     "Gripper",
     "MacroEnv",
     "MacroMode",

@@ -9,8 +9,10 @@ JOINT_LIMITS: list[tuple[float, float]]
 HOME: list[float]
 MAX_ENVS: int
 CTRL_NAMES: list[str]
+STATE_NAMES: list[str]
 CTRL_LOW: list[float]
 CTRL_HIGH: list[float]
+RESIDUAL_HIGH: list[float]
 
 class MacrotreeError(Exception):
     """Invalid input: the message is located (``file:line:column``) and says what to do."""
@@ -36,6 +38,7 @@ class Env:
         image_size: tuple[int, int],
         frame_rate: float | None,
         render_camera: str | None,
+        noise: str | None = None,
     ) -> None: ...
     def reset(
         self,
@@ -49,6 +52,7 @@ class Env:
     def step_macro(self, action: dict[str, Any]) -> dict[str, Any]: ...
     def step_ctrl(self, ctrl: np.ndarray) -> dict[str, Any]: ...
     def step_setpoint(self, setpoint: np.ndarray) -> dict[str, Any]: ...
+    def step_residual(self, residual: np.ndarray) -> dict[str, Any]: ...
     def step_leaf(self, text: str) -> dict[str, Any]: ...
     def step_subtree(self, name: str) -> dict[str, Any]: ...
     def observation(self) -> dict[str, Any]: ...
@@ -72,6 +76,7 @@ class VecEnv:
         fault: str | None,
         cameras: list[str],
         image_size: tuple[int, int],
+        noise: str | None = None,
     ) -> None: ...
     def reset(
         self,

@@ -3,7 +3,8 @@
 One ``step`` runs one macro action to completion on simulated time, closed loop inside the action
 (``action_mode="macro"``), or commands the arm and gripper for one control period: the 19-D
 command every leaf gives and a dataset's ``action`` records (``action_mode="ctrl"``), or plain
-7-D set points (``action_mode="setpoint"``). Any registered leaf runs through
+7-D set points (``action_mode="setpoint"``), or adds a 7-D correction to the command the tree
+gives in that period (``action_mode="residual"``, residual RL). Any registered leaf runs through
 :meth:`MacroEnv.step_leaf`, a named subtree through :meth:`MacroEnv.step_subtree`. Everything
 heavy happens in Rust with the GIL released; this class converts arguments and results.
 """
@@ -20,17 +21,25 @@ import numpy as np
 
 from macrotree import _native
 from macrotree.spaces import (
+    OBSERVATION_KEYS,
     ctrl_action_space,
     macro_action_space,
     macro_to_native,
     observation_space,
+    residual_action_space,
     setpoint_action_space,
+    with_keys,
 )
 
-ActionMode = Literal["macro", "ctrl", "setpoint"]
+ActionMode = Literal["macro", "ctrl", "setpoint", "residual"]
 
 #: Every action mode, and the shape of its array actions (``None`` for the macro ``Dict``).
-ACTION_MODES: dict[str, tuple[int, ...] | None] = {"macro": None, "ctrl": (19,), "setpoint": (7,)}
+ACTION_MODES: dict[str, tuple[int, ...] | None] = {
+    "macro": None,
+    "ctrl": (19,),
+    "setpoint": (7,),
+    "residual": (7,),
+}
 Observation = dict[str, Any]
 StepReturn = tuple[Observation, SupportsFloat, bool, bool, dict[str, Any]]
 
@@ -52,7 +61,13 @@ class MacroEnv(gym.Env[Observation, Any]):
             ``"ctrl"`` (``Box(19)``: six joint set points in radians, six velocities in rad/s,
             six accelerations in rad/s² and the gripper command 0…255 for one control period —
             what every leaf commands and a dataset's ``action`` column records) or
-            ``"setpoint"`` (``Box(7)``: six set points and the gripper command, zero velocity).
+            ``"setpoint"`` (``Box(7)``: six set points and the gripper command, zero velocity)
+            or ``"residual"`` (``Box(7)``: each step runs one control period of the base tree
+            and adds these offsets — six joint set points in radians, ±0.1, and the gripper
+            command, ±255 — to the command the tree gives; ``info["base_action"]`` holds the
+            tree's command, ``info["base_status"]`` its status; a zero residual replays the
+            scripted episode bit for bit).
+        base: the base tree of ``"residual"`` (default: ``tree``, the id's own tree).
         render_mode: ``None``, ``"rgb_array"`` (``render()`` gives an H×W×3 ``uint8`` image of
             ``render_camera`` now) or ``"rgb_array_list"`` (``render()`` gives the frames sampled
             at ``render_fps`` of simulated time during the steps since the last call).
@@ -64,6 +79,12 @@ class MacroEnv(gym.Env[Observation, Any]):
         max_sim_time: simulated seconds after which an episode is truncated.
         fault: a fault injected through physics (``slip``, ``nudge``, …), or ``None``.
         render_fps: frames per simulated second of ``rgb_array_list`` (``metadata["render_fps"]``).
+        noise: DART-style noise on what the arm and gripper execute, as ``sweep --dataset
+            --noise`` takes it: ``"JOINT_SIGMA[,GRIPPER_SIGMA]"`` (radians, actuator units) or a
+            pair; seeded per episode; the leaves' and the base tree's commands stay clean.
+        observation_keys: ``"gym"`` (``agent_pos``, ``environment_state``, ``pinch``,
+            ``pixels``) or ``"lerobot"`` (``observation.state``, ``observation.environment_state``,
+            ``observation.images.<camera>``: a LeRobot dataset's keys).
     """
 
     metadata: dict[str, Any] = {  # noqa: RUF012  (Gymnasium declares it so)
@@ -77,6 +98,7 @@ class MacroEnv(gym.Env[Observation, Any]):
         tree: str | os.PathLike[str] | None = None,
         *,
         action_mode: ActionMode = "macro",
+        base: str | os.PathLike[str] | None = None,
         render_mode: str | None = None,
         cameras: tuple[str, ...] | list[str] = (),
         image_size: tuple[int, int] = (240, 320),
@@ -85,11 +107,11 @@ class MacroEnv(gym.Env[Observation, Any]):
         max_sim_time: float = 120.0,
         fault: str | None = None,
         render_fps: int = 30,
+        noise: str | tuple[float, float] | None = None,
+        observation_keys: str = "gym",
     ) -> None:
-        if action_mode not in ACTION_MODES:
-            raise ValueError(
-                f"action_mode must be 'macro', 'ctrl' or 'setpoint', got {action_mode!r}"
-            )
+        tree = _base_tree(action_mode, tree, base)
+        _check_keys(observation_keys)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
                 f"render_mode must be None or one of {self.metadata['render_modes']}, "
@@ -107,7 +129,9 @@ class MacroEnv(gym.Env[Observation, Any]):
             image_size=(int(image_size[0]), int(image_size[1])),
             frame_rate=float(render_fps) if render_mode == "rgb_array_list" else None,
             render_camera=render_camera,
+            noise=_noise_text(noise),
         )
+        self.observation_keys = observation_keys
         self.metadata = {**self.metadata, "render_fps": int(render_fps)}
         self.action_mode: ActionMode = action_mode
         self.render_mode = render_mode
@@ -116,7 +140,7 @@ class MacroEnv(gym.Env[Observation, Any]):
         self.render_camera = render_camera
         self.object_names: list[str] = list(self._native.object_names)
         self.observation_space = observation_space(
-            len(self.object_names), self.cameras, self.image_size
+            len(self.object_names), self.cameras, self.image_size, observation_keys
         )
         self.action_space = action_space(action_mode)
         # LeRobot's environment contract.
@@ -156,7 +180,7 @@ class MacroEnv(gym.Env[Observation, Any]):
             placement=options.get("placement"),
         )
         self._last_info = dict(result["info"])
-        return result["obs"], dict(result["info"])
+        return with_keys(result["obs"], self.observation_keys), dict(result["info"])
 
     def step(self, action: Any) -> StepReturn:
         """Runs one action: a macro to completion, or one control period of ``ctrl``."""
@@ -171,8 +195,10 @@ class MacroEnv(gym.Env[Observation, Any]):
                 )
             if self.action_mode == "ctrl":
                 result = self._native.step_ctrl(values)
-            else:
+            elif self.action_mode == "setpoint":
                 result = self._native.step_setpoint(values)
+            else:
+                result = self._native.step_residual(values)
         return self._unpack(result)
 
     def render(self) -> Any:
@@ -236,7 +262,7 @@ class MacroEnv(gym.Env[Observation, Any]):
         info = dict(result["info"])
         self._last_info = info
         return (
-            result["obs"],
+            with_keys(result["obs"], self.observation_keys),
             float(result["reward"]),
             bool(result["terminated"]),
             bool(result["truncated"]),
@@ -250,4 +276,40 @@ def action_space(action_mode: str) -> gym.Space[Any]:
         return ctrl_action_space()
     if action_mode == "setpoint":
         return setpoint_action_space()
+    if action_mode == "residual":
+        return residual_action_space()
     return macro_action_space()
+
+
+def _base_tree(
+    action_mode: str,
+    tree: str | os.PathLike[str] | None,
+    base: str | os.PathLike[str] | None,
+) -> str | os.PathLike[str] | None:
+    """The tree of an environment: ``base`` for the residual mode when given, else ``tree``;
+    raises ``ValueError`` for an unknown mode, a ``base`` outside the residual mode, or a
+    residual mode without a tree."""
+    if action_mode not in ACTION_MODES:
+        raise ValueError(f"action_mode must be one of {list(ACTION_MODES)}, got {action_mode!r}")
+    if base is not None and action_mode != "residual":
+        raise ValueError(f"base= is the residual mode's base tree; action_mode is {action_mode!r}")
+    if action_mode == "residual":
+        tree = base if base is not None else tree
+        if tree is None:
+            raise ValueError("action_mode='residual' needs a base tree: give tree= or base=")
+    return tree
+
+
+def _check_keys(observation_keys: str) -> None:
+    if observation_keys not in OBSERVATION_KEYS:
+        raise ValueError(
+            f"observation_keys must be one of {list(OBSERVATION_KEYS)}, got {observation_keys!r}"
+        )
+
+
+def _noise_text(noise: str | tuple[float, float] | None) -> str | None:
+    """``noise`` as the extension reads it (``"JOINT_SIGMA[,GRIPPER_SIGMA]"``)."""
+    if noise is None or isinstance(noise, str):
+        return noise
+    joint, gripper = noise
+    return f"{float(joint)!r},{float(gripper)!r}"

@@ -5,7 +5,8 @@ to a ``Composite``; it has no converter for ``OneOf``). The ``ctrl`` action is a
 command every leaf gives and a dataset's ``action`` records — six joint set points (rad), six
 joint velocities (rad/s), six joint accelerations (rad/s²) and the gripper command — for one
 control period. The ``setpoint`` action is a ``Box(7)``: six set points and the gripper command,
-with zero velocity and acceleration.
+with zero velocity and acceleration. The ``residual`` action is a ``Box(7)``: offsets added to the
+base tree's six set points (radians) and gripper command for one control period.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from typing import Any
 import numpy as np
 from gymnasium import spaces
 
-from macrotree._native import CTRL_HIGH, CTRL_LOW, JOINT_LIMITS
+from macrotree._native import CTRL_HIGH, CTRL_LOW, JOINT_LIMITS, RESIDUAL_HIGH, STATE_NAMES
 
 #: Largest ``steps`` or ``settle_steps`` of one macro (control periods; 6000 = 60 s at 10 ms).
 #: ``steps = 0`` runs the macro closed loop: until its motion is done and the arm has settled.
@@ -114,25 +115,69 @@ def setpoint_action_space() -> spaces.Box:
     return spaces.Box(low, high, dtype=np.float32)
 
 
-def observation_space(objects: int, cameras: list[str], image_size: tuple[int, int]) -> spaces.Dict:
-    """Observations: ``agent_pos`` (the dataset's ``observation.state``: six joint angles and the
-    gripper closure, radians), ``environment_state`` (every object's x, y, z, qw, qx, qy, qz in
-    scene order: the dataset's ``observation.environment_state``), ``pinch`` (the gripper's pinch
-    point and orientation: x, y, z, qw, qx, qy, qz), and ``pixels`` (one H×W×3 ``uint8`` image per
-    camera) when
-    cameras are asked for."""
+def residual_action_space() -> spaces.Box:
+    """The ``residual`` action space, from the extension's bounds: offsets of the six joint set
+    points (±0.1 rad) and of the gripper command (±255) added to the base tree's command for one
+    control period. Values beyond it are clamped (``info["ctrl_clamped"]`` counts them)."""
+    bounds = [_inside_f32(-hi, hi) for hi in RESIDUAL_HIGH]
+    low = np.array([lo for lo, _ in bounds], dtype=np.float32)
+    high = np.array([hi for _, hi in bounds], dtype=np.float32)
+    return spaces.Box(low, high, dtype=np.float32)
+
+
+#: The observation key layouts: Gymnasium's (``agent_pos``, ``environment_state``, ``pinch``,
+#: ``pixels``; what LeRobot's ``preprocess_observation`` and its env plugins read) or LeRobot's
+#: dataset keys (``observation.state``, ``observation.environment_state``,
+#: ``observation.images.<camera>``; what a policy trained on a macrotree dataset takes).
+OBSERVATION_KEYS = ("gym", "lerobot")
+
+
+def observation_space(
+    objects: int, cameras: list[str], image_size: tuple[int, int], keys: str = "gym"
+) -> spaces.Dict:
+    """Observations: ``agent_pos`` (the dataset's ``observation.state``, named by
+    ``STATE_NAMES``: six joint angles and the gripper closure in radians, six joint velocities in
+    rad/s, the pinch point in metres and its orientation qw, qx, qy, qz), ``environment_state``
+    (every object's x, y, z, qw, qx, qy, qz in scene order: the dataset's
+    ``observation.environment_state``), ``pinch`` (the gripper's pinch point and orientation: x,
+    y, z, qw, qx, qy, qz), and ``pixels`` (one H×W×3 ``uint8`` image per camera) when cameras are
+    asked for. With ``keys="lerobot"`` the same arrays under the dataset's keys (see
+    :data:`OBSERVATION_KEYS`; ``pinch`` is part of the state)."""
     f32 = np.float32
+    state = spaces.Box(-np.inf, np.inf, (len(STATE_NAMES),), f32)
+    environment = spaces.Box(-np.inf, np.inf, (7 * objects,), f32)
+    h, w = image_size
+    if keys == "lerobot":
+        lerobot: dict[str, spaces.Space[Any]] = {
+            "observation.state": state,
+            "observation.environment_state": environment,
+        }
+        for c in cameras:
+            lerobot[f"observation.images.{c}"] = spaces.Box(0, 255, (h, w, 3), np.uint8)
+        return spaces.Dict(lerobot)
     fields: dict[str, spaces.Space[Any]] = {
-        "agent_pos": spaces.Box(-np.inf, np.inf, (7,), f32),
-        "environment_state": spaces.Box(-np.inf, np.inf, (7 * objects,), f32),
+        "agent_pos": state,
+        "environment_state": environment,
         "pinch": spaces.Box(-np.inf, np.inf, (7,), f32),
     }
     if cameras:
-        h, w = image_size
         fields["pixels"] = spaces.Dict(
             {c: spaces.Box(0, 255, (h, w, 3), np.uint8) for c in cameras}
         )
     return spaces.Dict(fields)
+
+
+def with_keys(obs: dict[str, Any], keys: str) -> dict[str, Any]:
+    """An observation (Gymnasium keys, as the extension gives it) under the layout ``keys``."""
+    if keys != "lerobot":
+        return obs
+    out = {
+        "observation.state": obs["agent_pos"],
+        "observation.environment_state": obs["environment_state"],
+    }
+    for camera, image in obs.get("pixels", {}).items():
+        out[f"observation.images.{camera}"] = image
+    return out
 
 
 def _vector(value: Any, n: int, name: str) -> list[float]:

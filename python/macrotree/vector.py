@@ -20,10 +20,21 @@ from gymnasium.vector import VectorEnv as GymVectorEnv
 from gymnasium.vector.utils import batch_space
 
 from macrotree import _native
-from macrotree.env import ACTION_MODES, RESET_OPTIONS, ActionMode, MacroEnv, _path, action_space
+from macrotree.env import (
+    ACTION_MODES,
+    RESET_OPTIONS,
+    ActionMode,
+    MacroEnv,
+    _base_tree,
+    _check_keys,
+    _noise_text,
+    _path,
+    action_space,
+)
 from macrotree.spaces import (
     macro_to_native,
     observation_space,
+    with_keys,
 )
 
 #: Most sub-environments one ``VectorEnv`` takes (the extension's ``MAX_ENVS``).
@@ -41,8 +52,9 @@ def _stack(items: Sequence[dict[str, Any]]) -> dict[str, Any]:
 
 
 def _batch_infos(infos: Sequence[dict[str, Any] | None]) -> dict[str, Any]:
-    """Gymnasium's vector info layout: each key an array over sub-environments, with a boolean
-    mask ``_key`` saying which sub-environments gave it."""
+    """Gymnasium's vector info layout: each key an array over sub-environments (arrays of one
+    shape stacked, e.g. ``base_action`` as ``(n, 19)``), with a boolean mask ``_key`` saying
+    which sub-environments gave it."""
     n = len(infos)
     out: dict[str, Any] = {}
     for i, info in enumerate(infos):
@@ -56,10 +68,19 @@ def _batch_infos(infos: Sequence[dict[str, Any] | None]) -> dict[str, Any]:
                     out[key] = np.zeros(n, dtype=np.int64)
                 elif isinstance(value, (float, np.floating)):
                     out[key] = np.zeros(n, dtype=np.float64)
+                elif isinstance(value, np.ndarray):
+                    out[key] = np.zeros((n, *value.shape), dtype=value.dtype)
                 else:
                     out[key] = np.full(n, None, dtype=object)
                 out[f"_{key}"] = np.zeros(n, dtype=bool)
-            out[key][i] = value
+            column = out[key]
+            if column.ndim > 1 and np.shape(value) != column.shape[1:]:
+                # Arrays of different shapes (per-tick rewards of steps of different lengths).
+                ragged = np.full(n, None, dtype=object)
+                for k in np.flatnonzero(out[f"_{key}"]):
+                    ragged[k] = column[k]
+                out[key] = column = ragged
+            column[i] = value
             out[f"_{key}"][i] = True
     return out
 
@@ -86,6 +107,7 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         *,
         num_envs: int = 2,
         action_mode: ActionMode = "macro",
+        base: str | os.PathLike[str] | None = None,
         autoreset_mode: AutoresetMode | str = AutoresetMode.SAME_STEP,
         render_mode: str | None = None,
         cameras: tuple[str, ...] | list[str] = (),
@@ -94,6 +116,8 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         max_sim_time: float = 120.0,
         fault: str | None = None,
         threads: int | None = None,
+        noise: str | tuple[float, float] | None = None,
+        observation_keys: str = "gym",
     ) -> None:
         if not 1 <= int(num_envs) <= MAX_ENVS:
             raise ValueError(f"num_envs must be 1…{MAX_ENVS}, got {num_envs}")
@@ -103,10 +127,9 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
                 "autoreset_mode must be SAME_STEP or DISABLED (TorchRL refuses NEXT_STEP), "
                 f"got {mode}"
             )
-        if action_mode not in ACTION_MODES:
-            raise ValueError(
-                f"action_mode must be 'macro', 'ctrl' or 'setpoint', got {action_mode!r}"
-            )
+        tree = _base_tree(action_mode, tree, base)
+        _check_keys(observation_keys)
+        self.observation_keys = observation_keys
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         if scene is None and tree is None:
@@ -127,10 +150,11 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
             fault=fault,
             cameras=list(cameras),
             image_size=self.image_size,
+            noise=_noise_text(noise),
         )
         self.object_names: list[str] = list(self._native.object_names)
         self.single_observation_space = observation_space(
-            len(self.object_names), list(cameras), self.image_size
+            len(self.object_names), list(cameras), self.image_size, observation_keys
         )
         self.single_action_space = action_space(action_mode)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
@@ -239,7 +263,7 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
                     f"{self.action_mode} actions must have shape ({n}, {shape[0]}), "
                     f"got {array.shape}"
                 )
-            return [row for row in array]
+            return [(self.action_mode, row) for row in array]
         if isinstance(actions, dict):
             return [
                 macro_to_native({k: np.asarray(v)[i] for k, v in actions.items()}) for i in range(n)
@@ -256,7 +280,7 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         observation and info, the others their last observation and no info."""
         infos: list[dict[str, Any] | None] = [None] * self.num_envs
         for i, r in zip(ids, results, strict=True):
-            self._last_obs[i] = r["obs"]
+            self._last_obs[i] = with_keys(r["obs"], self.observation_keys)
             infos[i] = dict(r["info"])
         missing = [i for i, o in enumerate(self._last_obs) if o is None]
         if missing:
@@ -269,7 +293,7 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         rewards = np.array([float(r["reward"]) for r in results], dtype=np.float64)
         terminated = np.array([bool(r["terminated"]) for r in results], dtype=bool)
         truncated = np.array([bool(r["truncated"]) for r in results], dtype=bool)
-        observations = [r["obs"] for r in results]
+        observations = [with_keys(r["obs"], self.observation_keys) for r in results]
         infos: list[dict[str, Any] | None] = [dict(r["info"]) for r in results]
         ended = [k for k in range(len(ids)) if terminated[k] or truncated[k]]
         final_obs: list[Any] = [None] * len(ids)
@@ -281,7 +305,7 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
             for k, r in zip(ended, again, strict=True):
                 final_obs[k] = observations[k]
                 final_info[k] = infos[k]
-                observations[k] = r["obs"]
+                observations[k] = with_keys(r["obs"], self.observation_keys)
                 infos[k] = dict(r["info"])
         for i, o in zip(ids, observations, strict=True):
             self._last_obs[i] = o

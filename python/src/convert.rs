@@ -128,6 +128,15 @@ pub fn step_result<'py>(
     info.set_item("sim_time", r.sim_time)?;
     info.set_item("physics_steps", r.physics_steps)?;
     info.set_item("ctrl_clamped", r.ctrl_clamped)?;
+    if let Some(base) = &r.base {
+        info.set_item("base_action", base.command.to_vec().into_pyarray(py))?;
+        let status = match base.status {
+            macrotree::runtime::TreeStatus::Running => "running",
+            macrotree::runtime::TreeStatus::Success => "success",
+            macrotree::runtime::TreeStatus::Failure => "failure",
+        };
+        info.set_item("base_status", status)?;
+    }
     info.set_item("goal_steps", r.goal_ticks)?;
     let collisions: Vec<&str> = r.collisions.iter().map(|c| c.what.as_str()).collect();
     info.set_item("collisions", collisions)?;

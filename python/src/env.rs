@@ -137,7 +137,7 @@ pub fn sizes(env: &MacroEnv) -> Vec<[f64; 3]> {
 #[pymethods]
 impl Env {
     #[new]
-    #[pyo3(signature = (*, scene, tree, control_period, max_sim_time, fault, cameras, image_size, frame_rate=None, render_camera=None))]
+    #[pyo3(signature = (*, scene, tree, control_period, max_sim_time, fault, cameras, image_size, frame_rate=None, render_camera=None, noise=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -150,6 +150,7 @@ impl Env {
         image_size: (u32, u32),
         frame_rate: Option<f64>,
         render_camera: Option<String>,
+        noise: Option<String>,
     ) -> PyResult<Self> {
         let settings = Settings {
             scene: scene.as_deref(),
@@ -157,6 +158,7 @@ impl Env {
             control_period,
             max_sim_time,
             fault: fault.as_deref(),
+            noise: noise.as_deref(),
         };
         let parts = py.detach(|| setup::build(&settings))?;
         let task = parts.scene.spec.name.clone();
@@ -267,19 +269,15 @@ impl Env {
     }
 
     fn step_ctrl(&self, py: Python<'_>, ctrl: PyReadonlyArray1<'_, f64>) -> PyResult<Py<PyDict>> {
-        let u: [f64; macrotree::motion::COMMAND_LEN] = ctrl
-            .as_slice()?
-            .try_into()
-            .map_err(|_| value("a ctrl action has 19 values"))?;
-        self.step(py, Action::Ctrl(u))
+        self.step(py, array_action("ctrl", ctrl.as_slice()?)?)
     }
 
     fn step_setpoint(&self, py: Python<'_>, setpoint: PyReadonlyArray1<'_, f64>) -> PyResult<Py<PyDict>> {
-        let u: [f64; 7] = setpoint
-            .as_slice()?
-            .try_into()
-            .map_err(|_| value("a setpoint action has 7 values"))?;
-        self.step(py, Action::Setpoint(u))
+        self.step(py, array_action("setpoint", setpoint.as_slice()?)?)
+    }
+
+    fn step_residual(&self, py: Python<'_>, residual: PyReadonlyArray1<'_, f64>) -> PyResult<Py<PyDict>> {
+        self.step(py, array_action("residual", residual.as_slice()?)?)
     }
 
     fn step_leaf(&self, py: Python<'_>, text: String) -> PyResult<Py<PyDict>> {
@@ -349,5 +347,22 @@ impl Env {
 
     fn gripper_command_for_width(&self, width: f64) -> PyResult<f64> {
         crate::gripper_command_for_width(width)
+    }
+}
+
+/// The action of an array mode: `"ctrl"` (19 values), `"setpoint"` (7) or `"residual"` (7).
+pub fn array_action(mode: &str, u: &[f64]) -> PyResult<Action> {
+    let wrong = |n: usize| value(format!("a {mode} action has {n} values, got {}", u.len()));
+    match mode {
+        "ctrl" => Ok(Action::Ctrl(
+            u.try_into().map_err(|_| wrong(macrotree::motion::COMMAND_LEN))?,
+        )),
+        "setpoint" => Ok(Action::Setpoint(u.try_into().map_err(|_| wrong(7))?)),
+        "residual" => Ok(Action::Residual(
+            u.try_into().map_err(|_| wrong(macrotree::env::RESIDUAL_LEN))?,
+        )),
+        other => Err(value(format!(
+            "unknown action mode `{other}`; expected ctrl, setpoint or residual"
+        ))),
     }
 }

@@ -27,9 +27,14 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("HOME", macrotree::motion::HOME_Q.to_vec())?;
     m.add("MAX_ENVS", macrotree::env::MAX_ENVS)?;
     m.add("CTRL_NAMES", macrotree::motion::COMMAND_NAMES.to_vec())?;
+    m.add("STATE_NAMES", macrotree::env::STATE_NAMES.to_vec())?;
     let (low, high) = ctrl_bounds();
     m.add("CTRL_LOW", low)?;
     m.add("CTRL_HIGH", high)?;
+    let r = macrotree::env::RESIDUAL_LIMITS;
+    let mut residual_high = vec![r.max_joint_offset; 6];
+    residual_high.push(r.max_gripper_offset);
+    m.add("RESIDUAL_HIGH", residual_high)?;
     m.add_function(wrap_pyfunction!(gripper_command_for_width, m)?)?;
     m.add_function(wrap_pyfunction!(video::write_mp4, m)?)?;
     m.add_class::<env::Env>()?;

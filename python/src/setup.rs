@@ -26,6 +26,8 @@ pub struct Settings<'a> {
     pub control_period: f64,
     pub max_sim_time: f64,
     pub fault: Option<&'a str>,
+    /// `JOINT_SIGMA[,GRIPPER_SIGMA]`, as `sweep --noise` reads it.
+    pub noise: Option<&'a str>,
 }
 
 /// Loads the scene (a file, or the tree's `scene:`) and the tree (checked against that scene).
@@ -62,10 +64,17 @@ pub fn build(s: &Settings<'_>) -> PyResult<Parts> {
         None => None,
         Some(name) => Some(name.parse().map_err(|e: String| value(e))?),
     };
+    let noise = match s.noise {
+        None => None,
+        Some(text) => {
+            Some(macrotree::faults::ActionNoise::parse(text).map_err(|e| value(format!("noise: {e}")))?)
+        }
+    };
     let config = EnvConfig {
         control_period: s.control_period,
         max_sim_time: s.max_sim_time,
         fault,
+        noise,
         ..EnvConfig::default()
     };
     config.check().map_err(to_py)?;

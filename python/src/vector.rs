@@ -23,22 +23,16 @@ pub struct VecEnv {
     image: (u32, u32),
 }
 
-/// An action from Python: a macro dict, a 19-value `ctrl` array or a 7-value `setpoint` array.
+/// An action from Python: a macro dict, or `(mode, values)` with `mode` `"ctrl"` (19 float64
+/// values), `"setpoint"` (7) or `"residual"` (7).
 fn action_of(a: &Bound<'_, PyAny>) -> PyResult<Action> {
     if let Ok(d) = a.cast::<PyDict>() {
         return Ok(Action::Primitive(macro_action::primitive(d)?));
     }
-    let array: PyReadonlyArray1<'_, f64> = a
-        .extract()
-        .map_err(|_| value("an action is a macro dict, 19 float64 ctrl values or 7 setpoint values"))?;
-    let u = array.as_slice()?;
-    if let Ok(ctrl) = <[f64; macrotree::motion::COMMAND_LEN]>::try_from(u) {
-        return Ok(Action::Ctrl(ctrl));
-    }
-    let setpoint: [f64; 7] = u
-        .try_into()
-        .map_err(|_| value("a ctrl action has 19 values and a setpoint action 7"))?;
-    Ok(Action::Setpoint(setpoint))
+    let (mode, array): (String, PyReadonlyArray1<'_, f64>) = a.extract().map_err(|_| {
+        value("an action is a macro dict or (mode, float64 values) with mode ctrl, setpoint or residual")
+    })?;
+    crate::env::array_action(&mode, array.as_slice()?)
 }
 
 type Guard<'a> = std::sync::MutexGuard<'a, macrotree::env::VecEnv>;
@@ -73,7 +67,7 @@ impl VecEnv {
 #[pymethods]
 impl VecEnv {
     #[new]
-    #[pyo3(signature = (*, num_envs, threads, scene, tree, control_period, max_sim_time, fault, cameras, image_size))]
+    #[pyo3(signature = (*, num_envs, threads, scene, tree, control_period, max_sim_time, fault, cameras, image_size, noise=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -86,6 +80,7 @@ impl VecEnv {
         fault: Option<String>,
         cameras: Vec<String>,
         image_size: (u32, u32),
+        noise: Option<String>,
     ) -> PyResult<Self> {
         let settings = Settings {
             scene: scene.as_deref(),
@@ -93,6 +88,7 @@ impl VecEnv {
             control_period,
             max_sim_time,
             fault: fault.as_deref(),
+            noise: noise.as_deref(),
         };
         let parts = py.detach(|| setup::build(&settings))?;
         let names = parts.scene.spec.objects.iter().map(|o| o.name.clone()).collect();

@@ -1,4 +1,4 @@
-"""Gymnasium's own checker on every registered id, in both action modes."""
+"""Gymnasium's own checker on every registered id, in every action mode."""
 
 from __future__ import annotations
 
@@ -14,12 +14,14 @@ import macrotree
 from macrotree.registration import GENERIC_ID, SHIPPED
 
 
-@pytest.mark.parametrize("action_mode", ["macro", "ctrl", "setpoint"])
+@pytest.mark.parametrize("action_mode", ["macro", "ctrl", "setpoint", "residual"])
 @pytest.mark.parametrize("env_id", [*SHIPPED, GENERIC_ID])
 def test_check_env_passes(env_id: str, action_mode: str, data: Path) -> None:
     kwargs: dict[str, Any] = {"action_mode": action_mode}
     if env_id == GENERIC_ID:
         kwargs["scene"] = str(data / "scenes/cube_bowl.yaml")
+        if action_mode == "residual":
+            kwargs["base"] = str(data / "trees/cube_to_bowl.yaml")
     env = gym.make(env_id, **kwargs)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

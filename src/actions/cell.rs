@@ -309,6 +309,15 @@ impl Cell {
         command
     }
 
+    /// Replaces the command of the control period starting now (call it after the tick that
+    /// set the period's command, before [`Cell::advance`]): the physics runs `command` for
+    /// this one period, while the arm's trajectory or hold and the gripper command stay as the
+    /// leaves set them — the next period's command is theirs again. The environment's residual
+    /// mode adds its correction this way.
+    pub fn override_period_command(&mut self, command: CellCommand) {
+        self.pending = Some(command);
+    }
+
     /// The command of the last control period the physics ran, `None` before the first.
     pub fn last_command(&self) -> Option<CellCommand> {
         self.last_command

@@ -23,9 +23,10 @@ use crate::render::{FrameSize, font, with_thread_renderer};
 use crate::runtime::TreeRunner;
 use crate::video::VideoEncoder;
 
-/// Names of the 7 values of `observation.state` (and `action`): the UR5e's joints, then the
-/// gripper. One definition with the environment's observation ([`crate::episode::vectors`]).
-pub use crate::episode::vectors::STATE_NAMES;
+/// Names of the values of `observation.state`: joint angles, gripper closure, joint
+/// velocities, pinch pose. One definition with the environment's observation
+/// ([`crate::episode::vectors`]).
+pub use crate::episode::vectors::{STATE_LEN, STATE_NAMES};
 
 /// The control rate of every tree, frames per second: one frame per control period.
 pub const CONTROL_RATE: u32 = 250;
@@ -68,10 +69,11 @@ pub struct FrameRecord {
     /// Simulated time when it was sampled (the first control tick at or after `timestamp`),
     /// seconds.
     pub sim_time: f64,
-    /// Measured arm joint angles (radians) and the gripper's closure (right driver joint angle,
-    /// radians: 0 open … about 0.8 closed).
+    /// The robot's state ([`crate::episode::vectors::state_vector`]): measured arm joint angles
+    /// (radians), the gripper's closure (radians), joint velocities (rad/s), the pinch point
+    /// (metres) and orientation (qw, qx, qy, qz); names [`STATE_NAMES`].
     #[serde(rename = "observation.state")]
-    pub state: [f32; 7],
+    pub state: [f32; STATE_LEN],
     /// The command held from this frame to the next: joint set points (radians), velocities
     /// (rad/s), accelerations (rad/s²) and the gripper command (0 open … 255 closed)
     /// ([`crate::motion::CellCommand::to_vector`]; names [`crate::motion::COMMAND_NAMES`]).
@@ -217,7 +219,7 @@ impl EpisodeRecorder {
         let world = cell.world();
         let sim = cell.sim();
         let gripper_joint = sim.data().qpos()[sim.scene().ids.gripper_driver_qpos];
-        let state = vectors::state_vector(&world.arm_q, gripper_joint);
+        let state = vectors::state_vector(&vectors::RobotState::of(world, gripper_joint));
         let action = vectors::command_vector(&command.to_vector());
         let mut environment = Vec::with_capacity(world.objects.len() * vectors::VALUES_PER_OBJECT);
         for o in &world.objects {

@@ -11,9 +11,10 @@ use std::path::{Path, PathBuf};
 
 use serde_json::{Value, json};
 
-use super::record::{FrameRecord, Recording, STATE_NAMES};
+use super::record::{FrameRecord, Recording, STATE_LEN, STATE_NAMES};
 use super::stats::{QUANTILES, VecStats, image_stats_json};
 use super::table::{Column, ParquetFile, Table};
+use crate::episode::vectors::VALUES_PER_OBJECT;
 use crate::motion::{COMMAND_LEN, COMMAND_NAMES};
 use crate::render::FrameSize;
 use crate::sweep::ScenarioResult;
@@ -198,7 +199,9 @@ impl DatasetWriter {
         let stage_lock = std::fs::File::open(&stage).ok().filter(crate::cleanup::try_lock);
         std::fs::create_dir(stage.join(CLIPS))
             .map_err(io_err(format!("cannot create a folder in {}", stage.display())))?;
-        let row_bytes = 8 * 5 + 4 * ((7 + COMMAND_LEN) as u64 + 7 * opts.objects.len() as u64) + 64;
+        let row_bytes = 8 * 5
+            + 4 * ((STATE_LEN + COMMAND_LEN) as u64 + (VALUES_PER_OBJECT * opts.objects.len()) as u64)
+            + 64;
         let cams = opts.cameras.len();
         Ok(Self {
             dir: dir.to_path_buf(),
@@ -360,7 +363,7 @@ impl DatasetWriter {
             "observation.state",
             Column::ListF32 {
                 values: flat(&|r| &r.state),
-                width: 7,
+                width: STATE_LEN,
             },
         );
         t.push(
@@ -375,7 +378,7 @@ impl DatasetWriter {
                 "observation.environment_state",
                 Column::ListF32 {
                     values: flat(&|r| &r.environment),
-                    width: 7 * self.opts.objects.len(),
+                    width: VALUES_PER_OBJECT * self.opts.objects.len(),
                 },
             );
         }
@@ -415,7 +418,7 @@ impl DatasetWriter {
         let names: Vec<&str> = STATE_NAMES.to_vec();
         f.insert(
             "observation.state".into(),
-            json!({"dtype": "float32", "shape": [7], "names": names}),
+            json!({"dtype": "float32", "shape": [STATE_LEN], "names": names}),
         );
         f.insert(
             "action".into(),
@@ -481,12 +484,12 @@ impl DatasetWriter {
         let list = |n: usize| json!({"feature": {"dtype": "float32", "_type": "Value"}, "length": n, "_type": "List"});
         let value = |d: &str| json!({"dtype": d, "_type": "Value"});
         let mut f = serde_json::Map::new();
-        f.insert("observation.state".into(), list(7));
+        f.insert("observation.state".into(), list(STATE_LEN));
         f.insert("action".into(), list(COMMAND_LEN));
         if !self.opts.objects.is_empty() {
             f.insert(
                 "observation.environment_state".into(),
-                list(7 * self.opts.objects.len()),
+                list(VALUES_PER_OBJECT * self.opts.objects.len()),
             );
         }
         f.insert("tree.active_leaf".into(), value("string"));

@@ -38,6 +38,18 @@ pub enum Action {
     /// subtree: `pick`), by its node path (`main/sequence[cube to bowl]/…`), or `main` for the
     /// whole tree: it runs until it finishes, ticked exactly as inside the whole tree.
     Subtree(String),
+    /// Residual control: one control period of the environment's tree, the base controller,
+    /// with this correction added to the command it gives (six joint set-point offsets in
+    /// radians, then a gripper-command offset; [`super::RESIDUAL_LEN`] values). The tree is
+    /// ticked once per residual step, exactly as `run_episode` ticks it (its first tick after a
+    /// reset starts it from the root), so an all-zero residual runs the scripted episode bit
+    /// for bit; the offsets, clamped to [`super::RESIDUAL_LIMITS`], are added to the base's set
+    /// points and gripper command (its velocities and accelerations stay), and the sum is
+    /// clamped like a `ctrl` command. Non-finite values are refused. The result's
+    /// [`super::StepResult::base`] holds the base command and the tree's status; a failed base
+    /// tree fails the step. Another kind of action ends the base run (its running leaves are
+    /// halted); the next residual step starts the tree again.
+    Residual([f64; super::RESIDUAL_LEN]),
 }
 
 impl Action {
@@ -49,6 +61,7 @@ impl Action {
             Action::Ctrl(_) => "ctrl",
             Action::Setpoint(_) => "setpoint",
             Action::Subtree(_) => "subtree",
+            Action::Residual(_) => "residual",
         }
     }
 }
@@ -107,10 +120,8 @@ pub(super) fn ctrl_of(action: &Action) -> Option<CtrlValues> {
 }
 
 /// A `ctrl` vector checked: finite, set points within the joint limits, the gripper command
-/// within 0 … 255 (else refused, naming the value as `name` does and the range); velocities and
-/// accelerations clamped to [`CTRL_LIMITS`]; set points clamped to within
-/// `max_joint_speed × period` of the arm's current set point `from` (radians), so no command
-/// asks for a faster motion.
+/// within 0 … 255 (else refused, naming the value as `name` does and the range); then clamped
+/// to the limits ([`clamp_to_limits`]).
 pub(super) fn check_ctrl(values: &CtrlValues, from: &[f64; 6], period: f64) -> Result<CheckedCtrl, Error> {
     let CtrlValues { vector: u, name } = values;
     let bad = |message: String| Error::Action { message };
@@ -121,7 +132,31 @@ pub(super) fn check_ctrl(values: &CtrlValues, from: &[f64; 6], period: f64) -> R
             u[i]
         )));
     }
-    let mut command = CellCommand::from_vector(u);
+    let command = CellCommand::from_vector(u);
+    for (i, (&q, &(lo, hi))) in command.arm.q.iter().zip(&JOINT_LIMITS).enumerate() {
+        if !(lo..=hi).contains(&q) {
+            return Err(bad(format!(
+                "{} ({} set point) is {q}; expected radians within {lo} … {hi}",
+                name(i),
+                crate::motion::ARM_JOINTS[i]
+            )));
+        }
+    }
+    let g = command.gripper;
+    if !(OPEN_CTRL..=CLOSED_CTRL).contains(&g) {
+        return Err(bad(format!(
+            "{} (gripper command) is {g}; expected {OPEN_CTRL} (open) … {CLOSED_CTRL} (closed)",
+            name(COMMAND_LEN - 1)
+        )));
+    }
+    Ok(clamp_to_limits(command, from, period))
+}
+
+/// `command` (finite values) clamped: set points to the joint limits and to within
+/// `max_joint_speed × period` of the arm's set point `from` (radians), so no command asks for
+/// a faster motion; velocities and accelerations to [`CTRL_LIMITS`]; the gripper command to
+/// 0 … 255. Counts the values changed.
+pub(super) fn clamp_to_limits(mut command: CellCommand, from: &[f64; 6], period: f64) -> CheckedCtrl {
     let mut clamped = 0;
     let mut clamp = |v: &mut f64, lo: f64, hi: f64| {
         let c = v.clamp(lo, hi);
@@ -133,28 +168,18 @@ pub(super) fn check_ctrl(values: &CtrlValues, from: &[f64; 6], period: f64) -> R
     let step = CTRL_LIMITS.max_joint_speed * period * (1.0 + 1e-9);
     for i in 0..6 {
         let (lo, hi) = JOINT_LIMITS[i];
-        let q = command.arm.q[i];
-        if !(lo..=hi).contains(&q) {
-            return Err(bad(format!(
-                "{} ({} set point) is {q}; expected radians within {lo} … {hi}",
-                name(i),
-                crate::motion::ARM_JOINTS[i]
-            )));
-        }
-        clamp(&mut command.arm.q[i], from[i] - step, from[i] + step);
+        // Within the joint limits first, then within one period's step (which wins: a set
+        // point the arm can reach from where it is commanded).
+        let q = command.arm.q[i].clamp(lo, hi);
+        let q = q.clamp(from[i] - step, from[i] + step);
+        clamp(&mut command.arm.q[i], q, q);
         let v = CTRL_LIMITS.max_joint_speed;
         clamp(&mut command.arm.qd[i], -v, v);
         let a = CTRL_LIMITS.max_joint_acc;
         clamp(&mut command.arm.qdd[i], -a, a);
     }
-    let g = command.gripper;
-    if !(OPEN_CTRL..=CLOSED_CTRL).contains(&g) {
-        return Err(bad(format!(
-            "{} (gripper command) is {g}; expected {OPEN_CTRL} (open) … {CLOSED_CTRL} (closed)",
-            name(COMMAND_LEN - 1)
-        )));
-    }
-    Ok(CheckedCtrl { command, clamped })
+    clamp(&mut command.gripper, OPEN_CTRL, CLOSED_CTRL);
+    CheckedCtrl { command, clamped }
 }
 
 #[cfg(test)]

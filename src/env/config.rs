@@ -30,6 +30,10 @@ pub struct EnvConfig {
     /// (`Reset::Default`, `Reset::Placement`); `Reset::Seed` and `Reset::Scenario` use the
     /// scenario's own, as a sweep does.
     pub seed: u64,
+    /// Noise injected into what the arm and gripper execute while the leaves' clean commands
+    /// stay the recorded ones (DART-style, as `sweep --dataset --noise`; see
+    /// [`crate::faults::ActionNoise`]), seeded by the episode seed (`None`: none).
+    pub noise: Option<crate::faults::ActionNoise>,
     /// Also report the reward of every control period of a step
     /// (`StepResult::rewards`, like the reference's `stack_rewards`). Default off: only their
     /// count ([`super::StepResult::goal_ticks`]).
@@ -42,6 +46,7 @@ impl Default for EnvConfig {
             control_period: CONTROL_PERIOD,
             max_sim_time: DEFAULT_MAX_SIM_TIME_S,
             fault: None,
+            noise: None,
             seed: 0,
             rewards_per_tick: false,
         }
@@ -60,6 +65,11 @@ impl EnvConfig {
     /// [`Error::Config`] naming the setting and the accepted range.
     pub fn check(&self) -> Result<(), Error> {
         crate::actions::check_control_period(self.control_period)?;
+        if let Some(noise) = &self.noise {
+            noise.check().map_err(|e| Error::Config {
+                message: format!("noise: {e}"),
+            })?;
+        }
         if !(self.max_sim_time.is_finite() && self.max_sim_time > 0.0 && self.max_sim_time <= MAX_SIM_TIME_S)
         {
             return Err(Error::Config {

@@ -42,6 +42,7 @@ mod primitive;
 #[cfg(feature = "render")]
 mod render;
 mod reset;
+mod residual;
 mod step;
 mod subtree;
 mod vector;
@@ -56,6 +57,7 @@ pub use primitive::{Duration, MAX_DURATION, MAX_REACH_DISTANCE, Primitive, REFER
 #[cfg(feature = "render")]
 pub use render::Image;
 pub use reset::Reset;
+pub use residual::{BaseStep, RESIDUAL_LEN, RESIDUAL_LIMITS, ResidualLimits};
 pub use step::{Status, StepResult};
 pub use vector::{Finished, MAX_ENVS, VecEnv};
 
@@ -85,6 +87,8 @@ pub struct MacroEnv {
     unstable: bool,
     placement: Placement,
     episode_seed: u64,
+    /// The base tree's run across residual steps, once one has started.
+    base: Option<residual::BaseRun>,
     #[cfg(feature = "render")]
     film: Option<film::Film>,
 }
@@ -132,6 +136,7 @@ impl MacroEnv {
             fault_reported: false,
             unstable: false,
             placement,
+            base: None,
         };
         env.reset(&Reset::Default)?;
         Ok(env)
@@ -145,6 +150,7 @@ impl MacroEnv {
     pub fn reset(&mut self, how: &Reset) -> Result<Observation, Error> {
         let (placement, seed) = reset::resolve(self.cell.sim().scene(), how)?;
         self.episode_seed = seed.unwrap_or(self.config.seed);
+        self.base = None;
         self.cell.observers.clear();
         self.cell.reset_placement(&placement);
         self.placement = placement;
@@ -154,6 +160,9 @@ impl MacroEnv {
             let (injector, log) = crate::faults::injector_with_log(kind, self.episode_seed);
             self.cell.observers.push(injector);
             self.fault_log = Some(log);
+        }
+        if let Some(noise) = self.config.noise {
+            self.cell.observers.push(noise.injector(self.episode_seed));
         }
         self.unstable = false;
         #[cfg(feature = "render")]
@@ -179,6 +188,9 @@ impl MacroEnv {
                 message: "the simulation became unstable in an earlier step; reset the environment"
                     .to_string(),
             });
+        }
+        if !matches!(action, Action::Residual(_)) {
+            self.end_base_run();
         }
         let dt = self.cell.control_period();
         let mut clamped = 0;
@@ -214,6 +226,7 @@ impl MacroEnv {
                     action.name(),
                 ))
             }
+            Action::Residual(r) => return self.step_residual(r),
         };
         let t0 = self.cell.world().time;
         let s0 = self.cell.sim().steps();
@@ -261,6 +274,7 @@ impl MacroEnv {
             goal,
             faults_fired: self.faults_fired(),
             ctrl_clamped: clamped,
+            base: None,
         })
     }
 

@@ -3,14 +3,16 @@
 //! (`observation.state`, `observation.environment_state`, `action`): one definition for both,
 //! in [`crate::episode::vectors`].
 
-use nalgebra::{Rotation3, UnitQuaternion};
+use nalgebra::UnitQuaternion;
 use serde::Serialize;
 
 use crate::actions::Cell;
 use crate::world::conditions::Tolerances;
 
-pub use crate::episode::vectors::{STATE_NAMES, VALUES_PER_OBJECT as ENVIRONMENT_VALUES_PER_OBJECT};
-use crate::episode::vectors::{command_vector, pose_vector, state_vector};
+use crate::episode::vectors::{RobotState, command_vector, pinch_quat, pose_vector, state_vector};
+pub use crate::episode::vectors::{
+    STATE_LEN, STATE_NAMES, VALUES_PER_OBJECT as ENVIRONMENT_VALUES_PER_OBJECT,
+};
 
 /// The cell at one instant, as the environment reports it. Units: metres, radians, seconds;
 /// quaternions are `[w, x, y, z]`, world frame.
@@ -85,7 +87,6 @@ impl Observation {
         let sim = cell.sim();
         let v3 = |v: &nalgebra::Vector3<f64>| [v.x, v.y, v.z];
         let wxyz = |q: &UnitQuaternion<f64>| [q.w, q.i, q.j, q.k];
-        let pinch = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(w.pinch_rot));
         let objects = w
             .objects
             .iter()
@@ -124,7 +125,7 @@ impl Observation {
                 })
                 .to_vector(),
             pinch_pos: v3(&w.pinch_pos),
-            pinch_quat: wxyz(&pinch),
+            pinch_quat: pinch_quat(&w.pinch_rot),
             left_pad_pos: v3(&w.left_pad_pos),
             right_pad_pos: v3(&w.right_pad_pos),
             objects,
@@ -132,11 +133,17 @@ impl Observation {
         }
     }
 
-    /// The dataset's `observation.state` (and the Python env's `agent_pos`): the six measured
-    /// arm joint angles (radians), then the gripper closure ([`gripper_joint`](Self::gripper_joint),
-    /// radians), as `f32`. Names: [`STATE_NAMES`].
-    pub fn state(&self) -> [f32; 7] {
-        state_vector(&self.joint_pos, self.gripper_joint)
+    /// The dataset's `observation.state` (and the Python env's `agent_pos`): joint angles,
+    /// gripper closure, joint velocities and the pinch pose ([`state_vector`]), as `f32`.
+    /// Names: [`STATE_NAMES`].
+    pub fn state(&self) -> [f32; STATE_LEN] {
+        state_vector(&RobotState {
+            joint_pos: self.joint_pos,
+            gripper_joint: self.gripper_joint,
+            joint_vel: self.joint_vel,
+            pinch_pos: self.pinch_pos,
+            pinch_quat: self.pinch_quat,
+        })
     }
 
     /// The dataset's `action` of the last control period, as `f32` — the layout

@@ -68,6 +68,8 @@ pub struct StepResult {
     /// Values of a `ctrl` or `setpoint` action clamped to the limits ([`super::CTRL_LIMITS`]);
     /// 0 for other actions.
     pub ctrl_clamped: u32,
+    /// For a residual step: the base tree's command and status; `None` for other actions.
+    pub base: Option<super::residual::BaseStep>,
 }
 
 impl StepResult {

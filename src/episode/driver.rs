@@ -56,6 +56,22 @@ pub struct MacroDriver<'a> {
     current: Option<LeafId>,
 }
 
+/// What a [`MacroDriver`] keeps of one episode between uses, without the cell it borrows: the
+/// running controllers, the checks, the counters and the collisions seen
+/// ([`MacroDriver::suspend`], [`MacroDriver::resume`]). Lets a tree run across calls that each
+/// borrow the cell for one control period (the environment's residual mode).
+pub struct DriverState {
+    active: HashMap<LeafId, Active>,
+    checks: ChecksRecorder,
+    counters: LeafCounters,
+    last_failure: Option<Failure>,
+    collisions: Vec<Collision>,
+    collision_policy: CollisionPolicy,
+    collision_failure: Option<Failure>,
+    leaf_paths: Vec<String>,
+    current: Option<LeafId>,
+}
+
 impl<'a> MacroDriver<'a> {
     /// A driver acting on `cell`, running each leaf as `factory` binds its kind.
     pub fn new(cell: &'a mut Cell, factory: &'a Factory) -> Self {
@@ -71,6 +87,40 @@ impl<'a> MacroDriver<'a> {
             collision_failure: None,
             leaf_paths: Vec::new(),
             current: None,
+        }
+    }
+
+    /// Ends this use of the cell, keeping what the driver knows of the episode (running
+    /// controllers included) for [`Self::resume`].
+    pub fn suspend(self) -> DriverState {
+        DriverState {
+            active: self.active,
+            checks: self.checks,
+            counters: self.counters,
+            last_failure: self.last_failure,
+            collisions: self.collisions,
+            collision_policy: self.collision_policy,
+            collision_failure: self.collision_failure,
+            leaf_paths: self.leaf_paths,
+            current: self.current,
+        }
+    }
+
+    /// A driver on `cell` that carries on where [`Self::suspend`] left `state` (the same cell,
+    /// the same episode).
+    pub fn resume(cell: &'a mut Cell, factory: &'a Factory, state: DriverState) -> Self {
+        Self {
+            cell,
+            factory,
+            active: state.active,
+            checks: state.checks,
+            counters: state.counters,
+            last_failure: state.last_failure,
+            collisions: state.collisions,
+            collision_policy: state.collision_policy,
+            collision_failure: state.collision_failure,
+            leaf_paths: state.leaf_paths,
+            current: state.current,
         }
     }
 

@@ -13,7 +13,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 pub use collision::{Collision, CollisionCounts, CollisionPolicy, HitKind, Hitter};
-pub use driver::{LeafCounters, MacroDriver};
+pub use driver::{DriverState, LeafCounters, MacroDriver};
 pub use report::{EpisodeReport, LayoutJson, NodeReport, ObjectReport};
 
 use crate::actions::Cell;

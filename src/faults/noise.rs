@@ -63,6 +63,25 @@ impl ActionNoise {
         })
     }
 
+    /// Both σ are finite and within their ranges (0 … [`MAX_JOINT_SIGMA`] radians, 0 …
+    /// [`MAX_GRIPPER_SIGMA`]).
+    pub fn check(&self) -> Result<(), String> {
+        let within = |v: f64, max: f64| v.is_finite() && (0.0..=max).contains(&v);
+        if !within(self.joint_sigma, MAX_JOINT_SIGMA) {
+            return Err(format!(
+                "the joint σ must be within 0 … {MAX_JOINT_SIGMA} rad, got {}",
+                self.joint_sigma
+            ));
+        }
+        if !within(self.gripper_sigma, MAX_GRIPPER_SIGMA) {
+            return Err(format!(
+                "the gripper σ must be within 0 … {MAX_GRIPPER_SIGMA}, got {}",
+                self.gripper_sigma
+            ));
+        }
+        Ok(())
+    }
+
     /// The observer that adds this noise in an episode seeded with `seed` (a stream of its own,
     /// apart from the faults').
     pub fn injector(self, seed: u64) -> Box<dyn StepObserver> {

@@ -139,10 +139,25 @@ fn the_flat_vectors_have_the_datasets_layout() {
     let mut env = env(EnvConfig::default());
     let o = env.reset(&Reset::Seed(5)).unwrap();
     let s = o.state();
-    for (v, q) in s.iter().zip(&o.joint_pos) {
-        assert_eq!(*v, *q as f32);
+    assert_eq!(s.len(), macrotree::env::STATE_NAMES.len());
+    let expected = o
+        .joint_pos
+        .iter()
+        .chain([&o.gripper_joint])
+        .chain(&o.joint_vel)
+        .chain(&o.pinch_pos)
+        .chain(&o.pinch_quat);
+    for ((v, e), name) in s.iter().zip(expected).zip(macrotree::env::STATE_NAMES) {
+        assert_eq!(*v, *e as f32, "{name}");
     }
-    assert_eq!(s[6], o.gripper_joint as f32);
+    let stepped = env
+        .step(&Action::Leaf(
+            r#"{"reach": {"target": "cube", "offset": [0, 0, 0.2]}}"#.into(),
+        ))
+        .unwrap()
+        .observation;
+    assert_eq!(stepped.state()[7..13], stepped.joint_vel.map(|v| v as f32));
+    assert_ne!(stepped.state()[13..16], s[13..16], "the pinch point moved");
     let e = o.environment_state();
     assert_eq!(e.len(), 7 * o.objects.len());
     let cube = &o.objects[0];

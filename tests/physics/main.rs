@@ -11,6 +11,7 @@ mod container_packing;
 mod ctrl_replay;
 mod env_primitives;
 mod env_replay;
+mod env_residual;
 mod env_step;
 mod env_subtree;
 mod env_vector;
