@@ -3,8 +3,10 @@
 //!
 //! 1. `setpoint` mode: 5000 `Action::Setpoint` steps (one 4 ms control period = 2 physics steps each)
 //!    against the same joint targets written straight into `ctrl` and `mj_step` in a loop.
-//! 2. `VecEnv` of 2 environments on 2 threads, 2000 synchronous `ctrl` steps, against one
-//!    environment's steps per second.
+//! 2. `VecEnv` of 2 environments on 2 threads against one environment, and against two
+//!    environments stepped on two threads of their own without any hand-off (the machine's
+//!    ceiling), in steps per second: 21 alternating rounds of 250 `setpoint` steps each, the
+//!    median round's ratios.
 //! 3. The flagship tree driven leaf by leaf (`Action::Leaf`, the leaves `run_episode` starts)
 //!    against `run_episode` of the tree (the same physics, bit for bit).
 
@@ -17,6 +19,7 @@ use macrotree::sim::{HOME_Q, Scene, Sim};
 
 const CTRL_STEPS: usize = 5000;
 const REPEAT: usize = 5;
+const VECTOR_ROUNDS: usize = 21;
 
 fn target(k: usize) -> [f64; 7] {
     let s = (k as f64 * 0.004).sin();
@@ -68,27 +71,56 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         b / e
     );
 
-    // The vector env: 2 environments on 2 threads.
+    // The vector env: 2 environments on 2 threads, against one environment and against two
+    // environments stepped freely on two threads of their own (what the machine's two cores give
+    // at best), in alternating rounds: the ratio of each round, so a machine whose speed drifts
+    // still compares like with like.
     let mut v = VecEnv::with_threads(&app, scene.clone(), None, EnvConfig::default(), 2, 2)?;
-    let mut vec_t = Vec::new();
-    for _ in 0..REPEAT {
-        v.reset(&[Reset::Default, Reset::Default])?;
+    v.reset(&[Reset::Default, Reset::Default])?;
+    env.reset(&Reset::Default)?;
+    let mut free = [
+        MacroEnv::new(&app, scene.clone(), None, EnvConfig::default())?,
+        MacroEnv::new(&app, scene.clone(), None, EnvConfig::default())?,
+    ];
+    let (mut over_single, mut over_free) = (Vec::new(), Vec::new());
+    let mut rates = [Vec::new(), Vec::new(), Vec::new()];
+    const ROUND: usize = 250;
+    for round in 0..VECTOR_ROUNDS {
         let t = Instant::now();
-        for k in 0..2000 {
-            for r in v.step(&[Action::Setpoint(target(k)), Action::Setpoint(target(k + 1))])? {
+        for k in 0..ROUND {
+            env.step(&Action::Setpoint(target(round * ROUND + k)))?;
+        }
+        let single = ROUND as f64 / t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        for k in 0..ROUND {
+            let j = round * ROUND + k;
+            for r in v.step(&[Action::Setpoint(target(j)), Action::Setpoint(target(j + 1))])? {
                 r?;
             }
         }
-        vec_t.push(t.elapsed().as_secs_f64());
+        let vector = (2 * ROUND) as f64 / t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        std::thread::scope(|s| {
+            for (e, env) in free.iter_mut().enumerate() {
+                s.spawn(move || {
+                    for k in 0..ROUND {
+                        let _ = env.step(&Action::Setpoint(target(round * ROUND + k + e)));
+                    }
+                });
+            }
+        });
+        let two_free = (2 * ROUND) as f64 / t.elapsed().as_secs_f64();
+        over_single.push(vector / single);
+        over_free.push(vector / two_free);
+        for (r, x) in rates.iter_mut().zip([single, vector, two_free]) {
+            r.push(x);
+        }
     }
-    let vt = median(vec_t);
-    let single = CTRL_STEPS as f64 / e;
-    let vector = 4000.0 / vt;
+    let [single, vector, two_free] = rates.map(median);
     println!(
-        "vector: 2 environments on 2 threads, {:.0} env steps/s vs {:.0} for one environment ({:.2}x)",
-        vector,
-        single,
-        vector / single
+        "vector: 2 environments on 2 threads, {vector:.0} env steps/s vs {single:.0} for one environment and {two_free:.0} for two on free threads; median of {VECTOR_ROUNDS} alternating rounds: {:.2}x one environment, {:.2} of the free threads",
+        median(over_single),
+        median(over_free)
     );
 
     // The flagship, leaf by leaf.

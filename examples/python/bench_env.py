@@ -6,7 +6,8 @@
    replay of the same controls.
 3. Vector environments, envpool-style: N single environments in a Python loop, Gymnasium's
    ``SyncVectorEnv`` and ``AsyncVectorEnv``, and ``macrotree.VectorEnv``, in ``ctrl`` steps per
-   second.
+   second; ``vector_vs_single`` is the median ratio of alternating rounds of the native vector env
+   and one environment.
 
     python examples/python/bench_env.py [--repeat 5] [--envs 2] [--json]
 """
@@ -150,11 +151,30 @@ def vector(n: int, repeat: int) -> dict[str, float]:
         out[name] = steps_per_second(step, n, repeat)
         envs.close()
 
+    # The native vector env against one environment in alternating rounds: the ratio of each
+    # round, so a machine whose speed drifts still compares like with like.
     native = macrotree.VectorEnv(scene(), num_envs=n, action_mode="setpoint", threads=n)
     native.reset(seed=0)
-    out["macrotree_vector_env"] = steps_per_second(lambda k: native.step(batch[k]), n, repeat)
+    rounds = 4 * repeat + 1
+    chunk = len(batch) // rounds
+    singles, vectors, ratios = [], [], []
+    for r in range(rounds):
+        ks = range(r * chunk, (r + 1) * chunk)
+        start = time.perf_counter()
+        for k in ks:
+            one.step(batch[k][0])
+        single = chunk / (time.perf_counter() - start)
+        start = time.perf_counter()
+        for k in ks:
+            native.step(batch[k])
+        vector = n * chunk / (time.perf_counter() - start)
+        singles.append(single)
+        vectors.append(vector)
+        ratios.append(vector / single)
     native.close()
-    out["vector_vs_single"] = out["macrotree_vector_env"] / out["single_env"]
+    out["macrotree_vector_env"] = statistics.median(vectors)
+    out["single_env_paired"] = statistics.median(singles)
+    out["vector_vs_single"] = statistics.median(ratios)
     return out
 
 

@@ -53,14 +53,16 @@ def _stack(items: Sequence[dict[str, Any]]) -> dict[str, Any]:
 
 def _batch_infos(infos: Sequence[dict[str, Any] | None]) -> dict[str, Any]:
     """Gymnasium's vector info layout: each key an array over sub-environments (arrays of one
-    shape stacked, e.g. ``base_action`` as ``(n, 19)``), with a boolean mask ``_key`` saying
-    which sub-environments gave it."""
+    shape stacked, e.g. ``base_action`` as ``(n, 19)``; nested dicts batched the same way), with
+    a boolean mask ``_key`` saying which sub-environments gave it."""
     n = len(infos)
     out: dict[str, Any] = {}
     for i, info in enumerate(infos):
         if info is None:
             continue
         for key, value in info.items():
+            if isinstance(value, dict):
+                continue
             if key not in out:
                 if isinstance(value, (bool, np.bool_)):
                     out[key] = np.zeros(n, dtype=bool)
@@ -82,7 +84,43 @@ def _batch_infos(infos: Sequence[dict[str, Any] | None]) -> dict[str, Any]:
                 out[key] = column = ragged
             column[i] = value
             out[f"_{key}"][i] = True
+    present = [info for info in infos if info is not None]
+    nested = {k for info in present for k, v in info.items() if isinstance(v, dict)}
+    for key in sorted(nested):
+        inner: list[dict[str, Any] | None] = [
+            info.get(key) if info is not None and isinstance(info.get(key), dict) else None
+            for info in infos
+        ]
+        out[key] = _batch_infos(inner)
+        out[f"_{key}"] = np.array([x is not None for x in inner], dtype=bool)
     return out
+
+
+def _put_rows(dst: dict[str, Any], rows: Sequence[int], src: dict[str, Any]) -> None:
+    """Writes the batch ``src`` into rows ``rows`` of the batch ``dst`` (nested dicts alike)."""
+    for key, value in src.items():
+        if isinstance(value, dict):
+            _put_rows(dst[key], rows, value)
+        else:
+            dst[key][list(rows)] = value
+
+
+def _mask_rows(info: dict[str, Any], keep: np.ndarray) -> dict[str, Any]:
+    """The batched ``info`` with every ``_key`` mask limited to the rows of ``keep``."""
+    out: dict[str, Any] = {}
+    for key, value in info.items():
+        if key.startswith("_"):
+            out[key] = value & keep
+        elif isinstance(value, dict):
+            out[key] = _mask_rows(value, keep)
+        else:
+            out[key] = value
+    return out
+
+
+def _rows(batch: dict[str, Any], k: int) -> dict[str, Any]:
+    """Row ``k`` of a batched observation (nested dicts alike)."""
+    return {key: _rows(v, k) if isinstance(v, dict) else v[k] for key, v in batch.items()}
 
 
 class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
@@ -161,7 +199,11 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self._pending: set[int] = set()
         self._rngs: list[np.random.Generator | None] = [None] * self.num_envs
-        self._last_obs: list[dict[str, Any] | None] = [None] * self.num_envs
+        # The last observation of every sub-environment, batched (rows of those never reset are
+        # meaningless until ``_seen``).
+        self._last_obs: dict[str, Any] | None = None
+        self._last_shared = False
+        self._seen = np.zeros(self.num_envs, dtype=bool)
 
     def _draw(self, i: int, seed: int | None) -> int:
         """Sub-environment *i*'s placement seed, drawn exactly as :meth:`MacroEnv.reset` draws
@@ -210,8 +252,7 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         sub-environment that ended is reset in the same step; its last observation and info are in
         ``info["final_obs"]`` and ``info["final_info"]``."""
         ids = list(range(self.num_envs))
-        results = self._native.step(ids, self._native_actions(actions, self.num_envs))
-        return self._finish(ids, results)
+        return self._finish(self._native.step(ids, self._native_actions(actions, self.num_envs)))
 
     def send(self, actions: Any, env_ids: Sequence[int] | np.ndarray | None = None) -> None:
         """Starts the actions of ``env_ids`` (default: all) on the worker threads and returns at
@@ -233,11 +274,10 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         want = len(self._pending) if batch_size is None else int(batch_size)
         if not 1 <= want <= len(self._pending):
             raise ValueError(f"batch_size must be 1…{len(self._pending)}, got {batch_size}")
-        done = self._native.recv(want)
-        ids = [int(i) for i, _ in done]
-        self._pending.difference_update(ids)
-        obs, rew, term, trunc, info = self._finish(ids, [r for _, r in done])
-        info["env_id"] = np.asarray(ids, dtype=np.int64)
+        batch = self._native.recv(want)
+        self._pending.difference_update(int(i) for i in batch["env_id"])
+        obs, rew, term, trunc, info = self._finish(batch)
+        info["env_id"] = np.asarray(batch["env_id"], dtype=np.int64)
         return obs, rew, term, trunc, info
 
     def render(self) -> tuple[np.ndarray, ...] | None:
@@ -280,45 +320,112 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         observation and info, the others their last observation and no info."""
         infos: list[dict[str, Any] | None] = [None] * self.num_envs
         for i, r in zip(ids, results, strict=True):
-            self._last_obs[i] = with_keys(r["obs"], self.observation_keys)
             infos[i] = dict(r["info"])
-        missing = [i for i, o in enumerate(self._last_obs) if o is None]
+        fresh = _stack([with_keys(r["obs"], self.observation_keys) for r in results])
+        self._remember(ids, fresh)
+        missing = [int(i) for i in np.flatnonzero(~self._seen)]
         if missing:
             raise ValueError(f"environments {missing} were never reset; reset them all first")
-        return _stack(self._last_obs), _batch_infos(infos)  # type: ignore[arg-type]
+        assert self._last_obs is not None
+        return _copy(self._last_obs), _batch_infos(infos)
+
+    def _remember(self, ids: list[int], batch: dict[str, Any]) -> None:
+        """Keeps the batched observations ``batch`` of ``ids`` as their last ones: by reference
+        when they are every sub-environment's (a step), else written into a private copy."""
+        if ids == list(range(self.num_envs)):
+            self._last_obs, self._last_shared = batch, True
+        else:
+            if self._last_obs is None:
+                self._last_obs = {k: _zeros_like(v, self.num_envs) for k, v in batch.items()}
+            elif self._last_shared:
+                self._last_obs = _copy(self._last_obs)
+            self._last_shared = False
+            _put_rows(self._last_obs, ids, batch)
+        self._seen[ids] = True
 
     def _finish(
-        self, ids: list[int], results: list[dict[str, Any]]
+        self, batch: dict[str, Any]
     ) -> tuple[dict[str, Any], np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
-        rewards = np.array([float(r["reward"]) for r in results], dtype=np.float64)
-        terminated = np.array([bool(r["terminated"]) for r in results], dtype=bool)
-        truncated = np.array([bool(r["truncated"]) for r in results], dtype=bool)
-        observations = [with_keys(r["obs"], self.observation_keys) for r in results]
-        infos: list[dict[str, Any] | None] = [dict(r["info"]) for r in results]
-        ended = [k for k in range(len(ids)) if terminated[k] or truncated[k]]
-        final_obs: list[Any] = [None] * len(ids)
-        final_info: list[Any] = [None] * len(ids)
+        """A batch of step results (built by the extension) as Gymnasium returns it; under
+        ``SAME_STEP`` the sub-environments that ended are reset and their rows replaced."""
+        ids = [int(i) for i in batch["env_id"]]
+        observations = with_keys(batch["obs"], self.observation_keys)
+        rewards = np.asarray(batch["reward"], dtype=np.float64)
+        terminated = np.asarray(batch["terminated"], dtype=bool)
+        truncated = np.asarray(batch["truncated"], dtype=bool)
+        info: dict[str, Any] = batch["info"]
+        ended = [int(k) for k in np.flatnonzero(terminated | truncated)]
         if self.autoreset_mode == AutoresetMode.SAME_STEP and ended:
-            again = self._native.reset(
-                ids=[ids[k] for k in ended], seeds=[self._draw(ids[k], None) for k in ended]
-            )
-            for k, r in zip(ended, again, strict=True):
-                final_obs[k] = observations[k]
-                final_info[k] = infos[k]
-                observations[k] = with_keys(r["obs"], self.observation_keys)
-                infos[k] = dict(r["info"])
-        for i, o in zip(ids, observations, strict=True):
-            self._last_obs[i] = o
-        info = _batch_infos(infos)
-        if ended and self.autoreset_mode == AutoresetMode.SAME_STEP:
             # Gymnasium 1.x: ``final_obs`` an object array, ``final_info`` the ended
             # sub-environments' infos batched like any info (``final_info["is_success"]`` and its
             # mask ``final_info["_is_success"]``), each with its ``_key`` mask.
-            info["final_obs"] = np.array(final_obs, dtype=object)
-            info["final_info"] = _batch_infos(final_info)
-            info["_final_obs"] = np.array([x is not None for x in final_obs], dtype=bool)
-            info["_final_info"] = info["_final_obs"].copy()
-        return _stack(observations), rewards, terminated, truncated, info
+            was_ended = np.zeros(len(ids), dtype=bool)
+            was_ended[ended] = True
+            final_obs = np.full(len(ids), None, dtype=object)
+            for k in ended:
+                final_obs[k] = _rows(observations, k)
+            final_info = _mask_rows(info, was_ended)
+            again = self._native.reset(
+                ids=[ids[k] for k in ended], seeds=[self._draw(ids[k], None) for k in ended]
+            )
+            observations = _copy(observations)
+            _put_rows(
+                observations,
+                ended,
+                _stack([with_keys(r["obs"], self.observation_keys) for r in again]),
+            )
+            # The reset sub-environments' info is their reset's.
+            info = _mask_rows(info, ~was_ended)
+            fresh: list[dict[str, Any] | None] = [None] * len(ids)
+            for k, r in zip(ended, again, strict=True):
+                fresh[k] = dict(r["info"])
+            _merge_infos(info, _batch_infos(fresh))
+            info["final_obs"] = final_obs
+            info["final_info"] = final_info
+            info["_final_obs"] = was_ended
+            info["_final_info"] = was_ended.copy()
+        self._remember(ids, observations)
+        return observations, rewards, terminated, truncated, info
+
+
+def _copy(batch: dict[str, Any]) -> dict[str, Any]:
+    """A copy of a batch (nested dicts alike), so that later writes do not reach the caller's."""
+    return {k: _copy(v) if isinstance(v, dict) else np.array(v) for k, v in batch.items()}
+
+
+def _zeros_like(value: Any, n: int) -> Any:
+    """A batch of ``n`` zero rows shaped like the batch ``value`` (nested dicts alike)."""
+    if isinstance(value, dict):
+        return {k: _zeros_like(v, n) for k, v in value.items()}
+    array = np.asarray(value)
+    return np.zeros((n, *array.shape[1:]), dtype=array.dtype)
+
+
+def _merge_infos(info: dict[str, Any], rows: dict[str, Any]) -> None:
+    """Writes the batched ``rows`` (with their masks) into the batched ``info``: where a row's
+    mask is set, its value and mask replace ``info``'s."""
+    for key, value in rows.items():
+        if key.startswith("_"):
+            continue
+        mask = rows[f"_{key}"]
+        if isinstance(value, dict):
+            if key not in info:
+                info[key] = value
+                info[f"_{key}"] = mask.copy()
+            else:
+                _merge_infos(info[key], value)
+                info[f"_{key}"] = info[f"_{key}"] | mask
+            continue
+        if key not in info:
+            info[key] = value
+            info[f"_{key}"] = mask.copy()
+            continue
+        column = info[key]
+        if column.dtype != value.dtype and column.dtype != object:
+            column = column.astype(object)
+        column[mask] = value[mask]
+        info[key] = column
+        info[f"_{key}"] = info[f"_{key}"] | mask
 
 
 def make_single(**kwargs: Any) -> MacroEnv:

@@ -130,12 +130,7 @@ pub fn step_result<'py>(
     info.set_item("ctrl_clamped", r.ctrl_clamped)?;
     if let Some(base) = &r.base {
         info.set_item("base_action", base.command.to_vec().into_pyarray(py))?;
-        let status = match base.status {
-            macrotree::runtime::TreeStatus::Running => "running",
-            macrotree::runtime::TreeStatus::Success => "success",
-            macrotree::runtime::TreeStatus::Failure => "failure",
-        };
-        info.set_item("base_status", status)?;
+        info.set_item("base_status", tree_status(base.status))?;
     }
     info.set_item("goal_steps", r.goal_ticks)?;
     let collisions: Vec<&str> = r.collisions.iter().map(|c| c.what.as_str()).collect();
@@ -146,4 +141,13 @@ pub fn step_result<'py>(
     }
     out.set_item("info", info)?;
     Ok(out)
+}
+
+/// A tree's status as the info says it: `running`, `success` or `failure`.
+pub fn tree_status(s: macrotree::runtime::TreeStatus) -> &'static str {
+    match s {
+        macrotree::runtime::TreeStatus::Running => "running",
+        macrotree::runtime::TreeStatus::Success => "success",
+        macrotree::runtime::TreeStatus::Failure => "failure",
+    }
 }

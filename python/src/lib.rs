@@ -2,6 +2,7 @@
 //! results and releases the GIL while Rust steps; every decision lives in `macrotree::env`.
 //! The Python package (`python/macrotree/`) wraps it as Gymnasium environments.
 
+mod batch;
 mod convert;
 mod env;
 mod error;

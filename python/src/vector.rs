@@ -8,11 +8,11 @@ use numpy::{PyArray3, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use crate::convert;
-use crate::env::{first_camera, image, pixels, reset_of, sizes};
+use crate::env::{first_camera, image, pixels, reset_of};
 use crate::error::{to_py, value};
 use crate::macro_action;
 use crate::setup::{self, Settings};
+use crate::{batch, convert};
 
 /// N environments stepped in parallel.
 #[pyclass(module = "macrotree._native")]
@@ -42,25 +42,31 @@ impl VecEnv {
         self.inner.lock().unwrap_or_else(|e| e.into_inner())
     }
 
-    fn result<'py>(
+    /// The batch of results `done` (environment id, result), in that order; the first error
+    /// is raised.
+    fn batch<'py>(
         &self,
         py: Python<'py>,
         v: &Guard<'_>,
-        i: usize,
-        r: Result<macrotree::env::StepResult, macrotree::Error>,
+        done: Vec<(usize, Result<macrotree::env::StepResult, macrotree::Error>)>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let r = r.map_err(to_py)?;
-        let (px, sz) = v
-            .with_env(i, |e| {
-                let px = if self.cameras.is_empty() {
-                    Ok(Vec::new())
-                } else {
-                    pixels(e, &self.cameras, self.image)
-                };
-                (px, sizes(e))
-            })
-            .map_err(to_py)?;
-        convert::step_result(py, &r, px?, &sz)
+        let mut results = Vec::with_capacity(done.len());
+        let mut images = Vec::with_capacity(done.len());
+        let mut ids = Vec::with_capacity(done.len());
+        for (i, r) in done {
+            results.push(r.map_err(to_py)?);
+            let px = if self.cameras.is_empty() {
+                Vec::new()
+            } else {
+                v.with_env(i, |e| pixels(e, &self.cameras, self.image))
+                    .map_err(to_py)??
+            };
+            images.push(px);
+            ids.push(i);
+        }
+        let out = batch::batch(py, &results, images)?;
+        out.set_item("env_id", ids)?;
+        Ok(out)
     }
 }
 
@@ -170,29 +176,19 @@ impl VecEnv {
         Ok(out)
     }
 
-    /// Steps environments `ids` with `actions` in parallel; results in the order of `ids`.
+    /// Steps environments `ids` with `actions` in parallel; the batch of their results, in
+    /// the order of `ids` (see `batch.rs`).
     fn step<'py>(
         &self,
         py: Python<'py>,
         ids: Vec<usize>,
         actions: Vec<Bound<'py, PyAny>>,
-    ) -> PyResult<Bound<'py, PyList>> {
+    ) -> PyResult<Bound<'py, PyDict>> {
         let actions = actions.iter().map(action_of).collect::<PyResult<Vec<_>>>()?;
         let mut v = self.vec();
         let e: &mut macrotree::env::VecEnv = &mut v;
-        let mut done = py
-            .detach(|| {
-                e.send(&ids, &actions)?;
-                e.recv(ids.len())
-            })
-            .map_err(to_py)?;
-        let order = |i: &usize| ids.iter().position(|j| j == i).unwrap_or(usize::MAX);
-        done.sort_by_key(|(i, _)| order(i));
-        let out = PyList::empty(py);
-        for (i, r) in done {
-            out.append(self.result(py, &v, i, r)?)?;
-        }
-        Ok(out)
+        let done = py.detach(|| e.step_each(&ids, &actions)).map_err(to_py)?;
+        self.batch(py, &v, ids.iter().copied().zip(done).collect())
     }
 
     /// Starts `actions` on environments `ids` and returns at once.
@@ -203,16 +199,13 @@ impl VecEnv {
         py.detach(|| e.send(&ids, &actions)).map_err(to_py)
     }
 
-    /// Waits for at least `count` environments to finish; `[(id, result)]` in finishing order.
-    fn recv<'py>(&self, py: Python<'py>, count: usize) -> PyResult<Bound<'py, PyList>> {
+    /// Waits for at least `count` environments to finish; the batch of their results in
+    /// finishing order, `env_id` saying whose.
+    fn recv<'py>(&self, py: Python<'py>, count: usize) -> PyResult<Bound<'py, PyDict>> {
         let mut v = self.vec();
         let e: &mut macrotree::env::VecEnv = &mut v;
         let done = py.detach(|| e.recv(count)).map_err(to_py)?;
-        let out = PyList::empty(py);
-        for (i, r) in done {
-            out.append((i, self.result(py, &v, i, r)?))?;
-        }
-        Ok(out)
+        self.batch(py, &v, done)
     }
 
     #[pyo3(signature = (camera, height, width))]

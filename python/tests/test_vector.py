@@ -71,6 +71,34 @@ def test_same_step_autoreset_returns_the_final_observation(data: Path) -> None:
     vec.close()
 
 
+def test_an_autoreset_replaces_only_the_ended_rows_and_masks_their_infos(data: Path) -> None:
+    vec = macrotree.VectorEnv(scene(data), num_envs=2, max_sim_time=0.1)
+    vec.reset(seed=0)
+    short = {"mode": int(MacroMode.WAIT), "steps": [2]}
+    long = {"mode": int(MacroMode.WAIT), "steps": [20]}
+    obs, _, _, truncated, info = vec.step([short, short])
+    assert not truncated.any()
+    before = obs["agent_pos"].copy()
+    obs, _, _, truncated, info = vec.step([long, short])
+    assert list(truncated) == [True, False]
+    # The ended row holds the new episode's first observation (time zero), the other its step's.
+    assert list(info["_final_obs"]) == [True, False]
+    assert info["final_obs"][0]["agent_pos"].shape == before[0].shape
+    assert list(info["final_info"]["_status"]) == [True, False]
+    assert info["final_info"]["failure_kind"][0] == "time_limit"
+    # The ended row's info is its reset's: the step's keys are masked out there.
+    assert list(info["_status"]) == [False, True]
+    assert list(info["_episode_sim_time"]) == [True, True]
+    assert info["episode_sim_time"][0] == 0.0 and info["episode_sim_time"][1] > 0.0
+    # Nested dicts are batched alike: one array per goal predicate, with its mask.
+    goal = info["goal"]
+    assert isinstance(goal, dict) and goal
+    for key, value in goal.items():
+        if not key.startswith("_"):
+            assert value.shape == (2,) and goal[f"_{key}"].all()
+    vec.close()
+
+
 def test_disabled_autoreset_takes_a_reset_mask(data: Path) -> None:
     vec = macrotree.VectorEnv(scene(data), num_envs=2, autoreset_mode=AutoresetMode.DISABLED)
     first, _ = vec.reset(seed=3)

@@ -77,10 +77,12 @@ pub struct Cell {
     /// The command of the last period the physics ran.
     last_command: Option<CellCommand>,
     steps_per_tick: u32,
-    /// The motion planner's collision checker of this cell (built with the cell, synced from the
-    /// simulation before each check), `None` when it could not be built (then motions run
-    /// unchecked, as before).
+    /// The motion planner's collision checker of this cell, built at its first use (it holds a
+    /// private copy of the model, tens of megabytes: a cell driven by `ctrl` actions alone never
+    /// pays for it) and synced from the simulation before each check.
     checker: Option<SceneChecker>,
+    /// The checker could not be built (then motions run unchecked).
+    checker_unavailable: bool,
     /// What motion checking and planning cost in this episode.
     tally: PlanningTally,
     /// Per-step hooks (fault injection, control recording), called in order.
@@ -94,13 +96,6 @@ impl Cell {
         let sim = Sim::new(scene);
         let world = sim.observe();
         let steps_per_tick = ((control_period / TIMESTEP).round() as u32).max(1);
-        let checker = match SceneChecker::from_sim(&sim, DEFAULT_MARGIN) {
-            Ok(c) => Some(c),
-            Err(e) => {
-                tracing::warn!(target: "macrotree::plan", "no collision checker for this cell, motions run unchecked: {e}");
-                None
-            }
-        };
         let mut cell = Self {
             sim,
             world,
@@ -109,7 +104,8 @@ impl Cell {
             pending: None,
             last_command: None,
             steps_per_tick,
-            checker,
+            checker: None,
+            checker_unavailable: false,
             tally: PlanningTally::default(),
             observers: Vec::new(),
         };
@@ -141,6 +137,15 @@ impl Cell {
     /// the gripper's opening), holding the block the gripper holds now (grasp and release are
     /// followed from the world: [`World::held_block`]), or `None` when the cell has none.
     pub fn checker(&mut self) -> Option<&mut SceneChecker> {
+        if self.checker.is_none() && !self.checker_unavailable {
+            match SceneChecker::from_sim(&self.sim, DEFAULT_MARGIN) {
+                Ok(c) => self.checker = Some(c),
+                Err(e) => {
+                    tracing::warn!(target: "macrotree::plan", "no collision checker for this cell, motions run unchecked: {e}");
+                    self.checker_unavailable = true;
+                }
+            }
+        }
         let c = self.checker.as_mut()?;
         let held = self
             .world

@@ -2,14 +2,19 @@
 //! ([`VecEnv::step`]), or envpool-style ([`VecEnv::send`] / [`VecEnv::recv`]), which returns
 //! whichever environments finish first: macro actions differ widely in duration.
 //!
-//! Each environment runs its actions in the order they were sent, one at a time, on whichever
-//! worker is free; its results depend only on its own resets and actions, so sub-environment
-//! `i` gives bit for bit what a single [`MacroEnv`] given the same resets and actions gives.
+//! Environment `i` belongs to worker `i mod threads`, which runs its actions in the order they
+//! were sent, one at a time; its results depend only on its own resets and actions, so
+//! sub-environment `i` gives bit for bit what a single [`MacroEnv`] given the same resets and
+//! actions gives. A synchronous [`VecEnv::step`] runs worker 0's share on the calling thread,
+//! so two environments on two cores need one hand-off, not two; workers and the waiting caller
+//! spin for up to [`SPIN_WAIT`] before they sleep, so a policy loop's next batch finds them
+//! awake (a sleeping thread takes tens of microseconds to wake, a `ctrl` step about 100).
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::sync::mpsc::{Receiver, Sender, channel};
+use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
 
 use super::{Action, EnvConfig, MacroEnv, Observation, Reset, StepResult};
 use crate::error::Error;
@@ -19,6 +24,10 @@ use crate::sim::Scene;
 /// Most environments in one [`VecEnv`].
 pub const MAX_ENVS: usize = 1024;
 
+/// How long a worker with nothing to do, or a caller waiting for results, polls before it
+/// sleeps.
+pub const SPIN_WAIT: Duration = Duration::from_micros(200);
+
 /// A step to run: the environment and its action.
 type Job = (usize, Action);
 /// A finished step: the environment's id and its result.
@@ -27,10 +36,9 @@ pub type Finished = (usize, Result<StepResult, Error>);
 /// N environments of one scene (and tree and config) on worker threads (see the module docs).
 pub struct VecEnv {
     envs: Vec<Arc<Mutex<MacroEnv>>>,
-    jobs: Option<Sender<Job>>,
+    /// Each worker's job queue (empty once dropping).
+    jobs: Vec<Sender<Job>>,
     done: Receiver<Finished>,
-    /// The job queue the workers take from; the caller takes from it too while it waits.
-    queue: Arc<Mutex<Receiver<Job>>>,
     workers: Vec<JoinHandle<()>>,
     busy: Vec<bool>,
     pending: usize,
@@ -83,27 +91,26 @@ impl VecEnv {
             let env = MacroEnv::new(app, scene.clone(), tree.clone(), config.clone())?;
             envs.push(Arc::new(Mutex::new(env)));
         }
-        let (jobs, queue) = channel::<Job>();
         let (done_tx, done) = channel::<Finished>();
-        let queue = Arc::new(Mutex::new(queue));
-        let workers = (0..threads.clamp(1, n))
-            .map(|k| {
-                let queue = queue.clone();
-                let done_tx = done_tx.clone();
-                let envs = envs.clone();
-                std::thread::Builder::new()
-                    .name(format!("macrotree-env-{k}"))
-                    .spawn(move || worker(&queue, &envs, &done_tx))
-                    .map_err(|e| Error::Simulator {
-                        message: format!("cannot start a worker thread: {e}"),
-                    })
-            })
-            .collect::<Result<Vec<_>, Error>>()?;
+        let mut jobs = Vec::new();
+        let mut workers = Vec::new();
+        for k in 0..threads.clamp(1, n) {
+            let (tx, queue) = channel::<Job>();
+            let done_tx = done_tx.clone();
+            let envs = envs.clone();
+            let handle = std::thread::Builder::new()
+                .name(format!("macrotree-env-{k}"))
+                .spawn(move || worker(&queue, &envs, &done_tx))
+                .map_err(|e| Error::Simulator {
+                    message: format!("cannot start a worker thread: {e}"),
+                })?;
+            jobs.push(tx);
+            workers.push(handle);
+        }
         Ok(Self {
             envs,
-            jobs: Some(jobs),
+            jobs,
             done,
-            queue,
             workers,
             busy: vec![false; n],
             pending: 0,
@@ -195,17 +202,50 @@ impl VecEnv {
     /// with [`send`](Self::send) are still pending. Each environment's own result may be an
     /// error (invalid action) as [`MacroEnv::step`]'s.
     pub fn step(&mut self, actions: &[Action]) -> Result<Vec<Result<StepResult, Error>>, Error> {
+        let ids: Vec<usize> = (0..self.envs.len()).collect();
+        self.step_each(&ids, actions)
+    }
+
+    /// Steps environments `ids` (`actions[k]` on `ids[k]`) in parallel and waits for them: the
+    /// share of worker 0 runs on the calling thread, the others' on their workers. The results
+    /// in the order of `ids`.
+    ///
+    /// # Errors
+    /// As [`step`](Self::step), and for unknown or repeated ids.
+    pub fn step_each(
+        &mut self,
+        ids: &[usize],
+        actions: &[Action],
+    ) -> Result<Vec<Result<StepResult, Error>>, Error> {
         if self.pending > 0 {
             return Err(invalid(format!(
                 "{} steps sent with send() are still pending; receive them first (recv)",
                 self.pending
             )));
         }
-        let ids: Vec<usize> = (0..self.envs.len()).collect();
-        self.send(&ids, actions)?;
+        self.check_ids(ids, actions.len())?;
+        let threads = self.jobs.len();
+        let (mine, theirs): (Vec<usize>, Vec<usize>) =
+            (0..ids.len()).partition(|&k| ids[k].is_multiple_of(threads));
+        let their_ids: Vec<usize> = theirs.iter().map(|&k| ids[k]).collect();
+        let their_actions: Vec<Action> = theirs.iter().map(|&k| actions[k].clone()).collect();
+        self.send(&their_ids, &their_actions)?;
         let mut out: Vec<Option<Result<StepResult, Error>>> = (0..ids.len()).map(|_| None).collect();
-        for (i, r) in self.recv(ids.len())? {
-            out[i] = Some(r);
+        for k in mine {
+            out[k] = Some(run_job(&self.envs, ids[k], &actions[k]));
+        }
+        // The workers are busy with their share and this thread has nothing else to do: poll
+        // for their results before sleeping.
+        let mut left = their_ids.len();
+        while left > 0 {
+            let (i, r) = wait(&self.done, true)
+                .ok_or_else(|| invalid("the worker threads have stopped".to_string()))?;
+            if let Some(k) = ids.iter().position(|&j| j == i) {
+                out[k] = Some(r);
+            }
+            self.busy[i] = false;
+            self.pending -= 1;
+            left -= 1;
         }
         Ok(out
             .into_iter()
@@ -221,9 +261,9 @@ impl VecEnv {
     /// still running a step.
     pub fn send(&mut self, ids: &[usize], actions: &[Action]) -> Result<(), Error> {
         self.check_ids(ids, actions.len())?;
-        let jobs = self.jobs.as_ref().expect("open until drop");
         for (&i, a) in ids.iter().zip(actions) {
-            jobs.send((i, a.clone()))
+            self.jobs[i % self.jobs.len()]
+                .send((i, a.clone()))
                 .map_err(|_| invalid("the worker threads have stopped".to_string()))?;
             self.busy[i] = true;
             self.pending += 1;
@@ -245,21 +285,9 @@ impl VecEnv {
         }
         let mut out = Vec::with_capacity(min_batch);
         while out.len() < min_batch {
-            // Rather than wait for a worker to wake up, run a queued step on this thread. The
-            // queue's lock is busy only while a worker waits on an empty queue: then nothing is
-            // left to take, and this thread waits for results instead.
-            let job = match self.queue.try_lock() {
-                Ok(q) => q.try_recv().ok(),
-                Err(_) => None,
-            };
-            if let Some((i, action)) = job {
-                out.push((i, run_job(&self.envs, i, &action)));
-                continue;
-            }
-            let d = self
-                .done
-                .recv()
-                .map_err(|_| invalid("the worker threads have stopped".to_string()))?;
+            // Sleep at once: while the workers run, this thread's core may be one they need.
+            let d = wait(&self.done, false)
+                .ok_or_else(|| invalid("the worker threads have stopped".to_string()))?;
             out.push(d);
         }
         while let Ok(d) = self.done.try_recv() {
@@ -293,21 +321,34 @@ impl VecEnv {
 
 impl Drop for VecEnv {
     fn drop(&mut self) {
-        self.jobs = None;
+        self.jobs.clear();
         for w in self.workers.drain(..) {
             let _ = w.join();
         }
     }
 }
 
-/// A worker: takes the next job, runs it on its environment, sends the result; stops when the
-/// job queue closes.
-fn worker(queue: &Mutex<Receiver<Job>>, envs: &[Arc<Mutex<MacroEnv>>], done: &Sender<Finished>) {
+/// The next message of `queue`: polled for up to [`SPIN_WAIT`] when `spin`, then waited for;
+/// `None` once every sender is gone.
+fn wait<T>(queue: &Receiver<T>, spin: bool) -> Option<T> {
+    if !spin {
+        return queue.recv().ok();
+    }
+    let start = Instant::now();
     loop {
-        let job = queue.lock().unwrap_or_else(|e| e.into_inner()).recv();
-        let Ok((i, action)) = job else {
-            return;
-        };
+        match queue.try_recv() {
+            Ok(m) => return Some(m),
+            Err(TryRecvError::Disconnected) => return None,
+            Err(TryRecvError::Empty) if start.elapsed() < SPIN_WAIT => std::hint::spin_loop(),
+            Err(TryRecvError::Empty) => return queue.recv().ok(),
+        }
+    }
+}
+
+/// A worker: takes the next job of its queue, runs it on its environment, sends the result;
+/// stops when its queue closes.
+fn worker(queue: &Receiver<Job>, envs: &[Arc<Mutex<MacroEnv>>], done: &Sender<Finished>) {
+    while let Some((i, action)) = wait(queue, true) {
         if done.send((i, run_job(envs, i, &action))).is_err() {
             return;
         }
