@@ -50,6 +50,12 @@ pub enum Error {
         /// What is wrong, and what is accepted.
         message: String,
     },
+    /// A step was stopped by its caller (Ctrl-C) at the start of a control period; the running
+    /// action was halted there and the environment must be reset before it steps again.
+    Interrupted {
+        /// Where it stopped.
+        message: String,
+    },
 }
 
 impl Error {
@@ -63,6 +69,7 @@ impl Error {
             Error::Registry { .. } => "registry",
             Error::Config { .. } => "config",
             Error::Action { .. } => "invalid_action",
+            Error::Interrupted { .. } => "interrupted",
         }
     }
 
@@ -103,7 +110,9 @@ impl fmt::Display for Error {
             Error::Registry { kind, message } => {
                 write!(f, "error: cannot register node kind `{kind}`: {message}")
             }
-            Error::Config { message } | Error::Action { message } => write!(f, "error: {message}"),
+            Error::Config { message } | Error::Action { message } | Error::Interrupted { message } => {
+                write!(f, "error: {message}")
+            }
         }
     }
 }

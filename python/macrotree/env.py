@@ -47,6 +47,16 @@ StepReturn = tuple[Observation, SupportsFloat, bool, bool, dict[str, Any]]
 RESET_OPTIONS = ("layout", "scenario", "sweep_seed", "placement", "reset_mask")
 
 
+class Closed:
+    """What a closed environment's native part becomes: every use raises ``RuntimeError``."""
+
+    def __init__(self, what: str) -> None:
+        self._what = what
+
+    def __getattr__(self, name: str) -> Any:
+        raise RuntimeError(f"this {self._what} is closed; make a new one")
+
+
 def _path(value: str | os.PathLike[str] | None) -> str | None:
     return None if value is None else os.fspath(value)
 
@@ -119,7 +129,7 @@ class MacroEnv(gym.Env[Observation, Any]):
             )
         if scene is None and tree is None:
             raise ValueError("MacroEnv needs a scene file, a tree file, or both")
-        self._native = _native.Env(
+        self._native: _native.Env | Closed = _native.Env(
             scene=_path(scene),
             tree=_path(tree),
             control_period=float(control_period),
@@ -213,7 +223,16 @@ class MacroEnv(gym.Env[Observation, Any]):
         return self._native.render(self.render_camera, h, w)
 
     def close(self) -> None:
-        """Releases nothing explicitly (the native cell is freed with the object); idempotent."""
+        """Frees the native cell; idempotent. Every later call raises ``RuntimeError``."""
+        self._native = Closed("MacroEnv")
+
+    def __copy__(self) -> MacroEnv:
+        raise TypeError(
+            "a MacroEnv cannot be copied (a copy would share its simulation); make a new one"
+        )
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> MacroEnv:
+        return self.__copy__()
 
     # --- beyond Gymnasium ------------------------------------------------------------------------
 

@@ -194,15 +194,44 @@ def _scalar(value: Any, name: str) -> float:
     return float(array[0])
 
 
+#: The keys of a ``macro`` action.
+MACRO_KEYS = (
+    "mode",
+    "position",
+    "quaternion",
+    "joints",
+    "gripper",
+    "gripper_command",
+    "path",
+    "steps",
+    "settle_steps",
+)
+
+
+def _integer(value: Any, name: str) -> int:
+    """One whole number (``mode``, ``steps``, …): a float must be integral, a string is refused."""
+    array = np.asarray(value)
+    if array.dtype.kind not in "biuf" or array.size != 1:
+        raise ValueError(f"macro action `{name}` must be one whole number, got {value!r:.60}")
+    number = float(array.reshape(-1)[0])
+    if not number.is_integer():
+        raise ValueError(f"macro action `{name}` must be a whole number, got {number!r:.60}")
+    return int(number)
+
+
 def macro_to_native(action: Any) -> dict[str, Any]:
     """A ``macro`` action (mapping) as the native extension takes it; raises ``ValueError`` on a
-    malformed one (missing key, wrong shape). Ranges are checked by the native side."""
+    malformed one (missing or unknown key, wrong shape, a fractional or text count). Ranges are
+    checked by the native side."""
     if not isinstance(action, dict):
         raise ValueError(f"a macro action is a dict of the action space's keys, got {type(action)}")
+    unknown = sorted(str(k)[:40] for k in action if k not in MACRO_KEYS)
+    if unknown:
+        raise ValueError(f"macro action keys {unknown} are unknown; keys: {list(MACRO_KEYS)}")
     missing = [k for k in ("mode",) if k not in action]
     if missing:
         raise ValueError(f"macro action misses {missing}")
-    out: dict[str, Any] = {"mode": int(_scalar(action["mode"], "mode"))}
+    out: dict[str, Any] = {"mode": _integer(action["mode"], "mode")}
     if "position" in action:
         out["position"] = _vector(action["position"], 3, "position")
     if "quaternion" in action:
@@ -210,13 +239,13 @@ def macro_to_native(action: Any) -> dict[str, Any]:
     if "joints" in action:
         out["joints"] = _vector(action["joints"], 6, "joints")
     if "gripper" in action:
-        out["gripper"] = int(_scalar(action["gripper"], "gripper"))
+        out["gripper"] = _integer(action["gripper"], "gripper")
     if "gripper_command" in action:
         out["gripper_command"] = _scalar(action["gripper_command"], "gripper_command")
     if "path" in action:
-        out["path"] = int(_scalar(action["path"], "path"))
+        out["path"] = _integer(action["path"], "path")
     if "steps" in action:
-        out["steps"] = int(_scalar(action["steps"], "steps"))
+        out["steps"] = _integer(action["steps"], "steps")
     if "settle_steps" in action:
-        out["settle_steps"] = int(_scalar(action["settle_steps"], "settle_steps"))
+        out["settle_steps"] = _integer(action["settle_steps"], "settle_steps")
     return out

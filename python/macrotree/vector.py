@@ -24,6 +24,7 @@ from macrotree.env import (
     ACTION_MODES,
     RESET_OPTIONS,
     ActionMode,
+    Closed,
     MacroEnv,
     _base_tree,
     _check_keys,
@@ -178,7 +179,7 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         self.action_mode: ActionMode = action_mode
         self.render_mode = render_mode
         self.image_size = (int(image_size[0]), int(image_size[1]))
-        self._native = _native.VecEnv(
+        self._native: _native.VecEnv | Closed = _native.VecEnv(
             num_envs=self.num_envs,
             threads=threads,
             scene=_path(scene),
@@ -274,7 +275,12 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         want = len(self._pending) if batch_size is None else int(batch_size)
         if not 1 <= want <= len(self._pending):
             raise ValueError(f"batch_size must be 1…{len(self._pending)}, got {batch_size}")
-        batch = self._native.recv(want)
+        try:
+            batch = self._native.recv(want)
+        except KeyboardInterrupt:
+            # Every pending step stopped at its next control period and was collected.
+            self._pending.clear()
+            raise
         self._pending.difference_update(int(i) for i in batch["env_id"])
         obs, rew, term, trunc, info = self._finish(batch)
         info["env_id"] = np.asarray(batch["env_id"], dtype=np.int64)
@@ -288,8 +294,10 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         return tuple(self._native.render(None, h, w))
 
     def close_extras(self, **kwargs: Any) -> None:
-        """Waits for the actions still running, then frees the cells."""
+        """Waits for the actions still running, then frees the cells; every later call raises
+        ``RuntimeError``."""
         self._native.close()
+        self._native = Closed("VectorEnv")
         self._pending.clear()
 
     # --- helpers ------------------------------------------------------------------------------

@@ -92,14 +92,19 @@ pub fn pixels(env: &MacroEnv, cameras: &[String], (h, w): (u32, u32)) -> PyResul
 }
 
 impl Env {
-    fn env(&self) -> MutexGuard<'_, MacroEnv> {
-        self.inner.lock().unwrap_or_else(|e| e.into_inner())
+    /// The environment, or a clear error when another thread is using it (an environment
+    /// serves one thread at a time; waiting here while holding the GIL would deadlock).
+    fn env(&self) -> PyResult<MutexGuard<'_, MacroEnv>> {
+        crate::error::try_lock(&self.inner)
     }
 
     fn step(&self, py: Python<'_>, action: Action) -> PyResult<Py<PyDict>> {
-        let mut env = self.env();
+        let mut env = self.env()?;
         let e: &mut MacroEnv = &mut env;
-        let r = py.detach(|| e.step(&action)).map_err(to_py)?;
+        let signals = crate::error::SignalPoll::default();
+        let r = py
+            .detach(|| e.step_with(&action, &mut signals.poll()))
+            .map_err(|e| signals.error(e))?;
         let px = pixels(&env, &self.cameras, self.image)?;
         Ok(convert::step_result(py, &r, px, &sizes(&env))?.unbind())
     }
@@ -185,20 +190,21 @@ impl Env {
 
     /// Object names, scene order.
     #[getter]
-    fn object_names(&self) -> Vec<String> {
-        self.env()
+    fn object_names(&self) -> PyResult<Vec<String>> {
+        Ok(self
+            .env()?
             .scene()
             .spec
             .objects
             .iter()
             .map(|o| o.name.clone())
-            .collect()
+            .collect())
     }
 
     /// The scene's cameras.
     #[getter]
-    fn cameras(&self) -> Vec<String> {
-        self.env().scene().camera_names()
+    fn cameras(&self) -> PyResult<Vec<String>> {
+        Ok(self.env()?.scene().camera_names())
     }
 
     /// The UR5e home joint angles, radians.
@@ -215,21 +221,21 @@ impl Env {
 
     /// A sentence about the task (LeRobot's `task_description`).
     #[getter]
-    fn task_description(&self) -> String {
-        let env = self.env();
+    fn task_description(&self) -> PyResult<String> {
+        let env = self.env()?;
         let goal = macrotree::world::goal::evaluate(env.cell().world());
-        if goal.is_empty() {
+        Ok(if goal.is_empty() {
             format!("scene {}: no goal", self.task)
         } else {
             let parts: Vec<&str> = goal.iter().map(|g| g.predicate.as_str()).collect();
             format!("scene {}: {}", self.task, parts.join(", "))
-        }
+        })
     }
 
     /// Seconds of one control period.
     #[getter]
-    fn control_period(&self) -> f64 {
-        self.env().config().control_period
+    fn control_period(&self) -> PyResult<f64> {
+        Ok(self.env()?.config().control_period)
     }
 
     #[pyo3(signature = (*, seed, layout=None, scenario=None, sweep_seed=None, placement=None))]
@@ -242,8 +248,8 @@ impl Env {
         sweep_seed: Option<u64>,
         placement: Option<Bound<'_, PyDict>>,
     ) -> PyResult<Py<PyDict>> {
-        let names = self.object_names();
-        let mut env = self.env();
+        let names = self.object_names()?;
+        let mut env = self.env()?;
         let how = reset_of(
             &names,
             &env.scene().default_placement(),
@@ -289,7 +295,7 @@ impl Env {
     }
 
     fn observation(&self, py: Python<'_>) -> PyResult<Py<PyDict>> {
-        let env = self.env();
+        let env = self.env()?;
         Ok(convert::full_observation(py, &env.observe(), &sizes(&env))?.unbind())
     }
 
@@ -301,7 +307,7 @@ impl Env {
         height: u32,
         width: u32,
     ) -> PyResult<Bound<'py, PyArray3<u8>>> {
-        let env = self.env();
+        let env = self.env()?;
         let camera = match camera {
             Some(c) => c,
             None => first_camera(&env)?,
@@ -312,14 +318,15 @@ impl Env {
 
     /// The frames filmed since the last call (`rgb_array_list`), each H×W×3 `uint8`.
     fn take_frames<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyArray3<u8>>>> {
-        let frames = self.env().take_frames();
+        let frames = self.env()?.take_frames();
         frames.into_iter().map(|img| image(py, img)).collect()
     }
 
     /// Records the actuator commands of every physics step from now until the next reset.
-    fn record_controls(&self) {
-        let log = self.env().record_controls();
+    fn record_controls(&self) -> PyResult<()> {
+        let log = self.env()?.record_controls();
         *self.recording.lock().unwrap_or_else(|e| e.into_inner()) = Some(log);
+        Ok(())
     }
 
     /// Replays the recorded commands on a fresh simulation with bare `mj_step` from this
@@ -332,7 +339,7 @@ impl Env {
             .unwrap_or_else(|e| e.into_inner())
             .clone()
             .ok_or_else(|| value("nothing recorded: call record_controls() after reset() first"))?;
-        let env = self.env();
+        let env = self.env()?;
         let controls = log.lock().unwrap_or_else(|e| e.into_inner()).clone();
         let nu = env.cell().sim().ctrl().len().max(1);
         let (scene, placement) = (env.scene(), env.placement());

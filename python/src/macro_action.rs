@@ -76,8 +76,36 @@ fn gripper_during(d: &Bound<'_, PyDict>) -> PyResult<Option<f64>> {
     })
 }
 
-/// Reads a macro action.
+/// The keys a macro action may have.
+const KEYS: [&str; 9] = [
+    "mode",
+    "position",
+    "quaternion",
+    "joints",
+    "gripper",
+    "gripper_command",
+    "path",
+    "steps",
+    "settle_steps",
+];
+
+/// Reads a macro action; unknown keys are refused, with the closest known one.
 pub fn primitive(d: &Bound<'_, PyDict>) -> PyResult<Primitive> {
+    for key in d.keys() {
+        let key: String = key
+            .extract()
+            .map_err(|_| value("macro action keys are strings"))?;
+        if !KEYS.contains(&key.as_str()) {
+            let hint = macrotree::yaml::suggest::closest(&key, KEYS.iter().copied())
+                .map(|c| format!("did you mean `{c}`? "))
+                .unwrap_or_default();
+            let shown: String = key.chars().take(40).collect();
+            return Err(value(format!(
+                "macro action key `{shown}` is unknown; {hint}keys: {}",
+                KEYS.join(", ")
+            )));
+        }
+    }
     let mode: i64 = field(d, "mode")?.ok_or_else(|| value("a macro action needs `mode` (0 … 5)"))?;
     let gripper = gripper_during(d)?;
     Ok(match mode {
@@ -97,6 +125,12 @@ pub fn primitive(d: &Bound<'_, PyDict>) -> PyResult<Primitive> {
                     let q: [f64; 4] = q
                         .try_into()
                         .map_err(|_| value("macro action `quaternion` needs 4 values (w, x, y, z)"))?;
+                    if let Some(i) = q.iter().position(|v| !v.is_finite()) {
+                        return Err(value(format!(
+                            "macro action `quaternion[{i}]` is {}; give a finite quaternion (w, x, y, z), or all zeros to keep the current orientation",
+                            q[i]
+                        )));
+                    }
                     // The reference's convention: an all-zero quaternion means position only.
                     (q.iter().map(|v| v * v).sum::<f64>() > 1e-12).then_some(q)
                 }
@@ -119,6 +153,7 @@ pub fn primitive(d: &Bound<'_, PyDict>) -> PyResult<Primitive> {
             }
         }
         OPEN_GRIPPER => Primitive::OpenGripper {
+            command: field::<f64>(d, "gripper_command")?.filter(|c| !c.is_nan()),
             duration: duration(d, false)?,
         },
         CLOSE_GRIPPER => Primitive::CloseGripper {

@@ -38,8 +38,9 @@ fn action_of(a: &Bound<'_, PyAny>) -> PyResult<Action> {
 type Guard<'a> = std::sync::MutexGuard<'a, macrotree::env::VecEnv>;
 
 impl VecEnv {
-    fn vec(&self) -> Guard<'_> {
-        self.inner.lock().unwrap_or_else(|e| e.into_inner())
+    /// The vector environment, or a clear error when another thread is using it.
+    fn vec(&self) -> PyResult<Guard<'_>> {
+        crate::error::try_lock(&self.inner)
     }
 
     /// The batch of results `done` (environment id, result), in that order; the first error
@@ -139,7 +140,7 @@ impl VecEnv {
         if ids.len() != seeds.len() {
             return Err(value(format!("{} ids but {} seeds", ids.len(), seeds.len())));
         }
-        let mut v = self.vec();
+        let mut v = self.vec()?;
         let default = v.with_env(0, |e| e.scene().default_placement()).map_err(to_py)?;
         let how = seeds
             .iter()
@@ -185,16 +186,19 @@ impl VecEnv {
         actions: Vec<Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let actions = actions.iter().map(action_of).collect::<PyResult<Vec<_>>>()?;
-        let mut v = self.vec();
+        let mut v = self.vec()?;
         let e: &mut macrotree::env::VecEnv = &mut v;
-        let done = py.detach(|| e.step_each(&ids, &actions)).map_err(to_py)?;
+        let signals = crate::error::SignalPoll::default();
+        let done = py
+            .detach(|| e.step_each_with(&ids, &actions, &mut signals.poll()))
+            .map_err(|e| signals.error(e))?;
         self.batch(py, &v, ids.iter().copied().zip(done).collect())
     }
 
     /// Starts `actions` on environments `ids` and returns at once.
     fn send<'py>(&self, py: Python<'py>, ids: Vec<usize>, actions: Vec<Bound<'py, PyAny>>) -> PyResult<()> {
         let actions = actions.iter().map(action_of).collect::<PyResult<Vec<_>>>()?;
-        let mut v = self.vec();
+        let mut v = self.vec()?;
         let e: &mut macrotree::env::VecEnv = &mut v;
         py.detach(|| e.send(&ids, &actions)).map_err(to_py)
     }
@@ -202,9 +206,12 @@ impl VecEnv {
     /// Waits for at least `count` environments to finish; the batch of their results in
     /// finishing order, `env_id` saying whose.
     fn recv<'py>(&self, py: Python<'py>, count: usize) -> PyResult<Bound<'py, PyDict>> {
-        let mut v = self.vec();
+        let mut v = self.vec()?;
         let e: &mut macrotree::env::VecEnv = &mut v;
-        let done = py.detach(|| e.recv(count)).map_err(to_py)?;
+        let signals = crate::error::SignalPoll::default();
+        let done = py
+            .detach(|| e.recv_with(count, &mut signals.poll()))
+            .map_err(|e| signals.error(e))?;
         self.batch(py, &v, done)
     }
 
@@ -216,7 +223,7 @@ impl VecEnv {
         height: u32,
         width: u32,
     ) -> PyResult<Vec<Bound<'py, PyArray3<u8>>>> {
-        let v = self.vec();
+        let v = self.vec()?;
         (0..v.num_envs())
             .map(|i| {
                 let img = v
@@ -235,7 +242,7 @@ impl VecEnv {
 
     /// Waits for running actions, then stops the worker threads.
     fn close(&self, py: Python<'_>) -> PyResult<()> {
-        let mut v = self.vec();
+        let mut v = self.vec()?;
         let pending = v.pending();
         if pending > 0 {
             let e: &mut macrotree::env::VecEnv = &mut v;

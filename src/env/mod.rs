@@ -89,6 +89,8 @@ pub struct MacroEnv {
     episode_seed: u64,
     /// The base tree's run across residual steps, once one has started.
     base: Option<residual::BaseRun>,
+    /// The last step was interrupted: a reset is needed.
+    interrupted: bool,
     #[cfg(feature = "render")]
     film: Option<film::Film>,
 }
@@ -137,6 +139,7 @@ impl MacroEnv {
             unstable: false,
             placement,
             base: None,
+            interrupted: false,
         };
         env.reset(&Reset::Default)?;
         Ok(env)
@@ -151,6 +154,7 @@ impl MacroEnv {
         let (placement, seed) = reset::resolve(self.cell.sim().scene(), how)?;
         self.episode_seed = seed.unwrap_or(self.config.seed);
         self.base = None;
+        self.interrupted = false;
         self.cell.observers.clear();
         self.cell.reset_placement(&placement);
         self.placement = placement;
@@ -183,12 +187,22 @@ impl MacroEnv {
     /// of range, an unknown subtree, a subtree without a tree, or a step after the simulation
     /// became unstable (reset first).
     pub fn step(&mut self, action: &Action) -> Result<StepResult, Error> {
-        if self.unstable {
-            return Err(Error::Action {
-                message: "the simulation became unstable in an earlier step; reset the environment"
-                    .to_string(),
-            });
-        }
+        self.step_with(action, &mut || false)
+    }
+
+    /// [`step`](Self::step), asking `interrupt` at the start of every control period after the
+    /// first whether to stop (a caller's Ctrl-C: the closure decides how often it really
+    /// looks). When it says so, the running action is halted there, the step returns
+    /// [`Error::Interrupted`] and the environment must be reset before it steps again.
+    ///
+    /// # Errors
+    /// As [`step`](Self::step); [`Error::Interrupted`] as above.
+    pub fn step_with(
+        &mut self,
+        action: &Action,
+        interrupt: &mut dyn FnMut() -> bool,
+    ) -> Result<StepResult, Error> {
+        self.check_usable()?;
         if !matches!(action, Action::Residual(_)) {
             self.end_base_run();
         }
@@ -247,9 +261,19 @@ impl MacroEnv {
                     filmed = f.tick(_cell);
                 }
             },
+            interrupt,
         );
         drop(driver);
         filmed?;
+        if ran.interrupted {
+            self.interrupted = true;
+            return Err(Error::Interrupted {
+                message: format!(
+                    "the step was interrupted at {:.3} s of simulated time; reset the environment",
+                    self.cell.world().time
+                ),
+            });
+        }
         self.unstable = ran.unstable;
         let world = self.cell.world();
         let goal = crate::world::goal::evaluate(world);
@@ -275,6 +299,59 @@ impl MacroEnv {
             faults_fired: self.faults_fired(),
             ctrl_clamped: clamped,
             base: None,
+        })
+    }
+
+    /// Checks `action` as [`step`](Self::step) would before simulating anything, without
+    /// running it: the leaf mapping compiles, the subtree exists, every number is in range, the
+    /// simulation is usable. A vector environment checks a whole batch this way before any
+    /// sub-environment moves.
+    ///
+    /// # Errors
+    /// The error [`step`](Self::step) would give for invalid input.
+    pub fn check_action(&mut self, action: &Action) -> Result<(), Error> {
+        self.check_usable()?;
+        let no_tree = |what: &str| Error::Action {
+            message: format!("{what}: this environment has no tree; give one to MacroEnv::new"),
+        };
+        match action {
+            Action::Leaf(text) => self
+                .leaves
+                .get(&self.loader, &self.cell.sim().scene().spec, text)
+                .map(drop),
+            Action::Subtree(name) => {
+                let tree = self
+                    .tree
+                    .as_ref()
+                    .ok_or_else(|| no_tree(&format!("subtree `{name}`")))?;
+                self.subtrees.get(tree, name).map(drop)
+            }
+            Action::Primitive(p) => p.check(),
+            Action::Ctrl(_) | Action::Setpoint(_) => {
+                let values = action::ctrl_of(action).expect("a ctrl or setpoint action");
+                action::check_ctrl(&values, &self.cell.arm_setpoint(), self.cell.control_period()).map(drop)
+            }
+            Action::Residual(r) => {
+                if self.tree.is_none() {
+                    return Err(no_tree("a residual step needs a base tree"));
+                }
+                residual::check(r)
+            }
+        }
+    }
+
+    /// The environment may step: no earlier step was interrupted or became unstable since the
+    /// last reset.
+    fn check_usable(&self) -> Result<(), Error> {
+        let why = if self.interrupted {
+            "the last step was interrupted"
+        } else if self.unstable {
+            "the simulation became unstable in an earlier step"
+        } else {
+            return Ok(());
+        };
+        Err(Error::Action {
+            message: format!("{why}; reset the environment"),
         })
     }
 

@@ -100,8 +100,10 @@ pub enum Primitive {
         /// The gripper command during the motion (0 open … 255 closed; `None`: keep it).
         gripper: Option<f64>,
     },
-    /// Open the gripper fully (command 0); the arm holds.
+    /// Open the gripper, fully (command 0) or to a command; the arm holds.
     OpenGripper {
+        /// Actuator command to open to, 0 … 255 (`None`: 0, fully open).
+        command: Option<f64>,
         /// How long.
         duration: Duration,
     },
@@ -141,7 +143,7 @@ impl Primitive {
             Primitive::Wait { duration, .. }
             | Primitive::ReachPose { duration, .. }
             | Primitive::ReachJoints { duration, .. }
-            | Primitive::OpenGripper { duration }
+            | Primitive::OpenGripper { duration, .. }
             | Primitive::CloseGripper { duration, .. }
             | Primitive::Reset { duration } => *duration,
         }
@@ -225,6 +227,13 @@ impl Primitive {
                         ));
                     }
                 }
+            }
+            Primitive::OpenGripper { command: Some(c), .. }
+                if !(c.is_finite() && (OPEN_CTRL..=CLOSED_CTRL).contains(c)) =>
+            {
+                return bad(format!(
+                    "open_gripper: command {c}; expected {OPEN_CTRL} (open) … {CLOSED_CTRL} (closed)"
+                ));
             }
             Primitive::CloseGripper { command, width, .. } => match (command, width) {
                 (Some(_), Some(_)) => {
@@ -426,7 +435,7 @@ impl MacroAction for PrimitiveRun {
                 }
                 self.start_motion(cell, Box::new(JointMove::new(from, joints, &limits)));
             }
-            Primitive::OpenGripper { .. } => self.start_gripper(cell, OPEN_CTRL),
+            Primitive::OpenGripper { command, .. } => self.start_gripper(cell, command.unwrap_or(OPEN_CTRL)),
             Primitive::CloseGripper { command, width, .. } => {
                 let ctrl = match (command, width) {
                     (Some(c), _) => c,
@@ -533,6 +542,7 @@ mod tests {
             ),
             (
                 Primitive::OpenGripper {
+                    command: None,
                     duration: Duration::Steps { steps: 0, settle: 0 },
                 },
                 "at least 1",

@@ -174,16 +174,20 @@ pub(super) struct Ran {
     pub rewards: Vec<f32>,
     /// Contacts that should not happen.
     pub collisions: Vec<Collision>,
+    /// The caller's interrupt stopped it (at the start of a control period; halted there).
+    pub interrupted: bool,
 }
 
 /// Runs `stepper` on the driver's cell until it finishes, the time limit `max_sim_time`
-/// (seconds) is reached, or the simulation becomes unstable.
+/// (seconds) is reached, the simulation becomes unstable, or `interrupt` (asked at the start
+/// of every control period after the first) says to stop.
 pub(super) fn run(
     d: &mut MacroDriver<'_>,
     stepper: &mut dyn Stepper,
     max_sim_time: f64,
     rewards_per_tick: bool,
     on_tick: &mut dyn FnMut(&crate::actions::Cell),
+    interrupt: &mut dyn FnMut() -> bool,
 ) -> Ran {
     let dt = d.cell().control_period();
     let mut ran = Ran {
@@ -193,8 +197,15 @@ pub(super) fn run(
         goal_ticks: 0,
         rewards: Vec::new(),
         collisions: Vec::new(),
+        interrupted: false,
     };
+    let mut first = true;
     loop {
+        if !std::mem::take(&mut first) && interrupt() {
+            stepper.halt(d);
+            ran.interrupted = true;
+            break;
+        }
         let now = d.cell().world().time;
         if now >= max_sim_time {
             stepper.halt(d);

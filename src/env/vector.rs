@@ -11,7 +11,8 @@
 //! awake (a sleeping thread takes tens of microseconds to wake, a `ctrl` step about 100).
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender, TryRecvError, channel};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -28,6 +29,9 @@ pub const MAX_ENVS: usize = 1024;
 /// sleeps.
 pub const SPIN_WAIT: Duration = Duration::from_micros(200);
 
+/// How often a waiting caller asks its interrupt poll (Ctrl-C) whether to stop.
+pub const INTERRUPT_POLL: Duration = Duration::from_millis(20);
+
 /// A step to run: the environment and its action.
 type Job = (usize, Action);
 /// A finished step: the environment's id and its result.
@@ -42,6 +46,10 @@ pub struct VecEnv {
     workers: Vec<JoinHandle<()>>,
     busy: Vec<bool>,
     pending: usize,
+    /// Set while an interrupt stops the running steps (each stops at its next control period).
+    cancel: Arc<AtomicBool>,
+    /// A step of this vector environment was interrupted: every environment must be reset.
+    interrupted: bool,
 }
 
 fn lock(env: &Mutex<MacroEnv>) -> MutexGuard<'_, MacroEnv> {
@@ -92,15 +100,17 @@ impl VecEnv {
             envs.push(Arc::new(Mutex::new(env)));
         }
         let (done_tx, done) = channel::<Finished>();
+        let cancel = Arc::new(AtomicBool::new(false));
         let mut jobs = Vec::new();
         let mut workers = Vec::new();
         for k in 0..threads.clamp(1, n) {
             let (tx, queue) = channel::<Job>();
             let done_tx = done_tx.clone();
             let envs = envs.clone();
+            let cancel = cancel.clone();
             let handle = std::thread::Builder::new()
                 .name(format!("macrotree-env-{k}"))
-                .spawn(move || worker(&queue, &envs, &done_tx))
+                .spawn(move || worker(&queue, &envs, &done_tx, &cancel))
                 .map_err(|e| Error::Simulator {
                     message: format!("cannot start a worker thread: {e}"),
                 })?;
@@ -114,6 +124,8 @@ impl VecEnv {
             workers,
             busy: vec![false; n],
             pending: 0,
+            cancel,
+            interrupted: false,
         })
     }
 
@@ -171,10 +183,15 @@ impl VecEnv {
     /// As [`reset`](Self::reset), for unknown or repeated ids too.
     pub fn reset_each(&mut self, ids: &[usize], how: &[Reset]) -> Result<Vec<Observation>, Error> {
         self.check_ids(ids, how.len())?;
-        ids.iter()
+        let obs = ids
+            .iter()
             .zip(how)
             .map(|(&i, h)| lock(&self.envs[i]).reset(h))
-            .collect()
+            .collect::<Result<Vec<_>, Error>>()?;
+        if ids.len() == self.envs.len() {
+            self.interrupted = false;
+        }
+        Ok(obs)
     }
 
     fn check_ids(&self, ids: &[usize], n: usize) -> Result<(), Error> {
@@ -190,6 +207,25 @@ impl VecEnv {
             if std::mem::replace(&mut seen[i], true) {
                 return Err(invalid(format!("environment {i} is given twice")));
             }
+        }
+        Ok(())
+    }
+
+    /// Checks every action of a batch before any environment moves ([`MacroEnv::check_action`]),
+    /// so an invalid one refuses the whole batch and leaves every environment as it was.
+    fn check_actions(&self, ids: &[usize], actions: &[Action]) -> Result<(), Error> {
+        if self.interrupted {
+            return Err(invalid(
+                "a step of this vector environment was interrupted; reset every environment".to_string(),
+            ));
+        }
+        for (&i, a) in ids.iter().zip(actions) {
+            lock(&self.envs[i]).check_action(a).map_err(|e| match e {
+                Error::Action { message } => invalid(format!(
+                    "environment {i}: {message} (no environment of the batch was stepped)"
+                )),
+                other => other,
+            })?;
         }
         Ok(())
     }
@@ -217,6 +253,22 @@ impl VecEnv {
         ids: &[usize],
         actions: &[Action],
     ) -> Result<Vec<Result<StepResult, Error>>, Error> {
+        self.step_each_with(ids, actions, &mut || false)
+    }
+
+    /// [`step_each`](Self::step_each), asking `interrupt` about every [`INTERRUPT_POLL`] (and
+    /// at every control period of this thread's own share) whether to stop: then every running
+    /// step stops at its next control period, the call returns [`Error::Interrupted`], and every
+    /// environment must be reset before the next step.
+    ///
+    /// # Errors
+    /// As [`step_each`](Self::step_each); [`Error::Interrupted`] as above.
+    pub fn step_each_with(
+        &mut self,
+        ids: &[usize],
+        actions: &[Action],
+        interrupt: &mut dyn FnMut() -> bool,
+    ) -> Result<Vec<Result<StepResult, Error>>, Error> {
         if self.pending > 0 {
             return Err(invalid(format!(
                 "{} steps sent with send() are still pending; receive them first (recv)",
@@ -224,6 +276,7 @@ impl VecEnv {
             )));
         }
         self.check_ids(ids, actions.len())?;
+        self.check_actions(ids, actions)?;
         let threads = self.jobs.len();
         let (mine, theirs): (Vec<usize>, Vec<usize>) =
             (0..ids.len()).partition(|&k| ids[k].is_multiple_of(threads));
@@ -231,14 +284,24 @@ impl VecEnv {
         let their_actions: Vec<Action> = theirs.iter().map(|&k| actions[k].clone()).collect();
         self.send(&their_ids, &their_actions)?;
         let mut out: Vec<Option<Result<StepResult, Error>>> = (0..ids.len()).map(|_| None).collect();
+        let cancel = self.cancel.clone();
+        let mut stop = || {
+            cancel.load(Ordering::Relaxed) || {
+                let asked = interrupt();
+                if asked {
+                    cancel.store(true, Ordering::Relaxed);
+                }
+                asked
+            }
+        };
         for k in mine {
-            out[k] = Some(run_job(&self.envs, ids[k], &actions[k]));
+            out[k] = Some(run_job(&self.envs, ids[k], &actions[k], &mut stop));
         }
         // The workers are busy with their share and this thread has nothing else to do: poll
         // for their results before sleeping.
         let mut left = their_ids.len();
         while left > 0 {
-            let (i, r) = wait(&self.done, true)
+            let (i, r) = wait_polled(&self.done, true, &mut stop)
                 .ok_or_else(|| invalid("the worker threads have stopped".to_string()))?;
             if let Some(k) = ids.iter().position(|&j| j == i) {
                 out[k] = Some(r);
@@ -247,6 +310,7 @@ impl VecEnv {
             self.pending -= 1;
             left -= 1;
         }
+        self.end_interrupt()?;
         Ok(out
             .into_iter()
             .map(|r| r.unwrap_or_else(|| Err(invalid("a step result went missing".to_string()))))
@@ -257,10 +321,12 @@ impl VecEnv {
     /// with [`recv`](Self::recv).
     ///
     /// # Errors
-    /// [`Error::Action`] for unknown or repeated ids, lengths that differ, or an environment
-    /// still running a step.
+    /// [`Error::Action`] for unknown or repeated ids, lengths that differ, an environment still
+    /// running a step, or an invalid action (checked for the whole batch first: then nothing is
+    /// sent).
     pub fn send(&mut self, ids: &[usize], actions: &[Action]) -> Result<(), Error> {
         self.check_ids(ids, actions.len())?;
+        self.check_actions(ids, actions)?;
         for (&i, a) in ids.iter().zip(actions) {
             self.jobs[i % self.jobs.len()]
                 .send((i, a.clone()))
@@ -277,6 +343,20 @@ impl VecEnv {
     /// # Errors
     /// [`Error::Action`] when `min_batch` is 0 or more than the steps pending.
     pub fn recv(&mut self, min_batch: usize) -> Result<Vec<Finished>, Error> {
+        self.recv_with(min_batch, &mut || false)
+    }
+
+    /// [`recv`](Self::recv), asking `interrupt` about every [`INTERRUPT_POLL`] whether to stop:
+    /// then every pending step stops at its next control period, their results are dropped, the
+    /// call returns [`Error::Interrupted`], and every environment must be reset.
+    ///
+    /// # Errors
+    /// As [`recv`](Self::recv); [`Error::Interrupted`] as above.
+    pub fn recv_with(
+        &mut self,
+        min_batch: usize,
+        interrupt: &mut dyn FnMut() -> bool,
+    ) -> Result<Vec<Finished>, Error> {
         if min_batch == 0 || min_batch > self.pending {
             return Err(invalid(format!(
                 "recv({min_batch}): expected 1 … {} (the steps pending)",
@@ -284,11 +364,34 @@ impl VecEnv {
             )));
         }
         let mut out = Vec::with_capacity(min_batch);
-        while out.len() < min_batch {
+        let cancel = self.cancel.clone();
+        let mut stop = || {
+            let asked = interrupt();
+            if asked {
+                cancel.store(true, Ordering::Relaxed);
+            }
+            asked
+        };
+        while out.len() < min_batch && !self.cancel.load(Ordering::Relaxed) {
             // Sleep at once: while the workers run, this thread's core may be one they need.
-            let d = wait(&self.done, false)
+            let d = wait_polled(&self.done, false, &mut stop)
                 .ok_or_else(|| invalid("the worker threads have stopped".to_string()))?;
             out.push(d);
+        }
+        if self.cancel.load(Ordering::Relaxed) {
+            // Every pending step stops at its next control period: collect them all.
+            while out.len() < self.pending {
+                let d = self
+                    .done
+                    .recv()
+                    .map_err(|_| invalid("the worker threads have stopped".to_string()))?;
+                out.push(d);
+            }
+            for (i, _) in &out {
+                self.busy[*i] = false;
+            }
+            self.pending = 0;
+            self.end_interrupt()?;
         }
         while let Ok(d) = self.done.try_recv() {
             out.push(d);
@@ -298,6 +401,18 @@ impl VecEnv {
         }
         self.pending -= out.len();
         Ok(out)
+    }
+
+    /// After the steps of a call have all returned: if an interrupt stopped them, clears the
+    /// stop, marks the vector environment for a reset and says so.
+    fn end_interrupt(&mut self) -> Result<(), Error> {
+        if !self.cancel.swap(false, Ordering::Relaxed) {
+            return Ok(());
+        }
+        self.interrupted = true;
+        Err(Error::Interrupted {
+            message: "the vector environment's steps were interrupted; reset every environment".to_string(),
+        })
     }
 
     /// The observation of environment `i` now.
@@ -328,12 +443,9 @@ impl Drop for VecEnv {
     }
 }
 
-/// The next message of `queue`: polled for up to [`SPIN_WAIT`] when `spin`, then waited for;
-/// `None` once every sender is gone.
-fn wait<T>(queue: &Receiver<T>, spin: bool) -> Option<T> {
-    if !spin {
-        return queue.recv().ok();
-    }
+/// The next message of `queue`: polled for up to [`SPIN_WAIT`], then waited for; `None` once
+/// every sender is gone.
+fn wait<T>(queue: &Receiver<T>) -> Option<T> {
     let start = Instant::now();
     loop {
         match queue.try_recv() {
@@ -345,20 +457,55 @@ fn wait<T>(queue: &Receiver<T>, spin: bool) -> Option<T> {
     }
 }
 
-/// A worker: takes the next job of its queue, runs it on its environment, sends the result;
-/// stops when its queue closes.
-fn worker(queue: &Receiver<Job>, envs: &[Arc<Mutex<MacroEnv>>], done: &Sender<Finished>) {
-    while let Some((i, action)) = wait(queue, true) {
-        if done.send((i, run_job(envs, i, &action))).is_err() {
+/// [`wait`], asking `stop` every [`INTERRUPT_POLL`] while it sleeps (the message still comes:
+/// a stopped step answers at its next control period).
+fn wait_polled<T>(queue: &Receiver<T>, spin: bool, stop: &mut dyn FnMut() -> bool) -> Option<T> {
+    if spin {
+        let start = Instant::now();
+        while start.elapsed() < SPIN_WAIT {
+            match queue.try_recv() {
+                Ok(m) => return Some(m),
+                Err(TryRecvError::Disconnected) => return None,
+                Err(TryRecvError::Empty) => std::hint::spin_loop(),
+            }
+        }
+    }
+    loop {
+        match queue.recv_timeout(INTERRUPT_POLL) {
+            Ok(m) => return Some(m),
+            Err(RecvTimeoutError::Disconnected) => return None,
+            Err(RecvTimeoutError::Timeout) => {
+                stop();
+            }
+        }
+    }
+}
+
+/// A worker: takes the next job of its queue, runs it on its environment (stopping at the next
+/// control period once `cancel` is set), sends the result; stops when its queue closes.
+fn worker(
+    queue: &Receiver<Job>,
+    envs: &[Arc<Mutex<MacroEnv>>],
+    done: &Sender<Finished>,
+    cancel: &AtomicBool,
+) {
+    while let Some((i, action)) = wait(queue) {
+        let r = run_job(envs, i, &action, &mut || cancel.load(Ordering::Relaxed));
+        if done.send((i, r)).is_err() {
             return;
         }
     }
 }
 
-/// Runs one step of environment `i`; a panic becomes an error result (never crosses threads or
-/// the FFI).
-fn run_job(envs: &[Arc<Mutex<MacroEnv>>], i: usize, action: &Action) -> Result<StepResult, Error> {
-    catch_unwind(AssertUnwindSafe(|| lock(&envs[i]).step(action))).unwrap_or_else(|panic| {
+/// Runs one step of environment `i`, asking `interrupt` at every control period; a panic
+/// becomes an error result (never crosses threads or the FFI).
+fn run_job(
+    envs: &[Arc<Mutex<MacroEnv>>],
+    i: usize,
+    action: &Action,
+    interrupt: &mut dyn FnMut() -> bool,
+) -> Result<StepResult, Error> {
+    catch_unwind(AssertUnwindSafe(|| lock(&envs[i]).step_with(action, interrupt))).unwrap_or_else(|panic| {
         let what = panic
             .downcast_ref::<&str>()
             .map(|s| s.to_string())

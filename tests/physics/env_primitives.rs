@@ -212,6 +212,7 @@ fn close_on_the_cube_grasps_it_and_open_lets_it_go() {
     let r = run(
         &mut env,
         Primitive::OpenGripper {
+            command: None,
             duration: Duration::Steps {
                 steps: 100,
                 settle: 20,

@@ -336,3 +336,32 @@ fn a_configured_fault_fires_on_the_leaves_it_watches_and_is_reported_once() {
         .unwrap();
     assert_eq!(r.faults_fired.len(), 1);
 }
+
+#[test]
+fn an_interrupted_step_halts_at_a_control_period_and_needs_a_reset() {
+    let mut env = env(EnvConfig::default());
+    env.reset(&Reset::Seed(3)).unwrap();
+    let long = Action::Primitive(Primitive::Wait {
+        duration: Duration::Seconds(10.0),
+        gripper: None,
+    });
+    let mut periods = 0;
+    let e = env
+        .step_with(&long, &mut || {
+            periods += 1;
+            periods > 50
+        })
+        .unwrap_err();
+    assert_eq!(e.kind(), "interrupted");
+    // Asked before every period after the first: the 51st answer stops it, after 51 periods.
+    let t = env.cell().world().time;
+    assert!((t - 51.0 * 0.004).abs() < 1e-9, "stopped at {t} s");
+    let again = env.step(&long).unwrap_err();
+    assert!(again.to_string().contains("interrupted; reset"), "{again}");
+    env.reset(&Reset::Seed(3)).unwrap();
+    assert!(
+        env.step(&Action::Leaf("wait: {seconds: 0.1}".into()))
+            .unwrap()
+            .success()
+    );
+}

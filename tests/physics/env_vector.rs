@@ -132,16 +132,70 @@ fn recv_returns_whichever_steps_finish_and_each_once() {
             .is_err()
     );
     assert!(v.step(&[actions(0)[2].clone()]).is_err());
-    // An invalid action fails that environment's step only.
+    // An invalid action refuses the whole batch before any environment moves.
+    let before: Vec<u64> = (0..n)
+        .map(|i| v.with_env(i, |e| e.cell().sim().steps()).unwrap())
+        .collect();
     let bad = Action::Setpoint([f64::NAN; 7]);
-    let res = v
+    let e = v
         .step(&[
-            bad,
             actions(1)[2].clone(),
+            bad,
             actions(2)[2].clone(),
             actions(3)[2].clone(),
         ])
+        .unwrap_err();
+    assert_eq!(e.kind(), "invalid_action");
+    assert!(e.to_string().contains("environment 1"), "{e}");
+    let after: Vec<u64> = (0..n)
+        .map(|i| v.with_env(i, |e| e.cell().sim().steps()).unwrap())
+        .collect();
+    assert_eq!(before, after, "no environment moved");
+    assert_eq!(v.pending(), 0);
+    let ok = v
+        .step(&(0..n).map(|i| actions(i)[2].clone()).collect::<Vec<_>>())
         .unwrap();
-    assert_eq!(res[0].as_ref().unwrap_err().kind(), "invalid_action");
-    assert!(res[1..].iter().all(|r| r.is_ok()));
+    assert!(ok.iter().all(|r| r.is_ok()), "the vector environment steps on");
+}
+
+#[test]
+fn an_interrupt_stops_every_running_step_and_asks_for_a_reset() {
+    let mut v = VecEnv::with_threads(
+        &App::new(),
+        flagship::scene().clone(),
+        None,
+        EnvConfig::default(),
+        2,
+        2,
+    )
+    .unwrap();
+    v.reset(&[Reset::Seed(1), Reset::Seed(2)]).unwrap();
+    let long = Action::Primitive(Primitive::Wait {
+        duration: Duration::Seconds(30.0),
+        gripper: None,
+    });
+    let mut asked = 0;
+    let e = v
+        .step_each_with(&[0, 1], &[long.clone(), long.clone()], &mut || {
+            asked += 1;
+            asked > 3
+        })
+        .unwrap_err();
+    assert_eq!(e.kind(), "interrupted");
+    for i in 0..2 {
+        let t = v.with_env(i, |e| e.cell().world().time).unwrap();
+        assert!(t < 30.0, "environment {i} stopped early, at {t} s");
+    }
+    assert!(
+        v.step(&[long.clone(), long.clone()])
+            .unwrap_err()
+            .to_string()
+            .contains("reset")
+    );
+    v.reset(&[Reset::Seed(1), Reset::Seed(2)]).unwrap();
+    let short = Action::Primitive(Primitive::Wait {
+        duration: Duration::Seconds(0.1),
+        gripper: None,
+    });
+    assert!(v.step(&[short.clone(), short]).unwrap().iter().all(|r| r.is_ok()));
 }

@@ -1,0 +1,180 @@
+"""The Python API under misuse: threads, invalid batches, malformed macro actions, closed and
+copied environments. Each refusal is a clear exception; nothing deadlocks or moves."""
+
+from __future__ import annotations
+
+import copy
+import json
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+import macrotree
+from macrotree import MacroMode
+
+
+def scene(data: Path) -> str:
+    return str(data / "scenes/cube_bowl.yaml")
+
+
+def test_a_second_thread_on_a_busy_environment_is_refused_not_deadlocked(data: Path) -> None:
+    env = macrotree.MacroEnv(scene(data))
+    env.reset(seed=0)
+    started = threading.Event()
+    errors: list[BaseException] = []
+
+    def long_step() -> None:
+        started.set()
+        env.step({"mode": int(MacroMode.WAIT), "steps": [3000]})
+
+    worker = threading.Thread(target=long_step)
+    worker.start()
+    started.wait(5)
+    refused = 0
+    deadline = time.monotonic() + 30
+    while worker.is_alive() and time.monotonic() < deadline:
+        try:
+            env.observation()
+        except RuntimeError as e:
+            assert "another thread" in str(e)
+            refused += 1
+            break
+        except BaseException as e:  # pragma: no cover - reported below
+            errors.append(e)
+            break
+        time.sleep(0.001)
+    worker.join(60)
+    assert not worker.is_alive(), "the stepping thread finished"
+    assert not errors, errors
+    assert refused == 1, "the second caller was refused while the step ran"
+    env.observation()  # usable again
+
+
+def test_an_invalid_action_refuses_the_whole_batch_before_anything_moves(data: Path) -> None:
+    vec = macrotree.VectorEnv(scene(data), num_envs=2, action_mode="setpoint")
+    vec.reset(seed=0)
+    good = np.concatenate([np.asarray(macrotree._native.HOME), [0.0]])
+    bad = good.copy()
+    bad[3] = np.nan
+    with pytest.raises(macrotree.MacrotreeError, match=r"environment 1: setpoint\[3\]"):
+        vec.step(np.stack([good, bad]))
+    with pytest.raises(macrotree.MacrotreeError, match="environment 1"):
+        vec.send(np.stack([good, bad]))
+    # Nothing moved, nothing is pending: the vector env steps on.
+    after, *_ = vec.step(np.stack([good, good]))
+    single = macrotree.MacroEnv(scene(data), action_mode="setpoint")
+    single.reset(seed=0)
+    one, *_ = single.step(good)
+    assert np.array_equal(after["agent_pos"][0], one["agent_pos"])
+    vec.send(np.stack([good, good]))
+    vec.recv()
+    vec.close()
+
+
+def macro_env(data: Path) -> macrotree.MacroEnv:
+    env = macrotree.MacroEnv(scene(data))
+    env.reset(seed=0)
+    return env
+
+
+@pytest.mark.parametrize(
+    ("action", "message"),
+    [
+        ({"mode": 2, "position": [0.4, 0.0, 0.3], "quaternion": [np.nan, 1, 0, 0]}, "quaternion"),
+        ({"mode": 0, "steps": [5], "setle_steps": [1]}, "setle_steps"),
+        ({"mode": 1.5}, "whole number"),
+        ({"mode": "0"}, "whole number"),
+        ({"mode": 0, "steps": [2.7]}, "whole number"),
+    ],
+)
+def test_malformed_macro_actions_are_refused(
+    data: Path, action: dict[str, Any], message: str
+) -> None:
+    env = macro_env(data)
+    before = env.observation()["time"]
+    with pytest.raises((ValueError, macrotree.MacrotreeError), match=message):
+        env.step(action)
+    assert env.observation()["time"] == before, "nothing moved"
+
+
+def test_open_gripper_opens_to_its_gripper_command(data: Path) -> None:
+    env = macro_env(data)
+    env.step({"mode": int(MacroMode.CLOSE_GRIPPER), "steps": [20]})
+    env.step({"mode": int(MacroMode.OPEN_GRIPPER), "gripper_command": [100.0], "steps": [20]})
+    assert env.observation()["gripper_command"] == 100.0
+    env.step({"mode": int(MacroMode.OPEN_GRIPPER), "steps": [20]})
+    assert env.observation()["gripper_command"] == 0.0
+
+
+def test_a_closed_environment_refuses_every_call_and_none_can_be_copied(data: Path) -> None:
+    env = macro_env(data)
+    with pytest.raises(TypeError, match="cannot be copied"):
+        copy.copy(env)
+    with pytest.raises(TypeError, match="cannot be copied"):
+        copy.deepcopy(env)
+    env.close()
+    env.close()
+    with pytest.raises(RuntimeError, match="closed"):
+        env.reset(seed=1)
+    with pytest.raises(RuntimeError, match="closed"):
+        env.observation()
+    vec = macrotree.VectorEnv(scene(data), num_envs=1)
+    vec.close()
+    with pytest.raises(RuntimeError, match="closed"):
+        vec.reset(seed=0)
+
+
+INTERRUPTED_STEP = """
+import json, os, signal, sys, threading
+import macrotree
+
+slow = {"control_period": 0.1, "max_sim_time": 3600.0}
+env = macrotree.MacroEnv(sys.argv[1], **slow)
+env.reset(seed=0)
+vec = macrotree.VectorEnv(sys.argv[1], num_envs=2, **slow)
+vec.reset(seed=0)
+out = {}
+long_wait = {"mode": 0, "steps": [6000]}  # 600 s of simulated time: several seconds of wall time
+steps = (("env", lambda: env.step(long_wait)), ("vec", lambda: vec.step([long_wait] * 2)))
+for name, step in steps:
+    threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+    try:
+        step()
+        out[name] = "finished"
+    except KeyboardInterrupt:
+        out[name] = "interrupted"
+try:
+    env.step(long_wait)
+except macrotree.MacrotreeError as e:
+    out["env_after"] = str(e)
+try:
+    vec.step([long_wait] * 2)
+except macrotree.MacrotreeError as e:
+    out["vec_after"] = str(e)
+env.reset(seed=1)
+out["env_time"] = env.step({"mode": 0, "steps": [1]})[4]["sim_time"]
+vec.reset(seed=1)
+out["vec_ok"] = bool(vec.step([{"mode": 0, "steps": [1]}] * 2)[0]["agent_pos"].shape[0] == 2)
+print(json.dumps(out))
+"""
+
+
+def test_ctrl_c_interrupts_a_long_step_and_the_environment_asks_for_a_reset(data: Path) -> None:
+    done = subprocess.run(
+        [sys.executable, "-c", INTERRUPTED_STEP, scene(data)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    out = json.loads(done.stdout.strip().splitlines()[-1])
+    assert out["env"] == "interrupted" and out["vec"] == "interrupted", out
+    assert "reset" in out["env_after"] and "reset" in out["vec_after"], out
+    assert out["env_time"] > 0 and out["vec_ok"], out
