@@ -1,8 +1,8 @@
 //! `macrotree report FILE.jsonl…`: shard outputs merged back into one run.
 //!
 //! Every line of a sweep's (or a suite's) JSONL carries the sweep's identity — tree, scene file,
-//! scene, scenario count, seed, fault, goal, time limit, substitutions and, for `macrotree test`,
-//! the scenario file — so the lines of all shards can be checked to belong to one run and put
+//! scene, scenario count, seed, fault, goal, time limit, collision policy, substitutions and,
+//! for `macrotree test`, the scenario file — so the lines of all shards can be checked to belong to one run and put
 //! back in scenario order. The merged results are exactly those of one unsharded run (the
 //! lines are byte-identical), so the summary built from them is too, but for the wall time and
 //! job count, which the lines do not carry (a merged summary says 0 for both).
@@ -64,6 +64,7 @@ fn identity(r: &ScenarioResult) -> Vec<(&'static str, String)> {
         ("fault", r.fault.map_or("none", FaultKind::name).to_string()),
         ("goal", r.sweep_goal.name().to_string()),
         ("max sim time", format!("{:?}", r.max_sim_time)),
+        ("collision policy", r.collision_policy.name().to_string()),
         (
             "substitutions",
             r.substitutions
@@ -188,6 +189,7 @@ fn merge_group(mut lines: Vec<(Origin, ScenarioResult)>) -> Result<Merged, Merge
         substitutions: first.substitutions.clone(),
         suite: first.suite.clone(),
         tree_digest: first.tree_digest.clone(),
+        collisions: first.collision_policy,
         ..SweepConfig::default()
     };
     Ok(Merged {

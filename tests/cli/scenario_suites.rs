@@ -464,6 +464,29 @@ fn four_sweep_shards_as_processes_merge_into_the_unsharded_report() {
         "{}",
         stderr(&out)
     );
+    // The collision policy is part of a run's identity, as for `--resume`.
+    let failing = dir.join("collisions_fail.jsonl");
+    let o = macrotree(
+        &[
+            &base[..],
+            &["--shard", "3/4", "--collisions", "fail", "--out", s(&failing)],
+        ]
+        .concat(),
+    );
+    assert!(o.status.code().is_some_and(|c| c < 2), "{}", stderr(&o));
+    let out = macrotree(&[
+        "report",
+        s(&shard_files[0]),
+        s(&shard_files[1]),
+        s(&shard_files[2]),
+        s(&failing),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("its collision policy is fail"),
+        "{}",
+        stderr(&out)
+    );
 }
 
 #[test]
