@@ -9,6 +9,7 @@ than N keeps every core busy.
 
 from __future__ import annotations
 
+import operator
 import os
 from collections.abc import Sequence
 from typing import Any
@@ -158,7 +159,11 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         noise: str | tuple[float, float] | None = None,
         observation_keys: str = "gym",
     ) -> None:
-        if not 1 <= int(num_envs) <= MAX_ENVS:
+        try:
+            count = operator.index(num_envs)
+        except TypeError:
+            raise ValueError(f"num_envs must be a whole number, got {num_envs!r:.40}") from None
+        if not 1 <= count <= MAX_ENVS:
             raise ValueError(f"num_envs must be 1…{MAX_ENVS}, got {num_envs}")
         mode = AutoresetMode(autoreset_mode)
         if mode not in (AutoresetMode.SAME_STEP, AutoresetMode.DISABLED):
@@ -173,7 +178,7 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         if scene is None and tree is None:
             raise ValueError("VectorEnv needs a scene file, a tree file, or both")
-        self.num_envs = int(num_envs)
+        self.num_envs = count
         self.autoreset_mode = mode
         self.metadata = {**self.metadata, "autoreset_mode": mode}
         self.action_mode: ActionMode = action_mode

@@ -113,6 +113,6 @@ def test_disabled_autoreset_takes_a_reset_mask(data: Path) -> None:
 
 def test_num_envs_is_bounded_by_the_extensions_maximum(data: Path) -> None:
     assert macrotree.vector.MAX_ENVS == _native.MAX_ENVS == 1024
-    for bad in (0, _native.MAX_ENVS + 1):
+    for bad in (0, _native.MAX_ENVS + 1, 1.5, "2"):
         with pytest.raises(ValueError, match="num_envs"):
-            macrotree.VectorEnv(scene(data), num_envs=bad)
+            macrotree.VectorEnv(scene(data), num_envs=bad)  # type: ignore[arg-type]
