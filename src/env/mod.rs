@@ -59,7 +59,7 @@ pub use render::Image;
 pub use reset::Reset;
 pub use residual::{BaseStep, RESIDUAL_LEN, RESIDUAL_LIMITS, ResidualLimits};
 pub use step::{Status, StepResult};
-pub use vector::{Finished, MAX_ENVS, VecEnv};
+pub use vector::{Finished, INTERRUPT_POLL, MAX_ENVS, SPIN_WAIT, VecEnv};
 
 use crate::actions::Cell;
 use crate::episode::MacroDriver;

@@ -76,8 +76,12 @@ impl IncludeScope {
     }
 }
 
+/// The folder beside a tree's folder whose YAML files a tree's `scene:` may name too.
+pub const SCENES_DIR: &str = "scenes";
+
 /// Checks a tree's `scene:` (written `rel`, at `path` once joined to the tree's folder `base`)
-/// against the include rule: by spelling, then (when it exists) resolved.
+/// against the include rule — by spelling, then (when it exists) resolved — or, for a YAML
+/// file, against the [`SCENES_DIR`] folder beside the tree's folder.
 pub(crate) fn check_scene_path(
     scope: &IncludeScope,
     base: Option<&Path>,
@@ -92,25 +96,35 @@ pub(crate) fn check_scene_path(
             Ok(canon) => scope.check_resolved(&canon, written, loc),
             Err(_) => Ok(()), // missing: the scene loader says so
         });
-    // The other place scenes live: a YAML file in the project the command runs in (the
-    // repository's `scenes/` next to its `trees/`).
+    // The other place scenes live: the `scenes/` folder beside the tree's folder (the
+    // repository's and the Python package's layout, `trees/` next to `scenes/`). Judged from the
+    // tree's own location, never from the folder the command runs in.
     let yaml = written
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"));
-    let in_project = || {
-        let Ok(cwd) = std::env::current_dir().and_then(|d| d.canonicalize()) else {
+    let beside = || {
+        let tree_dir = match base {
+            Some(b) if !b.as_os_str().is_empty() => b,
+            _ => Path::new("."),
+        };
+        let Ok(tree_dir) = tree_dir.canonicalize() else {
             return false;
         };
-        let spelled = std::path::absolute(path).map(|p| lexical(&p)).unwrap_or_default();
-        spelled.starts_with(&cwd) && path.canonicalize().map_or(true, |c| c.starts_with(&cwd))
+        let Some(spelled) = tree_dir.parent().map(|p| p.join(SCENES_DIR)) else {
+            return false;
+        };
+        let resolved = spelled.canonicalize().unwrap_or_else(|_| spelled.clone());
+        // By spelling first (nothing outside is touched), then resolved when the file exists.
+        lexical(&tree_dir.join(written)).starts_with(&spelled)
+            && path.canonicalize().map_or(true, |c| c.starts_with(&resolved))
     };
     match checked {
         Ok(()) => Ok(()),
-        Err(_) if yaml && in_project() => Ok(()),
+        Err(_) if yaml && beside() => Ok(()),
         Err(issue) => Err(
             Issue::new(loc, format!("the scene `{rel}` is outside the tree's folder"))
                 .label(format!(
-                    "{}, or YAML files under the current folder",
+                    "{}, or YAML files under the `{SCENES_DIR}/` folder beside it",
                     issue
                         .label
                         .unwrap_or_default()

@@ -154,6 +154,50 @@ fn a_tree_scene_outside_its_folder_is_refused_without_reading_it() {
 }
 
 #[test]
+fn the_scene_rule_does_not_depend_on_the_working_folder() {
+    let dir = scratch("h4-scene-any-folder");
+    let from_root = |args: &[&str]| {
+        Command::new(BIN)
+            .args(args)
+            .current_dir("/")
+            .env_remove("RUST_LOG")
+            .output()
+            .unwrap()
+    };
+    // The shipped trees name `../scenes/…`: allowed from any folder.
+    let shipped = repo().join("trees/sort_by_color.yaml");
+    let out = from_root(&["validate", s(&shipped)]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    // A project of one's own: trees/ and scenes/ side by side.
+    for sub in ["trees", "scenes", "elsewhere"] {
+        std::fs::create_dir_all(dir.join(sub)).unwrap();
+    }
+    std::fs::copy(repo().join("scenes/sort_three.yaml"), dir.join("scenes/s.yaml")).unwrap();
+    let body = "main: {home: {}}\n";
+    let ok = dir.join("trees/ok.yaml");
+    std::fs::write(&ok, format!("scene: ../scenes/s.yaml\n{body}")).unwrap();
+    let out = from_root(&["validate", s(&ok)]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    // A YAML file elsewhere is refused, though it is under the working folder `/`; nothing of it
+    // is read or shown.
+    std::fs::write(
+        dir.join("elsewhere/leak.yaml"),
+        format!("description: x\ntoken: line1-token\n{SECRET}"),
+    )
+    .unwrap();
+    let bad = dir.join("trees/bad.yaml");
+    std::fs::write(&bad, format!("scene: ../elsewhere/leak.yaml\n{body}")).unwrap();
+    let out = from_root(&["validate", s(&bad)]);
+    let all = stderr(&out) + &stdout(&out);
+    assert_eq!(out.status.code(), Some(2), "{all}");
+    assert!(all.contains("outside the tree's folder"), "{all}");
+    for secret in ["line1-token", "line2-very-secret", "line3-hunter2"] {
+        assert!(!all.contains(secret), "leaked {secret}: {all}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn a_scene_that_is_not_a_scene_file_gives_one_diagnostic_quoting_at_most_one_line() {
     let dir = scratch("h3-scene-not-scene");
     std::fs::write(

@@ -152,8 +152,10 @@ fn a_tree_that_succeeds_without_doing_the_job_is_caught() {
         format!("scene: {ROOT}/scenes/sort_three.yaml\nmain: {{home: {{}}}}\n"),
     )
     .unwrap();
+    // The scene is the repository's, outside this tree's folder and its `scenes/` neighbour.
     let plan = Arc::new(
         Loader::default()
+            .includes_anywhere(true)
             .load(&tree)
             .unwrap_or_else(|d| panic!("{}", d[0])),
     );
