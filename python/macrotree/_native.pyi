@@ -10,6 +10,7 @@ HOME: list[float]
 MAX_ENVS: int
 CTRL_NAMES: list[str]
 STATE_NAMES: list[str]
+MACRO_KEYS: list[str]
 CTRL_LOW: list[float]
 CTRL_HIGH: list[float]
 RESIDUAL_HIGH: list[float]

@@ -18,6 +18,7 @@ import numpy as np
 from gymnasium import spaces
 
 from macrotree._native import CTRL_HIGH, CTRL_LOW, JOINT_LIMITS, RESIDUAL_HIGH, STATE_NAMES
+from macrotree._native import MACRO_KEYS as _MACRO_KEYS
 
 #: Largest ``steps`` or ``settle_steps`` of one macro (control periods; 6000 = 60 s at 10 ms).
 #: ``steps = 0`` runs the macro closed loop: until its motion is done and the arm has settled.
@@ -194,18 +195,8 @@ def _scalar(value: Any, name: str) -> float:
     return float(array[0])
 
 
-#: The keys of a ``macro`` action.
-MACRO_KEYS = (
-    "mode",
-    "position",
-    "quaternion",
-    "joints",
-    "gripper",
-    "gripper_command",
-    "path",
-    "steps",
-    "settle_steps",
-)
+#: The keys of a ``macro`` action (the extension's).
+MACRO_KEYS = tuple(_MACRO_KEYS)
 
 
 def _integer(value: Any, name: str) -> int:

@@ -29,6 +29,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_ENVS", macrotree::env::MAX_ENVS)?;
     m.add("CTRL_NAMES", macrotree::motion::COMMAND_NAMES.to_vec())?;
     m.add("STATE_NAMES", macrotree::env::STATE_NAMES.to_vec())?;
+    m.add("MACRO_KEYS", macro_action::KEYS.to_vec())?;
     let (low, high) = ctrl_bounds();
     m.add("CTRL_LOW", low)?;
     m.add("CTRL_HIGH", high)?;

@@ -76,8 +76,8 @@ fn gripper_during(d: &Bound<'_, PyDict>) -> PyResult<Option<f64>> {
     })
 }
 
-/// The keys a macro action may have.
-const KEYS: [&str; 9] = [
+/// The keys a macro action may have (exported to Python as `MACRO_KEYS`).
+pub const KEYS: [&str; 9] = [
     "mode",
     "position",
     "quaternion",

@@ -284,6 +284,11 @@ impl VecEnv {
         let their_actions: Vec<Action> = theirs.iter().map(|&k| actions[k].clone()).collect();
         self.send(&their_ids, &their_actions)?;
         let mut out: Vec<Option<Result<StepResult, Error>>> = (0..ids.len()).map(|_| None).collect();
+        // Where environment `i`'s result goes in `out`.
+        let mut slot = vec![None; self.envs.len()];
+        for (k, &i) in ids.iter().enumerate() {
+            slot[i] = Some(k);
+        }
         let cancel = self.cancel.clone();
         let mut stop = || {
             cancel.load(Ordering::Relaxed) || {
@@ -303,7 +308,7 @@ impl VecEnv {
         while left > 0 {
             let (i, r) = wait_polled(&self.done, true, &mut stop)
                 .ok_or_else(|| invalid("the worker threads have stopped".to_string()))?;
-            if let Some(k) = ids.iter().position(|&j| j == i) {
+            if let Some(k) = slot[i] {
                 out[k] = Some(r);
             }
             self.busy[i] = false;
@@ -443,32 +448,31 @@ impl Drop for VecEnv {
     }
 }
 
+/// What polling a queue for up to [`SPIN_WAIT`] found: `Some` when it settled (a message, or
+/// `None` once every sender is gone), `None` when nothing came in that time.
+fn spin<T>(queue: &Receiver<T>) -> Option<Option<T>> {
+    let start = Instant::now();
+    while start.elapsed() < SPIN_WAIT {
+        match queue.try_recv() {
+            Ok(m) => return Some(Some(m)),
+            Err(TryRecvError::Disconnected) => return Some(None),
+            Err(TryRecvError::Empty) => std::hint::spin_loop(),
+        }
+    }
+    None
+}
+
 /// The next message of `queue`: polled for up to [`SPIN_WAIT`], then waited for; `None` once
 /// every sender is gone.
 fn wait<T>(queue: &Receiver<T>) -> Option<T> {
-    let start = Instant::now();
-    loop {
-        match queue.try_recv() {
-            Ok(m) => return Some(m),
-            Err(TryRecvError::Disconnected) => return None,
-            Err(TryRecvError::Empty) if start.elapsed() < SPIN_WAIT => std::hint::spin_loop(),
-            Err(TryRecvError::Empty) => return queue.recv().ok(),
-        }
-    }
+    spin(queue).unwrap_or_else(|| queue.recv().ok())
 }
 
-/// [`wait`], asking `stop` every [`INTERRUPT_POLL`] while it sleeps (the message still comes:
-/// a stopped step answers at its next control period).
-fn wait_polled<T>(queue: &Receiver<T>, spin: bool, stop: &mut dyn FnMut() -> bool) -> Option<T> {
-    if spin {
-        let start = Instant::now();
-        while start.elapsed() < SPIN_WAIT {
-            match queue.try_recv() {
-                Ok(m) => return Some(m),
-                Err(TryRecvError::Disconnected) => return None,
-                Err(TryRecvError::Empty) => std::hint::spin_loop(),
-            }
-        }
+/// [`wait`] (polling first only when `spin`), asking `stop` every [`INTERRUPT_POLL`] while it
+/// sleeps (the message still comes: a stopped step answers at its next control period).
+fn wait_polled<T>(queue: &Receiver<T>, spin_first: bool, stop: &mut dyn FnMut() -> bool) -> Option<T> {
+    if spin_first && let Some(settled) = spin(queue) {
+        return settled;
     }
     loop {
         match queue.recv_timeout(INTERRUPT_POLL) {

@@ -4,31 +4,14 @@
 //! at its own frame rate.
 
 use macrotree::App;
-use macrotree::actions::{CONTROL_PERIOD, Cell};
+use macrotree::actions::CONTROL_PERIOD;
 use macrotree::dataset::{DEFAULT_FRAME_RATE, EpisodeRecorder};
 use macrotree::env::{Action, EnvConfig, MacroEnv, Reset};
-use macrotree::episode::{EpisodeConfig, EpisodeObserver, run_episode};
-use macrotree::motion::CellCommand;
-use macrotree::runtime::TreeRunner;
+use macrotree::episode::{EpisodeConfig, run_episode};
 use macrotree::sweep::SweepConfig;
 
+use crate::support::commands::Commands;
 use crate::support::flagship;
-
-/// Every control period's command (in full precision) and the physics state after it.
-#[derive(Default)]
-struct Commands {
-    commands: Vec<CellCommand>,
-    states: Vec<Vec<u64>>,
-}
-
-impl EpisodeObserver for Commands {
-    fn on_period_start(&mut self, _cell: &Cell, command: &CellCommand, _runner: &mut TreeRunner) {
-        self.commands.push(*command);
-    }
-    fn on_tick(&mut self, cell: &Cell, _runner: &mut TreeRunner) {
-        self.states.push(cell.sim().state_fingerprint());
-    }
-}
 
 fn env(control_period: f64) -> MacroEnv {
     MacroEnv::new(

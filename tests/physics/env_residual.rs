@@ -5,30 +5,13 @@
 use std::sync::Arc;
 
 use macrotree::App;
-use macrotree::actions::Cell;
 use macrotree::env::{Action, EnvConfig, MacroEnv, RESIDUAL_LEN, RESIDUAL_LIMITS, Reset, Status};
-use macrotree::episode::{EpisodeObserver, run_episode};
-use macrotree::motion::CellCommand;
-use macrotree::runtime::{TreeRunner, TreeStatus};
+use macrotree::episode::run_episode;
+use macrotree::runtime::TreeStatus;
 use macrotree::sweep::SweepConfig;
 
+use crate::support::commands::Commands;
 use crate::support::flagship;
-
-/// Every control period's command and the physics state after it.
-#[derive(Default)]
-struct Commands {
-    commands: Vec<CellCommand>,
-    states: Vec<Vec<u64>>,
-}
-
-impl EpisodeObserver for Commands {
-    fn on_period_start(&mut self, _cell: &Cell, command: &CellCommand, _runner: &mut TreeRunner) {
-        self.commands.push(*command);
-    }
-    fn on_tick(&mut self, cell: &Cell, _runner: &mut TreeRunner) {
-        self.states.push(cell.sim().state_fingerprint());
-    }
-}
 
 fn residual_env() -> MacroEnv {
     MacroEnv::new(

@@ -4,6 +4,7 @@
 pub mod browser;
 pub mod cell_run;
 pub mod cli;
+pub mod commands;
 pub mod files;
 pub mod flagship;
 pub mod logs;
