@@ -50,8 +50,12 @@ pub struct App {
 impl Default for App {
     /// The built-in node kinds, bound to the built-in controllers and checks.
     fn default() -> Self {
+        #[allow(unused_mut)]
+        let mut registry = Registry::builtin();
+        #[cfg(feature = "policy")]
+        registry.check_files_with("policy", crate::actions::policy::check_model_file);
         App {
-            loader: Loader::default(),
+            loader: Loader::new(Arc::new(registry)),
             factory: Factory::builtin(),
             program: ProgramInfo::default(),
         }

@@ -16,6 +16,8 @@ mod macro_action;
 mod packing;
 mod place;
 mod planning;
+#[cfg(feature = "policy")]
+pub mod policy;
 mod reach;
 mod release;
 mod release_room;

@@ -100,8 +100,7 @@ pub fn target_object(target: &crate::kinds::Target, w: &World) -> Option<usize> 
 /// Yaw of the tool about world z, in the convention of [`crate::motion::ik_down`] (0 at home,
 /// where the pinch x axis points along world +y), radians.
 pub fn tool_yaw(pinch_rot: &Matrix3<f64>) -> f64 {
-    let x = pinch_rot.column(0);
-    (-x[0]).atan2(x[1])
+    crate::world::snapshot::tool_yaw(pinch_rot)
 }
 
 /// Distance from `p` to the segment `a`–`b` in the table plane, metres.

@@ -218,7 +218,7 @@ impl EpisodeRecorder {
         // The flat vectors are the environment's observation's: one definition for both.
         let world = cell.world();
         let sim = cell.sim();
-        let gripper_joint = sim.data().qpos()[sim.scene().ids.gripper_driver_qpos];
+        let gripper_joint = sim.gripper_joint();
         let state = vectors::state_vector(&vectors::RobotState::of(world, gripper_joint));
         let action = vectors::command_vector(&command.to_vector());
         let mut environment = Vec::with_capacity(world.objects.len() * vectors::VALUES_PER_OBJECT);

@@ -114,7 +114,7 @@ impl Observation {
             joint_pos: w.arm_q,
             joint_vel: w.arm_qd,
             joint_target: cell.arm_setpoint(),
-            gripper_joint: sim.data().qpos()[sim.scene().ids.gripper_driver_qpos],
+            gripper_joint: sim.gripper_joint(),
             gripper_width: w.gripper_width,
             gripper_command: cell.gripper_command(),
             last_command: cell

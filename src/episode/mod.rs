@@ -7,7 +7,7 @@ mod driver;
 pub mod replay;
 mod report;
 pub mod scenario;
-pub mod vectors;
+pub use crate::world::vectors;
 
 use std::sync::Arc;
 use std::time::Instant;

@@ -35,6 +35,19 @@ fn bind(f: &mut Factory) -> Result<(), BindError> {
     f.bind_action("carry", |p: &Carry| Box::new(CarryAction::new(p.clone())))?;
     f.bind_action("release", |p: &Release| Box::new(ReleaseAction::new(p.clone())))?;
     f.bind_action("place", |p: &Place| Box::new(PlaceAction::new(p.clone())))?;
+    #[cfg(feature = "policy")]
+    {
+        // `until:` is a built-in condition, answered by the built-in checks (the factory is
+        // built by then: the closure runs when a leaf checks, never while binding).
+        let check: crate::actions::policy::ConditionCheck =
+            std::sync::Arc::new(|call: &crate::kinds::LeafCall, w: &World| Factory::builtin().check(call, w));
+        f.bind_action("policy", move |p: &crate::kinds::Policy| {
+            Box::new(crate::actions::policy::PolicyAction::new(
+                p.clone(),
+                check.clone(),
+            ))
+        })?;
+    }
 
     // Conditions: pure functions of the world snapshot.
     f.bind_condition("grasped", |w, p: &Grasped| {

@@ -82,6 +82,7 @@ fn register(r: &mut Registry) -> Result<(), crate::error::Error> {
     r.declare_action_as::<Carry>("carry", doc!("carry"), ActionRole::Carry)?;
     r.declare_action_as::<Release>("release", doc!("release"), ActionRole::Release)?;
     r.declare_action_as::<Place>("place", doc!("place"), ActionRole::Carry)?;
+    r.declare_action::<super::policy::Policy>("policy", doc!("policy"))?;
 
     // Leaves the runtime handles itself.
     r.add("wait", Runtime, doc!("wait"), Imp::Wait)?;

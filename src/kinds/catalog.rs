@@ -246,9 +246,14 @@ impl Registry {
                 json!({"description": "A condition leaf, or an `inverter` of one.", "oneOf": cond_variants}),
             );
         }
-        // Parameter structs are inlined into the node variants; drop their standalone copies.
+        // Parameter structs are inlined into the node variants; drop their standalone copies,
+        // unless another definition still refers to one (a `policy`'s `until:` is a condition's
+        // parameters).
+        let referenced = serde_json::to_string(&defs).unwrap_or_default();
         for name in &bodies {
-            defs.remove(name);
+            if !referenced.contains(&format!("\"#/$defs/{name}\"")) {
+                defs.remove(name);
+            }
         }
 
         json!({

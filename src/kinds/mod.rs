@@ -23,6 +23,7 @@ pub mod leaves;
 pub mod objects;
 mod param_error;
 mod params;
+mod policy;
 mod registry;
 mod role;
 mod targets;
@@ -42,6 +43,7 @@ pub use leaves::{
 pub use objects::{ObjectRef, ObjectRole};
 pub use param_error::ParamError;
 pub use params::Params;
-pub use registry::{Category, NodeType, Registry};
+pub use policy::{MAX_ACTION_STEPS, MAX_POLICY_PERIOD, POLICY_OUTPUT_INVALID, Policy, Until};
+pub use registry::{Category, FileCheck, NodeType, Registry};
 pub use role::ActionRole;
 pub use targets::{PathKind, Target, Yaw};

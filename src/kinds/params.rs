@@ -35,6 +35,13 @@ pub trait Params:
     /// ```
     const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[];
 
+    /// The parameters (keys of the node's body, each a string) that name a file the leaf reads
+    /// when it runs, relative to the tree file that names it. The loader confines each to the
+    /// tree's folder (the rule of `include:`), checks it is a readable file, replaces the value
+    /// with the file's canonical path, and counts the file among the tree's inputs (its digest,
+    /// `--resume`). Default: none.
+    const FILE_PARAMS: &'static [&'static str] = &[];
+
     /// Every object reference among the parameters, so that `{variables}` are resolved before
     /// each tick. Default: none.
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {

@@ -67,6 +67,7 @@ pub(crate) struct LeafImp {
     parse: ParseParams,
     schema: fn(&mut SchemaGenerator) -> String,
     objects: &'static [(&'static str, ObjectRole)],
+    files: &'static [&'static str],
     failures: &'static [&'static str],
     role: ActionRole,
 }
@@ -77,6 +78,7 @@ impl LeafImp {
             parse: parse_params::<P>,
             schema: schema_of::<P>,
             objects: P::OBJECT_PARAMS,
+            files: P::FILE_PARAMS,
             failures: P::failure_kinds(),
             role,
         }
@@ -156,6 +158,15 @@ impl NodeType {
     pub fn object_params(&self) -> &'static [(&'static str, ObjectRole)] {
         match &self.imp {
             Imp::Action(l) | Imp::Condition(l) => l.objects,
+            _ => &[],
+        }
+    }
+
+    /// The parameters that name a file the leaf reads when it runs ([`Params::FILE_PARAMS`] of
+    /// the kind's parameter type; none for other kinds).
+    pub fn file_params(&self) -> &'static [&'static str] {
+        match &self.imp {
+            Imp::Action(l) | Imp::Condition(l) => l.files,
             _ => &[],
         }
     }
@@ -242,7 +253,13 @@ impl NodeType {
 #[derive(Clone, Debug)]
 pub struct Registry {
     types: Vec<Arc<NodeType>>,
+    file_checks: std::collections::BTreeMap<&'static str, FileCheck>,
 }
+
+/// Checks the content of a file a leaf names ([`Params::FILE_PARAMS`]; e.g. that a `policy`'s
+/// model fits), given its canonical path, when the tree loads: the error says what is wrong and
+/// what to do, and is reported at the parameter's value.
+pub type FileCheck = fn(&std::path::Path) -> Result<(), String>;
 
 impl Default for Registry {
     /// The built-in node kinds.
@@ -262,7 +279,22 @@ impl Registry {
     }
 
     pub(super) fn empty() -> Registry {
-        Registry { types: Vec::new() }
+        Registry {
+            types: Vec::new(),
+            file_checks: std::collections::BTreeMap::new(),
+        }
+    }
+
+    /// Checks the files the leaves of kind `kind` name with `check` when a tree loads (the
+    /// layer that runs the kind knows what such a file must hold; without a check, the loader
+    /// only confines and opens it).
+    pub fn check_files_with(&mut self, kind: &'static str, check: FileCheck) {
+        self.file_checks.insert(kind, check);
+    }
+
+    /// How the files the leaves of kind `kind` name are checked, if they are.
+    pub fn file_check(&self, kind: &str) -> Option<FileCheck> {
+        self.file_checks.get(kind).copied()
     }
 
     /// The kind called `name`.

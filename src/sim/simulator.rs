@@ -208,6 +208,12 @@ impl Sim {
         self.data.ffi().time
     }
 
+    /// The gripper's closure: its right driver joint's angle, radians (0 open … about 0.8
+    /// closed), which the world snapshot does not keep.
+    pub fn gripper_joint(&self) -> f64 {
+        self.data.qpos()[self.scene.ids.gripper_driver_qpos]
+    }
+
     /// Read-only access to the MuJoCo data (for the viewer and tests).
     pub fn data(&self) -> &MjData<Arc<MjModel>> {
         &self.data

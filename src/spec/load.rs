@@ -42,7 +42,8 @@ pub struct Spec {
     pub object_uses: Vec<super::check::ObjectUse>,
     /// Every blackboard variable a `select` or `for_each` writes.
     pub var_defs: Vec<super::check::VarDef>,
-    /// The canonical paths of the files read from disk (main file and includes), sorted.
+    /// The canonical paths of the files read from disk (main file, includes and the files leaves
+    /// name, such as a `policy`'s model), sorted.
     pub files: Vec<PathBuf>,
     /// Warnings: accepted, but probably not what was meant (e.g. `yaw: 5`, read as 5 radians).
     pub warnings: Vec<Diagnostic>,
@@ -245,9 +246,10 @@ impl TreeReader {
             .registry
             .clone()
             .unwrap_or_else(|| Arc::new(Registry::builtin()));
-        let mut ex = Expander::new(&registry, &table, &self.sources);
+        let mut ex = Expander::new(&registry, &table, &self.sources).with_scope(self.scope.clone());
         ex.reported.clone_from(&reported);
         let root = ex.node(&main, 0);
+        self.loaded.extend(std::mem::take(&mut ex.leaf_files));
         let called: HashSet<String> = ex.calls.keys().cloned().collect();
         self.issues.append(&mut ex.issues);
         warnings.append(&mut ex.warnings);
@@ -273,7 +275,7 @@ impl TreeReader {
             if called.contains(n) || d.params.iter().any(|p| p.default.is_none()) {
                 continue;
             }
-            let mut ex = Expander::new(&registry, &table, &self.sources);
+            let mut ex = Expander::new(&registry, &table, &self.sources).with_scope(self.scope.clone());
             ex.reported.clone_from(&reported);
             let call = crate::yaml::value::Value::new(
                 crate::yaml::value::ValueKind::Map(vec![(

@@ -58,6 +58,7 @@ mod legacy;
 pub mod objects;
 pub mod query;
 pub mod snapshot;
+pub mod vectors;
 
 pub use objects::{ObjectState, Part, Piece, Touch};
 pub use snapshot::World;

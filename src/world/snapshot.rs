@@ -51,6 +51,13 @@ pub fn yaw_of(q: &UnitQuaternion<f64>) -> f64 {
     x.y.atan2(x.x)
 }
 
+/// Yaw of the tool about world z, in the convention of `motion::ik_down` (0 at home, where the
+/// pinch x axis points along world +y), radians in (-π, π].
+pub fn tool_yaw(pinch_rot: &nalgebra::Matrix3<f64>) -> f64 {
+    let x = pinch_rot.column(0);
+    (-x[0]).atan2(x[1])
+}
+
 /// Folds an angle into [-π/4, π/4): the yaw of a square seen from above.
 pub fn fold_quarter_turn(a: f64) -> f64 {
     let q = std::f64::consts::FRAC_PI_2;

@@ -37,6 +37,7 @@ mod motion_trajectory;
 mod multi_object;
 mod nodes;
 mod place;
+mod policy_leaf;
 mod scene_layout;
 mod shipped_tree_contacts;
 mod side_grasp;

@@ -91,7 +91,7 @@ fn app() -> App {
 #[test]
 fn the_built_in_kinds_are_registry_entries() {
     let r = Registry::builtin();
-    assert_eq!(r.names().count(), 38);
+    assert_eq!(r.names().count(), 39);
     let count = |c| r.names_of(c).len();
     assert_eq!(
         [
@@ -101,7 +101,7 @@ fn the_built_in_kinds_are_registry_entries() {
             count(Category::Runtime),
             count(Category::Condition)
         ],
-        [6, 9, 7, 2, 14]
+        [6, 9, 8, 2, 14]
     );
     assert_eq!(r.get("grasp").map(|t| t.category()), Some(Category::Action));
     assert!(r.get("grasp").unwrap().doc().contains("```yaml"));
@@ -128,7 +128,7 @@ fn registration_refuses_bad_names_duplicates_and_incomplete_docs() {
         .unwrap_err();
     assert!(e.message().contains("example that uses `touching:`"), "{e}");
     // Nothing was added by the refused calls.
-    assert_eq!(r.names().count(), 38);
+    assert_eq!(r.names().count(), 39);
 }
 
 #[test]

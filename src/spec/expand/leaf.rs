@@ -5,11 +5,101 @@ use crate::kinds::NodeType;
 use crate::kinds::ObjectRole;
 use crate::spec::check::ObjectUse;
 use crate::yaml::de::DeError;
-use crate::yaml::diag::Loc;
+use crate::yaml::diag::{Issue, Loc};
 use crate::yaml::suggest::did_you_mean;
 use crate::yaml::value::{Value, ValueKind};
 
+/// Largest file a leaf may name (a `policy`'s model), bytes.
+pub const MAX_LEAF_FILE_BYTES: u64 = 256 << 20;
+
 impl Expander<'_> {
+    /// `body` with each file parameter of `ty` ([`crate::kinds::Params::FILE_PARAMS`]) replaced
+    /// by the canonical path of the file it names, relative to the file it is written in and
+    /// confined like `include:`; `None` (the problem reported, at the value) when one cannot be
+    /// read. The files are noted in [`Self::leaf_files`].
+    pub(super) fn resolve_files(&mut self, ty: &NodeType, body: &Value) -> Option<Value> {
+        let keys = ty.file_params();
+        let mut out = body.clone();
+        let ValueKind::Map(entries) = &mut out.kind else {
+            return Some(out);
+        };
+        for (k, v) in entries.iter_mut() {
+            let (Some(key), ValueKind::Str(written)) = (k.as_str(), &v.kind) else {
+                continue;
+            };
+            if !keys.contains(&key) {
+                continue;
+            }
+            match self.resolve_file(ty.name(), key, written, v.loc) {
+                Ok(canon) => v.kind = ValueKind::Str(canon.display().to_string()),
+                Err(issue) => {
+                    self.issues.push(issue);
+                    return None;
+                }
+            }
+        }
+        Some(out)
+    }
+
+    fn resolve_file(
+        &mut self,
+        kind: &str,
+        key: &str,
+        written: &str,
+        loc: Loc,
+    ) -> Result<std::path::PathBuf, Issue> {
+        use std::path::Path;
+        let rel = Path::new(written);
+        let base = Path::new(self.sources.name(loc.file)).parent();
+        let path = match base {
+            Some(b) if !b.as_os_str().is_empty() => b.join(rel),
+            _ => rel.to_path_buf(),
+        };
+        self.scope.check_spelling(base, rel, loc)?;
+        let help = format!(
+            "`{key}:` is a path relative to the file that names it, inside the tree's folder (see `macrotree nodes {kind}`)"
+        );
+        let canon = path.canonicalize().map_err(|e| {
+            Issue::new(loc, format!("cannot read `{written}` ({key} of `{kind}`): {e}"))
+                .label("expected a file relative to this file's folder")
+                .help(help.clone())
+        })?;
+        self.scope.check_resolved(&canon, rel, loc)?;
+        match std::fs::metadata(&canon) {
+            Ok(m) if m.is_file() && m.len() <= MAX_LEAF_FILE_BYTES => {}
+            Ok(m) if m.is_file() => {
+                return Err(Issue::new(
+                    loc,
+                    format!(
+                        "`{written}` is {} bytes; a file a leaf names may have at most {MAX_LEAF_FILE_BYTES}",
+                        m.len()
+                    ),
+                )
+                .help(help));
+            }
+            Ok(_) => {
+                return Err(Issue::new(loc, format!("`{written}` is not a regular file")).help(help));
+            }
+            Err(e) => {
+                return Err(Issue::new(loc, format!("cannot read `{written}`: {e}")).help(help));
+            }
+        }
+        if let Some(check) = self.registry.file_check(kind) {
+            check(&canon).map_err(|why| {
+                Issue::new(
+                    loc,
+                    format!("`{written}` ({key} of `{kind}`) does not fit: {why}"),
+                )
+                .label("this file")
+                .help(format!(
+                    "see `macrotree nodes {kind}` for what the file must hold"
+                ))
+            })?;
+        }
+        self.leaf_files.push(canon.clone());
+        Ok(canon)
+    }
+
     /// Notes where leaf `kind` names objects or variables (for the scene and blackboard checks),
     /// even when the leaf has other errors, so that every mistake is reported at once.
     /// The parameters that name objects are the ones the kind declares

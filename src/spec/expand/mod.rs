@@ -14,6 +14,7 @@ mod leaf;
 mod subtree;
 
 use super::check::{ObjectUse, VarDef};
+use super::confine::IncludeScope;
 use super::file::{SubtreeDef, param_ref};
 use super::node::{Node, NodeKind};
 use crate::kinds::leaves::Leaf;
@@ -23,6 +24,7 @@ use crate::yaml::suggest::did_you_mean;
 use crate::yaml::value::{Value, ValueKind};
 use std::collections::HashMap;
 
+pub use leaf::MAX_LEAF_FILE_BYTES;
 use leaf::{condition_param_help, parse_reporting_all};
 pub(super) use subtree::undefined_params;
 
@@ -54,6 +56,10 @@ pub(crate) struct Expander<'a> {
     pub object_uses: Vec<ObjectUse>,
     /// Every blackboard variable a `select` or `for_each` writes, located.
     pub var_defs: Vec<VarDef>,
+    /// The folder the files a leaf names ([`crate::kinds::Params::FILE_PARAMS`]) are confined to.
+    scope: IncludeScope,
+    /// The canonical paths of the files leaves name (a `policy`'s model), in reading order.
+    pub leaf_files: Vec<std::path::PathBuf>,
 }
 
 impl<'a> Expander<'a> {
@@ -76,7 +82,15 @@ impl<'a> Expander<'a> {
             reported: Vec::new(),
             object_uses: Vec::new(),
             var_defs: Vec::new(),
+            scope: IncludeScope::default(),
+            leaf_files: Vec::new(),
         }
+    }
+
+    /// Confines the files leaves name to `scope` (by default every such file is refused).
+    pub fn with_scope(mut self, scope: IncludeScope) -> Self {
+        self.scope = scope;
+        self
     }
 
     fn err(&mut self, issue: Issue) {
@@ -208,10 +222,16 @@ impl<'a> Expander<'a> {
         let category = ty.as_ref().map(|t| t.category());
         let node_kind = if let Some(t) = ty.as_ref().filter(|t| t.control_kind().is_some()) {
             self.control(t, loc, body, depth)?
-        } else if let (Some(parsed), warnings) = crate::yaml::de::collect_warnings(|| {
-            ty.as_ref()
-                .and_then(|t| parse_reporting_all(without_name(body), |v| t.parse_leaf(v)))
-        }) {
+        } else if let (Some(parsed), warnings) = {
+            let read = match &ty {
+                Some(t) => self.resolve_files(t, &without_name(body))?,
+                None => without_name(body),
+            };
+            crate::yaml::de::collect_warnings(|| {
+                ty.as_ref()
+                    .and_then(|t| parse_reporting_all(read, |v| t.parse_leaf(v)))
+            })
+        } {
             for w in warnings {
                 let mut issue = Issue::new(w.loc, format!("{} in `{k}`", w.message)).maybe_help(w.help);
                 if let Some(via) = w.via {

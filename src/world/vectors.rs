@@ -112,6 +112,42 @@ pub fn pose_vector(pos: &[f64; 3], quat_wxyz: &[f64; 4]) -> [f32; VALUES_PER_OBJ
     .map(|v| v as f32)
 }
 
+/// `observation.environment_state`: every object's [`pose_vector`], in scene order.
+pub fn environment_vector(world: &crate::world::World) -> Vec<f32> {
+    let mut out = Vec::with_capacity(world.objects.len() * VALUES_PER_OBJECT);
+    for o in &world.objects {
+        let p = [o.pos.x, o.pos.y, o.pos.z];
+        let q = o.quat.quaternion();
+        out.extend(pose_vector(&p, &[q.w, q.i, q.j, q.k]));
+    }
+    out
+}
+
+/// Values in an object vector ([`object_vector`]).
+pub const OBJECT_LEN: usize = 5;
+
+/// Names of the [`OBJECT_LEN`] values of an object vector ([`object_vector`]).
+pub const OBJECT_NAMES: [&str; OBJECT_LEN] = [
+    "object_dx",
+    "object_dy",
+    "object_dz",
+    "object_sin4yaw",
+    "object_cos4yaw",
+];
+
+/// `observation.object`: where object `i` is relative to the gripper — its centre minus the
+/// pinch point (metres, world frame), then sin and cos of four times its yaw (the rotation of
+/// its x axis about world z) minus the tool's yaw ([`crate::world::snapshot::tool_yaw`]; a square
+/// block looks the same every quarter turn), as `f32`.
+/// Names: [`OBJECT_NAMES`].
+pub fn object_vector(world: &crate::world::World, i: usize) -> [f32; OBJECT_LEN] {
+    let o = &world.objects[i];
+    let d = o.pos - world.pinch_pos;
+    let tool_yaw = crate::world::snapshot::tool_yaw(&world.pinch_rot);
+    let rel = 4.0 * (crate::world::snapshot::yaw_of(&o.quat) - tool_yaw);
+    [d.x, d.y, d.z, rel.sin(), rel.cos()].map(|v| v as f32)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

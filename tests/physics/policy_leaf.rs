@@ -1,0 +1,155 @@
+//! The `policy` leaf on real MuJoCo and a real ONNX Runtime: the small constant models of
+//! tests/fixtures/policy (make_models.py) drive the arm, end on their condition, fail typed, and
+//! bad models are refused where the tree names them.
+
+use macrotree::episode::{EpisodeConfig, EpisodeReport, Goal};
+use macrotree::{App, FailureKind};
+
+/// Where the fixtures are; trees are compiled as if written in this folder.
+const FOLDER: &str = "tests/fixtures/policy";
+
+fn run(yaml: &str) -> EpisodeReport {
+    let app = App::new();
+    let plan = app
+        .compile_str(yaml, &format!("{FOLDER}/t.yaml"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let config = EpisodeConfig {
+        goal: Goal::Tree,
+        ..EpisodeConfig::default()
+    };
+    app.run_episode(&plan, &config).unwrap()
+}
+
+fn load_error(yaml: &str) -> String {
+    match App::new().compile_str(yaml, &format!("{FOLDER}/t.yaml")) {
+        Ok(_) => panic!("the tree loaded:\n{yaml}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+const AWAY: &str = "move_joints: {joints: [-1.2, -1.3, 1.4, -1.6, -1.57, 0.3]}";
+
+#[test]
+fn a_policy_leaf_drives_the_arm_to_its_models_set_points_until_its_condition_holds() {
+    for (model, extra) in [
+        ("home.onnx", ""),
+        ("normalized_home.onnx", ""),
+        ("object_home.onnx", ", object: cube"),
+    ] {
+        let r = run(&format!(
+            "main: {{sequence: {{children: [{{{AWAY}}}, {{policy: {{model: {model}{extra}, until: {{at_home: {{}}}}, timeout: 3}}}}]}}}}"
+        ));
+        assert!(r.success, "{model}: {:?}", r.failure_reason);
+        // 0.37 rad at most 3 rad/s after a 0.38 s move: home within half a second more.
+        assert!(r.sim_time_s < 1.2, "{model}: {} s", r.sim_time_s);
+    }
+}
+
+#[test]
+fn a_non_finite_action_fails_the_leaf_as_policy_output_invalid() {
+    let r = run("main: {policy: {model: nan.onnx, timeout: 2}}");
+    assert!(!r.success);
+    assert_eq!(r.failure_kind, Some(FailureKind::Custom("policy_output_invalid")));
+    assert!(
+        r.failure_reason.as_deref().unwrap_or("").contains("finite"),
+        "{:?}",
+        r.failure_reason
+    );
+    assert!(
+        r.sim_time_s < 0.1,
+        "fails on its first call, not at its timeout: {} s",
+        r.sim_time_s
+    );
+}
+
+#[test]
+fn a_policy_without_its_condition_times_out_and_a_fallback_takes_over() {
+    let r = run("main: {policy: {model: still_relative.onnx, until: {at_home: {}}, timeout: 0.4}}");
+    // The arm starts at home, so `at_home` holds at once: the relative zero action never moves it.
+    assert!(r.success, "{:?}", r.failure_reason);
+    let r = run(&format!(
+        "main: {{sequence: {{children: [{{{AWAY}}}, {{policy: {{model: still_relative.onnx, until: {{at_home: {{}}}}, timeout: 0.4}}}}]}}}}"
+    ));
+    assert_eq!(
+        r.failure_kind,
+        Some(FailureKind::Timeout),
+        "{:?}",
+        r.failure_reason
+    );
+    let r = run(&format!(
+        "main: {{sequence: {{children: [{{{AWAY}}}, {{fallback: {{children: [{{policy: {{model: still_relative.onnx, until: {{at_home: {{}}}}, timeout: 0.4}}}}, {{home: {{}}}}]}}}}]}}}}"
+    ));
+    assert!(
+        r.success,
+        "the scripted fallback brings the arm home: {:?}",
+        r.failure_reason
+    );
+    assert_eq!(r.halts, 0);
+}
+
+/// The model calls in a `timeout` failure's reason ("… after N model calls").
+fn calls(r: &EpisodeReport) -> u32 {
+    let reason = r.failure_reason.as_deref().unwrap_or("");
+    let n = reason
+        .split("after ")
+        .last()
+        .and_then(|s| s.split(' ').next())
+        .and_then(|n| n.parse().ok());
+    n.unwrap_or_else(|| panic!("no call count in {reason:?}"))
+}
+
+#[test]
+fn a_chunk_runs_its_steps_before_the_model_runs_again() {
+    let tree = |steps: &str| {
+        format!(
+            "main: {{sequence: {{children: [{{{AWAY}}}, {{policy: {{model: chunk.onnx, until: {{at_home: {{}}}}, timeout: 0.4{steps}}}}}]}}}}"
+        )
+    };
+    // 0.4 s at 0.02 s per action: 20 actions, in chunks of 4 or one by one.
+    let whole = calls(&run(&tree("")));
+    let single = calls(&run(&tree(", n_action_steps: 1")));
+    assert!((5..=6).contains(&whole), "{whole}");
+    assert!((20..=21).contains(&single), "{single}");
+    let r = run(&tree(", n_action_steps: 5"));
+    assert!(r.failure_reason.unwrap_or_default().contains("chunk of 4"));
+}
+
+#[test]
+fn the_same_tree_and_model_give_the_same_episode() {
+    let yaml = format!(
+        "main: {{sequence: {{children: [{{{AWAY}}}, {{policy: {{model: object_home.onnx, object: cube, until: {{at_home: {{}}}}, period: 0.02}}}}]}}}}"
+    );
+    let a = run(&yaml);
+    let b = run(&yaml);
+    assert!(a.success);
+    assert_eq!(a.sim_time_s.to_bits(), b.sim_time_s.to_bits());
+    assert_eq!(a.physics_steps, b.physics_steps);
+    assert_eq!(
+        serde_json::to_string(&a.objects).unwrap(),
+        serde_json::to_string(&b.objects).unwrap()
+    );
+}
+
+#[test]
+fn a_model_that_does_not_fit_is_refused_at_its_model_value() {
+    for (model, says) in [
+        ("unknown_input.onnx", "input `obs` is not a feature"),
+        ("short_action.onnx", "expected the action, [1, 7]"),
+        ("missing.onnx", "cannot read `missing.onnx`"),
+        ("../trees/pick_place.yaml", "outside the tree's folder"),
+        ("make_models.py", "ONNX Runtime cannot load the model"),
+    ] {
+        let e = load_error(&format!("main:\n  policy: {{model: {model}, timeout: 2}}\n"));
+        assert!(e.contains(says), "{model}: {e}");
+        assert!(e.contains("t.yaml:2:19"), "{model}: located at the value: {e}");
+    }
+}
+
+#[test]
+fn the_model_file_is_an_input_of_the_tree() {
+    let plan = App::new()
+        .compile_str("main: {policy: {model: home.onnx}}", &format!("{FOLDER}/t.yaml"))
+        .unwrap();
+    let model = std::fs::canonicalize(format!("{FOLDER}/home.onnx")).unwrap();
+    assert!(plan.inputs.contains(&model), "{:?}", plan.inputs);
+}
