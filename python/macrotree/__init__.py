@@ -8,6 +8,9 @@
   ``macrotree/StackThree-v0``, ``macrotree/ClearTable-v0`` and ``macrotree/MacroEnv-v0`` (any
   scene: ``gymnasium.make("macrotree/MacroEnv-v0", scene=PATH)``).
 
+* :func:`run_policy_model`: an ONNX model run once as a ``policy`` leaf runs it;
+  ``python -m macrotree.bc`` clones a skill of a dataset into one (docs/learning.md).
+
 Errors in input (a bad leaf mapping, a bad scene file) raise :class:`MacrotreeError` with the
 located message (``file:line:column``).
 """
@@ -16,7 +19,14 @@ from macrotree._library import SetupError, prepare
 
 prepare()
 
-from macrotree._native import CTRL_NAMES, STATE_NAMES, MacrotreeError, __version__  # noqa: E402
+from macrotree._native import (  # noqa: E402
+    CTRL_NAMES,
+    OBJECT_NAMES,
+    STATE_NAMES,
+    MacrotreeError,
+    __version__,
+    run_policy_model,
+)
 from macrotree.env import MacroEnv  # noqa: E402
 from macrotree.registration import register_envs  # noqa: E402
 from macrotree.spaces import Gripper, MacroMode  # noqa: E402
@@ -26,6 +36,7 @@ register_envs()
 
 __all__ = [
     "CTRL_NAMES",
+    "OBJECT_NAMES",
     "STATE_NAMES",
     "Gripper",
     "MacroEnv",
@@ -34,4 +45,5 @@ __all__ = [
     "SetupError",
     "VectorEnv",
     "__version__",
+    "run_policy_model",
 ]

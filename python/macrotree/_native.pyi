@@ -14,6 +14,7 @@ MACRO_KEYS: list[str]
 CTRL_LOW: list[float]
 CTRL_HIGH: list[float]
 RESIDUAL_HIGH: list[float]
+OBJECT_NAMES: list[str]
 
 class MacrotreeError(Exception):
     """Invalid input: the message is located (``file:line:column``) and says what to do."""
@@ -96,3 +97,4 @@ class VecEnv:
     def close(self) -> None: ...
 
 def write_mp4(path: str, frames: list[np.ndarray], fps: int) -> int: ...
+def run_policy_model(path: str, inputs: dict[str, list[float]]) -> list[list[float]]: ...

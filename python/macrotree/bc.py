@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import itertools
 import json
 import os
 import sys
@@ -76,7 +77,9 @@ class Demonstrations:
     episode: npt.NDArray[np.int64]
 
 
-def load_dataset(path: str, leaf: str, object_index: int) -> tuple[Demonstrations, dict[str, object]]:
+def load_dataset(
+    path: str, leaf: str, object_index: int
+) -> tuple[Demonstrations, dict[str, object]]:
     """The demonstrations of the frames whose running leaf's path contains ``leaf``, and the
     dataset's ``meta/info.json``."""
     try:
@@ -159,7 +162,7 @@ def train(d: Demonstrations, cfg: TrainConfig, log: bool = True) -> Mlp:
     sizes = [x.shape[1], *cfg.hidden, y.shape[1]]
     ws = [
         (rng.standard_normal((a, b)) * np.sqrt(2.0 / a)).astype(np.float32)
-        for a, b in zip(sizes[:-1], sizes[1:], strict=True)
+        for a, b in itertools.pairwise(sizes)
     ]
     bs = [np.zeros(b, np.float32) for b in sizes[1:]]
     params = [*ws, *bs]
@@ -196,7 +199,9 @@ def train(d: Demonstrations, cfg: TrainConfig, log: bool = True) -> Mlp:
                 vh = v[j] / (1 - b2**step)
                 p -= (lr * mh / (np.sqrt(vh) + eps)).astype(np.float32)
         if log and (epoch % 10 == 0 or epoch == cfg.epochs - 1):
-            print(f"epoch {epoch + 1}/{cfg.epochs}: mse {total / n / y.shape[1]:.4f}", file=sys.stderr)
+            print(
+                f"epoch {epoch + 1}/{cfg.epochs}: mse {total / n / y.shape[1]:.4f}", file=sys.stderr
+            )
     skip = np.zeros((d.x.shape[1], y.shape[1]), np.float32)
     skip[np.arange(6), np.arange(6)] = 1.0  # offsets from the measured joints → set points
     first = np.zeros((d.x.shape[1], ws[0].shape[1]), np.float32)
@@ -230,14 +235,27 @@ def write_model(mlp: Mlp, out: str) -> None:
 def main(argv: Sequence[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m macrotree.bc", description=__doc__.split("\n\n")[0])
     p.add_argument("dataset", help="a dataset folder `macrotree sweep --dataset` wrote")
-    p.add_argument("--leaf", required=True, help="keep frames whose running leaf's path contains this")
-    p.add_argument("--object", type=int, default=0, metavar="INDEX", help="the object's index in the scene (default 0)")
+    p.add_argument(
+        "--leaf", required=True, help="keep frames whose running leaf's path contains this"
+    )
+    p.add_argument(
+        "--object",
+        type=int,
+        default=0,
+        metavar="INDEX",
+        help="the object's index in the scene (default 0)",
+    )
     p.add_argument("--out", required=True, help="the ONNX file to write")
     p.add_argument("--epochs", type=int, default=TrainConfig.epochs)
     p.add_argument("--hidden", type=int, nargs="+", default=list(TrainConfig.hidden))
     p.add_argument("--lr", type=float, default=TrainConfig.lr)
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--state", choices=sorted(STATE_CHOICES), default="all", help="the state values the network sees")
+    p.add_argument(
+        "--state",
+        choices=sorted(STATE_CHOICES),
+        default="all",
+        help="the state values the network sees",
+    )
     a = p.parse_args(argv)
     if not 1 <= a.epochs <= 10_000 or not all(1 <= h <= 4096 for h in a.hidden) or not 0 < a.lr < 1:
         p.error("--epochs is 1 … 10000, --hidden widths 1 … 4096, --lr in (0, 1)")

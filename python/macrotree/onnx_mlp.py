@@ -92,7 +92,7 @@ class Mlp:
     metadata: dict[str, str] = field(default_factory=dict)
 
     def forward(self, x: F32) -> F32:
-        """The model's output for rows ``x`` (the concatenated inputs), as ONNX Runtime computes it."""
+        """The model's output for rows ``x`` (the concatenated inputs), as the graph computes it."""
         h = (x - self.x_mean) / self.x_std
         for i, (w, b) in enumerate(zip(self.weights, self.biases, strict=True)):
             h = h @ w + b

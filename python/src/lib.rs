@@ -7,6 +7,7 @@ mod convert;
 mod env;
 mod error;
 mod macro_action;
+mod policy;
 mod setup;
 mod vector;
 mod video;
@@ -39,6 +40,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("RESIDUAL_HIGH", residual_high)?;
     m.add_function(wrap_pyfunction!(gripper_command_for_width, m)?)?;
     m.add_function(wrap_pyfunction!(video::write_mp4, m)?)?;
+    m.add_function(wrap_pyfunction!(policy::run_policy_model, m)?)?;
+    m.add("OBJECT_NAMES", macrotree::world::vectors::OBJECT_NAMES.to_vec())?;
     m.add_class::<env::Env>()?;
     m.add_class::<vector::VecEnv>()?;
     Ok(())

@@ -147,6 +147,36 @@ impl PolicyModel {
         }
     }
 
+    /// Runs the model once on `inputs` (one vector per [`ModelInfo::inputs`], in order, not yet
+    /// normalised), as a `policy` leaf does: the actions, un-normalised, one per chunk step. For
+    /// checking an exported model against the network it came from.
+    ///
+    /// # Errors
+    /// An input of the wrong length, or the model failing to run.
+    pub fn evaluate(&self, inputs: Vec<Vec<f32>>) -> Result<Vec<[f32; ACTION_LEN]>, String> {
+        if inputs.len() != self.info.inputs.len() {
+            return Err(format!(
+                "the model takes {} inputs, {} were given",
+                self.info.inputs.len(),
+                inputs.len()
+            ));
+        }
+        for (spec, values) in self.info.inputs.iter().zip(&inputs) {
+            if values.len() != spec.len {
+                return Err(format!(
+                    "input `{}` takes {} values, {} were given",
+                    spec.name,
+                    spec.len,
+                    values.len()
+                ));
+            }
+        }
+        let mut session = self.session()?;
+        let out = self.run(&mut session, inputs);
+        self.give_back(session);
+        out
+    }
+
     /// Runs the model on `inputs` (one vector per [`ModelInfo::inputs`], in order, not yet
     /// normalised): the actions, un-normalised, one per chunk step.
     pub(super) fn run(
