@@ -228,3 +228,142 @@ fn torchrl_check_env_specs_passes() {
     eprintln!("{out}");
     assert_eq!(out.matches(": passed").count(), 3, "{out}");
 }
+
+/// The summary of `macrotree sweep ARGS --json` (exit code 0, or 1 when a scenario failed).
+fn sweep_summary(args: &[&str]) -> serde_json::Value {
+    let out = Command::new(env!("CARGO_BIN_EXE_macrotree"))
+        .arg("sweep")
+        .args(args)
+        .arg("--json")
+        .current_dir(root())
+        .output()
+        .expect("macrotree sweep starts");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        matches!(out.status.code(), Some(0 | 1)),
+        "macrotree sweep {args:?}: {}\n{stdout}{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json = stdout
+        .lines()
+        .find(|l| l.starts_with('{'))
+        .expect("a JSON summary");
+    serde_json::from_str(json).expect("the summary is JSON")
+}
+
+/// The node of `summary` whose path ends with `tail`.
+fn node<'a>(summary: &'a serde_json::Value, tail: &str) -> &'a serde_json::Value {
+    summary["nodes"]
+        .as_array()
+        .and_then(|nodes| {
+            nodes
+                .iter()
+                .find(|n| n["path"].as_str().is_some_and(|p| p.ends_with(tail)))
+        })
+        .unwrap_or_else(|| panic!("no node ending with {tail}"))
+}
+
+/// docs/learning.md's loop, small: noisy demonstrations of the flagship, a short behaviour
+/// cloning of its pick (twice: the same bytes), the learned trees validated and swept on held-out
+/// seeds. A policy trained this little fails most picks; the scripted fallback must catch them.
+#[test]
+fn the_learning_loop_runs_end_to_end_and_its_model_is_reproducible() {
+    if skip() {
+        return;
+    }
+    let venv = installed();
+    let dir = root().join("target/python-test/learning");
+    let _ = std::fs::remove_dir_all(&dir);
+    for sub in ["trees/lib", "trees/policies"] {
+        std::fs::create_dir_all(dir.join(sub)).expect("learning folders");
+    }
+    for tree in [
+        "learned_cube_to_bowl.yaml",
+        "learned_pick_alone.yaml",
+        "lib/learned_pick.yaml",
+    ] {
+        std::fs::copy(root().join("trees").join(tree), dir.join("trees").join(tree)).expect("copy tree");
+    }
+    let demos = dir.join("demos");
+    let demos_arg = demos.to_str().expect("UTF-8 path");
+    sweep_summary(&[
+        "trees/cube_to_bowl.yaml",
+        "--scenarios",
+        "30",
+        "--seed",
+        "1",
+        "--dataset",
+        demos_arg,
+        "--cameras",
+        "none",
+        "--noise",
+        "0.02,10",
+        "--only-success",
+    ]);
+    let model = dir.join("trees/policies/cube_pick.onnx");
+    let again = dir.join("again.onnx");
+    for out in [&model, &again] {
+        run(
+            venv.command("python")
+                .args(["-m", "macrotree.bc"])
+                .arg(&demos)
+                .args([
+                    "--leaf",
+                    "subtree[pick]",
+                    "--state",
+                    "joints",
+                    "--epochs",
+                    "5",
+                    "--hidden",
+                    "64",
+                    "64",
+                ])
+                .arg("--out")
+                .arg(out)
+                .env("PYTHONPATH", root().join("third_party/pyarrow"))
+                .env("OPENBLAS_NUM_THREADS", "1"),
+            "python -m macrotree.bc",
+        );
+    }
+    assert_eq!(
+        std::fs::read(&model).expect("model"),
+        std::fs::read(&again).expect("model again"),
+        "the same dataset, settings and seed give the same model"
+    );
+    let with_fallback = dir.join("trees/learned_cube_to_bowl.yaml");
+    let alone = dir.join("trees/learned_pick_alone.yaml");
+    run(
+        Command::new(env!("CARGO_BIN_EXE_macrotree"))
+            .arg("validate")
+            .arg(&with_fallback)
+            .arg(&alone),
+        "macrotree validate",
+    );
+    let held_out = ["--scenarios", "6", "--seed", "7", "--jobs", "2"];
+    let scripted = sweep_summary(&[&["trees/cube_to_bowl.yaml"][..], &held_out].concat());
+    let learned = sweep_summary(&[&[with_fallback.to_str().expect("UTF-8")][..], &held_out].concat());
+    let policy = node(&learned, "policy[approach and grasp]");
+    let fallback = node(&learned, "subtree[scripted_pick]");
+    eprintln!(
+        "scripted {} / 6, learned with fallback {} / 6; the policy succeeded {} of {} times, the fallback ran {} times",
+        scripted["successes"],
+        learned["successes"],
+        policy["successes"],
+        policy["activations"],
+        fallback["activations"]
+    );
+    assert!(
+        policy["activations"].as_u64() >= Some(6),
+        "the policy ran in every scenario"
+    );
+    // Every policy failure handed over to the scripted pick.
+    assert_eq!(fallback["activations"], policy["failures"]);
+    assert!(
+        learned["successes"].as_u64() >= scripted["successes"].as_u64().map(|s| s.saturating_sub(1)),
+        "the fallback keeps the scripted rate: {learned}"
+    );
+    let alone = sweep_summary(&[&[alone.to_str().expect("UTF-8")][..], &held_out].concat());
+    assert_eq!(alone["scenarios"], 6);
+    assert_eq!(node(&alone, "policy[approach and grasp]")["scenarios_ran"], 6);
+}
