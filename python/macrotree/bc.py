@@ -78,10 +78,16 @@ class Demonstrations:
 
 
 def load_dataset(
-    path: str, leaf: str, object_index: int
+    path: str, leaf: str, object_index: int, drop_holds: bool = False
 ) -> tuple[Demonstrations, dict[str, object]]:
     """The demonstrations of the frames whose running leaf's path contains ``leaf``, and the
-    dataset's ``meta/info.json``."""
+    dataset's ``meta/info.json``.
+
+    With ``drop_holds``, frames where the arm only holds still (the next command's joint
+    velocities all zero and the gripper command unchanged) are left out — an attempt at the
+    ambiguity of a scripted leaf settling at its goal before the next leaf starts from the same
+    state (the pre-grasp pose above the block, then the descent). On the flagship's pick it
+    made things worse (docs/learning.md)."""
     try:
         import pyarrow.parquet as pq  # type: ignore[import-not-found,import-untyped,unused-ignore]
     except ImportError as e:  # pragma: no cover - depends on the machine
@@ -107,6 +113,10 @@ def load_dataset(
         # Frame k's label is the command of frame k + 1 (where the arm must be one period on),
         # within one episode.
         keep = np.array([leaf in a for a in active[:-1]], bool) & (episode[:-1] == episode[1:])
+        if drop_holds:
+            moving = np.abs(action[1:, 6:12]).max(1) > 1e-9
+            gripping = action[1:, GRIPPER_IN_ACTION] != action[:-1, GRIPPER_IN_ACTION]
+            keep &= moving | gripping
         idx = np.nonzero(keep)[0]
         x = np.column_stack([state[idx], object_features(state[idx], env[idx], object_index)])
         y = np.column_stack(
@@ -131,8 +141,13 @@ def dataset_digest(path: str) -> str:
 
 
 #: The ``observation.state`` values each ``--state`` choice feeds the network (the others get
-#: zero weights): ``all`` 20, ``joints`` the six joint angles and the gripper closure.
-STATE_CHOICES: dict[str, list[int]] = {"all": list(range(STATE_LEN)), "joints": list(range(7))}
+#: zero weights): ``all`` 20, ``joints`` the six joint angles and the gripper closure,
+#: ``joints_velocities`` those and the six joint velocities.
+STATE_CHOICES: dict[str, list[int]] = {
+    "all": list(range(STATE_LEN)),
+    "joints": list(range(7)),
+    "joints_velocities": list(range(13)),
+}
 
 
 @dataclass
@@ -251,6 +266,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--lr", type=float, default=TrainConfig.lr)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument(
+        "--drop-holds",
+        action="store_true",
+        help="leave out the frames where the arm only holds still",
+    )
+    p.add_argument(
         "--state",
         choices=sorted(STATE_CHOICES),
         default="all",
@@ -259,7 +279,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     a = p.parse_args(argv)
     if not 1 <= a.epochs <= 10_000 or not all(1 <= h <= 4096 for h in a.hidden) or not 0 < a.lr < 1:
         p.error("--epochs is 1 … 10000, --hidden widths 1 … 4096, --lr in (0, 1)")
-    d, info = load_dataset(a.dataset, a.leaf, a.object)
+    d, info = load_dataset(a.dataset, a.leaf, a.object, a.drop_holds)
     fps = info.get("fps")
     if not isinstance(fps, (int, float)) or fps <= 0:
         raise SystemExit(f"{a.dataset}/meta/info.json has no valid `fps`")
@@ -281,6 +301,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 "lr": cfg.lr,
                 "seed": cfg.seed,
                 "state": cfg.state,
+                "drop_holds": a.drop_holds,
                 "frames": len(d.x),
             }
         ),

@@ -39,7 +39,7 @@ impl Feature {
         match self {
             Feature::State => n == STATE_LEN,
             Feature::Object => n == OBJECT_LEN,
-            Feature::EnvironmentState => n > 0 && n % VALUES_PER_OBJECT == 0,
+            Feature::EnvironmentState => n > 0 && n.is_multiple_of(VALUES_PER_OBJECT),
         }
     }
 

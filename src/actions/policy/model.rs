@@ -71,10 +71,24 @@ impl std::fmt::Debug for PolicyModel {
 }
 
 /// A file's identity for the cache: its size and modification time.
-type Stamp = (u64, Option<SystemTime>);
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Stamp {
+    len: u64,
+    modified: Option<SystemTime>,
+}
 
-fn cache() -> &'static Mutex<HashMap<PathBuf, (Stamp, Arc<PolicyModel>)>> {
-    static CACHE: OnceLock<Mutex<HashMap<PathBuf, (Stamp, Arc<PolicyModel>)>>> = OnceLock::new();
+/// A loaded model and the identity of the file it came from.
+#[derive(Clone)]
+struct Cached {
+    stamp: Stamp,
+    model: Arc<PolicyModel>,
+}
+
+/// The loaded models, by canonical path.
+type Cache = Mutex<HashMap<PathBuf, Cached>>;
+
+fn cache() -> &'static Cache {
+    static CACHE: OnceLock<Cache> = OnceLock::new();
     CACHE.get_or_init(|| Mutex::new(HashMap::new()))
 }
 
@@ -106,12 +120,15 @@ impl PolicyModel {
                 meta.len()
             ));
         }
-        let stamp = (meta.len(), meta.modified().ok());
+        let stamp = Stamp {
+            len: meta.len(),
+            modified: meta.modified().ok(),
+        };
         let key = path.to_path_buf();
-        if let Some((s, m)) = cache().lock().ok().and_then(|c| c.get(&key).cloned())
-            && s == stamp
+        if let Some(hit) = cache().lock().ok().and_then(|c| c.get(&key).cloned())
+            && hit.stamp == stamp
         {
-            return Ok(m);
+            return Ok(hit.model);
         }
         let bytes = std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
         let session = new_session(&bytes)?;
@@ -126,7 +143,13 @@ impl PolicyModel {
             if c.len() >= MAX_CACHED {
                 c.clear();
             }
-            c.insert(key, (stamp, model.clone()));
+            c.insert(
+                key,
+                Cached {
+                    stamp,
+                    model: model.clone(),
+                },
+            );
         }
         Ok(model)
     }
@@ -230,7 +253,7 @@ fn new_session(bytes: &[u8]) -> Result<Session, String> {
     let env = environment()?;
     Session::builder(env)
         .and_then(|b| b.with_intra_threads(1).map_err(Into::into))
-        .and_then(|mut b| b.commit_from_memory(bytes).map_err(Into::into))
+        .and_then(|mut b| b.commit_from_memory(bytes))
         .map_err(|e| format!("ONNX Runtime cannot load the model: {e}"))
 }
 
