@@ -185,7 +185,7 @@ impl Registry {
 
         defs.insert(
             "NodeName".into(),
-            json!({"type": "string", "minLength": 1, "maxLength": 80, "pattern": "^[^/\\[\\]#\\n\\r]+$",
+            json!({"type": "string", "minLength": 1, "maxLength": 80, "pattern": "^[^/\\[\\]#|\\n\\r]+$",
                "description": "Optional label used in node paths, logs and diagrams."}),
         );
         defs.insert(

@@ -462,3 +462,15 @@ fn control_nodes_read_their_typed_parameters_with_located_errors() {
         "no second error for the `child` the misspelled key was suggested as: {d:#?}"
     );
 }
+
+#[test]
+fn a_node_name_with_the_dataset_label_separator_is_refused_at_the_name() {
+    // A dataset joins the paths of leaves running at once with ` | `: a name holding `|` would
+    // make such a label ambiguous.
+    let d = errors(
+        "main:\n  parallel:\n    children:\n      - wait: {seconds: 1, name: a | b}\n      - wait: {seconds: 1}\n",
+    );
+    let e = find(&d, "invalid node name `a | b`");
+    assert_eq!((e.line, e.column), (4, 34), "{e}");
+    assert!(e.label.as_deref().unwrap_or("").contains('|'), "{e}");
+}

@@ -318,9 +318,9 @@ impl<'a> Expander<'a> {
             Some(s) => {
                 self.err(
                     Issue::new(v.loc, format!("invalid node name `{s}`"))
-                        .label("expected 1–80 characters without `/`, `[`, `]`, `#` or line breaks")
+                        .label("expected 1–80 characters without `/`, `[`, `]`, `#`, `|` or line breaks")
                         .help(
-                            "names appear in node paths like `main/sequence[pick]/reach`; keep them simple",
+                            "names appear in node paths like `main/sequence[pick]/reach`, and a dataset joins the paths of leaves running at once with ` | `; keep them simple",
                         ),
                 );
                 None
@@ -351,8 +351,10 @@ impl<'a> Expander<'a> {
     }
 }
 
+/// A node name: 1–80 characters, none of them a node path's separators (`/`, `[`, `]`, `#`), the
+/// separator of several running leaves in a dataset's labels (`|`), or a line break.
 fn valid_name(s: &str) -> bool {
-    !s.trim().is_empty() && s.chars().count() <= 80 && !s.contains(['/', '[', ']', '#', '\n', '\r'])
+    !s.trim().is_empty() && s.chars().count() <= 80 && !s.contains(['/', '[', ']', '#', '|', '\n', '\r'])
 }
 
 fn without_name(body: &Value) -> Value {
