@@ -16,6 +16,13 @@ pub enum PlacementError {
         /// Its pose.
         pose: Pose,
     },
+    /// The yaw is not a finite angle within one turn either way.
+    BadYaw {
+        /// The object.
+        object: String,
+        /// Its yaw as given, radians.
+        yaw: f64,
+    },
     /// The object's footprint comes too close to the robot's base.
     OnRobotBase {
         /// The object.
@@ -98,6 +105,7 @@ impl PlacementError {
     pub fn object(&self) -> Option<&str> {
         match self {
             PlacementError::OffTable { object, .. }
+            | PlacementError::BadYaw { object, .. }
             | PlacementError::OnRobotBase { object, .. }
             | PlacementError::OutOfReach { object, .. }
             | PlacementError::OffSupport { object, .. }
@@ -114,6 +122,7 @@ impl PlacementError {
     pub fn constraint(&self) -> String {
         match self {
             PlacementError::OffTable { object, .. } => format!("off_table {object}"),
+            PlacementError::BadYaw { object, .. } => format!("bad_yaw {object}"),
             PlacementError::OnRobotBase { object, .. } => format!("on_robot_base {object}"),
             PlacementError::OutOfReach { object, .. } => format!("out_of_reach {object}"),
             PlacementError::TooClose { a, b, .. } => format!("too_close {a} {b}"),
@@ -129,6 +138,9 @@ impl PlacementError {
     pub fn hint(&self) -> String {
         match self {
             PlacementError::OffTable { .. } => "keep x and y within ±1 m of the robot".into(),
+            PlacementError::BadYaw { .. } => {
+                "give the yaw in radians within one turn (±2π), e.g. its value modulo 2π".into()
+            }
             PlacementError::OnRobotBase { object, .. } => {
                 format!("move `{object}` (or its `random:` region) away from the robot's base at the origin")
             }
@@ -168,7 +180,14 @@ impl std::fmt::Display for PlacementError {
             PlacementError::OffTable { object, pose } => write!(
                 f,
                 "`{object}` at ({}, {}) is off the table: x and y must be finite and within ±{TABLE_HALF} m",
-                pose.x, pose.y
+                short(pose.x),
+                short(pose.y)
+            ),
+            PlacementError::BadYaw { object, yaw } => write!(
+                f,
+                "`{object}`'s yaw is {}: a yaw must be a finite angle within ±{:.4} rad (one turn)",
+                short(*yaw),
+                crate::yaml::units::MAX_BARE_ANGLE
             ),
             PlacementError::OnRobotBase { object, distance } => write!(
                 f,
@@ -254,3 +273,14 @@ impl std::fmt::Display for PlacementError {
 }
 
 impl std::error::Error for PlacementError {}
+
+/// A number as a message shows it: as given up to 12 characters, else in scientific notation
+/// with 4 significant digits (a hostile 1e300 is not printed as 301 digits).
+fn short(x: f64) -> String {
+    let plain = format!("{x}");
+    if plain.chars().count() <= 12 {
+        plain
+    } else {
+        format!("{x:.3e}")
+    }
+}

@@ -112,11 +112,17 @@ impl Placement {
     /// robot's base, and for a block, within the arm's reach.
     pub fn check_one(scene: &SceneSpec, i: usize, p: &Pose) -> Result<(), PlacementError> {
         let o = &scene.objects[i];
-        let finite = p.x.is_finite() && p.y.is_finite() && p.yaw.is_finite() && p.z.is_finite();
+        let finite = p.x.is_finite() && p.y.is_finite() && p.z.is_finite();
         if !finite || p.x.abs() > TABLE_HALF || p.y.abs() > TABLE_HALF {
             return Err(PlacementError::OffTable {
                 object: o.name.clone(),
                 pose: *p,
+            });
+        }
+        if !(p.yaw.is_finite() && p.yaw.abs() <= crate::yaml::units::MAX_BARE_ANGLE) {
+            return Err(PlacementError::BadYaw {
+                object: o.name.clone(),
+                yaw: p.yaw,
             });
         }
         let base = o.shape.footprint(p).distance_to_point([0.0, 0.0]);

@@ -279,3 +279,24 @@ fn the_tutorial_sampler_is_a_scene_setting_that_needs_a_cube_and_a_bowl() {
         "{text}"
     );
 }
+
+#[test]
+fn a_placement_yaw_that_is_not_a_finite_angle_within_a_turn_is_refused_as_a_yaw() {
+    let scene = macrotree::spec::builtin_scene();
+    let fixed = Placement::fixed(&scene).expect("the built-in scene has fixed poses");
+    assert_eq!(fixed.check(&scene), Ok(()));
+    for yaw in [f64::NAN, f64::INFINITY, 1e300, -7.0] {
+        let mut p = fixed.clone();
+        p.poses[0].yaw = yaw;
+        let e = p.check(&scene).expect_err("a bad yaw");
+        assert_eq!(
+            e.constraint(),
+            format!("bad_yaw {}", scene.objects[0].name),
+            "{e}"
+        );
+        let text = e.to_string();
+        assert!(text.contains("yaw") && !text.contains("x and y"), "{text}");
+        // A hostile number is printed shortly, not as 301 digits.
+        assert!(text.len() < 160, "{text}");
+    }
+}
