@@ -33,6 +33,8 @@ pub trait Params:
     /// ```ignore
     /// const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("block", ObjectRole::Block)];
     /// ```
+    ///
+    /// A dotted key names a value inside a nested mapping (`until.grasped.object`).
     const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[];
 
     /// The parameters (keys of the node's body, each a string) that name a file the leaf reads

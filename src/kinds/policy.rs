@@ -168,7 +168,19 @@ impl Until {
 }
 
 impl Params for Policy {
-    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[("object", ObjectRole::Any)];
+    const OBJECT_PARAMS: &'static [(&'static str, ObjectRole)] = &[
+        ("object", ObjectRole::Any),
+        ("until.grasped.object", ObjectRole::Block),
+        ("until.lifted.object", ObjectRole::Block),
+        ("until.in.object", ObjectRole::Block),
+        ("until.in.container", ObjectRole::Container),
+        ("until.on.object", ObjectRole::Block),
+        ("until.on.support", ObjectRole::Block),
+        ("until.on_table.object", ObjectRole::Block),
+        ("until.at.object", ObjectRole::Block),
+        ("until.at.spot", ObjectRole::Spot),
+        ("until.goal_met.object", ObjectRole::Block),
+    ];
     const FILE_PARAMS: &'static [&'static str] = &["model"];
 
     fn objects_mut(&mut self) -> Vec<&mut ObjectRef> {

@@ -153,3 +153,12 @@ fn the_model_file_is_an_input_of_the_tree() {
     let model = std::fs::canonicalize(format!("{FOLDER}/home.onnx")).unwrap();
     assert!(plan.inputs.contains(&model), "{:?}", plan.inputs);
 }
+
+#[test]
+fn an_unknown_object_in_until_is_refused_where_it_is_written() {
+    let e = load_error("main:\n  policy: {model: home.onnx, until: {grasped: {object: cub}}}\n");
+    assert!(e.contains("`cub`") && e.contains("cube"), "{e}");
+    assert!(e.contains("t.yaml:2:56"), "{e}");
+    let e = load_error("main:\n  policy: {model: home.onnx, until: {in: {object: cube, container: cube}}}\n");
+    assert!(e.contains("container"), "a block where a container belongs: {e}");
+}

@@ -107,7 +107,10 @@ impl Expander<'_> {
     pub(super) fn record_objects(&mut self, ty: &NodeType, body: &Value) {
         let kind = ty.name();
         for &(key, role) in ty.object_params() {
-            let Some(v) = body.get(key) else { continue };
+            // A dotted key reaches into a nested mapping (`until.grasped.object`).
+            let Some(v) = key.split('.').try_fold(body, |v, k| v.get(k)) else {
+                continue;
+            };
             let reference = match &v.kind {
                 // `cube` and `bowl` are legacy names only where a `Target` is read (any object):
                 // an `ObjectRef` parameter resolves them as plain names when the tree runs.
