@@ -119,6 +119,57 @@ pub struct ScenarioFile {
     pub sweep: SweepConfig,
     /// What must hold.
     pub expect: Expect,
+    /// Where each node pattern of `expect:` is written (for [`Self::check_patterns`]).
+    pattern_at: Vec<PatternAt>,
+}
+
+/// Where one node pattern of `expect:` is written: its list (`ran`, `counts`, …), its index
+/// there, and its 1-based line and column in the file.
+#[derive(Clone, Debug, PartialEq)]
+struct PatternAt {
+    key: &'static str,
+    index: usize,
+    line: u32,
+    column: u32,
+}
+
+/// The lists of node patterns in `expect:`, by key.
+const PATTERN_KEYS: [&str; 6] = [
+    "ran",
+    "ran_in_every",
+    "failed",
+    "never_ran",
+    "never_failed",
+    "counts",
+];
+
+/// Where every node pattern of `expect:` in the scenario file `v` is written.
+fn pattern_locations(v: &Value) -> Vec<PatternAt> {
+    let mut out = Vec::new();
+    let expect = v.get("expect");
+    let at = |key: &'static str, index: usize, x: &Value| PatternAt {
+        key,
+        index,
+        line: x.loc.line,
+        column: x.loc.col,
+    };
+    for key in PATTERN_KEYS {
+        let Some(list) = expect.and_then(|e| e.get(key)).and_then(Value::as_seq) else {
+            continue;
+        };
+        for (i, item) in list.iter().enumerate() {
+            let node = if key == "counts" {
+                item.get("node").unwrap_or(item)
+            } else {
+                item
+            };
+            out.push(at(key, i, node));
+        }
+    }
+    if let Some(x) = expect.and_then(|e| e.get("failed_node")) {
+        out.push(at("failed_node", 0, x));
+    }
+    out
 }
 
 const KEYS: &[&str] = &[
@@ -435,6 +486,7 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>, custom_kinds: &[&str]) 
         scene,
         sweep,
         expect: raw.expect,
+        pattern_at: pattern_locations(v),
     })
 }
 
@@ -456,10 +508,15 @@ impl ScenarioFile {
             .into_iter()
             .chain([("failed_node", &failed_node), ("counts", &counted)])
         {
-            for p in list {
+            for (i, p) in list.iter().enumerate() {
                 if !plan.nodes.iter().any(|n| glob_match(p, &n.path)) {
+                    let at = self
+                        .pattern_at
+                        .iter()
+                        .find(|a| a.key == key && a.index == i)
+                        .map_or(String::new(), |a| format!(":{}:{}", a.line, a.column));
                     return Err(format!(
-                        "{}: `expect.{key}` pattern {p:?} matches no node of {}; `macrotree run {} --log-format json` lists the paths",
+                        "{}{at}: `expect.{key}` pattern {p:?} matches no node of {}; `macrotree run {} --log-format json` lists the paths",
                         self.path.display(),
                         self.tree.display(),
                         self.tree.display()

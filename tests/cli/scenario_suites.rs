@@ -304,6 +304,12 @@ fn bad_scenario_files_exit_2_with_located_errors_and_nothing_runs() {
             "matches no node",
             "subtree[pick]/sequence[pick]/grasp",
         ),
+        // An `expect:` glob that matches no node is located at the pattern.
+        (
+            "expect_nomatch.yaml",
+            "expect_nomatch.yaml:6:14",
+            "matches no node",
+        ),
     ];
     for (file, where_, what) in cases {
         let path = format!("tests/fixtures/scenarios/bad/{file}");
