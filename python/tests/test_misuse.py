@@ -178,3 +178,14 @@ def test_ctrl_c_interrupts_a_long_step_and_the_environment_asks_for_a_reset(data
     assert out["env"] == "interrupted" and out["vec"] == "interrupted", out
     assert "reset" in out["env_after"] and "reset" in out["vec_after"], out
     assert out["env_time"] > 0 and out["vec_ok"], out
+
+
+@pytest.mark.parametrize("size", [(100000, 100000), (8, 320), (240, 0)])
+def test_an_image_size_out_of_bounds_is_refused_before_anything_is_built(
+    data: Path, size: tuple[int, int]
+) -> None:
+    scene = data / "scenes/cube_bowl.yaml"
+    with pytest.raises(ValueError, match="height must be 16"):
+        macrotree.MacroEnv(scene, cameras=["front"], image_size=size)
+    with pytest.raises(ValueError, match="height must be 16"):
+        macrotree.VectorEnv(scene, num_envs=2, cameras=["front"], image_size=size)

@@ -55,6 +55,18 @@ impl fmt::Display for FrameSize {
     }
 }
 
+/// Checks an image's height and width (pixels) against [`MIN_SIDE`], [`MAX_WIDTH`] and
+/// [`MAX_HEIGHT`] (the offscreen buffer of `assets/scene.xml`): the error says the bounds.
+pub fn check_image_size(height: u32, width: u32) -> Result<(), String> {
+    if (MIN_SIDE..=MAX_WIDTH).contains(&width) && (MIN_SIDE..=MAX_HEIGHT).contains(&height) {
+        Ok(())
+    } else {
+        Err(format!(
+            "an image of {height}×{width} pixels (height × width): the height must be {MIN_SIDE}…{MAX_HEIGHT} and the width {MIN_SIDE}…{MAX_WIDTH}"
+        ))
+    }
+}
+
 impl FromStr for FrameSize {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
@@ -68,10 +80,7 @@ impl FromStr for FrameSize {
         let (Ok(width), Ok(height)) = (w.trim().parse::<u32>(), h.trim().parse::<u32>()) else {
             return Err(format!("{s:?}: {form}"));
         };
-        let ok = (MIN_SIDE..=MAX_WIDTH).contains(&width)
-            && (MIN_SIDE..=MAX_HEIGHT).contains(&height)
-            && width % 2 == 0
-            && height % 2 == 0;
+        let ok = check_image_size(height, width).is_ok() && width % 2 == 0 && height % 2 == 0;
         if !ok {
             return Err(format!("{s:?}: {form}"));
         }
