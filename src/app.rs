@@ -50,12 +50,8 @@ pub struct App {
 impl Default for App {
     /// The built-in node kinds, bound to the built-in controllers and checks.
     fn default() -> Self {
-        #[allow(unused_mut)]
-        let mut registry = Registry::builtin();
-        #[cfg(feature = "policy")]
-        registry.check_files_with("policy", crate::actions::policy::check_model_file);
         App {
-            loader: Loader::new(Arc::new(registry)),
+            loader: Loader::new(Arc::new(builtin_registry())),
             factory: Factory::builtin(),
             program: ProgramInfo::default(),
         }
@@ -285,6 +281,19 @@ fn check_config(c: &EpisodeConfig) -> Result<(), Error> {
         });
     }
     crate::actions::check_control_period(c.control_period)
+}
+
+/// The built-in node kinds, with the checks of the files their leaves name (a `policy`'s model
+/// is checked when the tree loads).
+fn builtin_registry() -> Registry {
+    let registry = Registry::builtin();
+    #[cfg(feature = "policy")]
+    let registry = {
+        let mut r = registry;
+        r.check_files_with("policy", crate::actions::policy::check_model_file);
+        r
+    };
+    registry
 }
 
 #[cfg(test)]

@@ -1,7 +1,7 @@
 //! Resolving named targets (`cube`, `bowl`, an object, a spot, a point) against the current
 //! world, and reading the tool's yaw.
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
 use crate::failure::Failure;
 use crate::kinds::ObjectRef;
@@ -97,11 +97,7 @@ pub fn target_object(target: &crate::kinds::Target, w: &World) -> Option<usize> 
     }
 }
 
-/// Yaw of the tool about world z, in the convention of [`crate::motion::ik_down`] (0 at home,
-/// where the pinch x axis points along world +y), radians.
-pub fn tool_yaw(pinch_rot: &Matrix3<f64>) -> f64 {
-    crate::world::snapshot::tool_yaw(pinch_rot)
-}
+pub use crate::world::snapshot::tool_yaw;
 
 /// Distance from `p` to the segment `a`–`b` in the table plane, metres.
 pub(crate) fn segment_distance(

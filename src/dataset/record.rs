@@ -221,12 +221,7 @@ impl EpisodeRecorder {
         let gripper_joint = sim.gripper_joint();
         let state = vectors::state_vector(&vectors::RobotState::of(world, gripper_joint));
         let action = vectors::command_vector(&command.to_vector());
-        let mut environment = Vec::with_capacity(world.objects.len() * vectors::VALUES_PER_OBJECT);
-        for o in &world.objects {
-            let q = o.quat.quaternion();
-            let p = [o.pos.x, o.pos.y, o.pos.z];
-            environment.extend(vectors::pose_vector(&p, &[q.w, q.i, q.j, q.k]));
-        }
+        let environment = vectors::environment_vector(world);
         let (mut paths, mut kinds) = (Vec::new(), Vec::new());
         for id in runner.running_leaves() {
             if let Some(leaf) = self.plan.leaf(id) {

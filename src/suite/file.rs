@@ -133,41 +133,49 @@ struct PatternAt {
     column: u32,
 }
 
-/// The lists of node patterns in `expect:`, by key.
-const PATTERN_KEYS: [&str; 6] = [
-    "ran",
-    "ran_in_every",
-    "failed",
-    "never_ran",
-    "never_failed",
-    "counts",
-];
+/// Every node pattern of `expect:`, by the key it is written under, in the order the file
+/// lists them (`failed_node` is one pattern, `counts` entries name theirs under `node:`).
+fn pattern_lists(e: &Expect) -> [(&'static str, Vec<&str>); 7] {
+    fn strs(l: &[String]) -> Vec<&str> {
+        l.iter().map(String::as_str).collect()
+    }
+    [
+        ("ran", strs(&e.ran)),
+        ("ran_in_every", strs(&e.ran_in_every)),
+        ("failed", strs(&e.failed)),
+        ("never_ran", strs(&e.never_ran)),
+        ("never_failed", strs(&e.never_failed)),
+        ("failed_node", e.failed_node.iter().map(String::as_str).collect()),
+        ("counts", e.counts.iter().map(|c| c.node.as_str()).collect()),
+    ]
+}
 
-/// Where every node pattern of `expect:` in the scenario file `v` is written.
-fn pattern_locations(v: &Value) -> Vec<PatternAt> {
+/// Where every node pattern of `expect` ([`pattern_lists`]) is written in the scenario file `v`.
+fn pattern_locations(v: &Value, expect: &Expect) -> Vec<PatternAt> {
     let mut out = Vec::new();
-    let expect = v.get("expect");
-    let at = |key: &'static str, index: usize, x: &Value| PatternAt {
-        key,
-        index,
-        line: x.loc.line,
-        column: x.loc.col,
-    };
-    for key in PATTERN_KEYS {
-        let Some(list) = expect.and_then(|e| e.get(key)).and_then(Value::as_seq) else {
+    let written = v.get("expect");
+    for (key, list) in pattern_lists(expect) {
+        let Some(value) = written.and_then(|e| e.get(key)) else {
             continue;
         };
-        for (i, item) in list.iter().enumerate() {
-            let node = if key == "counts" {
-                item.get("node").unwrap_or(item)
-            } else {
-                item
+        for index in 0..list.len() {
+            let item = match key {
+                "failed_node" => Some(value),
+                "counts" => value
+                    .as_seq()
+                    .and_then(|l| l.get(index))
+                    .map(|x| x.get("node").unwrap_or(x)),
+                _ => value.as_seq().and_then(|l| l.get(index)),
             };
-            out.push(at(key, i, node));
+            if let Some(x) = item {
+                out.push(PatternAt {
+                    key,
+                    index,
+                    line: x.loc.line,
+                    column: x.loc.col,
+                });
+            }
         }
-    }
-    if let Some(x) = expect.and_then(|e| e.get("failed_node")) {
-        out.push(at("failed_node", 0, x));
     }
     out
 }
@@ -408,16 +416,7 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>, custom_kinds: &[&str]) 
             .label("seconds of simulated time"),
         );
     }
-    let patterns = e
-        .ran
-        .iter()
-        .chain(&e.ran_in_every)
-        .chain(&e.failed)
-        .chain(&e.never_ran)
-        .chain(&e.never_failed)
-        .chain(&e.failed_node)
-        .chain(e.counts.iter().map(|c| &c.node));
-    for p in patterns {
+    for p in pattern_lists(e).into_iter().flat_map(|(_, list)| list) {
         if let Err(reason) = Substitution::check_pattern(p) {
             issues.push(Issue::new(at(&["expect"]), format!("node pattern: {reason}")));
         }
@@ -485,8 +484,8 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>, custom_kinds: &[&str]) 
         tree,
         scene,
         sweep,
+        pattern_at: pattern_locations(v, &raw.expect),
         expect: raw.expect,
-        pattern_at: pattern_locations(v),
     })
 }
 
@@ -494,20 +493,7 @@ impl ScenarioFile {
     /// Checks that every node pattern of `expect:` matches some node of `plan` (a pattern that
     /// matches nothing would pass or fail for the wrong reason).
     pub fn check_patterns(&self, plan: &Plan) -> Result<(), String> {
-        let e = &self.expect;
-        let lists: [(&str, &Vec<String>); 5] = [
-            ("ran", &e.ran),
-            ("ran_in_every", &e.ran_in_every),
-            ("failed", &e.failed),
-            ("never_ran", &e.never_ran),
-            ("never_failed", &e.never_failed),
-        ];
-        let failed_node: Vec<String> = e.failed_node.iter().cloned().collect();
-        let counted: Vec<String> = e.counts.iter().map(|c| c.node.clone()).collect();
-        for (key, list) in lists
-            .into_iter()
-            .chain([("failed_node", &failed_node), ("counts", &counted)])
-        {
+        for (key, list) in pattern_lists(&self.expect) {
             for (i, p) in list.iter().enumerate() {
                 if !plan.nodes.iter().any(|n| glob_match(p, &n.path)) {
                     let at = self

@@ -13,16 +13,18 @@ use crate::yaml::value::{Value, ValueKind};
 pub const MAX_LEAF_FILE_BYTES: u64 = 256 << 20;
 
 impl Expander<'_> {
-    /// `body` with each file parameter of `ty` ([`crate::kinds::Params::FILE_PARAMS`]) replaced
+    /// `out` (a leaf's body) with each file parameter of `ty` ([`crate::kinds::Params::FILE_PARAMS`]) replaced
     /// by the canonical path of the file it names, relative to the file it is written in and
     /// confined like `include:`; `None` (the problem reported, at the value) when one cannot be
     /// read. The files are noted in [`Self::leaf_files`].
-    pub(super) fn resolve_files(&mut self, ty: &NodeType, body: &Value) -> Option<Value> {
+    pub(super) fn resolve_files(&mut self, ty: &NodeType, mut out: Value) -> Option<Value> {
         let keys = ty.file_params();
-        let mut out = body.clone();
         let ValueKind::Map(entries) = &mut out.kind else {
             return Some(out);
         };
+        if keys.is_empty() {
+            return Some(out);
+        }
         for (k, v) in entries.iter_mut() {
             let (Some(key), ValueKind::Str(written)) = (k.as_str(), &v.kind) else {
                 continue;

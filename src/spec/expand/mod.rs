@@ -224,7 +224,7 @@ impl<'a> Expander<'a> {
             self.control(t, loc, body, depth)?
         } else if let (Some(parsed), warnings) = {
             let read = match &ty {
-                Some(t) => self.resolve_files(t, &without_name(body))?,
+                Some(t) => self.resolve_files(t, without_name(body))?,
                 None => without_name(body),
             };
             crate::yaml::de::collect_warnings(|| {
