@@ -73,6 +73,9 @@ pub enum FailureKind {
     Inverted,
     /// `forced`: a `force_failure` node failed as it always does, its child having succeeded.
     Forced,
+    /// `overridden`: a failure forced on a leaf from outside the tree (the monitor's "force
+    /// failure"), not the leaf's own.
+    Overridden,
     /// `max_iterations`: a `for_each` still found a match after its `max_iterations`.
     MaxIterations,
     /// `start_in_collision`: a planned motion cannot start: the arm (or the block it holds) is
@@ -100,7 +103,7 @@ pub enum FailureKind {
 
 impl FailureKind {
     /// Every built-in kind (all but [`Custom`](Self::Custom)).
-    pub const BUILTIN: [FailureKind; 25] = [
+    pub const BUILTIN: [FailureKind; 26] = [
         FailureKind::TimeLimit,
         FailureKind::Unstable,
         FailureKind::GoalNotMet,
@@ -119,6 +122,7 @@ impl FailureKind {
         FailureKind::GoalMoved,
         FailureKind::Inverted,
         FailureKind::Forced,
+        FailureKind::Overridden,
         FailureKind::MaxIterations,
         FailureKind::StartInCollision,
         FailureKind::GoalInCollision,
@@ -149,6 +153,7 @@ impl FailureKind {
             FailureKind::GoalMoved => "goal_moved",
             FailureKind::Inverted => "inverted",
             FailureKind::Forced => "forced",
+            FailureKind::Overridden => "overridden",
             FailureKind::MaxIterations => "max_iterations",
             FailureKind::StartInCollision => "start_in_collision",
             FailureKind::GoalInCollision => "goal_in_collision",

@@ -29,6 +29,11 @@ pub struct RunArgs {
     /// Port of the live view (0 picks a free one).
     #[arg(long, default_value_t = crate::viewer::DEFAULT_PORT, requires = "view")]
     pub port: u16,
+    /// Pause the live episode at every node whose path matches PATTERN (the glob of
+    /// --substitute), when it starts, or when it finishes with `PATTERN@after`; resume or step
+    /// from the page. Repeatable.
+    #[arg(long = "break", value_name = "PATTERN[@after]", requires = "view")]
+    pub breaks: Vec<crate::viewer::BreakSpec>,
     /// Pace the simulation to wall-clock time so a person can watch.
     #[arg(long, conflicts_with = "speed")]
     pub realtime: bool,
@@ -62,6 +67,15 @@ pub struct RunArgs {
 struct Both<'a>(&'a mut dyn EpisodeObserver, &'a mut dyn EpisodeObserver);
 
 impl EpisodeObserver for Both<'_> {
+    fn on_period_start(
+        &mut self,
+        cell: &crate::actions::Cell,
+        command: &crate::motion::CellCommand,
+        runner: &mut crate::runtime::TreeRunner,
+    ) {
+        self.0.on_period_start(cell, command, runner);
+        self.1.on_period_start(cell, command, runner);
+    }
     fn on_tick(&mut self, cell: &crate::actions::Cell, runner: &mut crate::runtime::TreeRunner) {
         self.0.on_tick(cell, runner);
         self.1.on_tick(cell, runner);
@@ -274,6 +288,8 @@ pub fn run(app: &crate::App, args: RunArgs) -> Result<(), CliError> {
         }
         (false, None) => None,
     };
+    // A --break pattern that matches no node is refused before the viewer starts.
+    crate::viewer::Monitor::new(&plan, &args.breaks).map_err(|e| CliError::Input(format!("error: {e}")))?;
     let live = if args.view {
         let opts = ViewerOptions {
             port: args.port,
@@ -299,6 +315,8 @@ pub fn run(app: &crate::App, args: RunArgs) -> Result<(), CliError> {
     let mut frame_recorder = recorder_for_frames.take();
     let report = if live.is_some() || recorder.is_some() || speed.is_some() {
         let mut view = ViewObserver::new(&plan, live, recorder, speed);
+        view.set_breakpoints(&plan, &args.breaks)
+            .map_err(|e| CliError::Input(format!("error: {e}")))?;
         let report = match frame_recorder.as_mut() {
             Some(frames) => run_episode(
                 &scene,
@@ -430,6 +448,14 @@ fn print_summary(r: &crate::episode::EpisodeReport, goal: Goal, json: bool) {
     }
     if let Some(node) = &r.failed_node {
         say!(json, "  failed node: {node}");
+    }
+    for n in r.nodes.iter().filter(|n| n.counts.overridden > 0) {
+        say!(
+            json,
+            "  result forced from the monitor: {} ({}×; its successes and failures count them)",
+            n.path,
+            n.counts.overridden
+        );
     }
     if goal != Goal::Scene {
         say!(

@@ -31,6 +31,7 @@
 #![warn(missing_docs)]
 
 pub mod blackboard;
+pub mod overrides;
 mod runner;
 pub mod scripted;
 pub mod substitute;
@@ -44,6 +45,7 @@ use crate::kinds::Leaf;
 use crate::plan::LeafId;
 
 pub use blackboard::Blackboard;
+pub use overrides::{ForceError, ForcedResult};
 pub use runner::TreeRunner;
 
 /// One blackboard write, as logged (also a `tracing` event, target `macrotree::blackboard`).
@@ -175,6 +177,14 @@ pub struct NodeCounts {
     pub failures: u32,
     /// Executions preempted while running.
     pub halts: u32,
+    /// Results forced from outside the tree (the monitor's force buttons), counted in
+    /// `successes` or `failures` too; absent from reports when 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub overridden: u32,
+}
+
+fn is_zero(n: &u32) -> bool {
+    *n == 0
 }
 
 impl NodeCounts {
@@ -184,6 +194,7 @@ impl NodeCounts {
         self.successes = self.successes.saturating_add(other.successes);
         self.failures = self.failures.saturating_add(other.failures);
         self.halts = self.halts.saturating_add(other.halts);
+        self.overridden = self.overridden.saturating_add(other.overridden);
     }
 }
 

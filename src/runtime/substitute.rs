@@ -315,7 +315,7 @@ pub fn resolve(plan: &Plan, subs: &[Substitution]) -> Result<Resolved, Substitut
 }
 
 /// Up to five leaf paths closest to `pattern` (by edit distance of the last segments).
-fn close_paths(plan: &Plan, pattern: &str) -> Vec<String> {
+pub(crate) fn close_paths(plan: &Plan, pattern: &str) -> Vec<String> {
     let last = pattern.rsplit('/').next().unwrap_or(pattern);
     let mut scored: Vec<(usize, &str)> = plan
         .leaves

@@ -13,6 +13,7 @@
 mod guard;
 mod http;
 pub mod limits;
+pub mod monitor;
 pub mod observer;
 pub mod page;
 pub mod panel;
@@ -34,6 +35,7 @@ use rmpv::Value;
 use tungstenite::Bytes;
 
 pub use limits::ServerLimits;
+pub use monitor::{BreakSpec, BreakWhen, Monitor, MonitorCommand};
 pub use observer::{PUBLISH_HZ, ViewObserver, tree_view};
 pub use panel::TreeNodeView;
 pub use record::Recorder;
@@ -277,6 +279,19 @@ impl LiveViewer {
         let mut st = self.hub.lock();
         st.panel.update(statuses, Some(attempts), events);
         Hub::panel_changed(&st, false);
+    }
+
+    /// The monitor's state for the page (paused, breakpoints, forced results), replaced whole.
+    pub fn publish_monitor(&self, monitor: serde_json::Value) {
+        let mut st = self.hub.lock();
+        st.panel.set_monitor(monitor);
+        Hub::panel_changed(&st, false);
+    }
+
+    /// The oldest monitor command a page sent (pause, step, breakpoints, forced results),
+    /// waiting up to `wait` for one (`Duration::ZERO`: do not wait).
+    pub fn next_command(&self, wait: Duration) -> Option<MonitorCommand> {
+        self.hub.next_command(wait)
     }
 
     /// Puts a three.js JSON object at `path` (replacing the previous one there).

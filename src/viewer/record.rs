@@ -122,11 +122,26 @@ impl Recorder {
         statuses: Vec<&'static str>,
         events: Vec<serde_json::Value>,
     ) {
-        if statuses == self.last_statuses && events.is_empty() {
+        self.tree_status_with_attempts(sim_time, statuses, None, events);
+    }
+
+    /// Like [`tree_status`](Self::tree_status), with the loop counters (retry attempts, repeat
+    /// runs, `for_each` iterations by preorder index) when they changed.
+    pub fn tree_status_with_attempts(
+        &mut self,
+        sim_time: f64,
+        statuses: Vec<&'static str>,
+        attempts: Option<Vec<u32>>,
+        events: Vec<serde_json::Value>,
+    ) {
+        if statuses == self.last_statuses && events.is_empty() && attempts.is_none() {
             return;
         }
-        self.timeline
-            .push(json!({ "t": sim_time, "statuses": statuses, "events": events }));
+        let mut entry = json!({ "t": sim_time, "statuses": statuses, "events": events });
+        if let Some(a) = attempts {
+            entry["attempts"] = json!(a);
+        }
+        self.timeline.push(entry);
         self.last_statuses = statuses;
     }
 

@@ -6,7 +6,8 @@
 //!
 //! Kinds produced elsewhere: `collision` in `tests/cli/collision_policy.rs`, `max_iterations` in
 //! `tests/tree/loops.rs`, `substituted` through a whole sweep in `tests/cli/scenario_suites.rs`,
-//! `container_full` in `tests/physics/place.rs`.
+//! `container_full` in `tests/physics/place.rs`, `overridden` in `tests/tree/forced_results.rs`
+//! and through a live episode in `tests/viewer/monitor.rs`.
 
 use std::ops::ControlFlow;
 use std::sync::{Arc, OnceLock};
@@ -653,6 +654,7 @@ fn every_built_in_kind_is_tested() {
         "goal_moved",
         "inverted",
         "forced",
+        "overridden",
         "max_iterations",
         "start_in_collision",
         "goal_in_collision",

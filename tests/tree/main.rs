@@ -10,6 +10,7 @@ mod scene_entry;
 mod support;
 
 mod common_mistakes;
+mod forced_results;
 mod fuzz_regressions;
 mod hostile_input;
 mod include_confinement;

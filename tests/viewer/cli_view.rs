@@ -242,6 +242,34 @@ fn a_taken_port_exits_2_and_says_what_to_do() {
 }
 
 #[test]
+fn a_break_pattern_that_matches_no_node_exits_2_before_serving() {
+    let mut cmd = macrotree();
+    cmd.args([
+        "run",
+        "trees/cube_to_bowl.yaml",
+        "--view",
+        "--port",
+        "0",
+        "--break",
+        "main/**/grsap",
+    ]);
+    let out = output_within(cmd, Duration::from_secs(60));
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("matches no node") && stderr.contains("grasp"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("live view:"), "refused before serving: {stderr}");
+    // A breakpoint needs the live page that resumes it.
+    let mut cmd = macrotree();
+    cmd.args(["run", "trees/cube_to_bowl.yaml", "--break", "main/**/grasp"]);
+    let out = output_within(cmd, Duration::from_secs(60));
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--view"));
+}
+
+#[test]
 fn record_writes_a_self_contained_replay() {
     let dir = std::env::temp_dir().join(format!("macrotree-record-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

@@ -8,6 +8,7 @@ mod support;
 mod bundle;
 mod cli_view;
 mod encoding;
+mod monitor;
 mod real_browser;
 mod replay_ui;
 mod websocket;

@@ -27,6 +27,7 @@ fn demo_tree() -> Vec<TreeNodeView> {
         kind: kind.into(),
         name: name.into(),
         parent,
+        ..TreeNodeView::default()
     };
     vec![
         n("root", "sequence", "cube_in_bowl", None),
@@ -381,6 +382,7 @@ fn hostile_tree() -> Vec<TreeNodeView> {
             kind: (*name).into(),
             name: (*name).into(),
             parent: (i > 0).then_some(0),
+            ..TreeNodeView::default()
         })
         .collect()
 }

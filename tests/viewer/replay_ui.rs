@@ -1,6 +1,6 @@
 //! The replay page in a real headless Chromium, on the replay of a real episode with a slipped
-//! grasp (so a retry restarts its child): long node names are cut with an ellipsis and shown
-//! whole on hover, a legend explains the colours, nodes of the failed attempt are reset to idle
+//! grasp (so a retry restarts its child): long node names wrap inside the panel and show whole
+//! on hover, a legend explains the colours, nodes of the failed attempt are reset to idle
 //! with the previous outcome as a badge, trace events are readable lines, the URL opens the
 //! replay paused at an instant (`#t=2.6&paused`), the arrow keys step it and the URL follows, and
 //! the default camera shows the objects.
@@ -108,8 +108,8 @@ fn the_replay_opens_at_an_instant_explains_its_colours_and_resets_a_retried_atte
     assert_eq!(s["preshape"]["status"], "running", "{s}");
     assert_eq!(s["preshape"]["badge"], "success", "{s}");
 
-    // The long name is cut inside the panel, and whole on hover.
-    assert_eq!(s["guard"]["cut"], true, "{s}");
+    // The long name wraps inside the panel, whole (never cut), and is whole on hover too.
+    assert_eq!(s["guard"]["cut"], false, "{s}");
     assert!(
         s["guard"]["right"].as_f64().unwrap() <= s["panel"].as_f64().unwrap(),
         "{s}"

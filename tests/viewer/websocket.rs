@@ -38,7 +38,7 @@ fn start_with(scene: &Scene, limits: ServerLimits) -> Option<LiveViewer> {
 }
 
 /// Connects as the live page does: from the server's own origin.
-fn connect(addr: SocketAddr) -> Client {
+pub(crate) fn connect(addr: SocketAddr) -> Client {
     let stream = TcpStream::connect(addr).unwrap();
     stream.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
     let (ws, _) = tungstenite::client(page_request(addr), stream).unwrap();
@@ -343,6 +343,7 @@ fn tree_panel_and_capture_replies_travel_as_text_frames() {
         kind: "sequence".into(),
         name: path.into(),
         parent,
+        ..TreeNodeView::default()
     };
     v.set_tree(vec![node("root", None), node("root/0", Some(0))]);
     for i in 0..250 {

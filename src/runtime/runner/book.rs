@@ -9,7 +9,7 @@ use crate::failure::{Failure, FailureKind};
 use crate::plan::{NodeTag, Plan};
 use crate::runtime::blackboard::Blackboard;
 use crate::runtime::substitute::{Resolved, Scripted};
-use crate::runtime::{NodeCounts, NodeStatus, Transition, TreeStatus};
+use crate::runtime::{ForcedResult, NodeCounts, NodeStatus, Transition, TreeStatus};
 
 #[derive(Default)]
 pub(super) struct LeafRt {
@@ -51,6 +51,8 @@ pub(super) struct RunState {
     pub(super) instant: Vec<bool>,
     pub(super) attempts: Vec<u32>,
     pub(super) leaves: Vec<LeafRt>,
+    /// Per leaf: the result forced on its next tick ([`TreeRunner::force`](super::TreeRunner::force)).
+    pub(super) forced: Vec<Option<ForcedResult>>,
     pub(super) yield_pending: Vec<bool>,
     /// Loop ends (`next`) that answered Running: (internal index, owning node, tick).
     pub(super) pending_yields: Vec<(usize, usize, u64)>,
@@ -118,6 +120,7 @@ impl RunState {
                     ..LeafRt::default()
                 })
                 .collect(),
+            forced: vec![None; plan.leaves.len()],
             yield_pending: vec![false; plan.internal.len()],
             pending_yields: Vec::new(),
             exit_flags: vec![false; n],

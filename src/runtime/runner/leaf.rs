@@ -9,7 +9,7 @@ use crate::failure::{Failure, FailureKind};
 use crate::kinds::{Leaf, Select};
 use crate::plan::{LeafId, Plan};
 use crate::runtime::substitute::Scripted;
-use crate::runtime::{LeafDriver, LeafOutcome, NodeStatus};
+use crate::runtime::{ForcedResult, LeafDriver, LeafOutcome, NodeStatus};
 
 impl RunState {
     pub(super) fn on_leaf(
@@ -27,8 +27,13 @@ impl RunState {
         };
         let node = info.node;
         self.touch(plan, node);
+        let forced = self.forced[id.index()].take();
+        let first = !self.leaves[id.index()].running;
+        if forced.is_some() && !first {
+            // The running activation ends with the forced result: stop the real leaf first.
+            self.halt_leaf(plan, driver, id);
+        }
         let rt = &mut self.leaves[id.index()];
-        let first = !rt.running;
         rt.last_tick = self.tick;
         if first {
             rt.elapsed = 0.0;
@@ -45,6 +50,18 @@ impl RunState {
             );
         }
         let (outcome, leftover) = match &info.kind {
+            _ if forced.is_some() => {
+                self.counts[node].overridden += 1;
+                let outcome = match forced {
+                    Some(ForcedResult::Failure) => LeafOutcome::failure(
+                        FailureKind::Overridden,
+                        "failure forced from outside the tree (the monitor)",
+                    ),
+                    _ => LeafOutcome::Success,
+                };
+                tracing::info!(target: "macrotree::tree", path = %info.path, "forced result: {outcome:?}");
+                (outcome, dt)
+            }
             _ if !rt.real => {
                 let outcome = match rt.scripted {
                     Some(Scripted::Running(n)) if rt.scripted_ticks < n => {

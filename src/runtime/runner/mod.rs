@@ -18,7 +18,7 @@ use bonsai_bt::{BT, Event, Status, UpdateArgs};
 
 use super::blackboard::Blackboard;
 use super::substitute::Resolved;
-use super::{LeafDriver, NodeCounts, NodeStatus, Transition, TreeStatus};
+use super::{ForceError, ForcedResult, LeafDriver, NodeCounts, NodeStatus, Transition, TreeStatus};
 use crate::failure::{Failure, FailureKind};
 use crate::plan::{LeafId, Plan};
 
@@ -100,6 +100,27 @@ impl TreeRunner {
     /// Status of every node (same indices as `plan.nodes`).
     pub fn node_statuses(&self) -> &[NodeStatus] {
         &self.st.statuses
+    }
+
+    /// Forces the result of the leaf at node index `node` at its next tick (the monitor's force
+    /// buttons, Groot2's REPLACE hook): a running leaf is halted and ends with `result`; an idle
+    /// one answers `result` when it is next ticked, without reaching the driver. A failure has
+    /// the kind `overridden`; [`NodeCounts::overridden`] counts each forced result. A second
+    /// call before that tick replaces the first; [`reset`](Self::reset) forgets it.
+    ///
+    /// # Errors
+    /// The node does not exist or is not a leaf.
+    pub fn force(&mut self, node: usize, result: ForcedResult) -> Result<(), ForceError> {
+        let info = self.plan.nodes.get(node).ok_or(ForceError::NoSuchNode(node))?;
+        let id = info.leaf.ok_or_else(|| ForceError::NotALeaf(info.path.clone()))?;
+        self.st.forced[id.index()] = Some(result);
+        Ok(())
+    }
+
+    /// The result forced on the leaf at node index `node` that its next tick will answer, if any.
+    pub fn forced(&self, node: usize) -> Option<ForcedResult> {
+        let id = self.plan.nodes.get(node)?.leaf?;
+        self.st.forced.get(id.index()).copied().flatten()
     }
 
     /// The last failure / halt reason of every node (same indices as `plan.nodes`).

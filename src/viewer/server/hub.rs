@@ -9,12 +9,15 @@ use std::time::{Duration, Instant};
 
 use tungstenite::Bytes;
 
+use crate::viewer::monitor::MonitorCommand;
 use crate::viewer::panel::PanelState;
 use crate::viewer::slots::Slots;
 use crate::viewer::tree::SceneTree;
 
 /// How long a client thread sleeps when it has nothing to send (it then polls for input).
 pub(super) const IDLE_POLL: Duration = Duration::from_millis(25);
+/// Shortest wall time between two live updates (poses, statuses) to one client: at most 40 per
+/// second; a slower client gets the latest poses, never a backlog (trace events are kept up
 /// to [`crate::viewer::panel::EVENT_HISTORY`]).
 pub const MIN_POSE_INTERVAL: Duration = Duration::from_millis(25);
 /// Structural messages a client may have queued before it is reset to a snapshot.
@@ -127,7 +130,13 @@ pub(crate) struct Hub {
     /// The open connections (HTTP and websocket).
     pub slots: Arc<Slots>,
     pub shutdown: AtomicBool,
+    /// Monitor commands from the pages, oldest first (at most [`MAX_PENDING_COMMANDS`]).
+    commands: Mutex<VecDeque<MonitorCommand>>,
+    command_ready: Condvar,
 }
+
+/// Monitor commands kept until the simulation thread takes them; more are dropped (and logged).
+pub(crate) const MAX_PENDING_COMMANDS: usize = 64;
 
 impl Hub {
     pub fn lock(&self) -> MutexGuard<'_, HubState> {
@@ -285,9 +294,40 @@ impl Hub {
         let Ok(value) = serde_json::from_str::<serde_json::Value>(text) else {
             return;
         };
-        if value.get("type").and_then(|t| t.as_str()) != Some("img") {
+        match value.get("type").and_then(|t| t.as_str()) {
+            Some("img") => self.on_capture(client, &value),
+            Some("monitor") => match MonitorCommand::parse(&value) {
+                Ok(cmd) => self.push_command(client, cmd),
+                Err(why) => tracing::info!(client, "viewer: ignored a monitor command: {why}"),
+            },
+            _ => {}
+        }
+    }
+
+    fn push_command(&self, client: u64, cmd: MonitorCommand) {
+        let mut queue = self.commands.lock().unwrap_or_else(|e| e.into_inner());
+        if queue.len() >= MAX_PENDING_COMMANDS {
+            tracing::info!(
+                client,
+                "viewer: dropped a monitor command ({MAX_PENDING_COMMANDS} are pending)"
+            );
             return;
         }
+        queue.push_back(cmd);
+        self.command_ready.notify_all();
+    }
+
+    /// The oldest pending monitor command, waiting up to `wait` for one.
+    pub fn next_command(&self, wait: Duration) -> Option<MonitorCommand> {
+        let queue = self.commands.lock().unwrap_or_else(|e| e.into_inner());
+        let (mut queue, _) = self
+            .command_ready
+            .wait_timeout_while(queue, wait, |q| q.is_empty())
+            .unwrap_or_else(|e| e.into_inner());
+        queue.pop_front()
+    }
+
+    fn on_capture(&self, client: u64, value: &serde_json::Value) {
         let mut st = self.lock();
         if st.capture.as_ref().is_none_or(|(cid, _)| *cid != client) {
             return;
