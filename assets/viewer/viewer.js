@@ -7,6 +7,9 @@
 (function () {
   "use strict";
   var mt = (window.macrotree = {});
+  // Work counters (tests check that an update rewrites only the rows that changed), and the
+  // wall time of the last panel update in milliseconds.
+  mt.stats = { rowWrites: 0, lastUpdateMs: 0 };
   var viewer = null;
   var socket = null;
   var MAX_EVENTS = 100;
@@ -239,6 +242,7 @@
     var shown = [s, displayName(i), counter, b ? b.outcome + "|" + b.of : "", hiddenText, bp, paused, forced].join("\u0001");
     if (lastShown[i] === shown) return;
     lastShown[i] = shown;
+    mt.stats.rowWrites += 1;
     e.row.className = "node " + s + (n.leaf ? " leaf" : "") + (paused ? " paused-here" : "") +
       (e.row.classList.contains("match") ? " match" : "") + (e.row.classList.contains("flash") ? " flash" : "");
     e.row.dataset.status = s;
@@ -434,6 +438,12 @@
     if (ev.kind === "forced") {
       return { t: t, text: who + ": " + ev.result + " forced from the monitor", cls: "forced" };
     }
+    if (ev.kind === "fault") {
+      return { t: t, text: "fault " + ev.fault + ": " + ev.detail, cls: "fault" };
+    }
+    if (ev.kind === "collision") {
+      return { t: t, text: "collision: " + ev.what + (ev.path ? "  (" + who + ")" : ""), cls: "fault" };
+    }
     if (ev.kind === "note") {
       return { t: t, text: String(ev.text), cls: "forced" };
     }
@@ -507,6 +517,7 @@
     if (msg.type === "tree") {
       renderTree(msg.nodes);
     } else if (msg.type === "status") {
+      var began = performance.now();
       var events = (msg.events || []).map(function (e) { return e.event; });
       noteEvents(events);
       applyStatuses(msg.statuses, msg.attempts);
@@ -527,6 +538,7 @@
       }
       refreshAll();
       addEvents(events);
+      mt.stats.lastUpdateMs = performance.now() - began;
     } else if (msg.type === "time") {
       setClock(msg.t);
     }
@@ -580,7 +592,8 @@
     return out;
   }
 
-  // What the markers above the scrubber show: failures, halts, retries and forced results.
+  // What the markers above the scrubber show: failures, halts, retries, forced results, faults
+  // and collisions.
   function markersOf(timeline) {
     var out = [];
     var prevAttempts = [];
@@ -590,6 +603,8 @@
         var i = byPath[ev.path];
         var who = i !== undefined ? nodes[i].name : ev.path;
         if (ev.kind === "forced") out.push({ t: ev.t, cls: "forced", text: who + ": " + ev.result + " forced" });
+        else if (ev.kind === "fault") out.push({ t: ev.t, cls: "fault", text: "fault " + ev.fault + ": " + ev.detail });
+        else if (ev.kind === "collision") out.push({ t: ev.t, cls: "collision", text: "collision: " + ev.what });
         else if (ev.to === "failure") out.push({ t: ev.t, cls: "failure", text: who + " failed" + (ev.reason ? ": " + ev.reason : "") });
         else if (ev.to === "halted") out.push({ t: ev.t, cls: "halted", text: who + " halted" });
       });

@@ -76,6 +76,10 @@ impl EpisodeObserver for Both<'_> {
         self.0.on_period_start(cell, command, runner);
         self.1.on_period_start(cell, command, runner);
     }
+    fn on_event(&mut self, event: crate::episode::EpisodeEvent<'_>) {
+        self.0.on_event(event);
+        self.1.on_event(event);
+    }
     fn on_tick(&mut self, cell: &crate::actions::Cell, runner: &mut crate::runtime::TreeRunner) {
         self.0.on_tick(cell, runner);
         self.1.on_tick(cell, runner);

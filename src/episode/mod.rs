@@ -144,6 +144,16 @@ impl Default for EpisodeConfig {
     }
 }
 
+/// Something that happened to the cell during a control period, as observers see it (the
+/// viewer marks it on its timeline).
+#[derive(Clone, Copy, Debug)]
+pub enum EpisodeEvent<'a> {
+    /// The episode's fault fired.
+    Fault(&'a crate::faults::FaultEvent),
+    /// A contact that should not happen was first seen.
+    Collision(&'a Collision),
+}
+
 /// Called after every control period (viewer, recorder, progress).
 pub trait EpisodeObserver {
     /// A control period starts: the tree was ticked, the physics has not advanced yet, and
@@ -151,6 +161,9 @@ pub trait EpisodeObserver {
     fn on_period_start(&mut self, _cell: &Cell, _command: &CellCommand, _runner: &mut TreeRunner) {}
     /// The tree was ticked and the physics advanced by one control period.
     fn on_tick(&mut self, _cell: &Cell, _runner: &mut TreeRunner) {}
+    /// A fault fired or a collision was first seen during the period just advanced (called
+    /// after [`on_tick`](Self::on_tick)).
+    fn on_event(&mut self, _event: EpisodeEvent<'_>) {}
 }
 
 /// An observer that does nothing.
@@ -187,8 +200,11 @@ pub fn run_in_cell(
     cell.reset_placement(&placement);
     let initial = cell.world().clone();
     let observers_before = cell.observers.len();
+    let mut fault_log = None;
     if let Some(kind) = config.fault {
-        cell.observers.push(crate::faults::injector(kind, config.seed));
+        let (injector, log) = crate::faults::injector_with_log(kind, config.seed);
+        cell.observers.push(injector);
+        fault_log = Some(log);
     }
     if let Some(noise) = config.noise {
         cell.observers.push(noise.injector(config.seed));
@@ -217,6 +233,7 @@ pub fn run_in_cell(
     let mut timed_out = false;
     let mut unstable = None;
     let mut collided = None;
+    let mut collisions_seen = 0;
     while status == TreeStatus::Running {
         let now = driver.cell().world().time;
         if now >= config.max_sim_time {
@@ -228,6 +245,18 @@ pub fn run_in_cell(
         observer.on_period_start(driver.cell(), &command, &mut runner);
         driver.advance();
         observer.on_tick(driver.cell(), &mut runner);
+        if let Some(log) = &fault_log {
+            let fired = log.lock().unwrap_or_else(|e| e.into_inner());
+            if let Some(event) = fired.as_ref() {
+                observer.on_event(EpisodeEvent::Fault(event));
+                drop(fired);
+                fault_log = None;
+            }
+        }
+        while collisions_seen < driver.collisions.len() {
+            observer.on_event(EpisodeEvent::Collision(&driver.collisions[collisions_seen]));
+            collisions_seen += 1;
+        }
         // MuJoCo resets an unstable simulation and carries on: the episode is no longer physics.
         if let Some(why) = driver.cell().sim().instability() {
             tracing::error!(target: "macrotree::episode", "{why}");

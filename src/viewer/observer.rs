@@ -24,7 +24,7 @@ use serde_json::{Value, json};
 use super::monitor::{BreakSpec, ForcedRecord, Monitor, MonitorCommand};
 use super::{LiveViewer, Recorder, TreeNodeView};
 use crate::actions::Cell;
-use crate::episode::EpisodeObserver;
+use crate::episode::{EpisodeEvent, EpisodeObserver};
 use crate::motion::CellCommand;
 use crate::plan::{Internal, Plan};
 use crate::runtime::{BlackboardWrite, Transition, TreeRunner};
@@ -269,6 +269,18 @@ impl EpisodeObserver for ViewObserver {
         if self.live.is_some() && self.monitor.check(runner.plan(), &transitions, time) {
             self.hold(cell, runner, time);
         }
+    }
+
+    fn on_event(&mut self, event: EpisodeEvent<'_>) {
+        // Sent with the next statuses; the replay marks them on its timeline.
+        self.pending.push(match event {
+            EpisodeEvent::Fault(f) => {
+                json!({"t": f.time, "kind": "fault", "fault": f.kind.name(), "detail": f.detail})
+            }
+            EpisodeEvent::Collision(c) => {
+                json!({"t": c.time, "kind": "collision", "what": c.what, "path": c.node})
+            }
+        });
     }
 
     fn on_tick(&mut self, cell: &Cell, _runner: &mut TreeRunner) {

@@ -172,6 +172,84 @@ fn every_shipped_tree_reads_whole_at_1280x800_and_its_subtrees_collapse_and_sear
     screenshot(&mut dt, "monitor_search.png");
 }
 
+#[test]
+fn a_200_node_tree_reads_whole_and_an_update_rewrites_only_the_rows_that_changed() {
+    if !browser_available() {
+        return;
+    }
+    // 1 root, 40 sequences, each with 4 leaves with long names, plus 39 more leaves: 200 nodes.
+    let mut nodes = vec![TreeNodeView {
+        path: "main".into(),
+        kind: "sequence".into(),
+        name: "sequence \"two hundred nodes\"".into(),
+        ..TreeNodeView::default()
+    }];
+    for s in 0..40 {
+        let parent = nodes.len();
+        nodes.push(TreeNodeView {
+            path: format!("main/sequence#{s}"),
+            kind: "sequence".into(),
+            name: format!("sequence \"stage {s} of the long task\""),
+            parent: Some(0),
+            ..TreeNodeView::default()
+        });
+        for l in 0..4 {
+            nodes.push(TreeNodeView {
+                path: format!("main/sequence#{s}/reach#{l}"),
+                kind: "reach".into(),
+                name: format!("reach {{block}} +[0, 0, 0.12] \"above the block of stage {s}, step {l}\""),
+                parent: Some(parent),
+                leaf: true,
+                ..TreeNodeView::default()
+            });
+        }
+    }
+    while nodes.len() < 200 {
+        let k = nodes.len();
+        nodes.push(TreeNodeView {
+            path: format!("main/wait#{k}"),
+            kind: "wait".into(),
+            name: format!("wait 0.5 s \"settle {k}\""),
+            parent: Some(0),
+            leaf: true,
+            ..TreeNodeView::default()
+        });
+    }
+    let viewer = live();
+    let browser = Chromium::open(&viewer.url(), WIDTH, HEIGHT);
+    assert!(viewer.wait_for_clients(1, Duration::from_secs(60)));
+    let mut dt = browser.devtools();
+    show_tree(&viewer, &mut dt, &nodes);
+    assert_eq!(eval_json(&mut dt, CUT_ROWS), serde_json::json!([]));
+    let mut statuses = vec!["idle"; nodes.len()];
+    statuses[0] = "running";
+    statuses[1] = "running";
+    statuses[2] = "running";
+    viewer.publish_tree_status(statuses.clone(), vec![]);
+    dt.wait_until(
+        "document.querySelectorAll('#tree .node.running').length",
+        Duration::from_secs(20),
+        |v| v.as_u64() == Some(3),
+    );
+    let before = eval_json(&mut dt, "JSON.stringify(macrotree.stats)");
+    // One leaf finishes and the next starts: two rows change.
+    statuses[2] = "success";
+    statuses[3] = "running";
+    viewer.publish_tree_status(statuses, vec![]);
+    dt.wait_until(
+        "document.querySelectorAll('#tree .node.success').length",
+        Duration::from_secs(20),
+        |v| v.as_u64() == Some(1),
+    );
+    let after = eval_json(&mut dt, "JSON.stringify(macrotree.stats)");
+    let writes = after["rowWrites"].as_u64().unwrap() - before["rowWrites"].as_u64().unwrap();
+    eprintln!(
+        "200 nodes: {writes} row(s) rewritten; the update took {} ms",
+        after["lastUpdateMs"]
+    );
+    assert_eq!(writes, 2, "{before} → {after}");
+}
+
 /// Records `clear_table` (default layout) into `path`; returns the report.
 fn record_clear_table(path: &Path) -> EpisodeReport {
     let plan = load("trees/clear_table.yaml");
@@ -321,7 +399,7 @@ fn replay_markers_and_transition_steps_seek_to_failures_retries_and_trace_lines(
     );
     let markers: Vec<(String, f64, String)> = serde_json::from_str(markers.as_str().unwrap()).unwrap();
     eprintln!("{markers:?}");
-    for cls in ["failure", "halted", "retry"] {
+    for cls in ["failure", "halted", "retry", "fault"] {
         assert!(
             markers.iter().any(|m| m.0.contains(cls)),
             "no {cls} marker: {markers:?}"
