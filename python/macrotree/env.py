@@ -95,6 +95,11 @@ class MacroEnv(gym.Env[Observation, Any]):
         observation_keys: ``"gym"`` (``agent_pos``, ``environment_state``, ``pinch``,
             ``pixels``) or ``"lerobot"`` (``observation.state``, ``observation.environment_state``,
             ``observation.images.<camera>``: a LeRobot dataset's keys).
+
+    Attributes:
+        dt: simulated seconds of one ``ctrl``, ``setpoint`` or ``residual`` step, as in
+            Gymnasium's MuJoCo environments (``control_period``); a macro step lasts a whole
+            number of them (``info["sim_time"]`` says how long).
     """
 
     metadata: dict[str, Any] = {  # noqa: RUF012  (Gymnasium declares it so)
@@ -156,6 +161,9 @@ class MacroEnv(gym.Env[Observation, Any]):
         # LeRobot's environment contract.
         self.task = str(self._native.task)
         self.task_description = str(self._native.task_description)
+        # Gymnasium's MuJoCo environments' `dt`: simulated seconds of one control period (one
+        # `ctrl`, `setpoint` or `residual` step; a macro step runs a whole number of them).
+        self.dt: float = float(control_period)
         self._last_info: dict[str, Any] = {}
 
     # --- Gymnasium API -------------------------------------------------------------------------

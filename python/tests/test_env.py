@@ -68,6 +68,16 @@ def test_ctrl_step_is_one_control_period(cube_env: macrotree.MacroEnv) -> None:
     assert info["physics_steps"] == 5
     assert info["sim_time"] == pytest.approx(0.01)
     assert info["ctrl_clamped"] == 0
+    assert ctrl_env.dt == info["sim_time"] == 0.01
+
+
+def test_dt_is_the_control_period_asked_for(cube_env: macrotree.MacroEnv) -> None:
+    env = macrotree.MacroEnv(cube_env_scene(cube_env), action_mode="ctrl", control_period=0.02)
+    env.reset(seed=0)
+    _, _, _, _, info = env.step(np.concatenate([env.home, np.zeros(12), [0.0]]))
+    assert env.dt == 0.02
+    assert info["sim_time"] == pytest.approx(env.dt)
+    env.close()
 
 
 def test_a_ctrl_jump_is_clamped_to_the_largest_joint_speed(cube_env: macrotree.MacroEnv) -> None:
