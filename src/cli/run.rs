@@ -483,9 +483,13 @@ fn print_summary(r: &crate::episode::EpisodeReport, goal: Goal, json: bool) {
         );
     }
     for g in &r.goal {
+        let matched = g
+            .matched_yaw_deg
+            .map(|y| format!(" (the block's yaw, at the quarter turn nearest the goal's: {y:.1}°)"))
+            .unwrap_or_default();
         say!(
             json,
-            "  goal: {} {}",
+            "  goal: {} {}{matched}",
             g.predicate,
             if g.holds { "holds" } else { "does NOT hold" }
         );

@@ -72,12 +72,22 @@ pub fn goal_holds(w: &World) -> bool {
 }
 
 /// One predicate's value, as reports carry it.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct GoalValue {
     /// The predicate, e.g. `red in red_bin`.
     pub predicate: String,
     /// Whether it holds.
     pub holds: bool,
+    /// An `at` goal with a yaw: the block's yaw taken at the quarter turn nearest the goal's
+    /// (a block's side faces repeat every 90°, so a block at 0.3° matches a goal of 90° as
+    /// 90.3°), degrees. Absent for other goals.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub matched_yaw_deg: Option<f64>,
+}
+
+/// The yaw of block `i` at the quarter turn nearest `target` (radians), radians.
+pub fn matched_yaw(w: &World, i: usize, target: f64) -> f64 {
+    target + super::snapshot::fold_quarter_turn(w.yaw(i) - target)
 }
 
 /// Every predicate's value, in the scene's order.
@@ -89,6 +99,13 @@ pub fn evaluate(w: &World) -> Vec<GoalValue> {
         .map(|a| GoalValue {
             predicate: a.to_string(),
             holds: atom_holds(w, a),
+            matched_yaw_deg: match a {
+                GoalAtom::At { place, .. } => place.yaw.zip(w.index_of(a.object())).map(|(target, i)| {
+                    // Rounded to 0.1° like every yaw a report prints, so lines stay short.
+                    (matched_yaw(w, i, target).to_degrees() * 10.0).round() / 10.0
+                }),
+                _ => None,
+            },
         })
         .collect()
 }

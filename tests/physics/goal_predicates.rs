@@ -170,6 +170,37 @@ fn an_at_goal_holds_after_a_real_place() {
     );
 }
 
+#[test]
+fn a_block_square_to_a_quarter_turned_goal_holds_and_the_report_names_the_yaw_it_matched() {
+    let dir = scratch("at-quarter-turn");
+    let scene = spot_scene(&dir);
+    let text = std::fs::read_to_string(&scene).unwrap().replace(
+        "yaw: 0, yaw_tolerance: deg(3)",
+        "yaw: deg(90), yaw_tolerance: deg(3)",
+    );
+    std::fs::write(&scene, text).unwrap();
+    let out = macrotree(&["run", "trees/place_on_table.yaml", "--scene", s(&scene), "--json"]);
+    let r = json(&out);
+    assert_eq!(r["goal"][0]["predicate"], "cube at (0.320, -0.300) yaw 90.0°");
+    assert_eq!(
+        r["goal"][0]["holds"], true,
+        "a cube's faces repeat every quarter turn: {r}"
+    );
+    // The block was set down square (about 0°); the report says which yaw matched 90°.
+    let matched = r["goal"][0]["matched_yaw_deg"].as_f64().unwrap();
+    assert!((matched - 90.0).abs() <= 3.0, "{r}");
+    let final_yaw = r["objects"][0]["final"][3].as_f64().unwrap();
+    assert!(final_yaw.abs() <= 3.0, "set down square: {final_yaw}");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(&format!("at the quarter turn nearest the goal's: {matched:.1}°")),
+        "{stderr}"
+    );
+    // Goals without a yaw carry no matched yaw.
+    let plain = macrotree(&["run", "trees/cube_to_bowl.yaml", "--json"]);
+    assert!(json(&plain)["goal"][0].get("matched_yaw_deg").is_none());
+}
+
 /// Regression: `at`, `cube_at` and `on_table` held while the block was still between the pads
 /// (pressed onto the table at the spot), so a retry's "already there?" passed and the `home`
 /// after it carried the block off the table. A block in the gripper is not placed.
