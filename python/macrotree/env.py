@@ -26,6 +26,7 @@ from macrotree.spaces import (
     macro_action_space,
     macro_to_native,
     observation_space,
+    real_array,
     residual_action_space,
     setpoint_action_space,
     with_keys,
@@ -205,7 +206,7 @@ class MacroEnv(gym.Env[Observation, Any]):
         if self.action_mode == "macro":
             result = self._native.step_macro(macro_to_native(action))
         else:
-            values = np.asarray(action, dtype=np.float64).reshape(-1)
+            values = real_array(action, f"a {self.action_mode} action").reshape(-1)
             shape = ACTION_MODES[self.action_mode]
             if values.shape != shape:
                 raise ValueError(

@@ -181,15 +181,25 @@ def with_keys(obs: dict[str, Any], keys: str) -> dict[str, Any]:
     return out
 
 
+def real_array(value: Any, what: str) -> np.ndarray:
+    """``value`` as a C-contiguous float64 array (any strides and real dtypes accepted); complex,
+    text or object values raise ``TypeError`` naming ``what`` rather than losing a part."""
+    array = np.asarray(value)
+    if array.dtype.kind not in "biuf":
+        kind = "complex" if array.dtype.kind == "c" else f"{array.dtype}"
+        raise TypeError(f"{what} must be real numbers, got {kind} values")
+    return np.ascontiguousarray(array, dtype=np.float64)
+
+
 def _vector(value: Any, n: int, name: str) -> list[float]:
-    array = np.asarray(value, dtype=np.float64).reshape(-1)
+    array = real_array(value, f"macro action `{name}`").reshape(-1)
     if array.shape != (n,):
         raise ValueError(f"macro action `{name}` must have {n} values, got shape {array.shape}")
     return [float(v) for v in array]
 
 
 def _scalar(value: Any, name: str) -> float:
-    array = np.asarray(value, dtype=np.float64).reshape(-1)
+    array = real_array(value, f"macro action `{name}`").reshape(-1)
     if array.shape != (1,):
         raise ValueError(f"macro action `{name}` must be one value, got shape {array.shape}")
     return float(array[0])

@@ -36,6 +36,7 @@ from macrotree.env import (
 from macrotree.spaces import (
     macro_to_native,
     observation_space,
+    real_array,
     with_keys,
 )
 
@@ -310,7 +311,7 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
     def _native_actions(self, actions: Any, n: int) -> list[Any]:
         shape = ACTION_MODES[self.action_mode]
         if shape is not None:
-            array = np.asarray(actions, dtype=np.float64)
+            array = real_array(actions, f"{self.action_mode} actions")
             if array.shape != (n, *shape):
                 raise ValueError(
                     f"{self.action_mode} actions must have shape ({n}, {shape[0]}), "

@@ -77,6 +77,38 @@ def test_an_invalid_action_refuses_the_whole_batch_before_anything_moves(data: P
     vec.close()
 
 
+def test_strided_actions_are_taken_and_complex_ones_refused(data: Path) -> None:
+    env = macrotree.MacroEnv(scene(data), action_mode="ctrl")
+    env.reset(seed=0)
+    action = np.concatenate([env.home, np.zeros(12), [0.0]])
+    # A column of a batch: the same values with a stride of 4 elements.
+    batch = np.zeros((19, 4))
+    batch[:, 2] = action
+    column = batch[:, 2]
+    assert not column.flags["C_CONTIGUOUS"]
+    strided, *_ = env.step(column)
+    env.reset(seed=0)
+    plain, *_ = env.step(action)
+    assert np.array_equal(strided["agent_pos"], plain["agent_pos"])
+    before = env.observation()["time"]
+    with pytest.raises(TypeError, match="real numbers, got complex"):
+        env.step(action + 1e-3j)
+    with pytest.raises(TypeError, match="real numbers"):
+        env.step(np.array(["0"] * 19))
+    assert env.observation()["time"] == before, "nothing moved"
+    # A Fortran-ordered batch (its rows strided) for a vector environment.
+    vec = macrotree.VectorEnv(scene(data), num_envs=2, action_mode="ctrl")
+    vec.reset(seed=0)
+    rows = np.asfortranarray(np.stack([action, action]))
+    assert not rows[0].flags["C_CONTIGUOUS"]
+    out, *_ = vec.step(rows)
+    assert np.array_equal(out["agent_pos"][0], plain["agent_pos"])
+    with pytest.raises(TypeError, match="complex"):
+        vec.step(rows.astype(np.complex128))
+    vec.close()
+    env.close()
+
+
 def macro_env(data: Path) -> macrotree.MacroEnv:
     env = macrotree.MacroEnv(scene(data))
     env.reset(seed=0)
