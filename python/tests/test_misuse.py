@@ -109,6 +109,18 @@ def test_strided_actions_are_taken_and_complex_ones_refused(data: Path) -> None:
     env.close()
 
 
+@pytest.mark.parametrize(("period", "shown"), [(1e-300, "1.000e-300"), (0.003, "0.003")])
+def test_a_control_period_off_the_physics_steps_is_refused_with_the_rule(
+    data: Path, period: float, shown: str
+) -> None:
+    with pytest.raises(macrotree.MacrotreeError) as e:
+        macrotree.MacroEnv(scene(data), action_mode="ctrl", control_period=period)
+    message = str(e.value)
+    assert "whole number (at least 1) of 2 ms physics steps" in message
+    assert message.endswith(f"got {shown}"), message
+    assert len(message) < 200, "a hostile number is printed shortly"
+
+
 def macro_env(data: Path) -> macrotree.MacroEnv:
     env = macrotree.MacroEnv(scene(data))
     env.reset(seed=0)

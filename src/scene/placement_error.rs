@@ -180,13 +180,13 @@ impl std::fmt::Display for PlacementError {
             PlacementError::OffTable { object, pose } => write!(
                 f,
                 "`{object}` at ({}, {}) is off the table: x and y must be finite and within ±{TABLE_HALF} m",
-                short(pose.x),
-                short(pose.y)
+                crate::error::short_number(pose.x),
+                crate::error::short_number(pose.y)
             ),
             PlacementError::BadYaw { object, yaw } => write!(
                 f,
                 "`{object}`'s yaw is {}: a yaw must be a finite angle within ±{:.4} rad (one turn)",
-                short(*yaw),
+                crate::error::short_number(*yaw),
                 crate::yaml::units::MAX_BARE_ANGLE
             ),
             PlacementError::OnRobotBase { object, distance } => write!(
@@ -273,14 +273,3 @@ impl std::fmt::Display for PlacementError {
 }
 
 impl std::error::Error for PlacementError {}
-
-/// A number as a message shows it: as given up to 12 characters, else in scientific notation
-/// with 4 significant digits (a hostile 1e300 is not printed as 301 digits).
-fn short(x: f64) -> String {
-    let plain = format!("{x}");
-    if plain.chars().count() <= 12 {
-        plain
-    } else {
-        format!("{x:.3e}")
-    }
-}
