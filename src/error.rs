@@ -118,14 +118,3 @@ impl fmt::Display for Error {
 }
 
 impl std::error::Error for Error {}
-
-/// A number as a message shows it: as given up to 12 characters, else in scientific notation
-/// with 4 significant digits (a hostile 1e300 or 1e-300 is not printed as 301 digits).
-pub fn short_number(x: f64) -> String {
-    let plain = format!("{x}");
-    if plain.chars().count() <= 12 {
-        plain
-    } else {
-        format!("{x:.3e}")
-    }
-}

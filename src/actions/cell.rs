@@ -33,7 +33,7 @@ pub fn check_control_period(period: f64) -> Result<(), crate::Error> {
     Err(crate::Error::Config {
         message: format!(
             "control_period must be a whole number (at least 1) of 2 ms physics steps, at most {MAX_CONTROL_PERIOD} s, got {}",
-            crate::error::short_number(period)
+            crate::yaml::short_number(period)
         ),
     })
 }

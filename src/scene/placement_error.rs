@@ -180,13 +180,13 @@ impl std::fmt::Display for PlacementError {
             PlacementError::OffTable { object, pose } => write!(
                 f,
                 "`{object}` at ({}, {}) is off the table: x and y must be finite and within ±{TABLE_HALF} m",
-                crate::error::short_number(pose.x),
-                crate::error::short_number(pose.y)
+                crate::yaml::short_number(pose.x),
+                crate::yaml::short_number(pose.y)
             ),
             PlacementError::BadYaw { object, yaw } => write!(
                 f,
                 "`{object}`'s yaw is {}: a yaw must be a finite angle within ±{:.4} rad (one turn)",
-                crate::error::short_number(*yaw),
+                crate::yaml::short_number(*yaw),
                 crate::yaml::units::MAX_BARE_ANGLE
             ),
             PlacementError::OnRobotBase { object, distance } => write!(

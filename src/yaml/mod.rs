@@ -16,6 +16,6 @@ pub mod suggest;
 pub mod units;
 pub mod value;
 
-pub use diag::{Diagnostic, Issue, Loc, Sources};
+pub use diag::{Diagnostic, Issue, Loc, Sources, short_number};
 pub use ident::is_identifier;
 pub use read::read_limited;
