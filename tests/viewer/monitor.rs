@@ -411,13 +411,8 @@ fn replay_markers_and_transition_steps_seek_to_failures_retries_and_trace_lines(
     // Clicking the retry marker seeks to it.
     let retry = markers.iter().find(|m| m.0.contains("retry")).unwrap();
     dt.eval("document.querySelector('#markers .marker.retry').click()");
-    let want = format!("{:.2} / ", retry.1 - start);
-    dt.wait_until(
-        "document.querySelector('#replay-time').textContent",
-        Duration::from_secs(10),
-        |v| v.as_str().is_some_and(|t| t.starts_with(&want)),
-    );
-    // ⏭ goes to the next transition: the next timeline entry after the marker.
+    wait_replay_time(&mut dt, retry.1 - start);
+    // ▶| goes to the next transition: the next timeline entry after the marker.
     let next = eval_json(
         &mut dt,
         &format!(
@@ -428,20 +423,10 @@ fn replay_markers_and_transition_steps_seek_to_failures_retries_and_trace_lines(
     .as_f64()
     .unwrap();
     dt.eval("document.querySelector('#next').click()");
-    let want = format!("{:.2} / ", next - start);
-    dt.wait_until(
-        "document.querySelector('#replay-time').textContent",
-        Duration::from_secs(10),
-        |v| v.as_str().is_some_and(|t| t.starts_with(&want)),
-    );
-    // ⏮ comes back.
+    wait_replay_time(&mut dt, next - start);
+    // |◀ comes back.
     dt.eval("document.querySelector('#prev').click()");
-    let want = format!("{:.2} / ", retry.1 - start);
-    dt.wait_until(
-        "document.querySelector('#replay-time').textContent",
-        Duration::from_secs(10),
-        |v| v.as_str().is_some_and(|t| t.starts_with(&want)),
-    );
+    wait_replay_time(&mut dt, retry.1 - start);
     // Clicking a trace line seeks to its time.
     let line_t = eval_json(
         &mut dt,
@@ -450,14 +435,19 @@ fn replay_markers_and_transition_steps_seek_to_failures_retries_and_trace_lines(
     .as_f64()
     .unwrap();
     dt.eval("document.querySelectorAll('#events li[data-t]')[3].click()");
-    let want = format!("{:.2} / ", line_t - start);
+    wait_replay_time(&mut dt, line_t - start);
+    screenshot(&mut dt, "monitor_markers.png");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Waits until the replay shows `seconds` since its start (to the hundredth).
+fn wait_replay_time(dt: &mut Devtools, seconds: f64) {
+    let want = format!("{seconds:.2} / ");
     dt.wait_until(
         "document.querySelector('#replay-time').textContent",
         Duration::from_secs(10),
         |v| v.as_str().is_some_and(|t| t.starts_with(&want)),
     );
-    screenshot(&mut dt, "monitor_markers.png");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// Runs `plan` on the flagship scene with a live viewer on its own thread.
