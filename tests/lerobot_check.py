@@ -59,8 +59,8 @@ def main():
                 want = np.array(ours[i][key], dtype=np.float32)
                 if got.shape != want.shape or not np.array_equal(got, want):
                     fail(f"episode {ep} frame {i} {key}: {got} != {want}")
-            if item["tree.active_leaf"] != ours[i]["active_leaf"]:
-                fail(f"episode {ep} frame {i} active leaf {item['tree.active_leaf']!r} != {ours[i]['active_leaf']!r}")
+            if item["tree.active_leaf"] != ours[i]["tree.active_leaf"]:
+                fail(f"episode {ep} frame {i} active leaf {item['tree.active_leaf']!r} != {ours[i]['tree.active_leaf']!r}")
             if abs(float(item["timestamp"]) - ours[i]["timestamp"]) > 1e-6:
                 fail(f"episode {ep} frame {i} timestamp {item['timestamp']} != {ours[i]['timestamp']}")
             if item["task"] != ds.meta.episodes[ep]["tasks"][0]:

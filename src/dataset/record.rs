@@ -81,9 +81,13 @@ pub struct FrameRecord {
     /// Every scene object's pose, scene order: x, y, z (metres), qw, qx, qy, qz.
     #[serde(rename = "observation.environment_state")]
     pub environment: Vec<f32>,
-    /// Path of the running leaf (several joined by ` | `; empty when none runs).
+    /// Path of the running leaf (several joined by ` | `; empty when none runs); the
+    /// dataset's `tree.active_leaf` column.
+    #[serde(rename = "tree.active_leaf")]
     pub active_leaf: String,
-    /// Node kind of the running leaf (`reach`, `grasp`, …; same joining).
+    /// Node kind of the running leaf (`reach`, `grasp`, …; same joining); the dataset's
+    /// `tree.active_kind` column.
+    #[serde(rename = "tree.active_kind")]
     pub active_kind: String,
 }
 

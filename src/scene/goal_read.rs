@@ -436,7 +436,7 @@ fn read_place(
                             "`{name}` is an object, not a spot: for a block on a block use `on:`, in a container `in:`"
                         )),
                         None if scene.spots.is_empty() => issue.help(
-                            "the scene declares no spots: add `spots: {NAME: {point: [x, y]}}` (see docs/scenes.md) or give `point: [x, y]`",
+                            "the scene declares no spots: add `spots: {NAME: [x, y]}` (metres; `[x, y, yaw]` with a yaw, see docs/scenes.md) or give `point: [x, y]`",
                         ),
                         None => issue,
                     };

@@ -153,6 +153,51 @@ fn only_success_keeps_the_episodes_that_met_the_goal_in_scenario_order() {
     check_layout(&ds, &ffmpeg);
 }
 
+/// `run --frames` names each field as the dataset names its column (`tree.active_leaf`, not
+/// `active_leaf`), so one reader serves both; only `sim_time` is its own.
+#[test]
+fn run_frames_fields_are_the_dataset_column_names() {
+    let dir = scratch("frames-names");
+    let (ds, frames) = (dir.join("ds"), dir.join("f.jsonl"));
+    let o = macrotree(&["run", TREE, "--fps", "25", "--frames", s(&frames)]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = sweep(&[
+        "--scenarios",
+        "1",
+        "--fps",
+        "25",
+        "--dataset",
+        s(&ds),
+        "--cameras",
+        "none",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let info: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(ds.join("meta/info.json")).unwrap()).unwrap();
+    let columns = info["features"].as_object().unwrap();
+    let text = std::fs::read_to_string(&frames).unwrap();
+    let first: serde_json::Value = serde_json::from_str(text.lines().next().unwrap()).unwrap();
+    let fields: Vec<&String> = first.as_object().unwrap().keys().collect();
+    for f in &fields {
+        assert!(
+            *f == "sim_time" || columns.contains_key(f.as_str()),
+            "--frames field `{f}` is not a dataset column ({:?})",
+            columns.keys().collect::<Vec<_>>()
+        );
+    }
+    for wanted in [
+        "tree.active_leaf",
+        "tree.active_kind",
+        "observation.state",
+        "action",
+    ] {
+        assert!(
+            fields.iter().any(|f| *f == wanted),
+            "{wanted} missing from {fields:?}"
+        );
+    }
+}
+
 #[test]
 fn the_dataset_folder_is_new_empty_or_ours_with_overwrite() {
     let dir = scratch("dataset-dir");

@@ -93,7 +93,16 @@ fn placement_goal_mistakes_are_located_and_explained() {
     let d = errors("  - at: {object: red, spot: slot_a}\n");
     let e = find(&d, "unknown spot `slot_a`");
     assert_eq!((e.line, e.column), (7, 29));
-    assert!(e.help.as_deref().unwrap().contains("declares no spots"), "{e}");
+    let help = e.help.as_deref().unwrap();
+    assert!(help.contains("declares no spots"), "{e}");
+    // The form the help suggests is one the loader takes.
+    let form = help.split('`').nth(1).unwrap();
+    assert_eq!(form, "spots: {NAME: [x, y]}", "{help}");
+    let fixed = format!(
+        "{OBJECTS}{}\ngoal:\n  - at: {{object: red, spot: slot_a}}\n",
+        form.replace("NAME", "slot_a").replace("[x, y]", "[0.4, 0.1]")
+    );
+    SceneSpec::from_str(&fixed, "cell.yaml").expect("the suggested spots form loads");
 
     let d = errors("  - at: {object: red, point: [0.9, 0.1]}\n");
     let e = find(&d, "outside the reach");
