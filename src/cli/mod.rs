@@ -18,6 +18,7 @@ mod outputs;
 mod plan;
 mod report;
 mod run;
+mod scenario_check;
 mod schema;
 mod signals;
 mod sweep;

@@ -13,10 +13,11 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
+use super::CliError;
 use super::outputs::{check_output, output_error};
-use super::{CliError, load_task};
+use super::scenario_check::{CheckedScenario, check_scenario};
 use crate::suite::junit::{Case, to_xml};
-use crate::suite::{ScenarioFile, SuiteOutcome, find_files, load_scenario_file, offending_commands};
+use crate::suite::{ScenarioFile, SuiteOutcome, find_files, offending_commands};
 use crate::sweep::run_sweep_from;
 
 /// Most reproduce commands listed per failing scenario file (JUnit and text).
@@ -51,6 +52,10 @@ pub struct TestArgs {
     /// Print the outcome as one JSON object on stdout (the only thing on stdout; the text for people goes to stderr).
     #[arg(long)]
     pub json: bool,
+    /// Check every scenario file, its scene, its tree, its substitutions and its node patterns,
+    /// and run nothing: exit 0 when all are valid, 2 with every error located otherwise.
+    #[arg(long, conflicts_with_all = ["junit", "out", "json", "shard"])]
+    pub check: bool,
 }
 
 /// The whole outcome, as `--json` prints it.
@@ -85,38 +90,56 @@ pub fn test(app: &crate::App, args: TestArgs) -> Result<(), CliError> {
                 .join(", ")
         )));
     }
-    // Everything is checked before anything runs.
+    // Everything is checked before anything runs, and every file's errors are reported.
     let mut diags = Vec::new();
-    let mut suites = Vec::new();
+    let mut checked = Vec::new();
     for f in &files {
-        match load_scenario_file(f, &app.registry().failure_kinds()) {
-            Ok(s) => suites.push(s),
+        match check_scenario(app, f) {
+            Ok(c) => checked.push(c),
             Err(d) => diags.extend(d),
         }
     }
     if !diags.is_empty() {
         return Err(super::invalid(diags, format!("{} scenario file(s)", files.len())));
     }
+    if args.check {
+        for c in &checked {
+            super::print_warnings(&c.plan);
+            println!(
+                "{}: ok ({} scenarios of {})",
+                c.file.path.display(),
+                c.file.sweep.scenarios,
+                c.file.tree.display()
+            );
+        }
+        println!(
+            "{} scenario file(s) checked; nothing was run (--check)",
+            checked.len()
+        );
+        return Ok(());
+    }
     let mut inputs: Vec<PathBuf> = files.clone();
+    let mut suites = Vec::new();
     let mut tasks = Vec::new();
-    for s in &mut suites {
-        let (plan, scene) = load_task(app, &s.tree, s.scene.as_deref()).map_err(|e| match e {
-            CliError::Input(m) => CliError::Input(format!("{m}\n  (named by {})", s.path.display())),
-            other => other,
-        })?;
-        let resolved = crate::runtime::substitute::resolve(&plan, &s.sweep.substitutions)
-            .map_err(|e| CliError::Input(format!("error: {}: {e}", s.path.display())))?;
+    for CheckedScenario {
+        file: mut s,
+        plan,
+        resolved,
+    } in checked
+    {
+        super::print_warnings(&plan);
+        let scene =
+            crate::sim::Scene::load_spec(&plan.scene).map_err(|e| CliError::Input(format!("error: {e}")))?;
         s.sweep.resolved = Some(Arc::new(resolved));
-        s.check_patterns(&plan)
-            .map_err(|e| CliError::Input(format!("error: {e}")))?;
         s.sweep.shard = shard;
         s.sweep.jobs = args.jobs.map_or(0, |j| j as usize);
         s.sweep.program = super::program_name();
         s.sweep.collisions = args.collisions;
-        let read = super::outputs::suite_inputs(s, &plan);
+        let read = super::outputs::suite_inputs(&s, &plan);
         s.sweep.tree_digest = Some(super::outputs::inputs_digest(&read));
         inputs.extend(read);
         tasks.push((Arc::new(plan), scene));
+        suites.push(s);
     }
     super::output_set::refuse_same_outputs(&[
         ("--junit", args.junit.as_deref()),

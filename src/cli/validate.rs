@@ -1,5 +1,7 @@
-//! `macrotree validate FILE...`: parse and check trees and scene files without simulating. A
-//! file whose top level has `objects:` and no `main:` is read as a scene.
+//! `macrotree validate FILE...`: parse and check trees, scene files and scenario files without
+//! simulating. A file whose top level has `objects:` and no `main:` is read as a scene; one
+//! with `tree:`, `count:` or `expect:` and no `main:` as a scenario file, checked as `macrotree
+//! test` checks it before running (its scene, its tree, its substitutions, its node patterns).
 
 use std::path::PathBuf;
 
@@ -11,10 +13,11 @@ use crate::spec::Diagnostic;
 /// Arguments of `validate`.
 #[derive(Debug, Args)]
 pub struct ValidateArgs {
-    /// Tree or scene files (YAML).
+    /// Tree, scene or scenario files (YAML).
     #[arg(required = true)]
     pub trees: Vec<PathBuf>,
-    /// Check the trees' object names against this scene instead of each tree's own `scene:`.
+    /// Check the trees' object names against this scene instead of each tree's own `scene:`
+    /// (a scenario file keeps the scene it names).
     #[arg(long, value_name = "FILE.yaml")]
     pub scene: Option<PathBuf>,
     /// How to print the result.
@@ -36,6 +39,103 @@ pub enum DiagnosticFormat {
     Github,
 }
 
+/// What a file given to `validate` is, judged by its top-level keys.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum FileKind {
+    /// A behavior tree (`main:`, `include:` or `subtrees:`; also anything unrecognised, which
+    /// the tree loader then explains).
+    Tree,
+    /// A scene: `objects:` and no `main:`.
+    Scene,
+    /// A scenario file of `macrotree test`: `tree:`, `count:` or `expect:` and no `main:`.
+    Scenario,
+}
+
+impl FileKind {
+    /// The kind of the file at `path` (read cheaply: a file that cannot be read or parsed is
+    /// left to the tree loader, which reports why).
+    fn of(path: &std::path::Path) -> Self {
+        let Ok(bytes) = crate::yaml::read_limited(path) else {
+            return Self::Tree;
+        };
+        let Ok(text) = std::str::from_utf8(&bytes) else {
+            return Self::Tree;
+        };
+        let Ok(v) = crate::yaml::value::parse_yaml(text, 0) else {
+            return Self::Tree;
+        };
+        if v.get("main").is_some() {
+            Self::Tree
+        } else if v.get("objects").is_some() {
+            Self::Scene
+        } else if crate::suite::is_scenario_file(&v) {
+            Self::Scenario
+        } else {
+            Self::Tree
+        }
+    }
+
+    /// `tree`, `scene` or `scenario` (the `kind` of `--format json`).
+    fn name(self) -> &'static str {
+        match self {
+            Self::Tree => "tree",
+            Self::Scene => "scene",
+            Self::Scenario => "scenario",
+        }
+    }
+}
+
+/// A valid file: what to print about it.
+struct Valid {
+    /// Nodes of the tree (a scene: its objects).
+    nodes: usize,
+    /// Leaves of the tree (a scene: its goal predicates).
+    leaves: usize,
+    /// The summary after `ok`, e.g. `12 nodes, 7 leaves`.
+    summary: String,
+    /// The tree's warnings.
+    warnings: Vec<Diagnostic>,
+}
+
+/// Checks one file of `kind`.
+fn check_file(
+    app: &crate::App,
+    path: &std::path::Path,
+    kind: FileKind,
+    scene: Option<&std::sync::Arc<crate::scene::SceneSpec>>,
+) -> Result<Valid, Vec<Diagnostic>> {
+    match kind {
+        FileKind::Scene => crate::scene::load_scene_file(path).map(|s| Valid {
+            nodes: s.objects.len(),
+            leaves: s.goal.atoms.len(),
+            summary: format!(
+                "scene: {} objects, {} goal predicates",
+                s.objects.len(),
+                s.goal.atoms.len()
+            ),
+            warnings: Vec::new(),
+        }),
+        FileKind::Scenario => super::scenario_check::check_scenario(app, path).map(|c| Valid {
+            nodes: c.plan.nodes.len(),
+            leaves: c.plan.leaves.len(),
+            summary: format!(
+                "scenario: {} scenarios of {}, {} nodes, {} leaves",
+                c.file.sweep.scenarios,
+                c.file.tree.display(),
+                c.plan.nodes.len(),
+                c.plan.leaves.len()
+            ),
+            warnings: c.plan.warnings,
+        }),
+        FileKind::Tree => app.loader().load_for(path, scene.cloned()).map(|p| Valid {
+            nodes: p.nodes.len(),
+            leaves: p.leaves.len(),
+            summary: format!("{} nodes, {} leaves", p.nodes.len(), p.leaves.len()),
+            warnings: p.warnings,
+        }),
+    }
+}
+
 /// Runs `macrotree validate`: every error of every file, exit 2 if any.
 pub fn validate(app: &crate::App, args: ValidateArgs) -> Result<(), CliError> {
     let mut failed = 0;
@@ -48,43 +148,32 @@ pub fn validate(app: &crate::App, args: ValidateArgs) -> Result<(), CliError> {
         )?)),
         None => None,
     };
-    for tree in &args.trees {
-        let mut warnings = Vec::new();
-        let result = if is_scene_file(tree) {
-            crate::scene::load_scene_file(tree).map(|s| (s.objects.len(), s.goal.atoms.len()))
-        } else {
-            app.loader().load_for(tree, override_scene.clone()).map(|p| {
-                warnings.clone_from(&p.warnings);
-                (p.nodes.len(), p.leaves.len())
-            })
-        };
+    for file in &args.trees {
+        let kind = FileKind::of(file);
+        let result = check_file(app, file, kind, override_scene.as_ref());
         if result.is_err() {
             failed += 1;
         }
         match args.format {
             DiagnosticFormat::Human => match &result {
-                _ if !warnings.is_empty() && result.is_ok() => {
-                    warnings.iter().for_each(|d| eprintln!("{d}"));
-                    let (nodes, leaves) = result.as_ref().map_or((0, 0), |r| *r);
-                    println!(
-                        "{}: ok with {} warning(s) ({nodes} nodes, {leaves} leaves)",
-                        tree.display(),
-                        warnings.len()
-                    );
+                Ok(v) => {
+                    v.warnings.iter().for_each(|d| eprintln!("{d}"));
+                    let with = match v.warnings.len() {
+                        0 => String::new(),
+                        n => format!(" with {n} warning(s)"),
+                    };
+                    println!("{}: ok{with} ({})", file.display(), v.summary);
                 }
-                Ok((a, b)) if is_scene_file(tree) => {
-                    println!("{}: ok (scene: {a} objects, {b} goal predicates)", tree.display())
-                }
-                Ok((nodes, leaves)) => println!("{}: ok ({nodes} nodes, {leaves} leaves)", tree.display()),
                 Err(diags) => diags.iter().for_each(|d| eprintln!("{d}")),
             },
             DiagnosticFormat::Json => {
                 let (nodes, leaves, diags) = match &result {
-                    Ok((a, b)) => (*a, *b, &warnings[..]),
+                    Ok(v) => (v.nodes, v.leaves, &v.warnings[..]),
                     Err(diags) => (0, 0, &diags[..]),
                 };
                 let line = serde_json::json!({
-                    "file": tree.display().to_string(),
+                    "file": file.display().to_string(),
+                    "kind": kind.name(),
                     "valid": result.is_ok(),
                     "nodes": nodes,
                     "leaves": leaves,
@@ -93,7 +182,10 @@ pub fn validate(app: &crate::App, args: ValidateArgs) -> Result<(), CliError> {
                 println!("{line}");
             }
             DiagnosticFormat::Github => {
-                let diags = result.as_ref().err().unwrap_or(&warnings);
+                let diags = match &result {
+                    Ok(v) => &v.warnings,
+                    Err(diags) => diags,
+                };
                 diags.iter().for_each(|d| println!("{}", github_annotation(d)));
             }
         }
@@ -105,21 +197,6 @@ pub fn validate(app: &crate::App, args: ValidateArgs) -> Result<(), CliError> {
         )))
     } else {
         Ok(())
-    }
-}
-
-/// True for a scene file: a YAML mapping with `objects:` and without `main:` (read cheaply: a
-/// file that cannot be read is left to the tree loader, which reports why).
-fn is_scene_file(path: &std::path::Path) -> bool {
-    let Ok(bytes) = crate::yaml::read_limited(path) else {
-        return false;
-    };
-    let Ok(text) = std::str::from_utf8(&bytes) else {
-        return false;
-    };
-    match crate::yaml::value::parse_yaml(text, 0) {
-        Ok(v) => v.get("objects").is_some() && v.get("main").is_none(),
-        Err(_) => false,
     }
 }
 

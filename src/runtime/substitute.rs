@@ -213,6 +213,8 @@ fn segment_match(pattern: &str, text: &str) -> bool {
 /// Why substitutions do not fit a tree. `Display` says which pattern and what to do.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct SubstitutionError {
+    /// The offending rule's index in the list given to [`resolve`], from 0.
+    pub index: usize,
     /// The offending rule, as written (`PATTERN=OUTCOME`).
     pub rule: String,
     /// What is wrong.
@@ -251,6 +253,7 @@ pub fn resolve(plan: &Plan, subs: &[Substitution]) -> Result<Resolved, Substitut
     let mut owner: Vec<Option<usize>> = vec![None; plan.leaves.len()];
     for (k, sub) in subs.iter().enumerate() {
         let err = |reason: String, close: Vec<String>| SubstitutionError {
+            index: k,
             rule: sub.to_string(),
             reason,
             close,

@@ -11,7 +11,7 @@ use crate::episode::Goal;
 use crate::failure::FailureKind;
 use crate::faults::FaultKind;
 use crate::plan::Plan;
-use crate::runtime::substitute::{Substitution, glob_match};
+use crate::runtime::substitute::{Resolved, Substitution, glob_match, resolve};
 use crate::sweep::SweepConfig;
 use crate::yaml::de::from_value;
 use crate::yaml::diag::{Diagnostic, Issue, Loc, Sources};
@@ -119,12 +119,14 @@ pub struct ScenarioFile {
     pub sweep: SweepConfig,
     /// What must hold.
     pub expect: Expect,
-    /// Where each node pattern of `expect:` is written (for [`Self::check_patterns`]).
+    /// Where each substitution and each node pattern of `expect:` is written (for
+    /// [`Self::check_against`]).
     pattern_at: Vec<PatternAt>,
 }
 
-/// Where one node pattern of `expect:` is written: its list (`ran`, `counts`, …), its index
-/// there, and its 1-based line and column in the file.
+/// Where one entry of a list is written: the list (`substitute`, or a pattern list of
+/// `expect:` such as `ran` or `counts`), the entry's index there, and its 1-based line and
+/// column in the file.
 #[derive(Clone, Debug, PartialEq)]
 struct PatternAt {
     key: &'static str,
@@ -150,9 +152,24 @@ fn pattern_lists(e: &Expect) -> [(&'static str, Vec<&str>); 7] {
     ]
 }
 
-/// Where every node pattern of `expect` ([`pattern_lists`]) is written in the scenario file `v`.
+/// Where every substitution and every node pattern of `expect` ([`pattern_lists`]) is written
+/// in the scenario file `v`.
 fn pattern_locations(v: &Value, expect: &Expect) -> Vec<PatternAt> {
     let mut out = Vec::new();
+    for (index, x) in v
+        .get("substitute")
+        .and_then(Value::as_seq)
+        .into_iter()
+        .flatten()
+        .enumerate()
+    {
+        out.push(PatternAt {
+            key: "substitute",
+            index,
+            line: x.loc.line,
+            column: x.loc.col,
+        });
+    }
     let written = v.get("expect");
     for (key, list) in pattern_lists(expect) {
         let Some(value) = written.and_then(|e| e.get(key)) else {
@@ -178,6 +195,12 @@ fn pattern_locations(v: &Value, expect: &Expect) -> Vec<PatternAt> {
         }
     }
     out
+}
+
+/// Whether the YAML document `v` is meant as a scenario file: a mapping with `tree:`,
+/// `count:` or `expect:` (keys no tree or scene file has) and without `main:`.
+pub fn is_scenario_file(v: &Value) -> bool {
+    v.get("main").is_none() && ["tree", "count", "expect"].iter().any(|k| v.get(k).is_some())
 }
 
 const KEYS: &[&str] = &[
@@ -490,27 +513,67 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>, custom_kinds: &[&str]) 
 }
 
 impl ScenarioFile {
-    /// Checks that every node pattern of `expect:` matches some node of `plan` (a pattern that
-    /// matches nothing would pass or fail for the wrong reason).
-    pub fn check_patterns(&self, plan: &Plan) -> Result<(), String> {
+    /// Checks the file against the plan of its tree, as `test` does before running anything:
+    /// every substitution resolves, and every node pattern of `expect:` matches some node (a
+    /// pattern that matches nothing would pass or fail for the wrong reason). The errors are
+    /// located in the scenario file.
+    pub fn check_against(&self, plan: &Plan) -> Result<Resolved, Vec<Diagnostic>> {
+        let resolved = resolve(plan, &self.sweep.substitutions).map_err(|e| {
+            let at = self.written_at("substitute", e.index);
+            let mut d = self.diagnostic(at, format!("substitution `{}`: {}", e.rule, e.reason));
+            if !e.close.is_empty() {
+                d.help = Some(format!("leaves with close paths: {}", e.close.join(", ")));
+            }
+            vec![d]
+        })?;
+        let mut diags = Vec::new();
         for (key, list) in pattern_lists(&self.expect) {
             for (i, p) in list.iter().enumerate() {
                 if !plan.nodes.iter().any(|n| glob_match(p, &n.path)) {
-                    let at = self
-                        .pattern_at
-                        .iter()
-                        .find(|a| a.key == key && a.index == i)
-                        .map_or(String::new(), |a| format!(":{}:{}", a.line, a.column));
-                    return Err(format!(
-                        "{}{at}: `expect.{key}` pattern {p:?} matches no node of {}; `macrotree run {} --log-format json` lists the paths",
-                        self.path.display(),
-                        self.tree.display(),
+                    let mut d = self.diagnostic(
+                        self.written_at(key, i),
+                        format!(
+                            "`expect.{key}` pattern {p:?} matches no node of {}",
+                            self.tree.display()
+                        ),
+                    );
+                    d.help = Some(format!(
+                        "`macrotree run {} --log-format json` lists the paths",
                         self.tree.display()
                     ));
+                    diags.push(d);
                 }
             }
         }
-        Ok(())
+        if diags.is_empty() {
+            Ok(resolved)
+        } else {
+            Err(diags)
+        }
+    }
+
+    /// Where entry `index` of the list under `key` (`substitute`, or a pattern list of
+    /// `expect:`) is written, if known.
+    fn written_at(&self, key: &str, index: usize) -> Option<&PatternAt> {
+        self.pattern_at.iter().find(|a| a.key == key && a.index == index)
+    }
+
+    /// An error in this file at `at` (the file's start when unknown).
+    fn diagnostic(&self, at: Option<&PatternAt>, message: String) -> Diagnostic {
+        let (line, column) = at.map_or((1, 1), |a| (a.line, a.column));
+        Diagnostic {
+            file: self.path.display().to_string(),
+            line,
+            column,
+            message,
+            label: None,
+            help: None,
+            note: None,
+            source_line: None,
+            source_column: column,
+            width: 1,
+            warning: false,
+        }
     }
 }
 

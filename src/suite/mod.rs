@@ -27,6 +27,6 @@ pub use counts::{Bounds, CountExpect, MAX_BOUND, Per};
 pub use discover::find_files;
 pub use expect::{Checked, Expect, Outcome, SuiteOutcome, check, offending_commands};
 pub use file::{
-    FaultName, GoalName, MAX_COUNT, MAX_RULES, ScenarioFile, ScenarioFileRaw, join_clean, load_scenario_file,
-    schema_text,
+    FaultName, GoalName, MAX_COUNT, MAX_RULES, ScenarioFile, ScenarioFileRaw, is_scenario_file, join_clean,
+    load_scenario_file, schema_text,
 };

@@ -255,9 +255,10 @@ fn there_were_no_count_expectations() {
             "bad_count.yaml:8",
             "-1",
         ),
+        // A count glob that matches no node is located at its `node:`.
         (
             "  counts:\n    - {node: \"main/**/cary\", ran: {exactly: 1}}\n",
-            "",
+            "bad_count.yaml:8:14",
             "matches no node",
         ),
     ] {

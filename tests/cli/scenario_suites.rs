@@ -299,9 +299,10 @@ fn bad_scenario_files_exit_2_with_located_errors_and_nothing_runs() {
         ("typo.yaml", "typo.yaml:4:3", "min_success_rate"),
         ("range.yaml", "range.yaml:2:8", "`count` must be 1 to"),
         ("kind.yaml", "kind.yaml:5:17", "did you mean `grasp_lost`"),
+        // A substitution that matches no leaf is located at its rule, with close paths.
         (
             "nomatch.yaml",
-            "matches no node",
+            "nomatch.yaml:4:5",
             "subtree[pick]/sequence[pick]/grasp",
         ),
         // An `expect:` glob that matches no node is located at the pattern.
@@ -324,6 +325,70 @@ fn bad_scenario_files_exit_2_with_located_errors_and_nothing_runs() {
     let out = macrotree(&["run", TREE, "--substitute", "main/**/grasp=fail_first:0"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("1 to 100000"), "{}", stderr(&out));
+}
+
+/// `validate` knows scenario files: it checks each as `test` would before running (its tree,
+/// its substitutions, its node patterns) instead of asking for a `main:` tree, and `test
+/// --check` does the same for a whole suite without running a scenario.
+#[test]
+fn validate_and_test_check_judge_scenario_files_without_running_them() {
+    let pass_file = "tests/fixtures/scenarios/pass/grasp_fails_once.yaml";
+    let out = macrotree(&["validate", pass_file, "scenarios/clear_table.yaml", TREE]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let text = stdout(&out);
+    assert!(
+        text.contains("scenarios/clear_table.yaml: ok (scenario: ")
+            && text.contains("of trees/clear_table.yaml"),
+        "{text}"
+    );
+    assert!(!stderr(&out).contains("main:"), "{}", stderr(&out));
+
+    let bad = "tests/fixtures/scenarios/bad";
+    let (nomatch, expect_nomatch) = (
+        format!("{bad}/nomatch.yaml"),
+        format!("{bad}/expect_nomatch.yaml"),
+    );
+    let out = macrotree(&[
+        "validate",
+        "--format",
+        "json",
+        &nomatch,
+        &expect_nomatch,
+        pass_file,
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let lines: Vec<serde_json::Value> = stdout(&out)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 3);
+    assert!(lines.iter().all(|l| l["kind"] == "scenario"), "{lines:?}");
+    assert_eq!(
+        lines.iter().map(|l| l["valid"] == true).collect::<Vec<_>>(),
+        [false, false, true]
+    );
+    let at = |l: &serde_json::Value| {
+        (
+            l["diagnostics"][0]["line"].as_u64(),
+            l["diagnostics"][0]["column"].as_u64(),
+        )
+    };
+    assert_eq!(at(&lines[0]), (Some(4), Some(5)), "{}", lines[0]);
+    assert_eq!(at(&lines[1]), (Some(6), Some(14)), "{}", lines[1]);
+
+    // `test --check`: every file's errors at once, exit 2, and no scenario runs.
+    let out = macrotree(&["test", "--check", &nomatch, &expect_nomatch]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert!(
+        err.contains("nomatch.yaml:4:5") && err.contains("expect_nomatch.yaml:6:14"),
+        "{err}"
+    );
+    let out = macrotree(&["test", "--check", PASS, FAIL]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let text = stdout(&out);
+    assert!(text.contains("nothing was run (--check)"), "{text}");
+    assert!(!text.contains("PASS") && !text.contains("FAIL"), "{text}");
 }
 
 /// Runs `args` with shard K of M through `--shard auto` and a Slurm array environment.
