@@ -168,8 +168,17 @@ pub enum GoalRaw {
     SortedByColor(NoParams),
 }
 
+/// Names the scene file declares (objects and spots) whose declaration was refused, its error
+/// reported where it is written: a goal that names one is not reported again as unknown.
+pub(super) type Rejected<'a> = std::collections::BTreeSet<&'a str>;
+
 /// The goal `v` (a list of predicates) of `scene`, every problem added to `issues`.
-pub(super) fn read_goal(v: &Value, scene: &SceneSpec, issues: &mut Vec<Issue>) -> Goal {
+pub(super) fn read_goal(
+    v: &Value,
+    scene: &SceneSpec,
+    rejected: &Rejected<'_>,
+    issues: &mut Vec<Issue>,
+) -> Goal {
     let Some(items) = v.as_seq() else {
         issues.push(
             Issue::new(
@@ -201,7 +210,7 @@ pub(super) fn read_goal(v: &Value, scene: &SceneSpec, issues: &mut Vec<Issue>) -
             } else {
                 loc_at(body, &[key])
             };
-            want_at(scene, name, at, kinds, issues)
+            want_at(scene, rejected, name, at, kinds, issues)
         };
         match raw {
             GoalRaw::In(r) => {
@@ -253,7 +262,7 @@ pub(super) fn read_goal(v: &Value, scene: &SceneSpec, issues: &mut Vec<Issue>) -
                     tolerance: r.tolerance,
                     yaw_tolerance: r.yaw_tolerance,
                 };
-                if let Some(place) = read_place(raw, body, scene, issues)
+                if let Some(place) = read_place(raw, body, scene, rejected, issues)
                     && ok
                 {
                     atoms.push((
@@ -286,7 +295,7 @@ pub(super) fn read_goal(v: &Value, scene: &SceneSpec, issues: &mut Vec<Issue>) -
                             .as_seq()
                             .and_then(|s| s.get(k))
                             .map_or(names_v.loc, |e| e.loc);
-                        want_at(scene, n, at, &[ObjectKind::Block], issues)
+                        want_at(scene, rejected, n, at, &[ObjectKind::Block], issues)
                     })
                     .collect();
                 let base = base_at.and_then(|b| {
@@ -297,7 +306,7 @@ pub(super) fn read_goal(v: &Value, scene: &SceneSpec, issues: &mut Vec<Issue>) -
                         tolerance: b.tolerance,
                         yaw_tolerance: b.yaw_tolerance,
                     };
-                    read_place(raw, body.get("base_at").unwrap_or(body), scene, issues)
+                    read_place(raw, body.get("base_at").unwrap_or(body), scene, rejected, issues)
                 });
                 if checked.iter().all(|&b| b) {
                     for pair in names.windows(2) {
@@ -373,9 +382,18 @@ pub(super) fn read_goal(v: &Value, scene: &SceneSpec, issues: &mut Vec<Issue>) -
     }
 }
 
-/// True when `name` is an object of `scene` of one of `kinds`; else an issue at `at`.
-fn want_at(scene: &SceneSpec, name: &str, at: Loc, kinds: &[ObjectKind], issues: &mut Vec<Issue>) -> bool {
+/// True when `name` is an object of `scene` of one of `kinds`; else an issue at `at` (none for
+/// a `rejected` name, whose declaration has its own).
+fn want_at(
+    scene: &SceneSpec,
+    rejected: &Rejected<'_>,
+    name: &str,
+    at: Loc,
+    kinds: &[ObjectKind],
+    issues: &mut Vec<Issue>,
+) -> bool {
     match scene.object(name) {
+        None if rejected.contains(name) => false,
         Some(o) if kinds.contains(&o.kind()) => true,
         Some(o) => {
             let expect: Vec<&str> = kinds.iter().map(|k| k.name()).collect();
@@ -413,11 +431,13 @@ struct PlaceFields {
 }
 
 /// The place `raw` (read from `body`) names: exactly one of `point` and `spot` (a spot of
-/// `scene`), within the arm's reach, the tolerances in range. `None` after adding an issue.
+/// `scene`), within the arm's reach, the tolerances in range. `None` after adding an issue (or
+/// for a `rejected` spot, whose declaration has its own).
 fn read_place(
     raw: PlaceFields,
     body: &Value,
     scene: &SceneSpec,
+    rejected: &Rejected<'_>,
     issues: &mut Vec<Issue>,
 ) -> Option<GoalPlace> {
     let before = issues.len();
@@ -427,6 +447,7 @@ fn read_place(
             let at = loc_at(body, &["spot"]);
             match scene.spot(name) {
                 Some(s) => Some(([s.x, s.y], at)),
+                None if rejected.contains(name.as_str()) => None,
                 None => {
                     let mut issue = Issue::new(at, format!("unknown spot `{name}`"))
                         .label("expected one of the scene's `spots:`");
@@ -547,7 +568,7 @@ mod tests {
         let id = sources.add("t.yaml", yaml);
         let v = parse_yaml(yaml, id).unwrap();
         let mut issues = Vec::new();
-        let goal = read_goal(&v, &scene, &mut issues);
+        let goal = read_goal(&v, &scene, &Rejected::new(), &mut issues);
         if issues.is_empty() {
             Ok(goal)
         } else {

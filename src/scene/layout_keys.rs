@@ -9,9 +9,9 @@ use serde::Deserialize;
 
 use super::load::is_object_name;
 use super::types::{ObjectKind, ObjectSpec, Region, RegionRole, SceneSpec, Spot, reach_limits};
+use crate::yaml::TablePose;
 use crate::yaml::de::from_value;
 use crate::yaml::diag::{Issue, Loc};
-use crate::yaml::units::Angle;
 use crate::yaml::value::Value;
 
 /// Most spots, and most regions, in one scene.
@@ -104,40 +104,40 @@ pub(super) fn read_spots(v: &Value, scene: &mut SceneSpec, issues: &mut Vec<Issu
         let Some(name) = name_of(k, "spot", scene, issues) else {
             continue;
         };
-        let p: Vec<Angle> = match from_value(body) {
+        let p: TablePose = match from_value(body) {
             Ok(p) => p,
             Err(e) => {
-                issues
-                    .push(e.into_issue(body.loc, |l| format!("{l:?}")).help_or(
-                        "a spot is `[x, y]` or `[x, y, yaw]` (metres; yaw in radians or `deg(..)`)",
-                    ));
+                let mut issue = e
+                    .into_issue(body.loc, |l| format!("{l:?}"))
+                    .help_or("a spot is `[x, y]` or `[x, y, yaw]` (metres; yaw in radians or `deg(..)`)");
+                issue.message = format!("{} in spot `{name}`", issue.message);
+                issues.push(issue);
                 continue;
             }
         };
-        if !(p.len() == 2 || p.len() == 3) {
-            issues.push(
-                Issue::new(body.loc, format!("a spot has 2 or 3 numbers, found {}", p.len()))
-                    .label("expected `[x, y]` or `[x, y, yaw]` (metres, radians or `deg(..)`)"),
-            );
-            continue;
-        }
-        let (x, y) = (p[0].0, p[1].0);
+        let (x, y) = (p.x, p.y);
         let r = x.hypot(y);
-        if !(x.is_finite() && y.is_finite() && (rmin..=rmax).contains(&r)) {
-            issues.push(
-                Issue::new(
-                    body.loc,
-                    format!("spot `{name}` at ({x}, {y}) is {r:.3} m from the robot's base: spots must be {rmin} … {rmax} m away, where the arm can set a block down from above"),
-                )
-                .label(format!("expected a point {rmin} … {rmax} m from the origin")),
-            );
+        if !(rmin..=rmax).contains(&r) {
+            let mut issue = Issue::new(
+                body.loc,
+                format!("spot `{name}` at ({x}, {y}) is {r:.3} m from the robot's base: spots must be {rmin} … {rmax} m away, where the arm can set a block down from above"),
+            )
+            .label(format!("expected a point {rmin} … {rmax} m from the origin"));
+            if (rmin..=rmax).contains(&(r / 100.0)) {
+                issue = issue.help(format!(
+                    "coordinates are metres: for centimetres write [{}, {}]",
+                    x / 100.0,
+                    y / 100.0
+                ));
+            }
+            issues.push(issue);
             continue;
         }
         scene.spots.push(Spot {
             name: name.to_string(),
             x,
             y,
-            yaw: p.get(2).map_or(0.0, |a| a.0),
+            yaw: p.yaw.unwrap_or(0.0),
         });
     }
 }

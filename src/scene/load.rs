@@ -9,9 +9,10 @@ use serde::Deserialize;
 
 use super::color::Color;
 use super::goal::Goal;
-use super::goal_read::{GoalRaw, read_goal};
+use super::goal_read::{GoalRaw, Rejected, read_goal};
 use super::sample::{Placement, sample_placement};
 use super::types::{ObjectKind, ObjectSpec, Pose, RandomPlacement, Sampler, SceneSpec, Shape};
+use crate::yaml::TablePose;
 use crate::yaml::de::from_value;
 use crate::yaml::diag::{Diagnostic, Issue, Loc, Sources};
 use crate::yaml::suggest::did_you_mean;
@@ -145,7 +146,7 @@ pub struct ObjectRaw {
     obstacle: Option<ObstacleRaw>,
     /// Fixed pose `[x, y]` or `[x, y, yaw]` (metres; yaw in radians or `deg(..)`), used by
     /// `macrotree run`.
-    pose: Option<Vec<Angle>>,
+    pose: Option<TablePose>,
     /// Randomization, used by sweeps.
     random: Option<RandomRaw>,
     /// A container or obstacle only: height of its base above the table, metres (0 … 0.6).
@@ -175,7 +176,7 @@ pub struct SceneFileSchema {
     /// Named points on the table: `NAME: [x, y]` or `[x, y, yaw]` (metres; yaw in radians or
     /// `deg(..)`), each 0.22 … 0.72 m from the robot's base.
     #[serde(default)]
-    pub spots: BTreeMap<String, Vec<Angle>>,
+    pub spots: BTreeMap<String, TablePose>,
     /// Named boxes on the table: `NAME: {x: [lo, hi], y: [lo, hi], role: keep_out | allowed}`.
     #[serde(default)]
     pub regions: BTreeMap<String, super::layout_keys::RegionRaw>,
@@ -361,8 +362,9 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
     if issues.is_empty() {
         super::layout_keys::resolve_layout(&mut scene, objects_v, issues);
     }
+    let rejected = rejected_names(&scene, objects_v, spots_v);
     let goal = match goal_v {
-        Some(g) => read_goal(g, &scene, issues),
+        Some(g) => read_goal(g, &scene, &rejected, issues),
         None => Goal::default(),
     };
     let sampler = match sampler_v {
@@ -390,6 +392,20 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
         super::feasible::check_has_block(&scene, objects_key, issues);
     }
     Some(scene)
+}
+
+/// The object and spot names written under `objects:` and `spots:` that `scene` lacks: their
+/// declarations were refused (each with its own issue).
+fn rejected_names<'a>(scene: &SceneSpec, objects_v: &'a Value, spots_v: Option<&'a Value>) -> Rejected<'a> {
+    let written = |v: Option<&'a Value>| {
+        v.and_then(Value::as_map)
+            .into_iter()
+            .flatten()
+            .filter_map(|(k, _)| k.as_str())
+    };
+    let objects = written(Some(objects_v)).filter(|n| scene.object(n).is_none());
+    let spots = written(spots_v).filter(|n| scene.spot(n).is_none());
+    objects.chain(spots).collect()
 }
 
 /// `sampler: objects | tutorial`; `tutorial` needs the scene's cube and bowl (one block and one
@@ -607,25 +623,12 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
         )
     };
     let kind = shape.kind();
-    let pose = match raw.pose {
-        None => None,
-        Some(p) if p.len() == 2 || p.len() == 3 => Some(Pose {
-            x: p[0].0,
-            y: p[1].0,
-            yaw: p.get(2).map_or(0.0, |a| a.0),
-            z: 0.0,
-        }),
-        Some(p) => {
-            issues.push(
-                Issue::new(
-                    loc_at(body, &["pose"]),
-                    format!("a pose has 2 or 3 numbers, found {}", p.len()),
-                )
-                .label("expected `[x, y]` or `[x, y, yaw]` (metres, radians or `deg(..)`)"),
-            );
-            None
-        }
-    };
+    let pose = raw.pose.map(|p| Pose {
+        x: p.x,
+        y: p.y,
+        yaw: p.yaw.unwrap_or(0.0),
+        z: 0.0,
+    });
     let z = match raw.z {
         None => 0.0,
         Some(z) if kind == ObjectKind::Block => {

@@ -13,9 +13,11 @@ pub mod diag;
 mod ident;
 mod read;
 pub mod suggest;
+mod table_pose;
 pub mod units;
 pub mod value;
 
 pub use diag::{Diagnostic, Issue, Loc, Sources, short_number};
 pub use ident::is_identifier;
 pub use read::read_limited;
+pub use table_pose::TablePose;

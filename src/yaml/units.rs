@@ -158,22 +158,28 @@ pub(crate) struct Coordinate<const POINT: bool>(pub(crate) f64);
 impl<'de, const POINT: bool> Deserialize<'de> for Coordinate<POINT> {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let x = number(d, "a coordinate (m)")?;
-        // A point's coordinate beyond the reach plus the shoulder's height is out of reach
-        // whatever the others are; an offset's beyond the reach is too long.
-        let limit = if POINT {
-            MAX_REACH + SHOULDER_HEIGHT
-        } else {
-            MAX_REACH
-        };
-        if x.abs() > limit {
-            return Err(de::Error::custom(format!(
-                "a coordinate of {x} m is beyond the arm's full reach of {MAX_REACH:.2} m{}lengths are in metres: write {} for {x} cm",
-                super::de::HELP_SEPARATOR,
-                x / 100.0
-            )));
-        }
-        Ok(Coordinate(x))
+        coordinate(x, "a coordinate of", POINT).map(Coordinate)
     }
+}
+
+/// Checks one coordinate `x` (metres) that `what` names in a message (`a coordinate of`,
+/// `x =`): at most the arm's reach from 0 — plus the shoulder's height for a `point`'s
+/// coordinate, beyond which it is out of reach whatever the others are; an offset's beyond
+/// the reach is too long.
+pub(crate) fn coordinate<E: de::Error>(x: f64, what: &str, point: bool) -> Result<f64, E> {
+    let limit = if point {
+        MAX_REACH + SHOULDER_HEIGHT
+    } else {
+        MAX_REACH
+    };
+    if x.abs() > limit {
+        return Err(E::custom(format!(
+            "{what} {x} m is beyond the arm's full reach of {MAX_REACH:.2} m{}lengths are in metres: write {} for {x} cm",
+            super::de::HELP_SEPARATOR,
+            x / 100.0
+        )));
+    }
+    Ok(x)
 }
 
 /// Three finite lengths `[x, y, z]` in metres.
@@ -230,10 +236,15 @@ pub const MAX_BARE_ANGLE: f64 = std::f64::consts::TAU;
 /// A plain number read as an angle in radians: an error beyond ±2π (with help to write `deg(..)`),
 /// and a warning for a whole number beyond ±π (`yaw: 5` is 286°, probably meant as degrees).
 pub(crate) fn bare_angle<E: de::Error>(x: f64, integer: bool) -> Result<f64, E> {
-    let x = finite(x, "an angle (rad)")?;
+    named_bare_angle(x, integer, "")
+}
+
+/// [`bare_angle`] with its messages starting with `field` (e.g. `yaw: `; empty for none).
+pub(crate) fn named_bare_angle<E: de::Error>(x: f64, integer: bool, field: &str) -> Result<f64, E> {
+    let x = finite(x, "an angle (rad)").map_err(|e: E| E::custom(format!("{field}{e}")))?;
     if x.abs() > MAX_BARE_ANGLE {
         return Err(E::custom(format!(
-            "`{x}` is more than a full turn as an angle in radians ({:.0}°){}write deg({x}) for degrees, or rad({x}) if you really mean radians",
+            "{field}`{x}` is more than a full turn as an angle in radians ({:.0}°){}write deg({x}) for degrees, or rad({x}) if you really mean radians",
             x.to_degrees(),
             super::de::HELP_SEPARATOR
         )));
@@ -241,7 +252,7 @@ pub(crate) fn bare_angle<E: de::Error>(x: f64, integer: bool) -> Result<f64, E> 
     if integer && x.abs() > std::f64::consts::PI {
         super::de::warn(
             format!(
-                "`{x}` is read as {x} rad ({:.1}°): plain numbers are radians",
+                "{field}`{x}` is read as {x} rad ({:.1}°): plain numbers are radians",
                 x.to_degrees()
             ),
             Some(format!(

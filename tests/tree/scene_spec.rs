@@ -142,6 +142,47 @@ fn scene_mistakes_are_located_and_explained() {
     assert!(e.message.contains("no placement found"), "{e}");
 }
 
+/// A pose or spot written in centimetres is reported once, at the number, naming the field (x,
+/// y or yaw) and in metres — not as an angle — and the goals that name the refused object or
+/// spot get no follow-on "unknown" error with a wrong did-you-mean.
+#[test]
+fn a_refused_declaration_names_its_field_and_causes_no_follow_on_errors() {
+    let d = scene_errors(
+        "objects:\n  a: {block: {size: 0.04}, pose: [40, -0.2]}\n  b: {block: {size: 0.04}, pose: [0.4, 0.2, 9]}\n  c: {block: {size: 0.04}, pose: [0.4, 0.0]}\nspots:\n  slot_1: [0.5, 0.1]\n  slot_2: [50, -30, deg(90)]\n  slot_3: [0.5, -30]\ngoal:\n  - at: {object: a, spot: slot_2}\n  - at: {object: b, spot: slot_3}\n  - at: {object: c, spot: slot_1}\n",
+    );
+    let x = find(&d, "x = 40 m is beyond the arm's full reach");
+    assert_eq!((x.line, x.column), (2, 35));
+    assert!(x.message.contains("object `a`"), "{x}");
+    assert_eq!(
+        x.help.as_deref(),
+        Some("lengths are in metres: write 0.4 for 40 cm")
+    );
+    let yaw = find(&d, "yaw: `9` is more than a full turn");
+    assert_eq!((yaw.line, yaw.column), (3, 45));
+    let spot = find(&d, "x = 50 m");
+    assert_eq!((spot.line, spot.column), (7, 12));
+    assert!(spot.message.contains("spot `slot_2`"), "{spot}");
+    let y = find(&d, "y = -30 m");
+    assert_eq!((y.line, y.column), (8, 17));
+    assert!(
+        d.iter()
+            .all(|e| !e.message.contains("unknown")
+                && !e.message.contains("full turn as an angle in radians (2")),
+        "{d:#?}"
+    );
+    assert_eq!(d.len(), 4, "{d:#?}");
+
+    // A spot in centimetres that parses as metres is out of reach: the help gives it in metres.
+    let d = scene_errors(
+        "objects:\n  a: {block: {size: 0.04}, pose: [0.4, 0.1]}\nspots:\n  s: [0.5, 0.3]\n  t: [45, -30]\n",
+    );
+    let t = find(&d, "x = 45 m");
+    assert_eq!(
+        t.help.as_deref(),
+        Some("lengths are in metres: write 0.45 for 45 cm")
+    );
+}
+
 #[test]
 fn sorted_by_color_needs_one_bin_per_block_colour() {
     let d = scene_errors(
