@@ -9,9 +9,10 @@ than N keeps every core busy.
 
 from __future__ import annotations
 
+import json
 import operator
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -292,6 +293,41 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         info["env_id"] = np.asarray(batch["env_id"], dtype=np.int64)
         return obs, rew, term, trunc, info
 
+    # --- beyond Gymnasium ------------------------------------------------------------------------
+
+    def step_leaf(
+        self,
+        leaves: Mapping[str, Any] | str | Sequence[Mapping[str, Any] | str],
+        env_ids: Sequence[int] | np.ndarray | None = None,
+    ) -> tuple[dict[str, Any], np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        """Runs a leaf to completion on each sub-environment of ``env_ids`` (default: all), in
+        parallel, as :meth:`MacroEnv.step_leaf` does: one leaf for all (a mapping such as
+        ``{"reach": {"target": "cube", "offset": [0, 0, 0.12]}}``, or its YAML/JSON text), or a
+        list of one per sub-environment. Every leaf is checked before any sub-environment moves
+        (a bad one raises :class:`macrotree.MacrotreeError` with a located message). Results come
+        in the order of ``env_ids``, which ``info["env_id"]`` repeats; under ``SAME_STEP`` those
+        that ended are reset, as in :meth:`step`."""
+        ids = self._ids(env_ids)
+        if isinstance(leaves, (str, Mapping)):
+            items: list[Mapping[str, Any] | str] = [leaves] * len(ids)
+        else:
+            items = list(leaves)
+            if len(items) != len(ids):
+                raise ValueError(f"{len(items)} leaves for {len(ids)} environments")
+        texts = [leaf if isinstance(leaf, str) else json.dumps(leaf) for leaf in items]
+        return self._step_ids(ids, [("leaf", t) for t in texts])
+
+    def step_subtree(
+        self, name: str = "main", env_ids: Sequence[int] | np.ndarray | None = None
+    ) -> tuple[dict[str, Any], np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        """Runs a node of the tree (a subtree call's name, a node path, or ``"main"``: the whole
+        tree) until it finishes, on each sub-environment of ``env_ids`` (default: all), in
+        parallel; results as :meth:`step_leaf`'s."""
+        if not isinstance(name, str):
+            raise TypeError(f"name must be a str, got {type(name).__name__}")
+        ids = self._ids(env_ids)
+        return self._step_ids(ids, [("subtree", name)] * len(ids))
+
     def render(self) -> tuple[np.ndarray, ...] | None:
         """One H×W×3 ``uint8`` image per sub-environment (``render_mode="rgb_array"``)."""
         if self.render_mode is None:
@@ -307,6 +343,25 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         self._pending.clear()
 
     # --- helpers ------------------------------------------------------------------------------
+
+    def _ids(self, env_ids: Sequence[int] | np.ndarray | None) -> list[int]:
+        """``env_ids`` as a list of distinct, idle sub-environment indices (default: all)."""
+        every = range(self.num_envs)
+        ids = list(every) if env_ids is None else [operator.index(i) for i in env_ids]
+        if len(set(ids)) != len(ids) or not all(i in every for i in ids):
+            raise ValueError(f"env_ids must be distinct indices 0…{self.num_envs - 1}, got {ids}")
+        busy = self._pending.intersection(ids)
+        if busy:
+            raise ValueError(f"environments {sorted(busy)} are still running; recv() them first")
+        return ids
+
+    def _step_ids(
+        self, ids: list[int], actions: list[Any]
+    ) -> tuple[dict[str, Any], np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        """Steps sub-environments ``ids`` with native ``actions``; results in that order."""
+        obs, rew, term, trunc, info = self._finish(self._native.step(ids, actions))
+        info["env_id"] = np.asarray(ids, dtype=np.int64)
+        return obs, rew, term, trunc, info
 
     def _native_actions(self, actions: Any, n: int) -> list[Any]:
         shape = ACTION_MODES[self.action_mode]

@@ -23,16 +23,32 @@ pub struct VecEnv {
     image: (u32, u32),
 }
 
-/// An action from Python: a macro dict, or `(mode, values)` with `mode` `"ctrl"` (19 float64
-/// values), `"setpoint"` (7) or `"residual"` (7).
+/// An action from Python: a macro dict; `(mode, values)` with `mode` `"ctrl"` (19 float64
+/// values), `"setpoint"` (7) or `"residual"` (7); or `("leaf", text)` (a leaf as YAML or JSON
+/// text) or `("subtree", name)`.
 fn action_of(a: &Bound<'_, PyAny>) -> PyResult<Action> {
     if let Ok(d) = a.cast::<PyDict>() {
         return Ok(Action::Primitive(macro_action::primitive(d)?));
     }
-    let (mode, array): (String, PyReadonlyArray1<'_, f64>) = a.extract().map_err(|_| {
-        value("an action is a macro dict or (mode, float64 values) with mode ctrl, setpoint or residual")
-    })?;
-    crate::env::array_action(&mode, array.as_slice()?)
+    let shape = "an action is a macro dict, (mode, float64 values) with mode ctrl, setpoint or residual, \
+                 (\"leaf\", text) or (\"subtree\", name)";
+    let (mode, payload): (String, Bound<'_, PyAny>) = a.extract().map_err(|_| value(shape))?;
+    match mode.as_str() {
+        "leaf" | "subtree" => {
+            let text: String = payload
+                .extract()
+                .map_err(|_| value(format!("a {mode} action is ({mode:?}, text)")))?;
+            Ok(if mode == "leaf" {
+                Action::Leaf(text)
+            } else {
+                Action::Subtree(text)
+            })
+        }
+        _ => {
+            let array: PyReadonlyArray1<'_, f64> = payload.extract().map_err(|_| value(shape))?;
+            crate::env::array_action(&mode, array.as_slice()?)
+        }
+    }
 }
 
 type Guard<'a> = std::sync::MutexGuard<'a, macrotree::env::VecEnv>;
