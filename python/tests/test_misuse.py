@@ -233,3 +233,23 @@ def test_an_image_size_out_of_bounds_is_refused_before_anything_is_built(
         macrotree.MacroEnv(scene, cameras=["front"], image_size=size)
     with pytest.raises(ValueError, match="height must be 16"):
         macrotree.VectorEnv(scene, num_envs=2, cameras=["front"], image_size=size)
+
+
+def test_a_file_that_is_not_a_tree_or_a_scene_is_named_never_quoted(tmp_path: Path) -> None:
+    secrets = {
+        "creds.yaml": "password: s3cr3t-1\nuser: s3cr3t-2\n",
+        "token.env": "TOKEN=s3cr3t-1\n",
+        "broken.txt": "x: [s3cr3t-1\n",
+    }
+    for name, text in secrets.items():
+        path = tmp_path / name
+        path.write_text(text)
+        for as_tree in (True, False):
+            with pytest.raises(macrotree.MacrotreeError) as caught:
+                if as_tree:
+                    macrotree.MacroEnv(tree=str(path))
+                else:
+                    macrotree.MacroEnv(scene=str(path))
+            message = str(caught.value)
+            assert name in message, message
+            assert "s3cr3t" not in message and "password" not in message, (as_tree, message)

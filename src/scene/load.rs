@@ -198,11 +198,25 @@ impl SceneSpec {
     /// Read a scene from text. `file_name` names it in diagnostics; its stem is the scene's name.
     #[allow(clippy::should_implement_trait)]
     pub fn from_str(text: &str, file_name: &str) -> Result<SceneSpec, Vec<Diagnostic>> {
+        Self::read_text(text, file_name, None)
+    }
+
+    /// [`from_str`](Self::from_str) for text read from the file at `disk`, if any: a file
+    /// that is not a scene, or not named `.yaml`, is never quoted ([`Sources::add_file`]).
+    fn read_text(text: &str, file_name: &str, disk: Option<&Path>) -> Result<SceneSpec, Vec<Diagnostic>> {
         let mut sources = Sources::new();
-        let id = sources.add(file_name, text);
+        let id = match disk {
+            Some(path) => sources.add_file(path, text),
+            None => sources.add(file_name, text),
+        };
         let mut issues = Vec::new();
         let spec = match parse_yaml(text, id) {
-            Ok(v) => read_scene(&v, stem(file_name), &mut issues),
+            Ok(v) => {
+                if !is_scene_document(&v) {
+                    sources.withhold(id);
+                }
+                read_scene(&v, stem(file_name), &mut issues)
+            }
             Err(issue) => {
                 issues.push(issue);
                 None
@@ -233,10 +247,10 @@ pub fn load_scene_file(path: &Path) -> Result<SceneSpec, Vec<Diagnostic>> {
         Err((msg, help)) => return fail(msg, help),
     };
     match std::str::from_utf8(&bytes) {
-        Ok(text) => SceneSpec::from_str(text, &name),
+        Ok(text) => SceneSpec::read_text(text, &name, Some(path)),
         Err(_) => {
             let mut sources = Sources::new();
-            let id = sources.add(name.clone(), String::from_utf8_lossy(&bytes).into_owned());
+            let id = sources.add_file(path, String::from_utf8_lossy(&bytes).into_owned());
             let issue = decode_utf8(&bytes, id)
                 .err()
                 .unwrap_or_else(|| Issue::new(Loc::file_start(id), "not UTF-8"));
@@ -273,11 +287,20 @@ pub(super) fn loc_at(v: &Value, path: &[&str]) -> Loc {
     cur.loc
 }
 
+/// Whether `v` is meant as a scene: a mapping with at least one of the scene file's keys.
+fn is_scene_document(v: &Value) -> bool {
+    v.as_map().is_some_and(|entries| {
+        entries
+            .iter()
+            .any(|(k, _)| k.as_str().is_some_and(|k| TOP_LEVEL_KEYS.contains(&k)))
+    })
+}
+
 fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneSpec> {
     let Some(entries) = v.as_map() else {
         issues.push(
             Issue::new(
-                v.loc,
+                Loc::file_start(v.loc.file),
                 format!(
                     "a scene file must be a mapping, found {}",
                     crate::yaml::value::kind_of(v)
@@ -287,18 +310,15 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
         );
         return None;
     };
-    // Not a scene file at all (a `.env`, a credentials file): one issue, quoting one line.
-    if !entries
-        .iter()
-        .any(|(k, _)| k.as_str().is_some_and(|k| TOP_LEVEL_KEYS.contains(&k)))
-    {
+    // Not a scene file at all (a `.env`, a credentials file): one issue, quoting nothing.
+    if !is_scene_document(v) {
         issues.push(
             Issue::new(
-                v.loc,
+                Loc::file_start(v.loc.file),
                 "this is not a scene file: it has none of `objects:`, `description:`, `goal:`",
             )
             .label("expected `objects:` (and optionally `description:` and `goal:`)")
-            .help("name a scene file (see docs/scenes.md)"),
+            .help("name a scene file (see docs/scenes.md); nothing of this file is shown"),
         );
         return None;
     }

@@ -6,8 +6,8 @@
 //! is refused before it is opened, unless the loader allows it (`Loader::includes_anywhere`,
 //! the command line's `--allow-include-outside`).
 //!
-//! A file that is not a tree (not a mapping, or a mapping without any of `include:`,
-//! `subtrees:` and `main:`) gets one diagnostic, which shows at most the one line it points at.
+//! A file that is not a tree (not a mapping, or a mapping without any of the tree keys) gets
+//! one diagnostic at its start that quotes nothing of it.
 
 use std::path::{Component, Path, PathBuf};
 
@@ -180,30 +180,46 @@ fn lexical(path: &Path) -> PathBuf {
     out
 }
 
-/// Reads the top level of a file like [`parse_tree_file`], and returns whether it is a tree.
-/// A file that is not a tree leaves only one issue in `issues` (the first one found in it), so
-/// that no more than one of its lines is ever shown.
+/// Reads the top level of a file like [`parse_tree_file`], and returns whether it is a tree (a
+/// mapping with a tree key or a plausible typo of one). A file that is not leaves exactly one
+/// issue in `issues`, at its start, that quotes nothing of it (not even a key); the caller
+/// withholds its text ([`Sources::withhold`]).
+///
+/// [`Sources::withhold`]: crate::yaml::Sources::withhold
 pub(crate) fn parse_top_level(v: &Value, issues: &mut Vec<Issue>) -> (Option<TreeFile>, bool) {
-    let mut found = Vec::new();
-    let file = parse_tree_file(v, &mut found);
+    // A tree key, or a plausible typo of one (`subtree:`), says the file is meant as a tree.
     let is_tree = v.as_map().is_some_and(|entries| {
-        entries
-            .iter()
-            .any(|(k, _)| k.as_str().is_some_and(|k| TOP_LEVEL_KEYS.contains(&k)))
+        entries.iter().any(|(k, _)| {
+            k.as_str().is_some_and(|k| {
+                TOP_LEVEL_KEYS.contains(&k)
+                    || crate::yaml::suggest::closest(k, TOP_LEVEL_KEYS.iter().copied()).is_some()
+            })
+        })
     });
     if !is_tree {
-        found.sort_by_key(|i| (i.loc.line, i.loc.col));
-        found.truncate(1);
-        if let Some(issue) = found.first_mut()
-            && !matches!(v.kind, ValueKind::Map(_))
-        {
-            // The value's description could quote text beyond its first line.
-            issue.message = format!(
+        let message = match v.kind {
+            ValueKind::Map(_) => format!(
+                "this is not a tree file: it has none of {}",
+                TOP_LEVEL_KEYS
+                    .iter()
+                    .map(|k| format!("`{k}:`"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+            _ => format!(
                 "a tree file must be a mapping, found {}",
                 crate::yaml::value::kind_of(v)
-            );
-        }
+            ),
+        };
+        issues.push(
+            Issue::new(Loc::file_start(v.loc.file), message)
+                .label("expected `main:` (and optionally `include:` and `subtrees:`)")
+                .help("name a tree file (see docs/tree_format.md); nothing of this file is shown"),
+        );
+        return (None, false);
     }
+    let mut found = Vec::new();
+    let file = parse_tree_file(v, &mut found);
     issues.append(&mut found);
     (file, is_tree)
 }

@@ -103,7 +103,7 @@ pub(crate) fn load(opts: &LoadOptions<'_>, source: Source<'_>) -> Result<Spec, V
             if let Ok(c) = path.canonicalize() {
                 l.loaded.insert(c);
             }
-            return l.finish(text, name, path.parent());
+            return l.finish(text, name, path.parent(), false);
         }
         Source::File(path) => match read_limited(path) {
             Ok(bytes) => (bytes.into(), path.display().to_string(), path),
@@ -120,7 +120,9 @@ pub(crate) fn load(opts: &LoadOptions<'_>, source: Source<'_>) -> Result<Spec, V
     let text = match std::str::from_utf8(&bytes) {
         Ok(t) => t,
         Err(_) => {
-            let id = l.sources.add(name, String::from_utf8_lossy(&bytes).into_owned());
+            let id = l
+                .sources
+                .add_file(Path::new(&name), String::from_utf8_lossy(&bytes).into_owned());
             let issue = decode_utf8(&bytes, id)
                 .err()
                 .unwrap_or_else(|| Issue::new(Loc::file_start(id), "not UTF-8"));
@@ -131,7 +133,7 @@ pub(crate) fn load(opts: &LoadOptions<'_>, source: Source<'_>) -> Result<Spec, V
     if let Ok(c) = path.canonicalize() {
         l.loaded.insert(c);
     }
-    l.finish(text, &name, path.parent())
+    l.finish(text, &name, path.parent(), true)
 }
 
 #[derive(Default)]
@@ -158,13 +160,30 @@ pub fn builtin_scene() -> Arc<SceneSpec> {
 }
 
 impl TreeReader {
-    fn finish(mut self, text: &str, name: &str, base: Option<&Path>) -> Result<Spec, Vec<Diagnostic>> {
+    /// Reads the main file `text` (named `name`; read from disk when `on_disk`, whose name
+    /// then decides whether its lines may be quoted, [`Sources::add_file`]).
+    fn finish(
+        mut self,
+        text: &str,
+        name: &str,
+        base: Option<&Path>,
+        on_disk: bool,
+    ) -> Result<Spec, Vec<Diagnostic>> {
         self.scope = IncludeScope::for_base(base, self.includes_anywhere);
         let mut warnings = Vec::new();
-        let id = self.sources.add(name, text);
-        let (root_file, is_tree) = match parse_yaml(text, id).map(|v| parse_top_level(&v, &mut self.issues)) {
-            Ok((Some(f), is_tree)) => (f, is_tree),
-            Ok((None, _)) => return Err(self.sources.diagnostics(&self.issues)),
+        let id = if on_disk {
+            self.sources.add_file(Path::new(name), text)
+        } else {
+            self.sources.add(name, text)
+        };
+        let root_file = match parse_yaml(text, id).map(|v| parse_top_level(&v, &mut self.issues)) {
+            Ok((Some(f), true)) => f,
+            Ok((_, is_tree)) => {
+                if !is_tree {
+                    self.sources.withhold(id);
+                }
+                return Err(self.sources.diagnostics(&self.issues));
+            }
             Err(issue) => {
                 self.issues.push(issue);
                 return Err(self.sources.diagnostics(&self.issues));
@@ -174,13 +193,8 @@ impl TreeReader {
         let main = match (&root_file.main, root_file.main_key) {
             (Some(m), _) => m.clone(),
             _ => {
-                // In a file that is not a tree, point at the one line already shown.
-                let at = match self.issues.iter().find(|i| i.loc.file == id) {
-                    Some(first) if !is_tree => first.loc,
-                    _ => Loc::file_start(id),
-                };
                 self.issues.push(
-                    Issue::new(at, "the file has no `main:` tree")
+                    Issue::new(Loc::file_start(id), "the file has no `main:` tree")
                         .label("expected `main: <node>`")
                         .help("add `main:` with the root node; files that only define subtrees are included with `include:`"),
                 );
@@ -418,7 +432,6 @@ impl TreeReader {
             if !self.loaded.insert(canon) {
                 continue; // already loaded (diamond or cycle): its subtrees are known
             }
-            let name = path.display().to_string();
             let bytes = match read_limited(&path) {
                 Ok(b) => b,
                 Err((msg, help)) => {
@@ -429,13 +442,13 @@ impl TreeReader {
             let id: FileId;
             let text = match String::from_utf8(bytes) {
                 Ok(t) => {
-                    id = self.sources.add(name, t.as_str());
+                    id = self.sources.add_file(&path, t.as_str());
                     t
                 }
                 Err(e) => {
                     id = self
                         .sources
-                        .add(name, String::from_utf8_lossy(e.as_bytes()).into_owned());
+                        .add_file(&path, String::from_utf8_lossy(e.as_bytes()).into_owned());
                     if let Err(issue) = decode_utf8(e.as_bytes(), id) {
                         self.issues.push(issue);
                     }
@@ -445,8 +458,13 @@ impl TreeReader {
             match parse_yaml(&text, id) {
                 Ok(v) => {
                     // A library's own `main:` is ignored (it can be a demo of its subtrees).
-                    if let (Some(f), _) = parse_top_level(&v, &mut self.issues) {
-                        self.collect(&f, path.parent(), depth + 1);
+                    match parse_top_level(&v, &mut self.issues) {
+                        (Some(f), true) => self.collect(&f, path.parent(), depth + 1),
+                        (_, is_tree) => {
+                            if !is_tree {
+                                self.sources.withhold(id);
+                            }
+                        }
                     }
                 }
                 Err(issue) => self.issues.push(issue),

@@ -203,6 +203,16 @@ pub fn is_scenario_file(v: &Value) -> bool {
     v.get("main").is_none() && ["tree", "count", "expect"].iter().any(|k| v.get(k).is_some())
 }
 
+/// Whether `v` is a mapping with at least one of the scenario file's keys (else nothing of it
+/// is quoted).
+fn is_scenario_document(v: &Value) -> bool {
+    v.as_map().is_some_and(|entries| {
+        entries
+            .iter()
+            .any(|(k, _)| k.as_str().is_some_and(|k| KEYS.contains(&k)))
+    })
+}
+
 const KEYS: &[&str] = &[
     "description",
     "tree",
@@ -245,7 +255,7 @@ pub fn load_scenario_file(path: &Path, custom_kinds: &[&str]) -> Result<Scenario
         }
     };
     let text = String::from_utf8_lossy(&bytes).into_owned();
-    let id = sources.add(name, text.clone());
+    let id = sources.add_file(path, text.clone());
     if let Err(issue) = decode_utf8(&bytes, id) {
         return Err(sources.diagnostics(&[issue]));
     }
@@ -253,6 +263,9 @@ pub fn load_scenario_file(path: &Path, custom_kinds: &[&str]) -> Result<Scenario
         Ok(v) => v,
         Err(issue) => return Err(sources.diagnostics(&[issue])),
     };
+    if !is_scenario_document(&v) {
+        sources.withhold(id);
+    }
     let mut issues = Vec::new();
     let file = read(path, &v, &mut issues, custom_kinds);
     match file {
@@ -265,7 +278,7 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>, custom_kinds: &[&str]) 
     let Some(entries) = v.as_map() else {
         issues.push(
             Issue::new(
-                v.loc,
+                Loc::file_start(v.loc.file),
                 format!(
                     "a scenario file must be a mapping, found {}",
                     crate::yaml::value::kind_of(v)
@@ -276,14 +289,11 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>, custom_kinds: &[&str]) 
         );
         return None;
     };
-    // Not a scenario file at all: one issue, quoting one line.
-    if !entries
-        .iter()
-        .any(|(k, _)| k.as_str().is_some_and(|k| KEYS.contains(&k)))
-    {
+    // Not a scenario file at all: one issue, quoting nothing.
+    if !is_scenario_document(v) {
         issues.push(
             Issue::new(
-                v.loc,
+                Loc::file_start(v.loc.file),
                 "this is not a scenario file: it has none of its keys (`tree:`, `count:`, `expect:`, …)",
             )
             .label("expected `tree:`, `count:` and `expect:`")

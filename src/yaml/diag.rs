@@ -229,9 +229,16 @@ fn sanitize(s: &str) -> String {
 pub struct SourceFile {
     /// Display name (path as given, or a test name).
     pub name: String,
-    /// Full text (may be empty when the file could not be read).
+    /// Full text (may be empty when the file could not be read, and is when withheld).
     pub text: Arc<str>,
+    /// Nothing of the file may be shown ([`Sources::withhold`]).
+    pub withheld: bool,
 }
+
+/// The help of every diagnostic in a withheld file, in place of whatever the issue said (a
+/// parser's label or help may quote the file's text).
+const WITHHELD_HELP: &str =
+    "nothing of this file is shown: it is not the kind of file expected here, or not named `.yaml`";
 
 /// The table of source files a tree was read from, for turning [`Issue`]s into
 /// [`Diagnostic`]s.
@@ -251,8 +258,36 @@ impl Sources {
         self.files.push(SourceFile {
             name: name.into(),
             text: text.into(),
+            withheld: false,
         });
         u32::try_from(self.files.len() - 1).unwrap_or(u32::MAX)
+    }
+
+    /// Register a file read from disk at `path`: like [`add`](Self::add), except that a file
+    /// whose name does not end in `.yaml` or `.yml`, or whose text holds a NUL (which no YAML
+    /// file does), is [withheld](Self::withhold) — a credentials file or `/proc/self/environ`
+    /// named by mistake is located, never quoted.
+    pub fn add_file(&mut self, path: &std::path::Path, text: impl Into<Arc<str>>) -> FileId {
+        let text: Arc<str> = text.into();
+        let binary = text.contains('\0');
+        let id = self.add(path.display().to_string(), text);
+        let yaml = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("yaml") || e.eq_ignore_ascii_case("yml"));
+        if binary || !yaml {
+            self.withhold(id);
+        }
+        id
+    }
+
+    /// Never quote a line of file `id` in a diagnostic again (it is not the kind of file that
+    /// was expected, so its text may be anything); its diagnostics keep `file:line:column`.
+    pub fn withhold(&mut self, id: FileId) {
+        if let Some(f) = self.files.get_mut(id as usize) {
+            f.text = Arc::from("");
+            f.withheld = true;
+        }
     }
 
     /// The file with id `id`.
@@ -283,6 +318,7 @@ impl Sources {
     /// Turn an issue into a self-contained diagnostic.
     pub fn diagnostic(&self, issue: &Issue) -> Diagnostic {
         let file = self.get(issue.loc.file);
+        let withheld = file.is_some_and(|f| f.withheld);
         let window = file.and_then(|f| {
             if issue.loc.line == 0 {
                 return None;
@@ -308,9 +344,12 @@ impl Sources {
             line: issue.loc.line,
             column: issue.loc.col,
             message: sanitize(&issue.message),
-            label: issue.label.as_deref().map(sanitize),
-            help: issue.help.as_deref().map(sanitize),
-            note: issue.note.as_deref().map(sanitize),
+            label: issue.label.as_deref().filter(|_| !withheld).map(sanitize),
+            help: match withheld {
+                true => Some(WITHHELD_HELP.to_string()),
+                false => issue.help.as_deref().map(sanitize),
+            },
+            note: issue.note.as_deref().filter(|_| !withheld).map(sanitize),
             source_line,
             source_column,
             width,

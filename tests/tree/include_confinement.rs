@@ -104,16 +104,29 @@ fn allow_include_outside_reads_a_library_elsewhere() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A file that is not a tree — included, given as the main tree, or not named `.yaml` — gets
+/// one diagnostic, located, that quotes nothing of it: not a line, not a key.
 #[test]
-fn a_file_that_is_not_a_tree_shows_at_most_one_line() {
+fn a_file_that_is_not_a_tree_quotes_nothing_of_it() {
     let dir = scratch("not-a-tree");
     std::fs::write(dir.join("secret.yaml"), SECRET).unwrap();
     std::fs::write(
         dir.join("multi.txt"),
-        "first line of text\nsecond-line-secret\nthird-line-secret\n",
+        "first-line-secret\nsecond-line-secret\nthird-line-secret\n",
     )
     .unwrap();
-    for (include, first) in [("secret.yaml", "s3cr3t-value-1"), ("multi.txt", "first line")] {
+    // Not a tree, and a syntax error in a file not named `.yaml`: located, never quoted.
+    std::fs::write(dir.join("env"), "TOKEN=s3cr3t-value-1\nx: [s3cr3t-value-2\n").unwrap();
+    let secrets = [
+        "api_token",
+        "s3cr3t-value-1",
+        "s3cr3t-value-2",
+        "s3cr3t-value-3",
+        "first-line",
+        "second-line",
+        "third-line",
+    ];
+    for include in ["secret.yaml", "multi.txt", "env"] {
         // Inside the tree folder, and outside it with the flag: the same rule.
         for (tree, flag) in [
             (tree_including(&dir, include), None),
@@ -132,19 +145,26 @@ fn a_file_that_is_not_a_tree_shows_at_most_one_line() {
                 2,
                 "one diagnostic and the total: {stderr}"
             );
-            assert!(stderr.contains(first), "the offending line is shown: {stderr}");
-            for other in ["s3cr3t-value-2", "s3cr3t-value-3", "second-line", "third-line"] {
+            assert!(stderr.contains(&format!("{include}:")), "located: {stderr}");
+            for other in secrets {
                 assert!(!stderr.contains(other), "{include}: showed {other:?}: {stderr}");
             }
         }
     }
-    // The main file too.
-    let out = macrotree(&["validate", s(&dir.join("secret.yaml"))]);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(
-        !stderr.contains("s3cr3t-value-2") && !stderr.contains("s3cr3t-value-3"),
-        "{stderr}"
-    );
+    // The main file too, as a tree and as a scene.
+    for file in ["secret.yaml", "multi.txt", "env"] {
+        let path = dir.join(file);
+        for args in [
+            vec!["validate", s(&path)],
+            vec!["run", "trees/cube_to_bowl.yaml", "--scene", s(&path)],
+        ] {
+            let out = macrotree(&args);
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(2), "{stderr}");
+            for other in secrets {
+                assert!(!stderr.contains(other), "{args:?} showed {other:?}: {stderr}");
+            }
+        }
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
