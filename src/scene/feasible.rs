@@ -1,12 +1,27 @@
 //! Scenes whose task can never be done are refused at load, located: a scene without a block
 //! (nothing to pick), goals that stack blocks in a cycle (`a on b`, `b on a`), and a block
-//! wider than the inside of the container it must end in, two blocks whose `at` goals overlap.
+//! wider than the inside of the container it must end in, two blocks whose `at` goals overlap,
+//! and an `at` goal (judged on the table or a container's floor) inside the footprint of a
+//! fixed obstacle too low to put the block under — a spot there is a set-down place on the
+//! obstacle's top, never an `at` place.
 
 use std::collections::BTreeMap;
 
 use super::goal::GoalAtom;
-use super::types::{SceneSpec, Shape};
+use super::types::{ObjectSpec, SceneSpec, Shape};
 use crate::yaml::diag::{Issue, Loc};
+
+/// The first obstacle with a fixed pose (and no `random:`) whose footprint contains the point
+/// `p` (metres) and whose underside is less than `height` metres above the table: a block that
+/// tall cannot rest on the table at `p`.
+pub(super) fn obstacle_over(scene: &SceneSpec, p: [f64; 2], height: f64) -> Option<&ObjectSpec> {
+    scene.objects.iter().find(|o| {
+        matches!(o.shape, Shape::Obstacle { .. })
+            && o.random.is_none()
+            && o.pose
+                .is_some_and(|pose| o.z < height && o.shape.footprint(&pose).distance_to_point(p) == 0.0)
+    })
+}
 
 /// A scene without a block: the issue at `objects:` (`at`).
 pub(super) fn check_has_block(scene: &SceneSpec, at: Loc, issues: &mut Vec<Issue>) {
@@ -83,6 +98,34 @@ pub(super) fn check_goal_feasible(scene: &SceneSpec, atoms: &[(GoalAtom, Loc)], 
                     .help("make the block smaller or the container wider (see docs/scenes.md)"),
                 );
             }
+        }
+    }
+    // An `at` goal inside a fixed obstacle that stands on the table (or too low to go under):
+    // `at` is judged on the table, and a block set down there rests on the obstacle's top.
+    for (a, loc) in atoms {
+        let (Some(place), Some(block)) = (a.place(), scene.object(a.object())) else {
+            continue;
+        };
+        if let Some(o) = obstacle_over(scene, place.point, block.shape.height()) {
+            issues.push(
+                Issue::new(
+                    *loc,
+                    format!(
+                        "block `{}` can never be `at` ({}, {}): the point is inside obstacle `{}`'s footprint, whose underside is {:.3} m above the table ({:.3} m needed), and `at` is judged on the table or a container's floor",
+                        a.object(),
+                        place.point[0],
+                        place.point[1],
+                        o.name,
+                        o.z,
+                        block.shape.height()
+                    ),
+                )
+                .label("this goal can never hold")
+                .help(format!(
+                    "move the point or spot out of `{}`'s footprint; a block set down on an obstacle's top is placed there by `place`, not graded by `at`",
+                    o.name
+                )),
+            );
         }
     }
     // Two `at` goals whose places overlap whatever the blocks' yaws, even at the tolerances'

@@ -72,6 +72,34 @@ fn a_stack_can_say_where_its_bottom_block_rests_and_the_list_form_still_reads() 
     assert_eq!(s.goal.atoms[0].to_string(), "red on blue");
 }
 
+/// An `at` goal is judged on the table (or a container's floor), so one inside a fixed
+/// obstacle's footprint — given as a point or as a spot — is refused at load, located at the
+/// goal; one under a board high enough for the block, or a spot on a pedestal (a set-down place
+/// for `place`), is not.
+#[test]
+fn an_at_goal_inside_an_obstacle_is_refused_where_it_is_written() {
+    let cell = |goal: &str| {
+        SceneSpec::from_str(
+            &format!(
+                "objects:\n  red: {{block: {{size: 0.04}}, pose: [0.40, 0.20]}}\n  wall: {{obstacle: {{size: [0.04, 0.30, 0.20]}}, pose: [0.50, 0.0]}}\n  board: {{obstacle: {{size: [0.10, 0.10, 0.02]}}, pose: [0.45, -0.30], z: 0.10}}\nspots:\n  by_wall: [0.50, 0.05]\n  under_board: [0.45, -0.30]\ngoal:\n{goal}"
+            ),
+            "cell.yaml",
+        )
+    };
+    for (goal, column) in [
+        ("  - at: {object: red, point: [0.50, -0.05]}\n", 5),
+        ("  - at: {object: red, spot: by_wall}\n", 5),
+    ] {
+        let d = cell(goal).expect_err(goal);
+        let e = find(&d, "can never be `at`");
+        assert_eq!((e.line, e.column), (9, column), "{e}");
+        assert!(e.message.contains("obstacle `wall`"), "{e}");
+        assert_eq!(d.len(), 1, "{d:#?}");
+    }
+    // Under a board 0.10 m up a 0.04 m block fits: accepted.
+    cell("  - at: {object: red, spot: under_board}\n").expect("a block fits under the board");
+}
+
 #[test]
 fn placement_goal_mistakes_are_located_and_explained() {
     let d = errors("  - at: {object: rde, point: [0.4, 0.1]}\n");
