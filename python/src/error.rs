@@ -11,9 +11,18 @@ create_exception!(
     "Invalid input (a tree, scene or leaf mapping that does not check, a number out of range): the message is located and says what to do."
 );
 
+/// Most characters of an exception's message: several located diagnostics, each bounded by
+/// the library; input quoted anywhere else (a 1 MB layout name) is cut to fit.
+const MAX_MESSAGE_CHARS: usize = 8 * macrotree::yaml::MAX_FIELD_CHARS;
+
+/// `message` cut to [`MAX_MESSAGE_CHARS`].
+fn bounded(message: &str) -> String {
+    macrotree::yaml::cut_text(message, MAX_MESSAGE_CHARS)
+}
+
 /// A library error as a Python exception; `kind` (e.g. `invalid_tree`) is kept as an attribute.
 pub fn to_py(e: macrotree::Error) -> PyErr {
-    let err = MacrotreeError::new_err(e.to_string());
+    let err = MacrotreeError::new_err(bounded(&e.to_string()));
     Python::attach(|py| {
         let _ = err.value(py).setattr("kind", e.kind());
     });
@@ -22,7 +31,7 @@ pub fn to_py(e: macrotree::Error) -> PyErr {
 
 /// A `ValueError` for a malformed argument caught on this side.
 pub fn value(message: impl Into<String>) -> PyErr {
-    pyo3::exceptions::PyValueError::new_err(message.into())
+    pyo3::exceptions::PyValueError::new_err(bounded(&message.into()))
 }
 
 /// `mutex` locked, or a `RuntimeError` when another thread holds it: an environment serves one

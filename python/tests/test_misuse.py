@@ -253,3 +253,17 @@ def test_a_file_that_is_not_a_tree_or_a_scene_is_named_never_quoted(tmp_path: Pa
             message = str(caught.value)
             assert name in message, message
             assert "s3cr3t" not in message and "password" not in message, (as_tree, message)
+
+
+def test_an_error_quoting_hostile_input_stays_short(data: Path) -> None:
+    env = macrotree.MacroEnv(scene(data))
+    env.reset(seed=0)
+    huge = "x" * 100_000
+    with pytest.raises(macrotree.MacrotreeError) as caught:
+        env.step_leaf(json.dumps({"reach": {"target": huge}}))
+    assert len(str(caught.value)) <= 8_000, len(str(caught.value))
+    with pytest.raises((ValueError, macrotree.MacrotreeError)) as refused:
+        env.reset(options={"layout": huge})
+    message = str(refused.value)
+    assert len(message) <= 8_000 and "characters left out" in message, len(message)
+    env.close()

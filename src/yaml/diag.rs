@@ -211,9 +211,11 @@ fn source_window(line: &str, col: u32) -> (String, u32) {
     (sanitize(&shown), column)
 }
 
-/// Replace control characters (except tabs) so that a diagnostic never garbles a terminal.
+/// Replace control characters (except tabs) so that a diagnostic never garbles a terminal, and
+/// cut the text to [`MAX_FIELD_CHARS`].
 fn sanitize(s: &str) -> String {
-    s.chars()
+    cut_text(s, MAX_FIELD_CHARS)
+        .chars()
         .map(|c| {
             if c.is_control() && c != '\t' {
                 '\u{FFFD}'
@@ -381,6 +383,27 @@ impl Sources {
     }
 }
 
+/// Most characters of one field of a diagnostic (its message, label, help or note): input
+/// quoted in it (a 60 KB object name, a 1 MB layout name) is cut to fit.
+pub const MAX_FIELD_CHARS: usize = 1000;
+
+/// `s` when it has at most `max` characters; otherwise its start and its end around a marker
+/// saying how many characters were left out, `max` characters or fewer in all (a message never
+/// grows with hostile input).
+pub fn cut_text(s: &str, max: usize) -> String {
+    let n = s.chars().count();
+    if n <= max {
+        return s.to_string();
+    }
+    let marker = format!(" … ({} characters left out) … ", n - max);
+    let keep = max.saturating_sub(marker.chars().count());
+    let head = keep * 3 / 4;
+    let tail = keep - head;
+    let start: String = s.chars().take(head).collect();
+    let end: String = s.chars().skip(n - tail).collect();
+    format!("{start}{marker}{end}")
+}
+
 /// A number as a message shows it: as given up to 12 characters, else in scientific notation
 /// with 4 significant digits (a hostile 1e300 or 1e-300 is not printed as 301 digits).
 pub fn short_number(x: f64) -> String {
@@ -395,6 +418,25 @@ pub fn short_number(x: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn cut_text_bounds_hostile_input_and_says_how_much_it_left_out() {
+        assert_eq!(cut_text("short", 10), "short");
+        let long = format!("unknown object `{}`", "a".repeat(60_000));
+        let cut = cut_text(&long, MAX_FIELD_CHARS);
+        assert!(cut.chars().count() <= MAX_FIELD_CHARS, "{}", cut.len());
+        assert!(
+            cut.starts_with("unknown object `aaa") && cut.ends_with("aaa`"),
+            "{cut}"
+        );
+        assert!(cut.contains(&format!(
+            "({} characters left out)",
+            long.chars().count() - MAX_FIELD_CHARS
+        )));
+        // Characters, not bytes: a multi-byte text is never split inside a character.
+        let wide = "é".repeat(5000);
+        assert!(cut_text(&wide, 100).chars().count() <= 100);
+    }
 
     #[test]
     fn display_is_rustc_like() {

@@ -17,7 +17,7 @@ mod table_pose;
 pub mod units;
 pub mod value;
 
-pub use diag::{Diagnostic, Issue, Loc, Sources, short_number};
+pub use diag::{Diagnostic, Issue, Loc, MAX_FIELD_CHARS, Sources, cut_text, short_number};
 pub use ident::is_identifier;
 pub use read::read_limited;
 pub use table_pose::TablePose;
