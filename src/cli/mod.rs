@@ -6,6 +6,7 @@
 
 mod args;
 mod bench;
+mod breakpoints;
 mod dataset;
 mod graph;
 mod human;

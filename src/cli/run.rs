@@ -292,8 +292,13 @@ pub fn run(app: &crate::App, args: RunArgs) -> Result<(), CliError> {
         }
         (false, None) => None,
     };
-    // A --break pattern that matches no node is refused before the viewer starts.
-    crate::viewer::Monitor::new(&plan, &args.breaks).map_err(|e| CliError::Input(format!("error: {e}")))?;
+    // A --break pattern that matches no node is refused before the viewer starts; a live view
+    // also pauses at the tree file's own `breakpoints:` (checked the same way, located).
+    let mut breaks = args.breaks.clone();
+    if args.view {
+        breaks.extend(super::breakpoints::declared(&plan).map_err(|d| super::invalid(d, plan.file.clone()))?);
+    }
+    crate::viewer::Monitor::new(&plan, &breaks).map_err(|e| CliError::Input(format!("error: {e}")))?;
     let live = if args.view {
         let opts = ViewerOptions {
             port: args.port,
@@ -319,7 +324,7 @@ pub fn run(app: &crate::App, args: RunArgs) -> Result<(), CliError> {
     let mut frame_recorder = recorder_for_frames.take();
     let report = if live.is_some() || recorder.is_some() || speed.is_some() {
         let mut view = ViewObserver::new(&plan, live, recorder, speed);
-        view.set_breakpoints(&plan, &args.breaks)
+        view.set_breakpoints(&plan, &breaks)
             .map_err(|e| CliError::Input(format!("error: {e}")))?;
         let report = match frame_recorder.as_mut() {
             Some(frames) => run_episode(

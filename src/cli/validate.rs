@@ -127,12 +127,16 @@ fn check_file(
             ),
             warnings: c.plan.warnings,
         }),
-        FileKind::Tree => app.loader().load_for(path, scene.cloned()).map(|p| Valid {
-            nodes: p.nodes.len(),
-            leaves: p.leaves.len(),
-            summary: format!("{} nodes, {} leaves", p.nodes.len(), p.leaves.len()),
-            warnings: p.warnings,
-        }),
+        FileKind::Tree => {
+            let p = app.loader().load_for(path, scene.cloned())?;
+            super::breakpoints::declared(&p)?;
+            Ok(Valid {
+                nodes: p.nodes.len(),
+                leaves: p.leaves.len(),
+                summary: format!("{} nodes, {} leaves", p.nodes.len(), p.leaves.len()),
+                warnings: p.warnings,
+            })
+        }
     }
 }
 

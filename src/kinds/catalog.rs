@@ -285,7 +285,10 @@ impl Registry {
                         "additionalProperties": false
                     }
                 },
-                "main": {"$ref": "#/$defs/Node"}
+                "main": {"$ref": "#/$defs/Node"},
+                "breakpoints": {"description": "Where a live monitor (`run --view`) pauses, as `--break` does: node path globs, each optionally ending in `@before` (the default) or `@after`.",
+                                "type": "array",
+                                "items": {"type": "string", "minLength": 1}}
             },
             "additionalProperties": false,
             "$defs": Value::Object(defs),

@@ -29,6 +29,7 @@ pub fn compile_spec(spec: &Spec) -> Result<Plan, Vec<Diagnostic>> {
         internal: c.internal,
         file: spec.sources.name(0).to_string(),
         description: spec.description.clone(),
+        breakpoints: spec.breakpoints.clone(),
         scene: spec.scene_spec.clone(),
         warnings: spec.warnings.clone(),
         inputs: spec.inputs(),

@@ -205,6 +205,9 @@ pub struct Plan {
     pub file: String,
     /// The tree's `description:`, if any.
     pub description: Option<String>,
+    /// The tree file's `breakpoints:`, for the live monitor (`run --view` pauses there as at
+    /// `--break`); nothing else reads them.
+    pub breakpoints: Vec<crate::spec::DeclaredBreakpoint>,
     /// The scene the tree's object names were checked against, which it runs on.
     pub scene: std::sync::Arc<crate::scene::SceneSpec>,
     /// Warnings about the tree file: accepted, but probably not what was meant.

@@ -99,6 +99,7 @@ impl Plan {
             internal,
             file: self.file.clone(),
             description: self.description.clone(),
+            breakpoints: Vec::new(),
             scene: self.scene.clone(),
             warnings: Vec::new(),
             inputs: self.inputs.clone(),

@@ -6,7 +6,18 @@ use crate::yaml::suggest::did_you_mean;
 use crate::yaml::value::{Value, ValueKind};
 
 /// Keys allowed at the top level of a tree file.
-pub const TOP_LEVEL_KEYS: &[&str] = &["description", "scene", "include", "subtrees", "main"];
+pub const TOP_LEVEL_KEYS: &[&str] = &[
+    "description",
+    "scene",
+    "include",
+    "subtrees",
+    "main",
+    "breakpoints",
+];
+/// Most `breakpoints:` entries of a tree file.
+pub const MAX_BREAKPOINTS: usize = 64;
+/// Most characters of one `breakpoints:` entry.
+pub const MAX_BREAKPOINT_CHARS: usize = 512;
 /// Keys allowed in a subtree definition.
 pub const SUBTREE_KEYS: &[&str] = &["params", "root", "description"];
 
@@ -60,6 +71,23 @@ pub struct TreeFile {
     pub scene: Option<(String, Loc)>,
     /// `description:`: what the tree does, one line (the task string of datasets and reports).
     pub description: Option<String>,
+    /// `breakpoints:` entries (text and where each is written), for the live monitor.
+    pub breakpoints: Vec<(String, Loc)>,
+}
+
+/// One `breakpoints:` entry of a tree file, as written: `PATTERN`, `PATTERN@before` or
+/// `PATTERN@after` (the syntax of `run --view --break`), checked against the tree's nodes by
+/// the command that serves the monitor.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct DeclaredBreakpoint {
+    /// The entry as written.
+    pub text: String,
+    /// The file it is written in.
+    pub file: String,
+    /// 1-based line.
+    pub line: u32,
+    /// 1-based column.
+    pub column: u32,
 }
 
 /// If `s` is a parameter reference `$name`, return `name`.
@@ -103,11 +131,12 @@ pub fn parse_tree_file(v: &Value, issues: &mut Vec<Issue>) -> Option<TreeFile> {
                     ),
                 ),
             },
+            Some("breakpoints") => parse_breakpoints(val, &mut out.breakpoints, issues),
             Some(other) => issues.push(
                 Issue::new(k.loc, format!("unknown top-level key `{other}`"))
-                    .label("expected `description`, `scene`, `include`, `subtrees` or `main`")
+                    .label("expected `description`, `scene`, `include`, `subtrees`, `main` or `breakpoints`")
                     .maybe_help(did_you_mean(other, TOP_LEVEL_KEYS.iter().copied()))
-                    .help_or("remove it; a tree file has only `description:`, `scene:`, `include:`, `subtrees:` and `main:`"),
+                    .help_or("remove it; a tree file has only `description:`, `scene:`, `include:`, `subtrees:`, `main:` and `breakpoints:`"),
             ),
             None => issues.push(
                 Issue::new(
@@ -119,6 +148,47 @@ pub fn parse_tree_file(v: &Value, issues: &mut Vec<Issue>) -> Option<TreeFile> {
         }
     }
     Some(out)
+}
+
+/// `breakpoints: [PATTERN, PATTERN@after, …]`: text entries, at most [`MAX_BREAKPOINTS`] of
+/// at most [`MAX_BREAKPOINT_CHARS`] characters each.
+fn parse_breakpoints(v: &Value, out: &mut Vec<(String, Loc)>, issues: &mut Vec<Issue>) {
+    let expected = "expected a list of node path globs, each optionally ending in `@before` or `@after`, e.g. `[\"main/**/grasp\", \"main/**/carry@after\"]`";
+    let Some(items) = v.as_seq() else {
+        issues.push(
+            Issue::new(
+                v.loc,
+                format!("`breakpoints` must be a list, found {}", v.describe()),
+            )
+            .label(expected),
+        );
+        return;
+    };
+    if items.len() > MAX_BREAKPOINTS {
+        issues.push(Issue::new(
+            v.loc,
+            format!("at most {MAX_BREAKPOINTS} breakpoints, found {}", items.len()),
+        ));
+        return;
+    }
+    for item in items {
+        match item.as_str() {
+            Some(s) if !s.is_empty() && s.chars().count() <= MAX_BREAKPOINT_CHARS => {
+                out.push((s.to_string(), item.loc));
+            }
+            Some(_) => issues.push(Issue::new(
+                item.loc,
+                format!("a breakpoint is 1 to {MAX_BREAKPOINT_CHARS} characters"),
+            )),
+            None => issues.push(
+                Issue::new(
+                    item.loc,
+                    format!("a breakpoint must be text, found {}", item.describe()),
+                )
+                .label(expected),
+            ),
+        }
+    }
 }
 
 impl Issue {

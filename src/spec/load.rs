@@ -37,6 +37,8 @@ pub struct Spec {
     pub scene_spec: Arc<SceneSpec>,
     /// The main file's `description:`.
     pub description: Option<String>,
+    /// The main file's `breakpoints:`, for the live monitor.
+    pub breakpoints: Vec<super::file::DeclaredBreakpoint>,
     /// Every object a leaf names or reads from the blackboard (checked against a scene by
     /// the loader when the tree is compiled).
     pub object_uses: Vec<super::check::ObjectUse>,
@@ -323,6 +325,16 @@ impl TreeReader {
                 let mut files: Vec<PathBuf> = self.loaded.into_iter().collect();
                 files.sort();
                 let warnings = self.sources.warnings(&warnings);
+                let breakpoints = root_file
+                    .breakpoints
+                    .iter()
+                    .map(|(text, loc)| super::file::DeclaredBreakpoint {
+                        text: text.clone(),
+                        file: self.sources.name(loc.file).to_string(),
+                        line: loc.line,
+                        column: loc.col,
+                    })
+                    .collect();
                 Ok(Spec {
                     root,
                     sources: self.sources,
@@ -330,6 +342,7 @@ impl TreeReader {
                     scene: root_file.scene.clone(),
                     scene_spec: scene.unwrap_or_else(builtin_scene),
                     description: root_file.description.clone(),
+                    breakpoints,
                     object_uses,
                     var_defs,
                     files,

@@ -19,7 +19,7 @@ mod node;
 pub use crate::yaml::{Diagnostic, Issue, Loc, Sources};
 pub use check::{Named, ObjectUse, VarDef, VarType};
 pub use expand::{MAX_LEAF_ERRORS, MAX_LEAF_FILE_BYTES, MAX_TREE_DEPTH, MAX_TREE_NODES};
-pub use file::{IncludeRef, ParamDef, SubtreeDef};
+pub use file::{DeclaredBreakpoint, IncludeRef, MAX_BREAKPOINTS, ParamDef, SubtreeDef};
 pub(crate) use load::{LoadOptions, Source, load};
 pub use load::{MAX_FILES, MAX_INCLUDE_DEPTH, Spec, builtin_scene};
 pub use node::{Node, NodeKind};

@@ -571,19 +571,7 @@ impl ScenarioFile {
     /// An error in this file at `at` (the file's start when unknown).
     fn diagnostic(&self, at: Option<&PatternAt>, message: String) -> Diagnostic {
         let (line, column) = at.map_or((1, 1), |a| (a.line, a.column));
-        Diagnostic {
-            file: self.path.display().to_string(),
-            line,
-            column,
-            message,
-            label: None,
-            help: None,
-            note: None,
-            source_line: None,
-            source_column: column,
-            width: 1,
-            warning: false,
-        }
+        Diagnostic::at(self.path.display().to_string(), line, column, message)
     }
 }
 

@@ -202,7 +202,7 @@ impl Monitor {
             if !matched {
                 let close = crate::runtime::substitute::close_paths(plan, &spec.pattern);
                 return Err(format!(
-                    "--break {spec}: the pattern matches no node of the tree; paths close to it: {}",
+                    "breakpoint {spec}: the pattern matches no node of the tree; paths close to it: {}",
                     close.join(", ")
                 ));
             }

@@ -79,6 +79,24 @@ pub struct Diagnostic {
 }
 
 impl Diagnostic {
+    /// An error at `file:line:column` whose source line is not at hand (a file read earlier):
+    /// no quote, no label, help or note.
+    pub fn at(file: impl Into<String>, line: u32, column: u32, message: impl Into<String>) -> Self {
+        Self {
+            file: file.into(),
+            line,
+            column,
+            message: sanitize(&message.into()),
+            label: None,
+            help: None,
+            note: None,
+            source_line: None,
+            source_column: column,
+            width: 1,
+            warning: false,
+        }
+    }
+
     /// `file:line:column`, the way editors and terminals make it clickable.
     pub fn location(&self) -> String {
         format!("{}:{}:{}", self.file, self.line, self.column)

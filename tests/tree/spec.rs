@@ -347,6 +347,28 @@ fn missing_main_and_unknown_top_level_keys() {
     find(&d, "no `main:` tree");
 }
 
+/// `breakpoints:` is a list of text entries, each located when malformed (its patterns are
+/// matched against the tree by `validate` and `run --view`).
+#[test]
+fn breakpoints_are_a_list_of_located_text_entries() {
+    let plan = macrotree::plan::Loader::default()
+        .compile_str(
+            "main: {home: {}}\nbreakpoints: [\"main/home\", \"main/home@after\"]\n",
+            "bp.yaml",
+        )
+        .unwrap();
+    let written: Vec<(&str, u32, u32)> = plan
+        .breakpoints
+        .iter()
+        .map(|b| (b.text.as_str(), b.line, b.column))
+        .collect();
+    assert_eq!(written, [("main/home", 2, 15), ("main/home@after", 2, 28)]);
+    let d = errors("main: {home: {}}\nbreakpoints: 3\n");
+    assert_eq!(at(find(&d, "`breakpoints` must be a list")), (2, 14));
+    let d = errors("main: {home: {}}\nbreakpoints: [main/home, {a: 1}]\n");
+    assert_eq!(at(find(&d, "a breakpoint must be text")), (2, 26));
+}
+
 #[test]
 fn calling_a_subtree_by_its_name_as_a_kind_gets_help() {
     let d = errors("subtrees:\n  pick: {root: {home: {}}}\nmain: {pick: {}}\n");

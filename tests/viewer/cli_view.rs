@@ -145,10 +145,16 @@ fn view_addr(line: &str) -> Option<String> {
     Some(line[i + 7..].split(['/', ' ']).next()?.to_string())
 }
 
-/// Starts `run TREE --view --port 0 EXTRA…`; returns the server, its output and its `host:port`.
+/// Starts `run trees/cube_to_bowl.yaml --view --port 0 EXTRA…`; returns the server, its output
+/// and its `host:port`.
 fn start_view(extra: &[&str]) -> (Killed, StderrLines, String) {
+    start_view_of("trees/cube_to_bowl.yaml", extra)
+}
+
+/// Starts `run TREE --view --port 0 EXTRA…`; returns the server, its output and its `host:port`.
+fn start_view_of(tree: &str, extra: &[&str]) -> (Killed, StderrLines, String) {
     let mut child = macrotree()
-        .args(["run", "trees/cube_to_bowl.yaml", "--view", "--port", "0"])
+        .args(["run", tree, "--view", "--port", "0"])
         .args(extra)
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
@@ -226,6 +232,66 @@ fn view_serves_the_page_and_keeps_serving_after_the_episode() {
     // Still serving: a second request after the episode is answered too.
     assert!(http_get(&addr, "/").starts_with("HTTP/1.1 200"));
     drop(child);
+}
+
+/// A tree file's `breakpoints:` pause `run --view` as `--break` does: the episode holds at the
+/// first `home` until the page (here a websocket client sending the page's message) resumes it,
+/// then ends with the tree's result. A pattern that matches no node is refused, located at its
+/// entry, by `validate` and by `run --view` before serving.
+#[test]
+fn breakpoints_declared_in_the_tree_file_pause_run_view_until_resumed() {
+    let dir = std::env::temp_dir().join(format!("macrotree-declared-break-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let flagship =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/trees/cube_to_bowl.yaml")).unwrap();
+    let tree = dir.join("paused.yaml");
+    std::fs::write(&tree, format!("{flagship}\nbreakpoints: [\"main/*/home#1\"]\n")).unwrap();
+    let (server, lines, addr) = start_view_of(tree.to_str().unwrap(), &[]);
+    // Held at the breakpoint: no end of the episode for 3 s.
+    let before = lines.collect_for(Duration::from_secs(3));
+    assert!(
+        !before.iter().any(|l| l.contains("still serving")),
+        "the episode did not hold at its declared breakpoint: {before:?}"
+    );
+    let mut ws = crate::websocket::connect(addr.parse().unwrap());
+    ws.send(tungstenite::Message::text(r#"{"type":"monitor","op":"resume"}"#))
+        .unwrap();
+    // Read what the server sends, as the page does (a client that stops reading is dropped).
+    std::thread::spawn(move || while ws.read().is_ok() {});
+    let deadline = Instant::now() + Duration::from_secs(120);
+    let after: Vec<String> = std::iter::from_fn(|| lines.next_by(deadline, "the end of the episode"))
+        .take_while(|line| !line.contains("still serving"))
+        .collect();
+    assert!(
+        after.iter().any(|l| l.contains("success")),
+        "the resumed episode did not succeed: {after:?}"
+    );
+    drop(server);
+
+    // A declared pattern that matches nothing: located at its entry, before serving.
+    let bad = dir.join("bad.yaml");
+    std::fs::write(&bad, format!("{flagship}\nbreakpoints:\n  - \"main/**/grsap\"\n")).unwrap();
+    let line = flagship.lines().count() + 3;
+    for args in [
+        vec!["validate", bad.to_str().unwrap()],
+        vec!["run", bad.to_str().unwrap(), "--view", "--port", "0"],
+    ] {
+        let mut cmd = macrotree();
+        cmd.args(&args);
+        let out = output_within(cmd, Duration::from_secs(60));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains(&format!("bad.yaml:{line}:5")),
+            "{args:?}: {stderr}"
+        );
+        assert!(
+            stderr.contains("matches no node") && stderr.contains("grasp"),
+            "{stderr}"
+        );
+        assert!(!stderr.contains("live view:"), "refused before serving: {stderr}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
