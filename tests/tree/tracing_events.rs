@@ -1,6 +1,6 @@
 //! Exactly one `tracing` event per node status transition, with the documented fields.
 
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use macrotree::plan::Loader;
 use macrotree::runtime::scripted::ScriptedDriver;
@@ -24,20 +24,46 @@ impl Visit for Recorded {
     }
 }
 
-struct Collect(Arc<Mutex<Vec<Recorded>>>);
+thread_local! {
+    /// The tree events this thread recorded, while inside [`recorded`].
+    static EVENTS: std::cell::RefCell<Option<Vec<Recorded>>> = const { std::cell::RefCell::new(None) };
+}
+
+/// Records `macrotree::tree` events into the emitting thread's [`EVENTS`].
+struct Collect;
 
 impl<S: tracing::Subscriber> Layer<S> for Collect {
     fn on_event(&self, event: &tracing::Event<'_>, _ctx: Context<'_, S>) {
         if event.metadata().target() != "macrotree::tree" {
             return;
         }
-        let mut r = Recorded {
-            level: event.metadata().level().to_string(),
-            ..Default::default()
-        };
-        event.record(&mut r);
-        self.0.lock().unwrap().push(r);
+        EVENTS.with(|events| {
+            if let Some(events) = events.borrow_mut().as_mut() {
+                let mut r = Recorded {
+                    level: event.metadata().level().to_string(),
+                    ..Default::default()
+                };
+                event.record(&mut r);
+                events.push(r);
+            }
+        });
     }
+}
+
+/// Runs `f` and returns what it returned and the tree events this thread emitted meanwhile.
+/// One global subscriber serves the whole test binary: a scoped one (`with_default`) races
+/// with the tests running beside it on tracing's shared callsite-interest cache and can miss
+/// events.
+fn recorded<R>(f: impl FnOnce() -> R) -> (R, Vec<Recorded>) {
+    static INSTALL: std::sync::Once = std::sync::Once::new();
+    INSTALL.call_once(|| {
+        tracing::subscriber::set_global_default(Registry::default().with(Collect))
+            .expect("no other global subscriber in this test binary");
+    });
+    EVENTS.with(|e| *e.borrow_mut() = Some(Vec::new()));
+    let result = f();
+    let events = EVENTS.with(|e| e.borrow_mut().take()).unwrap_or_default();
+    (result, events)
 }
 
 impl Recorded {
@@ -77,11 +103,10 @@ fn one_event_per_transition_with_fields() {
             LeafOutcome::Success,
         ],
     );
-    let events = Arc::new(Mutex::new(Vec::new()));
-    let subscriber = Registry::default().with(Collect(events.clone()));
+
     let mut runner = TreeRunner::new(plan.clone());
     let mut transitions = Vec::new();
-    tracing::subscriber::with_default(subscriber, || {
+    let ((), events) = recorded(|| {
         for i in 0..20 {
             let s = runner.tick(i as f64 * 0.1, 0.1, &mut d);
             transitions.extend(runner.drain_transitions());
@@ -91,7 +116,6 @@ fn one_event_per_transition_with_fields() {
             }
         }
     });
-    let events = events.lock().unwrap();
     let status_events: Vec<&Recorded> = events.iter().filter(|e| e.get("to").is_some()).collect();
     assert_eq!(status_events.len(), transitions.len(), "one event per transition");
     for (e, t) in status_events.iter().zip(&transitions) {
