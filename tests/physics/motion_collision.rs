@@ -213,9 +213,21 @@ fn the_check_budget_is_a_hard_deterministic_cap_ending_in_no_path_naming_the_pos
     };
     let e = plan(&mut c, &start, &goals, &config).unwrap_err();
     match &e.reason {
-        PlanFailure::SearchExhausted { checks, blocking, .. } => {
+        PlanFailure::SearchExhausted {
+            spent,
+            checks,
+            blocking,
+            ..
+        } => {
             assert!(*checks <= 120, "{checks} checks past the budget");
             assert!(blocking.iter().any(|(h, _)| h.b == "post"), "{e}");
+            // The message says the check budget ran out, not that the motion cannot exist.
+            assert_eq!(*spent, macrotree::motion::plan::SearchBudget::Checks(120));
+            assert!(
+                e.to_string()
+                    .contains("collision-check budget (120, `max_checks`) ran out"),
+                "{e}"
+            );
         }
         r => panic!("expected search_exhausted, got {r}"),
     }

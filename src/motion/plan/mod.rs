@@ -52,7 +52,7 @@ pub use checker::{Collision, CollisionChecker};
 pub use config::{JointLimits, PlannerConfig, UR5E_RATED_JOINT_SPEED};
 pub use goal::GoalSet;
 pub use planner::{PlannedMotion, SPARE_CAP, plan};
-pub use reason::{PlanError, PlanFailure};
+pub use reason::{PlanError, PlanFailure, SearchBudget};
 pub use spare::JointSpare;
 pub use stats::PlanStats;
 pub use timing::PathTrajectory;

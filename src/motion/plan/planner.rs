@@ -8,7 +8,7 @@ use super::checker::{CollisionChecker, Counting};
 use super::config::PlannerConfig;
 use super::edge::check_segment;
 use super::goal::GoalSet;
-use super::reason::{PlanError, PlanFailure, tally};
+use super::reason::{PlanError, PlanFailure, SearchBudget, tally};
 use super::rrt::{Search, rrt_connect};
 use super::shortcut::shortcut;
 use super::stats::{PlanStats, distance, path_length};
@@ -252,6 +252,15 @@ fn attempt<C: CollisionChecker + ?Sized>(
         match outcome {
             Search::Found { path, goal } => found = Some((path, free[goal])),
             Search::Exhausted => {
+                // Which budget ended it: the checks (counted over the whole query, so they may
+                // have run out before the search began), the nodes, or the iterations.
+                let spent = if checker.checks >= config.max_checks {
+                    SearchBudget::Checks(config.max_checks)
+                } else if log.nodes >= config.max_nodes {
+                    SearchBudget::Nodes(config.max_nodes)
+                } else {
+                    SearchBudget::Iterations(config.max_iterations)
+                };
                 let named: Vec<_> = direct_hits
                     .iter()
                     .take(NAMED_GOALS)
@@ -259,6 +268,7 @@ fn attempt<C: CollisionChecker + ?Sized>(
                     .map(|q| checker.collisions(q))
                     .collect();
                 let reason = PlanFailure::SearchExhausted {
+                    spent,
                     iterations: log.iterations,
                     nodes: log.nodes,
                     checks: checker.checks,

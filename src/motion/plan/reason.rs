@@ -39,6 +39,8 @@ pub enum PlanFailure {
     /// The search used its iteration, node or collision-check budget without connecting start
     /// and goal (deterministic: the same query always ends here).
     SearchExhausted {
+        /// The budget that ran out.
+        spent: SearchBudget,
         /// Iterations run.
         iterations: usize,
         /// Nodes in both trees.
@@ -58,6 +60,33 @@ pub enum PlanFailure {
         /// Iterations run before it.
         iterations: usize,
     },
+}
+
+/// Which of a search's budgets ran out, with its limit ([`super::PlannerConfig`]'s
+/// `max_iterations`, `max_nodes` or `max_checks`).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum SearchBudget {
+    /// The iteration budget.
+    Iterations(usize),
+    /// The node budget (both trees together).
+    Nodes(usize),
+    /// The collision-check budget of the whole query: the start, the goals and the direct
+    /// segments are checked first and count against it, so a small budget can leave the search
+    /// none at all. Checks refused past it are not collisions.
+    Checks(u64),
+}
+
+impl fmt::Display for SearchBudget {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SearchBudget::Iterations(n) => write!(f, "its iteration budget ({n}) ran out"),
+            SearchBudget::Nodes(n) => write!(f, "its node budget ({n}) ran out"),
+            SearchBudget::Checks(n) => write!(
+                f,
+                "its collision-check budget ({n}, `max_checks`) ran out — raise it if the motion should exist"
+            ),
+        }
+    }
 }
 
 impl PlanFailure {
@@ -116,13 +145,14 @@ impl fmt::Display for PlanFailure {
                 counted(collisions)
             ),
             PlanFailure::SearchExhausted {
+                spent,
                 iterations,
                 nodes,
                 checks,
                 blocking,
             } => write!(
                 f,
-                "no collision-free path found in {iterations} iterations ({nodes} nodes, {checks} collision checks); blocked most by {}",
+                "no collision-free path found: {spent} after {iterations} iterations ({nodes} nodes, {checks} collision checks); blocked most by {}",
                 counted(blocking)
             ),
             PlanFailure::TimeCap { cap_s, iterations } => write!(

@@ -230,11 +230,13 @@ fn a_disconnected_goal_exhausts_the_search_and_names_what_blocked_it() {
     .unwrap_err();
     match &e.reason {
         PlanFailure::SearchExhausted {
+            spent,
             iterations,
             nodes,
             blocking,
             ..
         } => {
+            assert_eq!(*spent, super::SearchBudget::Iterations(300));
             assert_eq!(*iterations, 300);
             assert!(*nodes > 2);
             assert_eq!(blocking[0].0.pair(), "arm–fence");
