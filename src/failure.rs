@@ -299,6 +299,13 @@ impl Failure {
         f
     }
 
+    /// The same failure with what to change appended to its message (`…; help: raise
+    /// \`lift:\` …`), as a loader diagnostic ends with its `help:`.
+    pub fn with_help(mut self, help: &str) -> Self {
+        self.message = format!("{}; help: {help}", self.message);
+        self
+    }
+
     /// The same failure with its message prefixed (`grasp: ` + message).
     pub fn prefixed(mut self, prefix: &str) -> Self {
         self.message = format!("{prefix}{}", self.message);

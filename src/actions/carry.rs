@@ -616,7 +616,7 @@ impl Carry {
         };
         let motion = super::planning::plan_motion(
             cell,
-            "carry transfer",
+            super::plan_help::PlanFor::Transfer { lift: self.spec.lift },
             from,
             &goals,
             self.spec.plan_budget(),

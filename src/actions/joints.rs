@@ -2,6 +2,7 @@
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
+use super::plan_help::PlanFor;
 use super::planning::{check_motion, describe, plan_motion};
 use crate::failure::FailureKind;
 use crate::kinds::PlanBudget;
@@ -53,7 +54,7 @@ impl MacroAction for MoveJoints {
             // exactly these joint angles.
             tracing::debug!(target: "macrotree::actions", "move_joints: the direct joint move would touch {}; planning", describe(&pairs));
             let goals = GoalSet::configs(vec![self.goal_q]);
-            let motion = match plan_motion(cell, "move_joints", &from, &goals, self.budget, None) {
+            let motion = match plan_motion(cell, PlanFor::Joints, &from, &goals, self.budget, None) {
                 Err(e) if e.kind == FailureKind::NoPath && self.budget.max_checks.is_none() => {
                     let checks = SECOND_SEARCH_BUDGET * PlannerConfig::default().max_checks;
                     tracing::debug!(target: "macrotree::actions", "move_joints: {e}; searching once more with {checks} checks");
@@ -61,7 +62,7 @@ impl MacroAction for MoveJoints {
                         max_checks: Some(checks),
                         ..self.budget
                     };
-                    plan_motion(cell, "move_joints", &from, &goals, budget, None)?
+                    plan_motion(cell, PlanFor::Joints, &from, &goals, budget, None)?
                 }
                 planned => planned?,
             };

@@ -15,6 +15,7 @@ mod joints;
 mod macro_action;
 mod packing;
 mod place;
+mod plan_help;
 mod planning;
 #[cfg(feature = "policy")]
 pub mod policy;

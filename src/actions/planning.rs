@@ -24,6 +24,7 @@ use std::time::{Duration, Instant};
 use serde::Serialize;
 
 use super::cell::Cell;
+use super::plan_help::{PlanFor, plan_help};
 use crate::failure::Failure;
 use crate::kinds::PlanBudget;
 use crate::motion::Trajectory;
@@ -350,7 +351,7 @@ pub(crate) const LEAF_TIME_CAP: Duration = Duration::from_secs(2);
 /// The planner's typed failure ([`crate::sim::planning::plan_failure`]).
 pub(crate) fn plan_motion(
     cell: &mut Cell,
-    what: &str,
+    what: PlanFor,
     start: &[f64; 6],
     goals: &GoalSet,
     budget: PlanBudget,
@@ -365,11 +366,20 @@ pub(crate) fn plan_motion(
     let Some(checker) = cell.checker() else {
         return Err(Failure::new(
             crate::failure::FailureKind::NoPath,
-            format!("{what}: the direct motion collides and the cell has no collision checker to plan with"),
+            format!(
+                "{}: the direct motion collides and the cell has no collision checker to plan with",
+                what.name()
+            ),
         ));
     };
     let mut allow = Allowing::new(checker, start, &[], false);
-    let result = crate::sim::planning::plan_in_cell(&mut allow, start, goals, &config);
+    let result = crate::sim::planning::plan_in_cell(&mut allow, start, goals, &config).map_err(|e| {
+        let f = crate::sim::planning::plan_failure(&e);
+        match plan_help(&e.reason, what, budget) {
+            Some(help) => f.with_help(&help),
+            None => f,
+        }
+    });
     let checks = allow.checks;
     let tally = cell.planning_mut();
     tally.plans += 1;
@@ -377,11 +387,11 @@ pub(crate) fn plan_motion(
     tally.add_time(t.elapsed());
     match &result {
         Ok(m) => {
-            tracing::debug!(target: "macrotree::plan", sim_time, "plan {what}: {} goals; {}", goals.len(), m.stats.summary());
+            tracing::debug!(target: "macrotree::plan", sim_time, "plan {}: {} goals; {}", what.name(), goals.len(), m.stats.summary());
         }
         Err(f) => {
             tally.plan_failures += 1;
-            tracing::debug!(target: "macrotree::plan", sim_time, "plan {what}: {} goals; failed: {f}", goals.len());
+            tracing::debug!(target: "macrotree::plan", sim_time, "plan {}: {} goals; failed: {f}", what.name(), goals.len());
         }
     }
     result

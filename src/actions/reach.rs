@@ -4,6 +4,7 @@ use nalgebra::{Isometry3, Translation3, Vector3};
 
 use super::cell::Cell;
 use super::macro_action::{Arrival, MacroAction, Progress};
+use super::plan_help::PlanFor;
 use super::planning::{arm_link, check_motion, check_straight, describe, look_ahead_clear, plan_motion};
 use super::targets::{resolve, segment_distance, target_block, target_object, tool_yaw};
 use crate::failure::{Failure, FailureKind};
@@ -117,12 +118,12 @@ impl Reach {
         offset: Vector3<f64>,
     ) -> Result<(), Failure> {
         let goals = GoalSet::down(position, yaw, quarter, from);
-        let mut motion = plan_motion(cell, "reach", from, &goals, self.spec.plan_budget(), None)?;
+        let mut motion = plan_motion(cell, PlanFor::Reach, from, &goals, self.spec.plan_budget(), None)?;
         if let Some(free) = self.descent_free_goals(cell, &goals, &motion.trajectory.end(), offset)? {
             // The straight descent a pick runs next from the pose reached would touch
             // (the forearm on the table): plan again to the branches whose descent is free.
             tracing::debug!(target: "macrotree::actions", "reach: the descent from the planned pose would touch; planning to the {} goal(s) whose descent is free", free.configs.len());
-            motion = plan_motion(cell, "reach", from, &free, self.spec.plan_budget(), None)?;
+            motion = plan_motion(cell, PlanFor::Reach, from, &free, self.spec.plan_budget(), None)?;
         }
         self.goal_q = motion.trajectory.end();
         cell.track(Box::new(motion.trajectory));
@@ -246,7 +247,7 @@ impl Reach {
         let goals = GoalSet::down(&position, yaw, quarter, &from);
         if let Some(free) = self.descent_free_goals(cell, &goals, &goal_q, offset)? {
             tracing::debug!(target: "macrotree::actions", "reach: the descent from the direct move's end would touch; planning to the {} goal(s) whose descent is free", free.configs.len());
-            let motion = plan_motion(cell, "reach", &from, &free, self.spec.plan_budget(), None)?;
+            let motion = plan_motion(cell, PlanFor::Reach, &from, &free, self.spec.plan_budget(), None)?;
             self.goal_q = motion.trajectory.end();
             cell.track(Box::new(motion.trajectory));
             return Ok(());

@@ -15,6 +15,7 @@
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
 use super::cell::Cell;
+use super::plan_help::PlanFor;
 use super::planning::{check_motion, check_straight, look_ahead_clear, plan_motion};
 use crate::failure::{Failure, FailureKind};
 use crate::kinds::PlanBudget;
@@ -421,7 +422,7 @@ fn go_to(
         cell.track(Box::new(direct));
         return Ok(goals[0]);
     }
-    let motion = plan_motion(cell, "reach", from, &GoalSet::configs(goals), budget, None)?;
+    let motion = plan_motion(cell, PlanFor::Reach, from, &GoalSet::configs(goals), budget, None)?;
     let end = motion.trajectory.end();
     cell.track(Box::new(motion.trajectory));
     Ok(end)

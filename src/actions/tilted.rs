@@ -14,6 +14,7 @@
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
 use super::cell::Cell;
+use super::plan_help::PlanFor;
 use super::planning::{look_ahead_clear, plan_motion};
 use crate::failure::Failure;
 use crate::kinds::PlanBudget;
@@ -112,7 +113,7 @@ pub(crate) fn plan(
         }
         match plan_motion(
             cell,
-            "reach (tilted)",
+            PlanFor::Reach,
             from,
             &GoalSet::configs(free),
             budget,

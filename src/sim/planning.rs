@@ -40,17 +40,18 @@ pub fn plan_failure(e: &PlanError) -> Failure {
 }
 
 /// Plans the arm from `start` to any of `goals` (radians) against the checker's snapshot of the
-/// cell (a [`SceneChecker`](super::collision::SceneChecker), or one wrapping it with allowances); a typed [`Failure`] when there is no motion. Logs each plan at debug level (query,
-/// time, nodes, path length, duration).
+/// cell (a [`SceneChecker`](super::collision::SceneChecker), or one wrapping it with
+/// allowances). Logs each plan at debug level (query, time, nodes, path length, duration).
 ///
 /// # Errors
-/// [`plan_failure`] of the planner's reason.
+/// The planner's [`PlanError`] when there is no motion ([`plan_failure`] makes it a typed
+/// [`Failure`]; a leaf adds what to change).
 pub fn plan_in_cell<C: CollisionChecker + ?Sized>(
     checker: &mut C,
     start: &[f64; 6],
     goals: &GoalSet,
     config: &PlannerConfig,
-) -> Result<PlannedMotion, Failure> {
+) -> Result<PlannedMotion, PlanError> {
     match plan(checker, start, goals, config) {
         Ok(m) => {
             tracing::debug!(target: "macrotree::plan", goals = goals.len(), stats = %m.stats.summary(), "planned");
@@ -58,7 +59,7 @@ pub fn plan_in_cell<C: CollisionChecker + ?Sized>(
         }
         Err(e) => {
             tracing::debug!(target: "macrotree::plan", reason = e.reason.name(), stats = %e.stats.summary(), "no plan: {e}");
-            Err(plan_failure(&e))
+            Err(e)
         }
     }
 }

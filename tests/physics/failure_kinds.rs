@@ -23,7 +23,7 @@ use macrotree::runtime::scripted::ScriptedDriver;
 use macrotree::runtime::substitute::{Substitution, resolve};
 use macrotree::runtime::{LeafOutcome, NodeStatus, TreeRunner, TreeStatus};
 use macrotree::sim::collision::SceneChecker;
-use macrotree::sim::planning::plan_in_cell;
+use macrotree::sim::planning::{plan_failure, plan_in_cell};
 use macrotree::sim::{Layout, Scene, Sim};
 use macrotree::sweep::{SweepConfig, run_scene_scenario, run_sweep_with};
 use macrotree::world::World;
@@ -579,7 +579,7 @@ fn a_custom_condition_fails_with_its_declared_kind() {
 fn planned(scene: &Scene, start: &[f64; 6], goals: &GoalSet, config: &PlannerConfig) -> Failure {
     let sim = Sim::new(scene);
     let mut checker = SceneChecker::from_sim(&sim, macrotree::sim::collision::DEFAULT_MARGIN).unwrap();
-    plan_in_cell(&mut checker, start, goals, config).expect_err("no motion")
+    plan_failure(&plan_in_cell(&mut checker, start, goals, config).expect_err("no motion"))
 }
 
 #[test]

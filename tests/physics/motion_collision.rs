@@ -236,7 +236,8 @@ fn the_check_budget_is_a_hard_deterministic_cap_ending_in_no_path_naming_the_pos
     let again = plan(&mut c, &start, &goals, &config).unwrap_err();
     assert_eq!(again.reason, e.reason);
     // Through the cell's planning entry point it is a typed `no_path` failure.
-    let f = macrotree::sim::planning::plan_in_cell(&mut c, &start, &goals, &config).unwrap_err();
+    let e = macrotree::sim::planning::plan_in_cell(&mut c, &start, &goals, &config).unwrap_err();
+    let f = macrotree::sim::planning::plan_failure(&e);
     assert_eq!(f.kind, macrotree::failure::FailureKind::NoPath);
     assert!(f.message.contains("post"), "{}", f.message);
     // With the default budget the same query plans.
