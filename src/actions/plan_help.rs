@@ -131,9 +131,9 @@ fn goal_blocked(c: &Collision, what: PlanFor) -> String {
         (Mover::HeldBlock, PlanFor::Transfer { lift }) => format!(
             "the held block would meet `{o}` above the goal: choose a goal clear of `{o}` (`macrotree validate` checks spots and goals against fixed obstacles), or raise `lift:` (now {lift} m) to pass over it"
         ),
-        (Mover::HeldBlock, PlanFor::Reach) => format!(
-            "the held block would meet `{o}` at the goal: choose a goal clear of `{o}`"
-        ),
+        (Mover::HeldBlock, PlanFor::Reach) => {
+            format!("the held block would meet `{o}` at the goal: choose a goal clear of `{o}`")
+        }
     }
 }
 
@@ -166,13 +166,19 @@ mod tests {
             PlanBudget::default(),
         )
         .unwrap();
-        assert!(help.contains("`lift:` (now 0.15 m)") && help.contains("`bin`"), "{help}");
+        assert!(
+            help.contains("`lift:` (now 0.15 m)") && help.contains("`bin`"),
+            "{help}"
+        );
     }
 
     #[test]
     fn a_goal_blocked_by_the_held_block_names_the_obstacle_not_lift_for_a_reach() {
         let help = plan_help(&blocked("red", "wall"), PlanFor::Reach, PlanBudget::default()).unwrap();
-        assert!(help.contains("clear of `wall`") && !help.contains("lift"), "{help}");
+        assert!(
+            help.contains("clear of `wall`") && !help.contains("lift"),
+            "{help}"
+        );
         let help = plan_help(
             &blocked("gripper/left_pad1", "bin/wall_px"),
             PlanFor::Reach,
@@ -191,14 +197,25 @@ mod tests {
             checks: 500,
             blocking: vec![(pair("ur5e/wrist_1_link", "shelf_top"), 9)],
         };
-        let help = plan_help(&spent(SearchBudget::Checks(500)), PlanFor::Reach, PlanBudget::default()).unwrap();
-        assert!(help.contains("`max_checks:` (now 500") && help.contains("`shelf_top`"), "{help}");
+        let help = plan_help(
+            &spent(SearchBudget::Checks(500)),
+            PlanFor::Reach,
+            PlanBudget::default(),
+        )
+        .unwrap();
+        assert!(
+            help.contains("`max_checks:` (now 500") && help.contains("`shelf_top`"),
+            "{help}"
+        );
         let budget = PlanBudget {
             max_checks: Some(7000),
             time_cap: None,
         };
         let help = plan_help(&spent(SearchBudget::Iterations(100)), PlanFor::Joints, budget).unwrap();
-        assert!(help.contains("waypoint") && help.contains("now 7000 checks"), "{help}");
+        assert!(
+            help.contains("waypoint") && help.contains("now 7000 checks"),
+            "{help}"
+        );
     }
 
     #[test]
@@ -206,7 +223,9 @@ mod tests {
         let b = PlanBudget::default();
         let reasons = [
             PlanFailure::StartInCollision { collisions: vec![] },
-            PlanFailure::NoGoal { reason: "no IK".into() },
+            PlanFailure::NoGoal {
+                reason: "no IK".into(),
+            },
             blocked("ur5e/upper_arm_link", "shelf_low"),
             PlanFailure::TimeCap {
                 cap_s: 2.0,

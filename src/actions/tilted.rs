@@ -111,14 +111,7 @@ pub(crate) fn plan(
         if free.is_empty() {
             continue;
         }
-        match plan_motion(
-            cell,
-            PlanFor::Reach,
-            from,
-            &GoalSet::configs(free),
-            budget,
-            None,
-        ) {
+        match plan_motion(cell, PlanFor::Reach, from, &GoalSet::configs(free), budget, None) {
             Ok(m) => return Ok(Some(m)),
             Err(e) => last = Some(e),
         }

@@ -281,11 +281,20 @@ impl Summary {
             "  sim time: median {:.2} s, p95 {:.2} s",
             self.median_sim_time_s, self.p95_sim_time_s
         );
-        let _ = writeln!(
-            s,
-            "  wall time {:.1} s on {} job(s): {:.0} scenarios/minute",
-            self.wall_time_s, self.jobs, self.scenarios_per_minute
-        );
+        if self.jobs == 0 {
+            // `macrotree report`: the lines carry results only (they are the same bytes for any
+            // machine and `--jobs`), not the time they took.
+            let _ = writeln!(
+                s,
+                "  wall time, physics and planning shares: not in the lines (each run's own summary has them)"
+            );
+        } else {
+            let _ = writeln!(
+                s,
+                "  wall time {:.1} s on {} job(s): {:.0} scenarios/minute",
+                self.wall_time_s, self.jobs, self.scenarios_per_minute
+            );
+        }
         if !self.substitutions.is_empty() {
             let _ = writeln!(s, "  substitutions: {}", self.substitutions.join(", "));
         }

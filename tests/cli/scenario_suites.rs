@@ -457,6 +457,14 @@ fn four_sweep_shards_as_processes_merge_into_the_unsharded_report() {
     assert!(merged.status.code().is_some_and(|c| c < 2), "{}", stderr(&merged));
     // Byte-identical summaries, text and JSON.
     assert_eq!(stdout(&merged), stdout(&unsharded));
+    assert_eq!(stderr(&merged), stderr(&unsharded));
+    // The text does not pass off what the lines do not carry as a measured zero.
+    let text = stderr(&merged);
+    assert!(
+        text.contains("wall time, physics and planning shares: not in the lines"),
+        "{text}"
+    );
+    assert!(!text.contains("0 job(s)"), "{text}");
     // And the sweep's own summary, but for wall time and jobs (which the lines do not carry).
     let strip = |mut v: serde_json::Value| {
         for k in [

@@ -123,7 +123,10 @@ fn a_carry_with_a_small_check_budget_ends_in_no_path_naming_the_fixture() {
     let why = r.failure_reason.unwrap_or_default();
     assert!(why.contains("fixture"), "{why}");
     // The refusal ends with what to change: the leaf's own budget, with its value.
-    assert!(why.contains("; help: raise the leaf's `max_checks:` (now 40"), "{why}");
+    assert!(
+        why.contains("; help: raise the leaf's `max_checks:` (now 40"),
+        "{why}"
+    );
     assert_eq!(r.planning.plan_failures, 1, "{:?}", r.planning);
     assert!(r.collisions.is_empty(), "{:?}", r.collisions);
     let r = run(&cell, carry_around(""));
@@ -188,7 +191,10 @@ fn no_path_through_a_tree_when_the_check_budget_runs_out_names_the_fixture() {
     let why = r.failure_reason.unwrap_or_default();
     assert!(why.contains("fixture"), "{why}");
     // The refusal ends with what to change: the leaf's own budget, with its value.
-    assert!(why.contains("; help: raise the leaf's `max_checks:` (now 40"), "{why}");
+    assert!(
+        why.contains("; help: raise the leaf's `max_checks:` (now 40"),
+        "{why}"
+    );
     assert_eq!(r.planning.plan_failures, 1, "{:?}", r.planning);
     // Failed before swinging: nothing was hit.
     assert!(r.collisions.is_empty(), "{:?}", r.collisions);
