@@ -54,6 +54,9 @@ pub enum PlacementError {
         /// `a` is a block whose centre lies over `b`'s top or inside its walls: it was probably
         /// meant to start on `b`.
         on_b: bool,
+        /// `a` or `b` is drawn from a `random:` region (else both have fixed poses, and only
+        /// moving one helps).
+        randomized: bool,
     },
     /// A block does not lie on what it is declared to rest on (`on:`, `random: {in: ..}`):
     /// its footprint sticks out of the support's top, or comes closer to a container's walls
@@ -153,9 +156,27 @@ impl PlacementError {
             PlacementError::TooClose { a, b, on_b: true, .. } => format!(
                 "to start `{a}` on or inside `{b}`, declare it: `on: {b}` with a fixed pose, or `random: {{in: {b}}}` (`{{on: {b}}}` for a top)"
             ),
-            PlacementError::TooClose { a, b, min, .. } => format!(
+            PlacementError::TooClose {
+                a,
+                b,
+                min,
+                randomized: true,
+                ..
+            } if *min > 0.0 => format!(
                 "move `{a}` and `{b}` apart, widen their `random:` regions, or lower their `clearance` ({min:.3} m needed)"
             ),
+            PlacementError::TooClose {
+                a,
+                b,
+                randomized: true,
+                ..
+            } => format!("move `{a}` and `{b}` apart, or widen their `random:` regions"),
+            PlacementError::TooClose { a, b, min, .. } if *min > 0.0 => format!(
+                "move `{a}` or `{b}` (both have fixed poses) so that {min:.3} m lies between them, or lower their `clearance`"
+            ),
+            PlacementError::TooClose { a, b, .. } => {
+                format!("move `{a}` or `{b}`: both have fixed poses, and their footprints must not meet")
+            }
             PlacementError::OffSupport { object, support, .. } => format!(
                 "put `{object}` over `{support}`'s top (inside its walls), make `{support}` larger or `{object}` smaller, or lower `{object}`'s clearance"
             ),

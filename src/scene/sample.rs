@@ -272,6 +272,7 @@ impl Placement {
             min,
             centres,
             on_b,
+            randomized: a.random.is_some() || b.random.is_some(),
         })
     }
 

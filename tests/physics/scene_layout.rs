@@ -88,6 +88,33 @@ fn blocks_drawn_in_a_randomized_bin_lie_on_its_floor_inside_the_walls_for_every_
 }
 
 #[test]
+fn overlapping_fixed_objects_are_told_to_move_one_not_to_widen_random_regions() {
+    // Two fixed objects (no `random:`, no clearance) whose footprints meet.
+    let d = scene_errors(
+        "objects:\n  bowl: {container: {inner: [0.14, 0.14], wall_height: 0.05}, pose: [0.45, 0.05]}\n  wall: {obstacle: {size: [0.30, 0.02, 0.25]}, pose: [0.45, 0.0]}\n",
+    );
+    let e = find(&d, "overlap");
+    let help = e.help.as_deref().unwrap();
+    assert!(help.contains("both have fixed poses"), "{help}");
+    assert!(!help.contains("random") && !help.contains("0.000 m"), "{help}");
+    // A randomized block too close to a fixed wall keeps the advice about its region.
+    let d = scene_errors(
+        "objects:\n  wall: {obstacle: {size: [0.30, 0.02, 0.25]}, pose: [0.45, 0.0]}\n  red:\n    block: {size: 0.04}\n    pose: [0.45, 0.05]\n    random: {x: [0.44, 0.46], y: [0.04, 0.06], clearance: 0.08}\n",
+    );
+    let e = d
+        .iter()
+        .find(|d| d.help.as_deref().is_some_and(|h| h.contains("`red`")))
+        .unwrap_or_else(|| panic!("{d:#?}"));
+    assert!(
+        e.help
+            .as_deref()
+            .unwrap()
+            .contains("widen their `random:` regions"),
+        "{e}"
+    );
+}
+
+#[test]
 fn random_in_a_bin_failed_after_100000_draws_with_a_wrong_hint() {
     // The old way: an x/y region inside the bin, without saying the block starts in it. It still
     // is refused (the block would stand in the bin's walls' footprint as if on the table), but the
