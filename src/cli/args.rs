@@ -1,9 +1,10 @@
-//! Parsers for the layout arguments `--cube X,Y[,YAW_DEG]` and `--bowl X,Y`, and for `plan`'s
+//! Parsers for the layout arguments `--cube X,Y[,YAW]` and `--bowl X,Y`, yaws in degrees (or with
+//! their unit: `30deg`, `0.5236rad`), and for `plan`'s
 //! joint configurations (`home` or `J1,…,J6`) and points (`X,Y,Z`).
 
 use std::str::FromStr;
 
-/// `--cube X,Y[,YAW_DEG]`: cube centre on the table (metres) and yaw (degrees).
+/// `--cube X,Y[,YAW]`: cube centre on the table (metres) and yaw (degrees; see [`yaw_degrees`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CubeArg {
     /// x, metres.
@@ -37,19 +38,62 @@ fn numbers(s: &str, min: usize, max: usize, what: &str) -> Result<Vec<f64>, Stri
         .collect()
 }
 
+/// Largest yaw the command line takes either way, degrees (one turn).
+pub const MAX_YAW_DEG: f64 = 360.0;
+
+/// A yaw on the command line, in degrees: a plain number is degrees (as every report prints
+/// them), and an explicit unit is accepted, `30deg` or `0.5236rad`; within ±360°. A plain number
+/// that looks like radians (`0.785`, near a multiple of π/12: [`looks_like_radians`]) is refused
+/// with both readings, so a slip between the conventions never runs silently.
+///
+/// [`looks_like_radians`]: crate::yaml::units::looks_like_radians
+pub fn yaw_degrees(text: &str) -> Result<f64, String> {
+    let t = text.trim();
+    let (number, unit) = if let Some(n) = t.strip_suffix("deg") {
+        (n, Some(1.0))
+    } else if let Some(n) = t.strip_suffix("rad") {
+        (n, Some(180.0 / std::f64::consts::PI))
+    } else {
+        (t, None)
+    };
+    let form = "degrees (`30`, `30deg`) or radians with their unit (`0.5236rad`)";
+    let x = match number.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() => x,
+        _ => return Err(format!("{t:?} is not a yaw: write {form}")),
+    };
+    if unit.is_none()
+        && let Some(deg) = crate::yaml::units::looks_like_radians(x)
+    {
+        return Err(format!(
+            "the yaw `{x}` is read as {x}° (plain numbers on the command line are degrees), but it looks like radians ({deg}°): write {deg} for {deg}°, `{x}rad` for radians, or `{x}deg` to keep {x}°"
+        ));
+    }
+    let deg = x * unit.unwrap_or(1.0);
+    if deg.abs() > MAX_YAW_DEG {
+        return Err(format!(
+            "the yaw {t} is {deg:.1}°, more than a full turn: write {form} within ±{MAX_YAW_DEG}°"
+        ));
+    }
+    Ok(deg)
+}
+
 impl FromStr for CubeArg {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        let v = numbers(
-            s,
-            2,
-            3,
-            "X,Y or X,Y,YAW_DEG (metres, degrees), e.g. 0.45,-0.18,30",
-        )?;
+        let form = "X,Y or X,Y,YAW (metres; the yaw in degrees, or with its unit: 30deg, 0.5236rad), e.g. 0.45,-0.18,30";
+        let parts: Vec<&str> = s.split(',').collect();
+        if !(2..=3).contains(&parts.len()) {
+            return Err(format!("expected {form}, got {s:?}"));
+        }
+        let v = numbers(&parts[..2].join(","), 2, 2, form)?;
+        let yaw_deg = match parts.get(2) {
+            Some(y) => yaw_degrees(y)?,
+            None => 0.0,
+        };
         Ok(Self {
             x: v[0],
             y: v[1],
-            yaw_deg: v.get(2).copied().unwrap_or(0.0),
+            yaw_deg,
         })
     }
 }
@@ -188,6 +232,33 @@ mod tests {
                 y: -0.1,
                 yaw_deg: 30.0
             }
+        );
+    }
+
+    #[test]
+    fn a_command_line_yaw_is_degrees_takes_an_explicit_unit_and_refuses_a_radian_look() {
+        assert_eq!(yaw_degrees("30"), Ok(30.0));
+        assert_eq!(yaw_degrees("30deg"), Ok(30.0));
+        assert_eq!(yaw_degrees("-45.5 deg"), Ok(-45.5));
+        assert!((yaw_degrees("0.785rad").unwrap() - 0.785f64.to_degrees()).abs() < 1e-12);
+        assert_eq!(yaw_degrees("0.785deg"), Ok(0.785));
+        let e = yaw_degrees("0.785").unwrap_err();
+        assert!(
+            e.contains("looks like radians (45°)") && e.contains("`0.785rad`"),
+            "{e}"
+        );
+        for bad in ["361", "7rad", "x", "30 degrees", "nan", ""] {
+            assert!(yaw_degrees(bad).is_err(), "{bad}");
+        }
+        assert_eq!(
+            "0.45,-0.1,0.785rad".parse::<CubeArg>().unwrap().yaw_deg,
+            0.785f64.to_degrees()
+        );
+        assert!(
+            "0.45,-0.1,0.785"
+                .parse::<CubeArg>()
+                .unwrap_err()
+                .contains("radians")
         );
     }
 

@@ -98,11 +98,6 @@ pub fn repeat(s: &str) -> Result<usize, String> {
     }
 }
 
-/// `plan --yaw DEG`: −360 ≤ DEG ≤ 360.
-pub fn yaw_deg(s: &str) -> Result<f64, String> {
-    number_in(s, |v| v.abs() <= 360.0, "degrees from -360 to 360")
-}
-
 /// `plan --margin M`: 0 ≤ M ≤ [`crate::sim::collision::MAX_MARGIN`], metres.
 pub fn margin(s: &str) -> Result<f64, String> {
     let max = crate::sim::collision::MAX_MARGIN;
@@ -139,9 +134,9 @@ mod tests {
         for bad in ["0", "1025", "100000", "-1", "x"] {
             assert!(jobs(bad).is_err(), "{bad}");
         }
-        assert_eq!(yaw_deg("-360"), Ok(-360.0));
+        assert_eq!(super::super::args::yaw_degrees("-360"), Ok(-360.0));
         for bad in ["360.5", "nan", "inf"] {
-            assert!(yaw_deg(bad).is_err(), "{bad}");
+            assert!(super::super::args::yaw_degrees(bad).is_err(), "{bad}");
         }
         assert_eq!(margin("0"), Ok(0.0));
         for bad in ["-0.001", "0.2", "nan"] {

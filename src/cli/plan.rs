@@ -54,9 +54,9 @@ pub struct PlanArgs {
     /// Goal: the tool pointing down with its pinch point at X,Y,Z (metres, world frame).
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
     pub to_point: Option<PointArg>,
-    /// The finger axis's yaw at --to-point, degrees (−360 … 360); the yaw half a turn away is
-    /// equivalent and also a goal.
-    #[arg(long, value_name = "DEG", default_value_t = 0.0, requires = "to_point", allow_hyphen_values = true, value_parser = super::limits::yaw_deg)]
+    /// The finger axis's yaw at --to-point, degrees (−360 … 360; or with its unit, `30deg`,
+    /// `0.5236rad`); the yaw half a turn away is equivalent and also a goal.
+    #[arg(long, value_name = "DEG", default_value_t = 0.0, requires = "to_point", allow_hyphen_values = true, value_parser = super::args::yaw_degrees)]
     pub yaw: f64,
     /// Clearance margin, metres (0 … 0.1; the leaves use 0.005).
     #[arg(long, value_name = "M", value_parser = super::limits::margin)]

@@ -99,8 +99,9 @@ pub struct EpisodeArgs {
     /// The sweep seed S of --scenario.
     #[arg(long, value_name = "S", default_value_t = 0, requires = "scenario")]
     pub sweep_seed: u64,
-    /// Cube centre and yaw: X,Y[,YAW_DEG] (metres, degrees). Default 0.45,-0.18,0.
-    #[arg(long, value_name = "X,Y[,YAW_DEG]", allow_hyphen_values = true)]
+    /// Cube centre and yaw: X,Y[,YAW] (metres; the yaw in degrees, or with its unit: `30deg`,
+    /// `0.5236rad`). Default 0.45,-0.18,0.
+    #[arg(long, value_name = "X,Y[,YAW]", allow_hyphen_values = true)]
     pub cube: Option<CubeArg>,
     /// Bowl centre: X,Y (metres). Default 0.45,0.08.
     #[arg(long, value_name = "X,Y", allow_hyphen_values = true)]

@@ -227,7 +227,7 @@ impl ScenarioResult {
     pub fn reproduce(&self, tree: &str, config: &SweepConfig) -> String {
         let mut cmd = match &self.layout {
             Some(l) => format!(
-                "{} run {} --cube {},{},{} --bowl {},{} --seed {}",
+                "{} run {} --cube {},{},{}deg --bowl {},{} --seed {}",
                 config.program,
                 shell_quote(tree),
                 l.cube[0],

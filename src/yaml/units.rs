@@ -215,7 +215,8 @@ pub fn joints6<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 6], D::Error> {
 }
 
 /// Parse an angle written as text: `deg(90)`, `rad(1.57)`, `pi/2`, `deg(-45)`; plain numbers are
-/// radians. Uses serde-saphyr's `robotics` angle evaluator. Returns radians.
+/// radians. Uses serde-saphyr's `robotics` angle evaluator. Returns radians. A `deg(x)` whose `x`
+/// looks like radians raises a warning (inside a reading that collects them).
 pub fn parse_angle_text(s: &str) -> Result<f64, String> {
     let t = s.trim();
     if t.is_empty() || t.len() > 200 {
@@ -223,7 +224,10 @@ pub fn parse_angle_text(s: &str) -> Result<f64, String> {
     }
     let options = serde_saphyr::options! { angle_conversions: true };
     match serde_saphyr::from_str_with_options::<f64>(t, options) {
-        Ok(x) if x.is_finite() => Ok(x),
+        Ok(x) if x.is_finite() => {
+            warn_degrees_like_radians(t);
+            Ok(x)
+        }
         Ok(x) => Err(format!("an angle must be finite, found `{x}`")),
         Err(_) => Err(format!("`{s}` is not an angle")),
     }
@@ -233,8 +237,31 @@ pub fn parse_angle_text(s: &str) -> Result<f64, String> {
 /// certainly degrees written without `deg(..)`.
 pub const MAX_BARE_ANGLE: f64 = std::f64::consts::TAU;
 
+/// Smallest whole number of radians that warns: `yaw: 3` is 171.9°, almost certainly meant as
+/// degrees (radians are written as fractions of π: 1.5708, 0.785).
+pub const MIN_WARNED_WHOLE_RADIANS: f64 = 2.0;
+
+/// How close to a multiple of 15° (π/12 rad) a number written as degrees must be to look like
+/// radians (`deg(1.5708)`, `--cube …,0.785`), radians.
+const RADIAN_LOOK: f64 = 0.002;
+
+/// The degrees `x` would be if it were radians, when it looks like radians although written where
+/// degrees are read: not a whole number, within a full turn, and within 0.002 of a non-zero
+/// multiple of π/12 (1.5708 ≈ π/2, 0.785 ≈ π/4, 3.14 ≈ π). `None` otherwise.
+pub fn looks_like_radians(x: f64) -> Option<f64> {
+    let step = std::f64::consts::PI / 12.0;
+    let k = (x / step).round();
+    (x.is_finite()
+        && x.fract() != 0.0
+        && x.abs() <= MAX_BARE_ANGLE
+        && k != 0.0
+        && (x - k * step).abs() < RADIAN_LOOK)
+        .then_some(k * 15.0)
+}
+
 /// A plain number read as an angle in radians: an error beyond ±2π (with help to write `deg(..)`),
-/// and a warning for a whole number beyond ±π (`yaw: 5` is 286°, probably meant as degrees).
+/// and a warning for a whole number of at least [`MIN_WARNED_WHOLE_RADIANS`] (`yaw: 3` is 172°,
+/// probably meant as degrees).
 pub(crate) fn bare_angle<E: de::Error>(x: f64, integer: bool) -> Result<f64, E> {
     named_bare_angle(x, integer, "")
 }
@@ -249,7 +276,7 @@ pub(crate) fn named_bare_angle<E: de::Error>(x: f64, integer: bool, field: &str)
             super::de::HELP_SEPARATOR
         )));
     }
-    if integer && x.abs() > std::f64::consts::PI {
+    if integer && x.abs() >= MIN_WARNED_WHOLE_RADIANS {
         super::de::warn(
             format!(
                 "{field}`{x}` is read as {x} rad ({:.1}°): plain numbers are radians",
@@ -261,6 +288,24 @@ pub(crate) fn named_bare_angle<E: de::Error>(x: f64, integer: bool, field: &str)
         );
     }
     Ok(x)
+}
+
+/// Warns when `text` is `deg(x)` with an `x` that looks like radians ([`looks_like_radians`]):
+/// `deg(1.5708)` is 1.57°, almost certainly meant as 90°.
+fn warn_degrees_like_radians(text: &str) {
+    let inner = text
+        .trim()
+        .strip_prefix("deg(")
+        .and_then(|r| r.strip_suffix(')'))
+        .and_then(|n| n.trim().parse::<f64>().ok());
+    if let Some((x, deg)) = inner.and_then(|x| looks_like_radians(x).map(|d| (x, d))) {
+        super::de::warn(
+            format!("`{}` is {x}°, but {x} looks like radians ({deg}°)", text.trim()),
+            Some(format!(
+                "write {x} (a plain number is radians) or deg({deg}) for {deg}°"
+            )),
+        );
+    }
 }
 
 /// An angle in radians. YAML accepts a plain number (radians, within ±2π) or `deg(x)` / `rad(x)`
@@ -318,6 +363,43 @@ impl JsonSchema for Angle {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_number_looks_like_radians_near_a_multiple_of_fifteen_degrees_only() {
+        assert_eq!(looks_like_radians(1.5708), Some(90.0));
+        assert_eq!(looks_like_radians(0.785), Some(45.0));
+        assert_eq!(looks_like_radians(-3.14), Some(-180.0));
+        for x in [0.0, 1.5, 30.0, 45.0, 0.5, 90.0, 7.0, f64::NAN] {
+            assert_eq!(looks_like_radians(x), None, "{x}");
+        }
+    }
+
+    #[test]
+    fn degrees_that_look_like_radians_and_whole_radians_warn_with_the_other_reading() {
+        use crate::yaml::de::{collect_warnings, from_value};
+        use crate::yaml::value::parse_yaml;
+        let read = |text: &str| {
+            let v = parse_yaml(text, 0).unwrap();
+            collect_warnings(|| from_value::<std::collections::BTreeMap<String, Angle>>(&v))
+        };
+        let (r, w) = read("yaw: deg(1.5708)");
+        assert!((r.unwrap()["yaw"].0 - 1.5708f64.to_radians()).abs() < 1e-12);
+        assert_eq!(w.len(), 1, "{w:?}");
+        assert!(w[0].message.contains("looks like radians (90°)"), "{w:?}");
+        assert!(w[0].help.as_deref().unwrap().contains("deg(90)"), "{w:?}");
+        let (_, w) = read("yaw: 3");
+        assert!(w.len() == 1 && w[0].message.contains("171.9°"), "{w:?}");
+        for quiet in [
+            "yaw: deg(90)",
+            "yaw: 1.5708",
+            "yaw: 1",
+            "yaw: 3.0",
+            "yaw: deg(1.5)",
+        ] {
+            let (r, w) = read(quiet);
+            assert!(r.is_ok() && w.is_empty(), "{quiet}: {w:?}");
+        }
+    }
 
     #[test]
     fn angles() {

@@ -119,10 +119,7 @@ fn plan_refuses_bad_input_with_exit_2() {
         (vec!["--to-joints", "0,0,0,0,0"], "six joint angles"),
         (vec!["--to-point", "0.4,0.1,nan"], "not a finite number"),
         (vec!["--to-point", "0.4,0.1,1e9"], "within ±2 m"),
-        (
-            vec!["--to-point", "0.4,0.1,0.2", "--yaw", "400"],
-            "degrees from -360 to 360",
-        ),
+        (vec!["--to-point", "0.4,0.1,0.2", "--yaw", "400"], "within ±360°"),
         (
             vec!["--to-point", "0.4,0.1,0.2", "--margin", "0.5"],
             "metres from 0 to 0.1",

@@ -182,6 +182,38 @@ fn bad_arguments_and_missing_files_exit_2_without_panicking() {
 }
 
 #[test]
+fn a_command_line_yaw_that_looks_like_radians_is_refused_and_one_with_its_unit_runs() {
+    let tree = "tests/fixtures/cli/gripper_open.yaml";
+    let out = macrotree(&["run", tree, "--cube", "0.45,-0.1,0.785", "--goal", "tree"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("looks like radians (45°)") && err.contains("0.785rad"),
+        "{err}"
+    );
+    let out = macrotree(&[
+        "run",
+        tree,
+        "--cube",
+        "0.45,-0.1,0.785rad",
+        "--goal",
+        "tree",
+        "--json",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let yaw = last_json_line(&out)["layout"]["cube"][2].as_f64().unwrap();
+    assert!(
+        (yaw - 0.785f64.to_degrees()).abs() < 1e-9,
+        "reported in degrees: {yaw}"
+    );
+}
+
+#[test]
 fn missing_models_exit_2_and_say_how_to_get_them() {
     let out = Command::new(env!("CARGO_BIN_EXE_macrotree"))
         .args(["run", "trees/cube_to_bowl.yaml"])

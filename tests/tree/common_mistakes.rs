@@ -58,7 +58,7 @@ fn a_bare_angle_beyond_a_full_turn_is_an_error_that_suggests_degrees() {
 }
 
 #[test]
-fn a_whole_number_of_radians_beyond_a_half_turn_is_a_warning() {
+fn a_whole_number_of_two_or_more_radians_is_a_warning() {
     let plan = Loader::default()
         .compile_str("main: {reach: {target: cube, yaw: 5}}\n", "w.yaml")
         .expect("accepted");
@@ -76,10 +76,21 @@ fn a_whole_number_of_radians_beyond_a_half_turn_is_a_warning() {
         "{w}"
     );
     assert!(w.help.as_deref().unwrap().starts_with("write deg(5)"), "{w}");
-    // 3 rad is below a half turn; 5.0 is written as a real number on purpose.
+    // `yaw: 3` (171.9°) is almost certainly 3° too.
+    let plan = Loader::default()
+        .compile_str("main: {reach: {target: cube, yaw: 3}}\n", "w.yaml")
+        .unwrap();
+    assert_eq!(plan.warnings.len(), 1, "{:?}", plan.warnings);
+    assert!(
+        plan.warnings[0].to_string().contains("171.9°"),
+        "{}",
+        plan.warnings[0]
+    );
+    // 1 rad is a plausible angle; 5.0 is written as a real number on purpose.
     for yaml in [
-        "main: {reach: {target: cube, yaw: 3}}\n",
+        "main: {reach: {target: cube, yaw: 1}}\n",
         "main: {reach: {target: cube, yaw: 5.0}}\n",
+        "main: {reach: {target: cube, yaw: deg(90)}}\n",
     ] {
         assert!(
             Loader::default()
@@ -90,6 +101,18 @@ fn a_whole_number_of_radians_beyond_a_half_turn_is_a_warning() {
             "{yaml}"
         );
     }
+}
+
+#[test]
+fn degrees_written_as_radians_are_a_located_warning_with_both_readings() {
+    let plan = Loader::default()
+        .compile_str("main: {reach: {target: cube, yaw: deg(1.5708)}}\n", "w.yaml")
+        .expect("accepted");
+    assert_eq!(plan.warnings.len(), 1, "{:?}", plan.warnings);
+    let w = &plan.warnings[0];
+    assert_eq!((w.line, w.column), (1, 35), "{w}");
+    assert!(w.to_string().contains("looks like radians (90°)"), "{w}");
+    assert!(w.help.as_deref().unwrap().contains("deg(90)"), "{w}");
 }
 
 #[test]
