@@ -365,6 +365,7 @@ mod tests {
     use super::*;
 
     #[test]
+    #[allow(clippy::approx_constant)] // rounded radians are what these tests are about
     fn a_number_looks_like_radians_near_a_multiple_of_fifteen_degrees_only() {
         assert_eq!(looks_like_radians(1.5708), Some(90.0));
         assert_eq!(looks_like_radians(0.785), Some(45.0));
@@ -375,6 +376,7 @@ mod tests {
     }
 
     #[test]
+    #[allow(clippy::approx_constant)] // rounded radians are what these tests are about
     fn degrees_that_look_like_radians_and_whole_radians_warn_with_the_other_reading() {
         use crate::yaml::de::{collect_warnings, from_value};
         use crate::yaml::value::parse_yaml;

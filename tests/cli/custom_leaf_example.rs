@@ -143,7 +143,7 @@ fn trees_with_the_new_kinds_are_validated_with_located_errors() {
 }
 
 #[test]
-fn validate_error_of_a_params_type_was_placed_at_the_node_kind_not_the_value() {
+fn a_params_type_error_is_located_at_the_value_not_the_node_kind() {
     let dir = scratch("custom-leaf-validate-fields");
     let bad = dir.join("tilt.yaml");
     std::fs::write(

@@ -491,7 +491,7 @@ fn a_second_writer_of_one_sweep_out_is_refused() {
 }
 
 #[test]
-fn a_sweep_whose_out_was_replaced_while_it_ran_exits_2() {
+fn a_sweep_whose_out_is_replaced_while_it_runs_exits_2() {
     let dir = scratch("h3-replaced");
     let results = dir.join("r.jsonl");
     let first = spawn(&[
@@ -533,7 +533,7 @@ fn small_sweep(tree: &Path, out: &Path, resume: bool) -> Output {
 }
 
 #[test]
-fn resume_after_the_tree_was_edited_is_refused() {
+fn resume_after_the_tree_is_edited_is_refused() {
     let dir = scratch("h3-resume-edited-tree");
     let tree = tree_copy(&dir);
     let results = dir.join("r.jsonl");

@@ -29,7 +29,7 @@ fn whole_stdout_json(what: &str, out: &std::process::Output) -> serde_json::Valu
 }
 
 #[test]
-fn json_flag_left_the_human_summary_on_stdout_before_the_json() {
+fn json_flag_leaves_stdout_to_the_json_alone() {
     let dir = scratch("round2-json");
     let out_file = dir.join("sweep.jsonl");
 
@@ -110,7 +110,7 @@ fn testcase_names(xml: &str) -> Vec<String> {
 }
 
 #[test]
-fn junit_testcase_name_was_the_absolute_path_of_the_scenario_file() {
+fn junit_testcase_names_are_relative_to_the_suite_not_absolute_paths() {
     let dir = scratch("round2-junit");
     let (xml, jsonl, merged) = (dir.join("a.xml"), dir.join("a.jsonl"), dir.join("m.xml"));
     // The suite folder given by an absolute path, as a CI checkout in some build folder would.
@@ -160,7 +160,7 @@ fn grasp_fails_once_suite(dir: &Path, name: &str, expect: &str) -> std::path::Pa
 }
 
 #[test]
-fn there_were_no_count_expectations() {
+fn count_expectations_on_node_failures_are_checked() {
     let dir = scratch("round2-counts");
     // Each scenario: the grasp runs twice (the substituted failure, then the real one) and fails
     // once; over the 3 scenarios it fails exactly 3 times.
@@ -273,7 +273,7 @@ fn there_were_no_count_expectations() {
 }
 
 #[test]
-fn failed_node_was_documented_as_the_node_that_ended_the_episode() {
+fn failed_node_is_the_leaf_where_the_failure_started() {
     // The grasp never works: the retry gives up after 3 attempts and the episode ends there, but
     // `failed_node` is the leaf where the failure started.
     let out = macrotree(&["run", TREE, "--substitute", "main/**/grasp=failure", "--json"]);
@@ -294,7 +294,7 @@ fn failed_node_was_documented_as_the_node_that_ended_the_episode() {
 }
 
 #[test]
-fn grasp_histogram_left_out_grasps_answered_by_a_substitution() {
+fn the_grasp_histogram_counts_only_physical_grasps_and_says_so() {
     let out = macrotree(&[
         "sweep",
         TREE,
@@ -374,7 +374,7 @@ fn tree_format_read_as_if_a_subtree_call_could_not_be_named() {
 }
 
 #[test]
-fn stock_validate_did_not_say_a_custom_kind_is_validated_by_its_program() {
+fn stock_validate_says_a_custom_kind_is_validated_by_its_program() {
     let dir = scratch("round2-custom-kind");
     let tree = dir.join("t.yaml");
     std::fs::write(

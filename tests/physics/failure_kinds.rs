@@ -535,7 +535,7 @@ fn a_custom_action_fails_with_the_kind_it_declares() {
 }
 
 #[test]
-fn a_custom_kind_the_action_did_not_declare_is_reported_as_other() {
+fn a_custom_kind_the_action_does_not_declare_is_reported_as_other() {
     let r = stuck_episode(FailureKind::Custom("wedged"));
     assert_eq!(kind_of(&r), FailureKind::Other);
     assert!(

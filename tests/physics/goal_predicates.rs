@@ -242,7 +242,7 @@ fn a_block_square_to_a_quarter_turned_goal_holds_and_the_report_names_the_yaw_it
 /// (pressed onto the table at the spot), so a retry's "already there?" passed and the `home`
 /// after it carried the block off the table. A block in the gripper is not placed.
 #[test]
-fn at_held_while_the_block_was_still_in_the_gripper() {
+fn an_at_goal_does_not_hold_while_the_block_is_still_in_the_gripper() {
     let dir = scratch("at-held");
     let scene = spot_scene(&dir);
     let tree = dir.join("still_holding.yaml");

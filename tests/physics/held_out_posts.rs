@@ -55,7 +55,7 @@ fn clean(k: u64, seed: u64) -> serde_json::Value {
 /// post_2 … from every arm configuration above it"), and all three attempts failed. The approach
 /// now tilts the tool about its closing axis so the wrist leans away from the post.
 #[test]
-fn pick_beside_a_post_was_blocked_from_every_straight_down_pre_grasp() {
+fn a_pick_beside_a_post_finds_a_pre_grasp_with_one_grasp_per_block() {
     let r = clean(9, 1);
     assert_eq!(
         r["grasp_attempts"], 4,
@@ -150,7 +150,7 @@ fn descent_ran_the_arm_into_a_post_after_the_block_slid_on() {
 /// goal") 0.3 s later while still converging. A resting arm is blocked only when its error stops
 /// halving. The same false `blocked` had cost a quarter of this cell's episodes a retry.
 #[test]
-fn a_reach_still_closing_in_on_its_goal_was_called_blocked() {
+fn a_reach_still_closing_in_on_its_goal_is_not_called_blocked() {
     clean(89, 2);
     // Scenario 2's first reach above a block stopped "2.0 mm short" and its attempt was retried;
     // now no reach fails on the way.

@@ -115,7 +115,7 @@ fn overlapping_fixed_objects_are_told_to_move_one_not_to_widen_random_regions() 
 }
 
 #[test]
-fn random_in_a_bin_failed_after_100000_draws_with_a_wrong_hint() {
+fn a_random_region_inside_a_bin_is_refused_with_help_to_start_the_block_in_it() {
     // The old way: an x/y region inside the bin, without saying the block starts in it. It still
     // is refused (the block would stand in the bin's walls' footprint as if on the table), but the
     // message names the pair and the help says how to start a block inside.
@@ -140,7 +140,7 @@ fn random_in_a_bin_failed_after_100000_draws_with_a_wrong_hint() {
 }
 
 #[test]
-fn a_pose_inside_a_bin_was_an_overlap_error() {
+fn a_fixed_pose_inside_a_bin_needs_on_and_is_refused_with_that_help() {
     // Without `on:` the fixed pose is refused with the way to say it…
     let d = scene_errors(
         "objects:\n  bin: {container: {inner: [0.20, 0.20]}, pose: [0.45, 0.0]}\n  red: {block: {size: 0.04}, pose: [0.47, 0.02]}\n",

@@ -65,7 +65,7 @@ fn clear_table_set_down_allowed_the_arm_on_the_bin_wall() {
 /// put the forearm on the fixture (`arm-obstacle`, 0.02 s before the reach's end). The checker
 /// now measures those pairs itself (`sim::margin`).
 #[test]
-fn go_around_reach_grazed_the_fixture_where_the_checker_left_out_its_margin() {
+fn go_around_reaches_keep_the_checkers_margin_from_the_fixture() {
     for k in [127, 174, 195] {
         let r = clean("trees/go_around.yaml", k, 1);
         assert!(

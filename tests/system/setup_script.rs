@@ -65,7 +65,7 @@ fn has_dpkg() -> bool {
 }
 
 #[test]
-fn test_command_without_chromium_failed_after_building_instead_of_setting_up() {
+fn the_test_command_without_chromium_stops_before_building_and_names_the_install() {
     assert!(has_dpkg(), "these checks need a Debian machine (dpkg-query)");
     let db = empty_dpkg_db("check");
     let out = setup(&["--check"], Some(&db), false);

@@ -352,7 +352,7 @@ const LIFT_BLOCK_DOC: &str = "Lift a block into a container.\n\nHalt: the arm ho
 /// `support`, `container`, `target`, `to`), so `block:` in a custom leaf was never checked against
 /// the scene and a misspelled block name only failed when the leaf ran.
 #[test]
-fn a_custom_leafs_block_parameter_was_never_checked_against_the_scene() {
+fn a_custom_leafs_block_parameter_is_checked_against_the_scene() {
     let mut app = App::new();
     app.register_action("lift_block", LIFT_BLOCK_DOC, |_: &LiftBlock| Box::new(Idle))
         .unwrap();
