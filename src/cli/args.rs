@@ -4,7 +4,7 @@
 
 use std::str::FromStr;
 
-/// `--cube X,Y[,YAW]`: cube centre on the table (metres) and yaw (degrees; see [`yaw_degrees`]).
+/// `--cube X,Y[,YAW]`: cube centre on the table (metres) and yaw (degrees; or with its unit, `30deg`, `0.5236rad`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CubeArg {
     /// x, metres.
