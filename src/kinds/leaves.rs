@@ -542,7 +542,8 @@ pub struct In {
 pub struct On {
     /// The block on top (a name or `{var}`).
     pub object: ObjectRef,
-    /// The block under it (a name or `{var}`).
+    /// What it rests on: a block, or an obstacle's top (a shelf board, a pedestal) (a name or
+    /// `{var}`).
     pub support: ObjectRef,
     /// Speed below which the block counts as at rest, m/s (> 0). Default 0.05.
     #[serde(default = "d_rest_speed", deserialize_with = "units::speed")]

@@ -1,9 +1,9 @@
 //! Scenes whose task can never be done are refused at load, located: a scene without a block
 //! (nothing to pick), goals that stack blocks in a cycle (`a on b`, `b on a`), and a block
 //! wider than the inside of the container it must end in, two blocks whose `at` goals overlap,
-//! and an `at` goal (judged on the table or a container's floor) inside the footprint of a
-//! fixed obstacle too low to put the block under — a spot there is a set-down place on the
-//! obstacle's top, never an `at` place.
+//! and an `at` goal where the block can rest on nothing: inside the footprint of fixed
+//! obstacles that leave no room on the table under them and whose tops are too small for the
+//! block or too close under another board.
 
 use std::collections::BTreeMap;
 
@@ -11,16 +11,83 @@ use super::goal::GoalAtom;
 use super::types::{ObjectSpec, SceneSpec, Shape};
 use crate::yaml::diag::{Issue, Loc};
 
-/// The first obstacle with a fixed pose (and no `random:`) whose footprint contains the point
-/// `p` (metres) and whose underside is less than `height` metres above the table: a block that
-/// tall cannot rest on the table at `p`.
-pub(super) fn obstacle_over(scene: &SceneSpec, p: [f64; 2], height: f64) -> Option<&ObjectSpec> {
-    scene.objects.iter().find(|o| {
-        matches!(o.shape, Shape::Obstacle { .. })
-            && o.random.is_none()
-            && o.pose
-                .is_some_and(|pose| o.z < height && o.shape.footprint(&pose).distance_to_point(p) == 0.0)
-    })
+/// The fixed obstacles (a `pose:`, no `random:`) whose footprint contains the point `p`
+/// (metres), lowest first.
+fn fixed_obstacles_at(scene: &SceneSpec, p: [f64; 2]) -> Vec<&ObjectSpec> {
+    let mut over: Vec<&ObjectSpec> = scene
+        .objects
+        .iter()
+        .filter(|o| {
+            matches!(o.shape, Shape::Obstacle { .. })
+                && o.random.is_none()
+                && o.pose
+                    .is_some_and(|pose| o.shape.footprint(&pose).distance_to_point(p) == 0.0)
+        })
+        .collect();
+    over.sort_by(|a, b| a.z.total_cmp(&b.z));
+    over
+}
+
+/// Why a block cannot rest at a point.
+struct NoRest<'a> {
+    /// The lowest obstacle over the point (it leaves no room on the table).
+    lowest: &'a ObjectSpec,
+    /// What stops each obstacle top there from holding the block, for the message.
+    tops: Vec<String>,
+}
+
+/// Whether a block `half` metres in half-width can rest at `p` on the table or on the top of a
+/// fixed obstacle over `p` (a board, a pedestal): the level needs room for the block up to the
+/// next obstacle's underside, and a top must hold the block's inscribed circle around `p`.
+/// `Ok` when it can (or nothing stands there), else why not.
+fn rest_at<'a>(scene: &'a SceneSpec, p: [f64; 2], half: f64) -> Result<(), NoRest<'a>> {
+    let over = fixed_obstacles_at(scene, p);
+    let Some(&lowest) = over.first() else {
+        return Ok(());
+    };
+    let height = 2.0 * half;
+    // Room above `level` up to the underside of the next obstacle over the point.
+    let room = |level: f64| {
+        over.iter()
+            .map(|o| o.z)
+            .filter(|&z| z >= level - 1e-9)
+            .fold(f64::INFINITY, f64::min)
+            - level
+    };
+    if room(0.0) >= height {
+        return Ok(());
+    }
+    let mut tops = Vec::new();
+    for o in &over {
+        let (Some(pose), Shape::Obstacle { half: oh }) = (o.pose, &o.shape) else {
+            continue;
+        };
+        let top = o.z + 2.0 * oh[2];
+        let footprint = o.shape.footprint(&pose);
+        let [u, v] = footprint.local(p);
+        let inside = (footprint.half[0] - u.abs()).min(footprint.half[1] - v.abs());
+        let above = over
+            .iter()
+            .map(|x| x.z)
+            .filter(|&z| z >= top - 1e-9)
+            .fold(f64::INFINITY, f64::min)
+            - top;
+        if inside + 1e-9 < half {
+            tops.push(format!(
+                "`{}`'s top holds {:.3} m around the point ({half:.3} m needed)",
+                o.name,
+                inside.max(0.0)
+            ));
+        } else if above < height {
+            tops.push(format!(
+                "`{}`'s top has {above:.3} m of room under the next board ({height:.3} m needed)",
+                o.name
+            ));
+        } else {
+            return Ok(());
+        }
+    }
+    Err(NoRest { lowest, tops })
 }
 
 /// A scene without a block: the issue at `objects:` (`at`).
@@ -100,30 +167,34 @@ pub(super) fn check_goal_feasible(scene: &SceneSpec, atoms: &[(GoalAtom, Loc)], 
             }
         }
     }
-    // An `at` goal inside a fixed obstacle that stands on the table (or too low to go under):
-    // `at` is judged on the table, and a block set down there rests on the obstacle's top.
+    // An `at` goal where the block can rest on nothing: neither on the table (obstacles over
+    // the point leave no room under them) nor on an obstacle's top (too small, or too close
+    // under the next board). `at` is judged on whatever the block rests on.
     for (a, loc) in atoms {
-        let (Some(place), Some(block)) = (a.place(), scene.object(a.object())) else {
+        let (Some(place), Some(Shape::Block { half, .. })) =
+            (a.place(), scene.object(a.object()).map(|b| &b.shape))
+        else {
             continue;
         };
-        if let Some(o) = obstacle_over(scene, place.point, block.shape.height()) {
+        if let Err(no) = rest_at(scene, place.point, *half) {
             issues.push(
                 Issue::new(
                     *loc,
                     format!(
-                        "block `{}` can never be `at` ({}, {}): the point is inside obstacle `{}`'s footprint, whose underside is {:.3} m above the table ({:.3} m needed), and `at` is judged on the table or a container's floor",
+                        "block `{}` can never be `at` ({}, {}): obstacle `{}` stands there ({:.3} m of room under it, {:.3} m needed), and {}",
                         a.object(),
                         place.point[0],
                         place.point[1],
-                        o.name,
-                        o.z,
-                        block.shape.height()
+                        no.lowest.name,
+                        no.lowest.z,
+                        2.0 * half,
+                        no.tops.join("; ")
                     ),
                 )
-                .label("this goal can never hold")
+                .label("the block can rest on nothing here")
                 .help(format!(
-                    "move the point or spot out of `{}`'s footprint; a block set down on an obstacle's top is placed there by `place`, not graded by `at`",
-                    o.name
+                    "move the point or spot off `{}`, onto a top wide enough for the block, or give the shelf's boards more room between them",
+                    no.lowest.name
                 )),
             );
         }

@@ -4,7 +4,7 @@
 //! | YAML | meaning |
 //! |---|---|
 //! | `in: {object: red, container: red_bin}` | the block rests in the container |
-//! | `on: {object: red, support: green}` | the block rests on top of the other block |
+//! | `on: {object: red, support: green}` | the block rests on top of the other block (or of an obstacle: a shelf board) |
 //! | `at: {object: red, point: [0.4, -0.2], yaw: deg(90)}` | the block rests at the point (or `spot: NAME`), at the yaw if given |
 //! | `all_in: {container: bin}` | every block rests in the container |
 //! | `stack: [red, green, blue]` | red on green on blue (the last one stays on the table) |
@@ -72,11 +72,12 @@ pub enum GoalAtom {
     On {
         /// The block on top.
         object: String,
-        /// The block under it.
+        /// The block or obstacle (a shelf board, a pedestal) under it.
         support: String,
     },
-    /// `object` rests at a place: released, at rest, on the table (or on the floor of the
-    /// container it is in), its centre within the tolerance of the point, at the yaw if given.
+    /// `object` rests at a place: released, at rest, on the table, the floor of the container
+    /// it is in, or the top of what it rests on (a shelf board, a pedestal, a block), its centre
+    /// within the tolerance of the point, at the yaw if given.
     At {
         /// The block.
         object: String,

@@ -228,7 +228,7 @@ pub(super) fn read_goal(
             }
             GoalRaw::On(r) => {
                 if want(&r.object, "object", &[ObjectKind::Block])
-                    & want(&r.support, "support", &[ObjectKind::Block])
+                    & want(&r.support, "support", &[ObjectKind::Block, ObjectKind::Obstacle])
                 {
                     atoms.push((
                         GoalAtom::On {

@@ -40,7 +40,8 @@ pub fn lifted(w: &World, i: usize, min_height: f64) -> bool {
 /// Block `i` rests at `point` = (x, y), metres (the `at` condition and the scene goal's `at`):
 /// released (no pad touches it), at rest (speed below `rest_speed`, m/s), its bottom within
 /// [`Tolerances::ON_TABLE_HEIGHT`] of the surface under it — the table outside every container
-/// ([`on_table`]), or the floor of the container it is inside (a kitting tray) —, its centre within
+/// ([`on_table`]), the floor of the container it is inside (a kitting tray), or the top of the
+/// obstacle or block it rests on ([`World::resting_on`]: a shelf board, a pedestal) —, its centre within
 /// `tolerance` metres of the point in the table plane and, when `yaw` is given, its side faces
 /// within `yaw_tolerance` radians of `yaw` modulo a quarter turn (a cube looks the same every
 /// quarter turn).
@@ -63,7 +64,11 @@ pub fn at(
                 && w.released(i)
                 && w.at_rest(i, rest_speed)
         }
-        None => on_table(w, i, Tolerances::ON_TABLE_HEIGHT, rest_speed),
+        // On the table, or on the top of what it rests on: a shelf board, a pedestal, a block.
+        None => {
+            on_table(w, i, Tolerances::ON_TABLE_HEIGHT, rest_speed)
+                || (w.resting_on(i).is_some() && w.released(i) && w.at_rest(i, rest_speed))
+        }
     };
     resting && near && turned
 }

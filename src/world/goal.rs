@@ -22,8 +22,13 @@ pub fn rests_in(w: &World, i: usize, c: usize, rest_speed: f64) -> bool {
 
 /// Block `i` rests on block `s`: its centre within half its edge + [`STACK_XY_SLACK`] of `s`'s
 /// in x and in y, its centre higher than `s`'s by the two half edges ± [`STACK_Z_TOLERANCE`],
-/// released, and at rest (speed below `rest_speed`, m/s).
+/// released, and at rest (speed below `rest_speed`, m/s). On an obstacle `s` (a shelf board, a
+/// pedestal): its bottom on the obstacle's top over its footprint ([`World::resting_on`]),
+/// released and at rest.
 pub fn rests_on(w: &World, i: usize, s: usize, rest_speed: f64) -> bool {
+    if w.spec(s).kind() == ObjectKind::Obstacle {
+        return w.resting_on(i) == Some(s) && w.released(i) && w.at_rest(i, rest_speed);
+    }
     let (a, b) = (&w.objects[i], &w.objects[s]);
     let d = a.pos - b.pos;
     let (ha, hb) = (w.half(i), w.half(s));
@@ -35,7 +40,8 @@ pub fn rests_on(w: &World, i: usize, s: usize, rest_speed: f64) -> bool {
 }
 
 /// Block `i` rests at `place` ([`super::conditions::at`] with the place's point, yaw and
-/// tolerances): released, at rest, on the table or a container's floor.
+/// tolerances): released, at rest, on the table, a container's floor, or the top of what it
+/// rests on (a shelf board, a pedestal, a block).
 pub fn rests_at(w: &World, i: usize, place: &GoalPlace, rest_speed: f64) -> bool {
     super::conditions::at(
         w,
@@ -152,6 +158,8 @@ pub fn pending(w: &World, i: usize) -> bool {
         GoalAtom::On { support, .. } => w.index_of(support).is_some_and(|s| {
             let settled = match w.scene.goal.of(support) {
                 Some(a) => atom_holds(w, a),
+                // A fixed obstacle (a board, a pedestal) is always ready to take a block.
+                None if w.spec(s).kind() == ObjectKind::Obstacle => true,
                 None => {
                     w.bottom(s) < Tolerances::ON_TABLE_HEIGHT && w.container_of(s).is_none() && w.released(s)
                 }

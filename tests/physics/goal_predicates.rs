@@ -72,32 +72,104 @@ fn a_stack_can_say_where_its_bottom_block_rests_and_the_list_form_still_reads() 
     assert_eq!(s.goal.atoms[0].to_string(), "red on blue");
 }
 
-/// An `at` goal is judged on the table (or a container's floor), so one inside a fixed
-/// obstacle's footprint — given as a point or as a spot — is refused at load, located at the
-/// goal; one under a board high enough for the block, or a spot on a pedestal (a set-down place
-/// for `place`), is not.
+/// An `at` goal is judged on whatever the block rests on: the table, a container's floor, an
+/// obstacle's top. One where the block can rest on nothing — inside a thin wall's footprint, or
+/// on a shelf board too close under the next — is refused at load, located at the goal, whether
+/// it names a point or a spot (the shelf's upper board here a 3 cm rail, too narrow to hold the
+/// block either); a place under a high board, on a pedestal or on a shelf board with room above
+/// it is not.
 #[test]
-fn an_at_goal_inside_an_obstacle_is_refused_where_it_is_written() {
+fn an_at_goal_where_the_block_can_rest_on_nothing_is_refused_where_it_is_written() {
     let cell = |goal: &str| {
         SceneSpec::from_str(
             &format!(
-                "objects:\n  red: {{block: {{size: 0.04}}, pose: [0.40, 0.20]}}\n  wall: {{obstacle: {{size: [0.04, 0.30, 0.20]}}, pose: [0.50, 0.0]}}\n  board: {{obstacle: {{size: [0.10, 0.10, 0.02]}}, pose: [0.45, -0.30], z: 0.10}}\nspots:\n  by_wall: [0.50, 0.05]\n  under_board: [0.45, -0.30]\ngoal:\n{goal}"
+                "objects:
+  red: {{block: {{size: 0.04}}, pose: [0.40, 0.20]}}
+  wall: {{obstacle: {{size: [0.02, 0.30, 0.20]}}, pose: [0.55, 0.0]}}
+  board: {{obstacle: {{size: [0.10, 0.10, 0.02]}}, pose: [0.45, -0.30], z: 0.10}}
+  pedestal: {{obstacle: {{size: [0.10, 0.10, 0.10]}}, pose: [0.30, -0.15]}}
+  tight_low: {{obstacle: {{size: [0.12, 0.12, 0.02]}}, pose: [0.30, 0.40]}}
+  tight_top: {{obstacle: {{size: [0.03, 0.12, 0.02]}}, pose: [0.30, 0.40], z: 0.05}}
+spots:
+  by_wall: [0.55, 0.05]
+  under_board: [0.45, -0.30]
+  on_pedestal: [0.30, -0.15]
+  tight: [0.30, 0.40]
+goal:
+{goal}"
             ),
             "cell.yaml",
         )
     };
-    for (goal, column) in [
-        ("  - at: {object: red, point: [0.50, -0.05]}\n", 5),
-        ("  - at: {object: red, spot: by_wall}\n", 5),
+    for (goal, needle) in [
+        (
+            "  - at: {object: red, point: [0.55, -0.05]}\n",
+            "`wall`'s top holds 0.010 m",
+        ),
+        (
+            "  - at: {object: red, spot: by_wall}\n",
+            "`wall`'s top holds 0.010 m",
+        ),
+        (
+            "  - at: {object: red, spot: tight}\n",
+            "room under the next board",
+        ),
     ] {
         let d = cell(goal).expect_err(goal);
         let e = find(&d, "can never be `at`");
-        assert_eq!((e.line, e.column), (9, column), "{e}");
-        assert!(e.message.contains("obstacle `wall`"), "{e}");
+        assert_eq!((e.line, e.column), (14, 5), "{e}");
+        assert!(e.message.contains(needle), "{e}");
         assert_eq!(d.len(), 1, "{d:#?}");
     }
-    // Under a board 0.10 m up a 0.04 m block fits: accepted.
+    // Under a board 0.10 m up a 0.04 m block fits on the table; a pedestal's top holds it.
     cell("  - at: {object: red, spot: under_board}\n").expect("a block fits under the board");
+    cell("  - at: {object: red, spot: on_pedestal}\n").expect("a pedestal's top holds the block");
+}
+
+/// A block resting on an obstacle's top (a pedestal, a shelf board) is graded by its `at` goal
+/// and by an `on` goal naming the obstacle, on real MuJoCo: the goal holds there, and not at a
+/// point beside it.
+#[test]
+fn at_and_on_goals_hold_for_a_block_resting_on_a_pedestal() {
+    let dir = scratch("at-on-pedestal");
+    let scene = dir.join("pedestal.yaml");
+    let write_goal = |point: &str, goal: &str| {
+        std::fs::write(
+            &scene,
+            format!(
+                "objects:
+  red: {{block: {{size: 0.04}}, pose: [0.45, -0.10], on: pedestal}}
+  pedestal: {{obstacle: {{size: [0.10, 0.10, 0.08]}}, pose: [0.45, -0.10]}}
+spots:
+  top: {point}
+goal:
+  - {goal}
+"
+            ),
+        )
+        .unwrap();
+    };
+    let write = |point: &str| write_goal(point, "at: {object: red, spot: top}");
+    let tree = dir.join("wait.yaml");
+    std::fs::write(&tree, "main: {wait: {seconds: 0.5}}\n").unwrap();
+    write("[0.45, -0.10]");
+    let r = json(&macrotree(&["run", s(&tree), "--scene", s(&scene), "--json"]));
+    let z = r["objects"][0]["final"][2].as_f64().unwrap();
+    assert!(
+        (z - 0.10).abs() < 0.005,
+        "the block rests on the 8 cm pedestal: {r}"
+    );
+    assert_eq!(r["goal"][0]["holds"], true, "{r}");
+    assert_eq!(r["success"], true, "{r}");
+    // 3 cm beside it, still on the pedestal's top: the tolerance (1 cm) decides, not the support.
+    write("[0.45, -0.07]");
+    let r = json(&macrotree(&["run", s(&tree), "--scene", s(&scene), "--json"]));
+    assert_eq!(r["goal"][0]["holds"], false, "{r}");
+    // `on` takes an obstacle as the support, and holds for the block on its top.
+    write_goal("[0.45, -0.10]", "on: {object: red, support: pedestal}");
+    let r = json(&macrotree(&["run", s(&tree), "--scene", s(&scene), "--json"]));
+    assert_eq!(r["goal"][0]["predicate"], "red on pedestal", "{r}");
+    assert_eq!(r["goal"][0]["holds"], true, "{r}");
 }
 
 #[test]
@@ -144,6 +216,9 @@ fn placement_goal_mistakes_are_located_and_explained() {
 
     let d = errors("  - at: {object: bin, point: [0.4, 0.1]}\n");
     find(&d, "`bin` is a container, not a block");
+    // `on` rests a block on a block or an obstacle's top, never on a container (that is `in`).
+    let d = errors("  - on: {object: red, support: bin}\n");
+    find(&d, "`bin` is a container, not a block or obstacle");
 
     // Two blocks that can never both be at their points.
     let d =
