@@ -97,6 +97,9 @@ pub(crate) struct Chain {
     pub origins: [Vector3<f64>; 6],
     /// Joint axes (world, unit).
     pub axes: [Vector3<f64>; 6],
+    /// The upper arm's far end on its own axis, before the elbow's lateral offset (world),
+    /// metres.
+    pub upper_arm_end: Vector3<f64>,
     /// Pinch position (world), metres.
     pub pinch_pos: Vector3<f64>,
     /// Pinch rotation (world).
@@ -123,6 +126,7 @@ pub(crate) fn chain(q: &[f64; 6]) -> Chain {
     origins[1] = p;
     axes[1] = r * ey;
     r *= rot_y(q[1]);
+    let upper_arm_end = p + r * Vector3::new(0.0, 0.0, UPPER_ARM);
     // forearm_link
     p += r * Vector3::new(0.0, -0.131, UPPER_ARM);
     origins[2] = p;
@@ -150,6 +154,7 @@ pub(crate) fn chain(q: &[f64; 6]) -> Chain {
     Chain {
         origins,
         axes,
+        upper_arm_end,
         pinch_pos,
         pinch_rot,
     }

@@ -7,12 +7,14 @@
 //! | module | what |
 //! |---|---|
 //! | [`kinematics`] | [`fk`], [`jacobian`], the chain's dimensions and [`JOINT_LIMITS`] |
+//! | [`body`] | the arm's and gripper's links as capsules along the chain ([`body::arm_capsules`]) |
 //! | [`mod@ik`] | closed-form [`ik()`] with nearest-to-seed branch choice, every branch ([`ik_all`]), [`ik_down`], [`down_pose`], [`IkError`], [`ik_benchmark`] |
 //! | [`mod@plan`] | collision-aware joint-space planning: RRT-Connect to goal sets, shortcutting, blends, timing, typed failure reasons |
 //! | [`trajectory`] | the [`Trajectory`] trait, [`JointMove`], [`CartesianMove`], [`Hold`], [`MotionLimits`] |
 //! | [`gripper`] | command ↔ opening calibration of the simulated 2F-85 |
 //! | [`command`] | [`ArmCommand`] and [`CellCommand`]: one control period's command, the one action |
 
+pub mod body;
 pub mod command;
 pub mod gripper;
 pub mod ik;

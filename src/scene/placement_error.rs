@@ -30,6 +30,16 @@ pub enum PlacementError {
         /// Distance from the base axis to the nearest point of its footprint, metres.
         distance: f64,
     },
+    /// A fixed object stands where the arm rests at home: a link of the arm at home (as
+    /// [`crate::motion::body::arm_capsules`] models it) comes into its box.
+    InArmAtHome {
+        /// The object.
+        object: String,
+        /// The link (`forearm`, `gripper`, …).
+        link: &'static str,
+        /// How far the link comes into the object, metres.
+        depth: f64,
+    },
     /// A block lies where the arm cannot pick it from above.
     OutOfReach {
         /// The block.
@@ -110,6 +120,7 @@ impl PlacementError {
             PlacementError::OffTable { object, .. }
             | PlacementError::BadYaw { object, .. }
             | PlacementError::OnRobotBase { object, .. }
+            | PlacementError::InArmAtHome { object, .. }
             | PlacementError::OutOfReach { object, .. }
             | PlacementError::OffSupport { object, .. }
             | PlacementError::InKeepOut { object, .. }
@@ -127,6 +138,7 @@ impl PlacementError {
             PlacementError::OffTable { object, .. } => format!("off_table {object}"),
             PlacementError::BadYaw { object, .. } => format!("bad_yaw {object}"),
             PlacementError::OnRobotBase { object, .. } => format!("on_robot_base {object}"),
+            PlacementError::InArmAtHome { object, .. } => format!("in_arm_at_home {object}"),
             PlacementError::OutOfReach { object, .. } => format!("out_of_reach {object}"),
             PlacementError::TooClose { a, b, .. } => format!("too_close {a} {b}"),
             PlacementError::OffSupport { object, support, .. } => format!("off_support {object} {support}"),
@@ -146,6 +158,16 @@ impl PlacementError {
             }
             PlacementError::OnRobotBase { object, .. } => {
                 format!("move `{object}` (or its `random:` region) away from the robot's base at the origin")
+            }
+            PlacementError::InArmAtHome { object, .. } => {
+                let pinch = crate::motion::fk(&crate::motion::HOME_Q).translation.vector;
+                format!(
+                    "move `{object}` (or its `random:` region) clear of the arm at home, or make it lower: at home the upper arm rises beside the base to {:.2} m and the forearm reaches over to the gripper, which hangs down to ({:.2}, {:.2}, {:.2}) m",
+                    crate::motion::kinematics::SHOULDER_HEIGHT + crate::motion::kinematics::UPPER_ARM,
+                    pinch.x,
+                    pinch.y,
+                    pinch.z
+                )
             }
             PlacementError::OutOfReach { object, .. } => {
                 let [lo, hi] = reach_limits();
@@ -213,6 +235,10 @@ impl std::fmt::Display for PlacementError {
             PlacementError::OnRobotBase { object, distance } => write!(
                 f,
                 "`{object}` overlaps the robot's base: its footprint comes within {distance:.3} m of the base axis (keep it clear of {ROBOT_BASE_RADIUS} m)"
+            ),
+            PlacementError::InArmAtHome { object, link, depth } => write!(
+                f,
+                "`{object}` stands where the arm rests at home: its {link} would be {depth:.3} m inside it, and every episode starts at home"
             ),
             PlacementError::OutOfReach { object, distance } => write!(
                 f,

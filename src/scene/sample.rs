@@ -73,6 +73,28 @@ fn support_rect(shape: &Shape, pose: &Pose) -> Rect {
     }
 }
 
+/// How far the arm at home comes into the box of an object of `shape` at `pose` (its footprint,
+/// from its base `pose.z` up its height): the deepest link and depth, metres; `None` when no
+/// link's capsule ([`crate::motion::body::arm_capsules`]) reaches it.
+fn arm_at_home_inside(shape: &Shape, pose: &Pose) -> Option<(&'static str, f64)> {
+    let rect = shape.footprint(pose);
+    let (bottom, top) = (pose.z, pose.z + shape.height());
+    let mut deepest: Option<(&'static str, f64)> = None;
+    for c in crate::motion::body::arm_capsules(&crate::motion::HOME_Q) {
+        for p in c.axis_points(0.005) {
+            let [u, v] = rect.local([p.x, p.y]);
+            let dx = (u.abs() - rect.half[0]).max(0.0);
+            let dy = (v.abs() - rect.half[1]).max(0.0);
+            let dz = (p.z - top).max(bottom - p.z).max(0.0);
+            let depth = c.radius - (dx * dx + dy * dy + dz * dz).sqrt();
+            if depth > 0.0 && deepest.is_none_or(|(_, d)| depth > d) {
+                deepest = Some((c.link, depth));
+            }
+        }
+    }
+    deepest
+}
+
 /// Object `i`'s `random.clearance`, 0 for an object without `random:`, metres.
 fn clearance(scene: &SceneSpec, i: usize) -> f64 {
     scene.objects[i].random.as_ref().map_or(0.0, |r| r.clearance)
@@ -130,6 +152,15 @@ impl Placement {
             return Err(PlacementError::OnRobotBase {
                 object: o.name.clone(),
                 distance: base,
+            });
+        }
+        if o.kind() != ObjectKind::Block
+            && let Some((link, depth)) = arm_at_home_inside(&o.shape, p)
+        {
+            return Err(PlacementError::InArmAtHome {
+                object: o.name.clone(),
+                link,
+                depth,
             });
         }
         let r = p.x.hypot(p.y);

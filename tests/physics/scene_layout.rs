@@ -88,6 +88,53 @@ fn blocks_drawn_in_a_randomized_bin_lie_on_its_floor_inside_the_walls_for_every_
 }
 
 #[test]
+fn an_obstacle_the_arm_at_home_stands_in_is_refused_at_its_pose() {
+    let pinch = macrotree::motion::fk(&macrotree::motion::HOME_Q)
+        .translation
+        .vector;
+    let cell = |height: f64| {
+        SceneSpec::from_str(
+            &format!(
+                "objects:\n  red: {{block: {{size: 0.04}}, pose: [0.45, 0.0]}}\n  post:\n    obstacle: {{size: [0.06, 0.06, {height}]}}\n    pose: [{:.3}, {:.3}]\n",
+                pinch.x, pinch.y
+            ),
+            "cell.yaml",
+        )
+    };
+    // A post under the gripper, up past its pinch point: every episode would start inside it.
+    let d = cell(0.40).expect_err("the arm at home stands in the post");
+    let e = find(&d, "stands where the arm rests at home");
+    assert_eq!((e.line, e.column), (5, 11), "located at the post's pose: {e}");
+    assert!(e.message.contains("its gripper"), "{e}");
+    assert!(
+        e.help.as_deref().unwrap().contains("clear of the arm at home"),
+        "{e}"
+    );
+    // A low one under the hanging gripper is fine.
+    cell(0.20).expect("a post below the gripper at home");
+    // Randomized, the draws keep clear of the arm: every drawn pose of the post is outside it.
+    let s = SceneSpec::from_str(
+        &format!(
+            "objects:\n  red: {{block: {{size: 0.04}}, pose: [0.45, 0.0]}}\n  post:\n    obstacle: {{size: [0.06, 0.06, 0.40]}}\n    random: {{x: [{:.3}, 0.30], y: [0.0, {:.3}]}}\n",
+            pinch.x, pinch.y
+        ),
+        "cell.yaml",
+    )
+    .expect("the region has room clear of the arm");
+    // (Without the check, about 1 draw in 60 would put the gripper's axis inside the post.)
+    for k in 0..400 {
+        let (_, p) = sample_placement(&s, 3, k).unwrap();
+        let post = p.poses[1];
+        assert!(
+            (post.x - pinch.x).abs().max((post.y - pinch.y).abs()) >= 0.03,
+            "scenario {k}: the post drawn around the gripper at ({}, {})",
+            post.x,
+            post.y
+        );
+    }
+}
+
+#[test]
 fn overlapping_fixed_objects_are_told_to_move_one_not_to_widen_random_regions() {
     // Two fixed objects (no `random:`, no clearance) whose footprints meet.
     let d = scene_errors(
