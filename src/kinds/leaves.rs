@@ -70,8 +70,10 @@ fn d_off_axis() -> f64 {
 fn d_rest_speed() -> f64 {
     Tolerances::REST_SPEED
 }
+/// The `at` and `cube_at` conditions default to the scene goal's `at` tolerances: one check,
+/// one default ([`crate::scene::AT_TOLERANCE`], [`crate::scene::AT_YAW_TOLERANCE`]).
 fn d_point_tol() -> f64 {
-    Tolerances::AT_POINT
+    crate::scene::AT_TOLERANCE
 }
 
 #[doc = include_str!("../../docs/nodes/reach.md")]
@@ -446,7 +448,8 @@ pub struct CubeAt {
     /// The yaw the cube's faces should have (radians or `deg(..)`, modulo 90°). Absent: any.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub yaw: Option<Angle>,
-    /// Largest yaw error when `yaw` is given, radians (or `deg(..)`). Default 3°.
+    /// Largest yaw error when `yaw` is given, radians (or `deg(..)`). Default 5°, as the scene
+    /// goal's `at`.
     #[serde(default = "d_yaw_tol", deserialize_with = "units::angle_tolerance")]
     #[schemars(with = "units::Angle")]
     pub yaw_tolerance: f64,
@@ -494,7 +497,7 @@ impl Default for AtHome {
 }
 
 fn d_yaw_tol() -> f64 {
-    3f64.to_radians()
+    crate::scene::AT_YAW_TOLERANCE
 }
 
 #[doc = include_str!("../../docs/nodes/grasped.md")]
@@ -593,7 +596,8 @@ pub struct At {
     /// (also for a `spot`: its yaw is checked only when `yaw` is given, as in the scene goal).
     #[serde(default)]
     pub yaw: Option<Angle>,
-    /// Largest yaw error when `yaw` is given, radians (or `deg(..)`). Default 3°.
+    /// Largest yaw error when `yaw` is given, radians (or `deg(..)`). Default 5°, as the scene
+    /// goal's `at`.
     #[serde(default = "d_yaw_tol", deserialize_with = "units::angle_tolerance")]
     #[schemars(with = "units::Angle")]
     pub yaw_tolerance: f64,

@@ -21,8 +21,6 @@ impl Tolerances {
     pub const HOME_TOLERANCE: f64 = 0.04;
     /// Cube bottom height above the table that still counts as resting on it, metres.
     pub const ON_TABLE_HEIGHT: f64 = 0.01;
-    /// Horizontal distance of the cube's centre from a goal point that counts as there, metres.
-    pub const AT_POINT: f64 = 0.01;
 }
 
 /// Both pads touch block `i` and its centre lies between them, at most `off_axis` metres from

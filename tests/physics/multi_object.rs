@@ -256,7 +256,7 @@ fn the_tutorial_sampler_follows_the_scene_setting_not_the_scene_name() {
 }
 
 #[test]
-fn load_spec_panicked_in_default_placement_on_an_unsatisfiable_random_placement() {
+fn an_unsatisfiable_random_placement_is_a_typed_error_from_load_spec_not_a_panic() {
     // A scene built in code (never read from a file, so never checked there) whose two
     // `random:`-only objects must both sit on one point: no draw can separate them.
     let mut spec = macrotree::scene::SceneSpec::builtin();

@@ -341,3 +341,37 @@ fn a_placement_yaw_that_is_not_a_finite_angle_within_a_turn_is_refused_as_a_yaw(
         assert!(text.len() < 160, "{text}");
     }
 }
+
+#[test]
+fn the_at_condition_defaults_to_the_scene_goals_at_tolerances() {
+    let plan = macrotree::plan::Loader::default()
+        .compile_str(
+            "main: {sequence: {children: [{at: {object: cube, point: [0.4, 0.1], yaw: 0}}, {cube_at: {point: [0.4, 0.1], yaw: 0}}]}}\n",
+            "t.yaml",
+        )
+        .expect("compiles");
+    let at = plan.leaves[0]
+        .kind
+        .params::<macrotree::kinds::At>()
+        .expect("an at");
+    let cube_at = plan.leaves[1]
+        .kind
+        .params::<macrotree::kinds::CubeAt>()
+        .expect("a cube_at");
+    let scene = SceneSpec::from_str(
+        "objects:\n  cube: {block: {size: 0.04}, pose: [0.45, 0.0]}\ngoal:\n  - at: {object: cube, point: [0.4, 0.1], yaw: 0}\n",
+        "cell.yaml",
+    )
+    .unwrap();
+    let goal = scene.goal.atoms[0].place().unwrap();
+    // One check, one default: the condition and the goal agree on what `at` means.
+    assert_eq!(
+        (at.tolerance, at.yaw_tolerance),
+        (goal.tolerance, goal.yaw_tolerance)
+    );
+    assert_eq!(
+        (cube_at.tolerance, cube_at.yaw_tolerance),
+        (goal.tolerance, goal.yaw_tolerance)
+    );
+    assert_eq!(goal.yaw_tolerance, macrotree::scene::AT_YAW_TOLERANCE);
+}
