@@ -137,6 +137,18 @@ impl SceneChecker {
     /// # Errors
     /// A margin out of range, or `data` not of this scene's model.
     pub fn new(scene: &Scene, data: &MjData<Arc<MjModel>>, margin: f64) -> Result<Self, SimError> {
+        let model = scene.collision_model()?;
+        Self::on_model(scene, data, margin, &model)
+    }
+
+    /// [`SceneChecker::new`] on a copy of `model`, a model of `scene` with its ids (its
+    /// collision model, or in tests the whole model).
+    fn on_model(
+        scene: &Scene,
+        data: &MjData<Arc<MjModel>>,
+        margin: f64,
+        model: &MjModel,
+    ) -> Result<Self, SimError> {
         if !(margin.is_finite() && (0.0..=MAX_MARGIN).contains(&margin)) {
             return Err(SimError::Scene(format!(
                 "collision margin {margin} m: use a value in [0, {MAX_MARGIN}] metres"
@@ -184,9 +196,9 @@ impl SceneChecker {
         let bodies: [usize; 6] = std::array::from_fn(|k| src.jnt_bodyid()[arm_joints[k]] as usize);
         let mut checker = Self {
             scene: scene.clone(),
-            // The one copy of the model this checker makes (a copy takes tens of milliseconds;
-            // holds, releases and margin changes edit it in place).
-            data: MjData::new(Box::new((*scene.model).clone())),
+            // The one copy of the model this checker makes (holds, releases and margin changes
+            // edit it in place).
+            data: MjData::new(Box::new(model.clone())),
             group,
             collidable,
             labels,

@@ -9,7 +9,7 @@ use rand_chacha::ChaCha8Rng;
 use super::{SPARE_TOLERANCE, SceneChecker};
 use crate::motion::plan::config::UR5E_LEVER_ARMS;
 use crate::motion::plan::shapes::{Shape, clearance};
-use crate::motion::plan::{CollisionChecker, JointSpare, SPARE_CAP};
+use crate::motion::plan::{Collision, CollisionChecker, JointSpare, SPARE_CAP};
 use crate::motion::{HOME_Q, JOINT_LIMITS, down_pose, fk, ik};
 use crate::scene::SceneSpec;
 use crate::sim::chain::ArmChain;
@@ -566,4 +566,149 @@ fn a_coupler_within_the_margin_of_a_bin_wall_went_unreported_while_their_bodies_
         .unwrap_or_else(|| panic!("{hits:?}"));
     assert!((0.0..0.005).contains(&coupler.distance), "{coupler:?}");
     assert!((truth(&mut c, &q) - coupler.distance).abs() < 1e-6);
+}
+
+/// The checker of [`CELL`] on `model` (the cell's collision model or its whole model), holding
+/// the cube in the pinch or not.
+fn checker_on(scene: &Scene, model: &mujoco_rs::prelude::MjModel, hold: bool) -> SceneChecker {
+    let mut sim = Sim::new(scene);
+    if hold {
+        place_cube(scene, &mut sim, &Isometry3::identity());
+    }
+    let mut c = SceneChecker::on_model(scene, sim.data(), 0.005, model).expect("checker");
+    if hold {
+        c.hold(0).expect("the cube is a block");
+    }
+    c
+}
+
+#[test]
+fn the_collision_model_keeps_every_id_and_collidable_geom_of_the_cell_in_a_fraction_of_the_memory() {
+    let spec = SceneSpec::from_str(CELL, "spare.yaml").expect("valid scene");
+    let scene = Scene::load_spec(&spec).expect("scene (run tools/bootstrap)");
+    let (whole, lean) = (&scene.model, scene.collision_model().expect("collision model"));
+    let (w, l) = (whole.ffi(), lean.ffi());
+    let counts = |m: &mujoco_rs::mujoco_c::mjModel| {
+        [
+            m.nq, m.nv, m.nu, m.nbody, m.njnt, m.ngeom, m.nsite, m.ncam, m.nmocap, m.neq, m.nexclude,
+        ]
+    };
+    assert_eq!(
+        counts(w),
+        counts(l),
+        "nq nv nu nbody njnt ngeom nsite ncam nmocap neq nexclude"
+    );
+    let (mut collidable, mut meshes) = (0, 0);
+    for g in 0..w.ngeom as usize {
+        assert_eq!(whole.geom_bodyid()[g], lean.geom_bodyid()[g], "geom {g}'s body");
+        assert_eq!(
+            whole.geom_contype()[g],
+            lean.geom_contype()[g],
+            "geom {g}'s contype"
+        );
+        assert_eq!(
+            whole.geom_conaffinity()[g],
+            lean.geom_conaffinity()[g],
+            "geom {g}'s conaffinity"
+        );
+        if whole.geom_contype()[g] == 0 && whole.geom_conaffinity()[g] == 0 {
+            continue;
+        }
+        collidable += 1;
+        assert_eq!(whole.geom_type()[g], lean.geom_type()[g], "geom {g}'s type");
+        let (dw, dl) = (whole.geom_dataid()[g], lean.geom_dataid()[g]);
+        assert_eq!(dw < 0, dl < 0, "geom {g} has a mesh in one model only");
+        if dw < 0 {
+            assert_eq!(whole.geom_size()[g], lean.geom_size()[g], "geom {g}'s size");
+            assert_eq!(whole.geom_pos()[g], lean.geom_pos()[g], "geom {g}'s position");
+            assert_eq!(
+                whole.geom_quat()[g],
+                lean.geom_quat()[g],
+                "geom {g}'s orientation"
+            );
+        } else {
+            // The mesh is its convex hull, recentred: as many hull vertices, fewer vertices.
+            let hull = |m: &mujoco_rs::prelude::MjModel, d: i32| {
+                m.mesh_graph()[m.mesh_graphadr()[d as usize] as usize]
+            };
+            assert_eq!(hull(whole, dw), hull(&lean, dl), "geom {g}'s hull vertices");
+            meshes += 1;
+        }
+    }
+    assert!(meshes >= 6, "{meshes} collidable meshes");
+    assert!(collidable > 20, "{collidable} collidable geoms");
+    // The meshes are most of the cell's model (44 MB; the collision model 1.1 MB).
+    let (wb, lb) = (w.nbuffer as f64, l.nbuffer as f64);
+    assert!(
+        lb < wb / 20.0,
+        "collision model {lb} bytes, whole model {wb} bytes"
+    );
+}
+
+/// How far two distances of the same geoms may differ by rounding alone, metres: MuJoCo stores
+/// mesh vertices as `f32` (7 digits, tens of nanometres at a gripper's size), and the hull's
+/// vertices pass through two such roundings (out of the whole model, then recentred).
+const ROUNDING: f64 = 1e-6;
+
+/// Over seeded configurations near the obstacles, holding the cube and not, a checker on the
+/// collision model reports the same collisions (pairs and distances) and the same exact spare
+/// clearance as one on the whole model.
+#[test]
+fn a_checker_on_the_collision_model_answers_as_on_the_whole_model() {
+    let spec = SceneSpec::from_str(CELL, "spare.yaml").expect("valid scene");
+    let scene = Scene::load_spec(&spec).expect("scene (run tools/bootstrap)");
+    let lean = scene.collision_model().expect("collision model");
+    let mut r = ChaCha8Rng::seed_from_u64(17);
+    let (mut touching, mut near) = (0, 0);
+    for hold in [false, true] {
+        let mut whole = checker_on(&scene, &scene.model, hold);
+        let mut twin = checker_on(&scene, &lean, hold);
+        for _ in 0..300 {
+            let q = drawn(&mut r);
+            let by_pair = |mut c: Vec<Collision>| {
+                c.sort_by_key(Collision::pair);
+                c
+            };
+            let (found, twin_found) = (by_pair(whole.collisions(&q)), by_pair(twin.collisions(&q)));
+            touching += usize::from(!found.is_empty());
+            let pairs = |c: &[Collision]| c.iter().map(Collision::pair).collect::<Vec<_>>();
+            assert_eq!(
+                pairs(&found),
+                pairs(&twin_found),
+                "pairs at {q:?} (holding: {hold})"
+            );
+            for (a, b) in found.iter().zip(&twin_found) {
+                // A penetration's depth is MuJoCo's estimate, found from the shapes' centres,
+                // which the recentred hull moves: both penetrate there. Apart (within the
+                // margin) the distance is exact, so equal up to rounding.
+                if a.distance < -ROUNDING {
+                    assert!(b.distance < 0.0, "{a:?} and {b:?} at {q:?}");
+                } else {
+                    assert!(
+                        (a.distance - b.distance).abs() < ROUNDING,
+                        "{a:?} and {b:?} at {q:?}"
+                    );
+                    near += 1;
+                }
+            }
+            assert_eq!(whole.is_free(&q), twin.is_free(&q), "free at {q:?}");
+            match (whole.exact_spare(&q, SPARE_CAP), twin.exact_spare(&q, SPARE_CAP)) {
+                (None, None) => {}
+                (Some(a), Some(b)) => {
+                    for lo in 0..6 {
+                        for hi in lo..6 {
+                            let (x, y) = (a.get(lo, hi), b.get(lo, hi));
+                            assert!((x - y).abs() < ROUNDING, "spare {a:?} and {b:?} at {q:?}");
+                        }
+                    }
+                }
+                (a, b) => panic!("spare {a:?} and {b:?} at {q:?}"),
+            }
+        }
+    }
+    assert!(
+        touching > 50,
+        "only {touching} of 600 configurations touch something"
+    );
+    assert!(near > 10, "only {near} pairs within the margin and apart");
 }

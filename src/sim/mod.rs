@@ -4,6 +4,7 @@
 pub mod cache;
 mod chain;
 pub mod collision;
+pub mod collision_model;
 pub mod error;
 pub mod layout;
 mod margin;

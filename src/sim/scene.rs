@@ -13,6 +13,7 @@ use std::sync::Arc;
 use mujoco_rs::prelude::*;
 use mujoco_rs::wrappers::mj_editing::{Attach, MjSpec};
 
+use super::collision_model::CollisionModel;
 use super::error::SimError;
 use super::layout::Layout;
 use crate::scene::{OBJECT_PREFIX, ObjectKind, Placement, Pose, SceneSpec, sample_placement};
@@ -96,6 +97,8 @@ pub struct Scene {
     /// Every object's `pose:`, with the `random:`-only objects drawn as scenario 0 of sweep
     /// seed 0 (drawn once, when the scene is built).
     default_placement: Placement,
+    /// The model the collision checker copies, compiled when first asked for.
+    collision_model: Arc<CollisionModel>,
 }
 
 impl std::fmt::Debug for Scene {
@@ -165,11 +168,27 @@ impl Scene {
             Some(dir) => cached_model(&xml, &ur5e, &gripper, menagerie, dir)?,
             None => (compile_model(&xml, &ur5e, &gripper)?, ModelOrigin::Compiled),
         };
-        Ok((Self::from_model(model, spec, placement)?, origin))
+        let collision_model = CollisionModel::new(&xml, &ur5e, &gripper);
+        Ok((Self::from_model(model, spec, placement, collision_model)?, origin))
+    }
+
+    /// The model the collision checker copies: this scene's bodies, joints, sites and geoms with
+    /// the same ids, without what only shows ([`super::collision_model`]), compiled on the
+    /// first call and shared by every clone of this scene.
+    ///
+    /// # Errors
+    /// The collision model does not compile.
+    pub fn collision_model(&self) -> Result<Arc<MjModel>, SimError> {
+        self.collision_model.get(&self.model)
     }
 
     /// The scene of `spec` around an already compiled `model` (of that scene).
-    fn from_model(model: MjModel, spec: &SceneSpec, default_placement: Placement) -> Result<Self, SimError> {
+    fn from_model(
+        model: MjModel,
+        spec: &SceneSpec,
+        default_placement: Placement,
+        collision_model: CollisionModel,
+    ) -> Result<Self, SimError> {
         let objects = lookup_objects(&model, spec)?;
         let ids = SceneIds::lookup(&model)?;
         let geom_parts = geom_parts(&model, spec, &objects);
@@ -187,6 +206,7 @@ impl Scene {
             arm_gains,
             arm_ctrlrange,
             default_placement,
+            collision_model: Arc::new(collision_model),
         })
     }
 }
@@ -259,7 +279,18 @@ pub const ARM_PREFIX: &str = "ur5e/";
 /// Parses the cell `xml`, attaches the UR5e (`ur5e/`) and the 2F-85 at its attachment site
 /// (`gripper/`) and compiles the whole.
 pub fn compile_model(xml: &str, ur5e: &Path, gripper: &Path) -> Result<MjModel, SimError> {
-    let spec_err = |what: &str, e: MjEditError| SimError::Scene(format!("{what}: {e:?}"));
+    let mut scene = cell_spec(xml, ur5e, gripper)?;
+    scene.compile().map_err(|e| spec_err("compiling the scene", e))
+}
+
+/// A [`SimError::Scene`] for a failed MjSpec step.
+pub(super) fn spec_err(what: &str, e: MjEditError) -> SimError {
+    SimError::Scene(format!("{what}: {e:?}"))
+}
+
+/// The cell's specification: `xml` with the UR5e and the 2F-85 attached and the wrist camera
+/// added, not yet compiled.
+pub(super) fn cell_spec(xml: &str, ur5e: &Path, gripper: &Path) -> Result<MjSpec, SimError> {
     let mut scene = MjSpec::from_xml_string(xml).map_err(|e| spec_err("the scene's MJCF", e))?;
     let mut arm = MjSpec::from_xml(ur5e).map_err(|e| spec_err("ur5e.xml", e))?;
     let mut hand = MjSpec::from_xml(gripper).map_err(|e| spec_err("2f85.xml", e))?;
@@ -273,7 +304,7 @@ pub fn compile_model(xml: &str, ur5e: &Path, gripper: &Path) -> Result<MjModel, 
         .attach_by_deep_copy(&mut hand, "gripper/", "")
         .map_err(|e| spec_err("attaching the 2F-85", e))?;
     add_wrist_camera(&mut scene)?;
-    scene.compile().map_err(|e| spec_err("compiling the scene", e))
+    Ok(scene)
 }
 
 /// Name of the wrist camera on the 2F-85's base, added when the scene is compiled.
