@@ -6,11 +6,18 @@ reads a LeRobot dataset that ``macrotree sweep --dataset`` wrote (best with ``--
 demonstrations, whose labels are the clean commands), keeps the frames whose running leaf's path
 contains ``--leaf``, and fits a multilayer perceptron from what the `policy` leaf feeds a model
 (``observation.state`` and ``observation.object``, the named object's pose relative to the
-gripper) to the next frame's commanded set points and gripper command. The network predicts
-offsets from the measured joints; the exported graph adds them back (``action`` is absolute set
-points, ``macrotree.action = absolute``), bakes the normalisation in, and records the dataset's
-digest, the segment and the training settings in its metadata. Reading Parquet needs
-``pyarrow``; training needs only numpy (two CPU cores, minutes).
+gripper) to the commanded set points and gripper commands of the next ``--chunk`` frames (an
+action chunk ``[1, k, 7]``; the tree's ``n_action_steps`` says how many of them run before the
+model is called again). The network predicts offsets from the measured joints; the exported
+graph adds them back (``action`` is absolute set points, ``macrotree.action = absolute``), bakes
+the normalisation in, and records the dataset's digest, the segment and the training settings
+in its metadata. Reading Parquet needs ``pyarrow``; training needs only numpy (two CPU cores,
+minutes).
+
+Why chunks: a scripted skill often holds still while one leaf settles and then moves on from the
+same state (the pick's pre-grasp pose above the block, then the descent). Cloned one command at
+a time, "hold" and "move on" average into a fixed point where the policy stops; a chunk of the
+coming commands includes the move, so running a few of its actions leaves that state.
 """
 
 from __future__ import annotations
@@ -22,7 +29,7 @@ import json
 import os
 import sys
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -38,8 +45,13 @@ STATE_LEN = 20
 OBJECT_LEN = 5
 #: Values per object in ``observation.environment_state``.
 VALUES_PER_OBJECT = 7
+#: Values of one action the `policy` leaf takes: six joint set points and the gripper command.
+ACTION_LEN = 7
 #: Index of the gripper command in a dataset's 19-value ``action``.
 GRIPPER_IN_ACTION = 18
+#: Commands a model predicts by default (``--chunk``): 0.4 s at 50 fps, longer than the
+#: flagship's pick holds still at its pre-grasp pose.
+DEFAULT_CHUNK = 20
 #: The smallest input spread normalisation divides by (a near-constant input, such as the
 #: tool's orientation during a top grasp, must not blow small deviations up).
 MIN_STD = 1e-2
@@ -68,9 +80,9 @@ def object_features(state: F64, environment: F64, index: int) -> F64:
 
 @dataclass
 class Demonstrations:
-    """Training pairs: inputs (state then object features), labels (six joint offsets from the
-    measured joints to the next set point, radians, and the next gripper command), and the
-    episode of each row."""
+    """Training pairs: inputs (state then object features), labels (per action of the chunk:
+    six joint offsets from the measured joints to the set point, radians, and the gripper
+    command), and the episode of each row."""
 
     x: F64
     y: F64
@@ -78,16 +90,17 @@ class Demonstrations:
 
 
 def load_dataset(
-    path: str, leaf: str, object_index: int, drop_holds: bool = False
+    path: str, leaf: str, object_index: int, drop_holds: bool = False, chunk: int = 1
 ) -> tuple[Demonstrations, dict[str, object]]:
     """The demonstrations of the frames whose running leaf's path contains ``leaf``, and the
-    dataset's ``meta/info.json``.
+    dataset's ``meta/info.json``. Frame k's labels are the commands of frames k + 1 … k +
+    ``chunk`` (the last frame of the episode repeated past its end), 7 values each.
 
     With ``drop_holds``, frames where the arm only holds still (the next command's joint
     velocities all zero and the gripper command unchanged) are left out — an attempt at the
     ambiguity of a scripted leaf settling at its goal before the next leaf starts from the same
     state (the pre-grasp pose above the block, then the descent). On the flagship's pick it
-    made things worse (docs/learning.md)."""
+    made things worse (docs/history.md, 2026-11-29)."""
     try:
         import pyarrow.parquet as pq  # type: ignore[import-not-found,import-untyped,unused-ignore]
     except ImportError as e:  # pragma: no cover - depends on the machine
@@ -119,8 +132,14 @@ def load_dataset(
             keep &= moving | gripping
         idx = np.nonzero(keep)[0]
         x = np.column_stack([state[idx], object_features(state[idx], env[idx], object_index)])
+        # The last frame of each frame's episode: a chunk running past it repeats it.
+        starts = np.r_[0, np.nonzero(episode[1:] != episode[:-1])[0] + 1, len(episode)]
+        last = np.repeat(starts[1:] - 1, np.diff(starts))
         y = np.column_stack(
-            [action[idx + 1, :6] - state[idx, :6], action[idx + 1, GRIPPER_IN_ACTION]]
+            [
+                np.column_stack([action[j, :6] - state[idx, :6], action[j, GRIPPER_IN_ACTION]])
+                for j in (np.minimum(idx + step, last[idx]) for step in range(1, chunk + 1))
+            ]
         )
         xs.append(x)
         ys.append(y)
@@ -160,10 +179,18 @@ class TrainConfig:
     lr: float = 1e-3
     seed: int = 0
     state: str = "all"
+    #: Epochs after which ``train`` hands the network to its ``checkpoint`` callback.
+    checkpoints: tuple[int, ...] = ()
 
 
-def train(d: Demonstrations, cfg: TrainConfig, log: bool = True) -> Mlp:
-    """Fits an MLP (ReLU, Adam, mean squared error on normalised labels) to ``d``."""
+def train(
+    d: Demonstrations,
+    cfg: TrainConfig,
+    log: bool = True,
+    checkpoint: Callable[[int, Mlp], None] | None = None,
+) -> Mlp:
+    """Fits an MLP (ReLU, Adam, mean squared error on normalised labels) to ``d``; calls
+    ``checkpoint(epoch, mlp)`` after each epoch listed in ``cfg.checkpoints``."""
     rng = np.random.default_rng(cfg.seed)
     used = np.array([*STATE_CHOICES[cfg.state], *range(STATE_LEN, STATE_LEN + OBJECT_LEN)])
     x_mean = np.zeros(d.x.shape[1])
@@ -217,13 +244,32 @@ def train(d: Demonstrations, cfg: TrainConfig, log: bool = True) -> Mlp:
             print(
                 f"epoch {epoch + 1}/{cfg.epochs}: mse {total / n / y.shape[1]:.4f}", file=sys.stderr
             )
-    skip = np.zeros((d.x.shape[1], y.shape[1]), np.float32)
-    skip[np.arange(6), np.arange(6)] = 1.0  # offsets from the measured joints → set points
+        if checkpoint is not None and epoch + 1 in cfg.checkpoints and epoch + 1 < cfg.epochs:
+            checkpoint(epoch + 1, _mlp(d, used, ws, bs, x_mean, x_std, y_mean, y_std))
+    return _mlp(d, used, ws, bs, x_mean, x_std, y_mean, y_std)
+
+
+def _mlp(
+    d: Demonstrations,
+    used: npt.NDArray[np.int64],
+    ws: list[F32],
+    bs: list[F32],
+    x_mean: F64,
+    x_std: F64,
+    y_mean: F64,
+    y_std: F64,
+) -> Mlp:
+    """The network of weights ``ws`` and biases ``bs`` (over the ``used`` inputs) as the
+    exported MLP: every input, the normalisation, the skip term (copies of the current values)."""
+    skip = np.zeros((d.x.shape[1], d.y.shape[1]), np.float32)
+    for c in range(d.y.shape[1] // ACTION_LEN):
+        # offsets from the measured joints → set points, for each action of a chunk
+        skip[np.arange(6), c * ACTION_LEN + np.arange(6)] = 1.0
     first = np.zeros((d.x.shape[1], ws[0].shape[1]), np.float32)
     first[used] = ws[0]  # unused inputs get zero weights
     return Mlp(
-        weights=[first, *ws[1:]],
-        biases=bs,
+        weights=[first.copy(), *(w.copy() for w in ws[1:])],
+        biases=[b.copy() for b in bs],
         x_mean=x_mean.astype(np.float32),
         x_std=x_std.astype(np.float32),
         y_mean=y_mean.astype(np.float32),
@@ -234,8 +280,13 @@ def train(d: Demonstrations, cfg: TrainConfig, log: bool = True) -> Mlp:
 
 def write_model(mlp: Mlp, out: str) -> None:
     """Writes ``mlp`` as the `policy` leaf's ONNX model at ``out``, through an exclusive
-    temporary file beside it (an existing file is replaced only once the new one is whole)."""
-    data = to_onnx(mlp, [("observation.state", STATE_LEN), ("observation.object", OBJECT_LEN)])
+    temporary file beside it (an existing file is replaced only once the new one is whole): one
+    action ``[1, 7]``, or a chunk ``[1, k, 7]`` when the network has 7 k outputs."""
+    data = to_onnx(
+        mlp,
+        [("observation.state", STATE_LEN), ("observation.object", OBJECT_LEN)],
+        chunk=mlp.y_mean.size // ACTION_LEN,
+    )
     folder = os.path.dirname(os.path.abspath(out))
     fd, tmp = tempfile.mkstemp(prefix=".policy-", suffix=".onnx", dir=folder)
     try:
@@ -276,39 +327,71 @@ def main(argv: Sequence[str] | None = None) -> int:
         default="all",
         help="the state values the network sees",
     )
+    p.add_argument(
+        "--chunk",
+        type=int,
+        default=DEFAULT_CHUNK,
+        metavar="K",
+        help=f"predict the next K commands, a chunk [1, K, 7] (1: one action [1, 7]; "
+        f"default {DEFAULT_CHUNK})",
+    )
+    p.add_argument(
+        "--checkpoints",
+        type=int,
+        nargs="+",
+        default=[],
+        metavar="EPOCH",
+        help="also write the network after these epochs, to OUT with -eEPOCH before .onnx",
+    )
     a = p.parse_args(argv)
     if not 1 <= a.epochs <= 10_000 or not all(1 <= h <= 4096 for h in a.hidden) or not 0 < a.lr < 1:
         p.error("--epochs is 1 … 10000, --hidden widths 1 … 4096, --lr in (0, 1)")
-    d, info = load_dataset(a.dataset, a.leaf, a.object, a.drop_holds)
+    if not 1 <= a.chunk <= 1000:
+        p.error("--chunk is 1 … 1000")
+    d, info = load_dataset(a.dataset, a.leaf, a.object, a.drop_holds, a.chunk)
     fps = info.get("fps")
     if not isinstance(fps, (int, float)) or fps <= 0:
         raise SystemExit(f"{a.dataset}/meta/info.json has no valid `fps`")
-    cfg = TrainConfig(hidden=tuple(a.hidden), epochs=a.epochs, lr=a.lr, seed=a.seed, state=a.state)
+    cfg = TrainConfig(
+        hidden=tuple(a.hidden),
+        epochs=a.epochs,
+        lr=a.lr,
+        seed=a.seed,
+        state=a.state,
+        checkpoints=tuple(a.checkpoints),
+    )
     print(
         f"{len(d.x)} frames of {len(np.unique(d.episode))} episodes from {a.dataset}",
         file=sys.stderr,
     )
-    mlp = train(d, cfg)
-    mlp.metadata = {
-        "macrotree.action": "absolute",
-        "macrotree.period": repr(1.0 / float(fps)),
-        "macrotree.dataset": dataset_digest(a.dataset),
-        "macrotree.segment": a.leaf,
-        "macrotree.training": json.dumps(
-            {
-                "hidden": list(cfg.hidden),
-                "epochs": cfg.epochs,
-                "lr": cfg.lr,
-                "seed": cfg.seed,
-                "state": cfg.state,
-                "drop_holds": a.drop_holds,
-                "frames": len(d.x),
-            }
-        ),
-        "macrotree.inputs": "observation.state,observation.object",
-    }
-    write_model(mlp, a.out)
-    print(f"wrote {a.out}", file=sys.stderr)
+    digest = dataset_digest(a.dataset)
+
+    def save(epoch: int, mlp: Mlp, out: str) -> None:
+        mlp.metadata = {
+            "macrotree.action": "absolute",
+            "macrotree.period": repr(1.0 / float(fps)),
+            "macrotree.dataset": digest,
+            "macrotree.segment": a.leaf,
+            "macrotree.training": json.dumps(
+                {
+                    "hidden": list(cfg.hidden),
+                    "epochs": epoch,
+                    "lr": cfg.lr,
+                    "seed": cfg.seed,
+                    "state": cfg.state,
+                    "drop_holds": a.drop_holds,
+                    "chunk": a.chunk,
+                    "frames": len(d.x),
+                }
+            ),
+            "macrotree.inputs": "observation.state,observation.object",
+        }
+        write_model(mlp, out)
+        print(f"wrote {out}", file=sys.stderr)
+
+    stem, ext = os.path.splitext(a.out)
+    mlp = train(d, cfg, checkpoint=lambda e, m: save(e, m, f"{stem}-e{e}{ext or '.onnx'}"))
+    save(cfg.epochs, mlp, a.out)
     return 0
 
 

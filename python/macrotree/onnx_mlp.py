@@ -4,7 +4,8 @@ The `policy` leaf runs ONNX models; this writes the one kind the behaviour-cloni
 makes (``macrotree.bc``): named float32 inputs concatenated, normalised, a stack of
 ``MatMul``/``Add``/``Relu`` layers, un-normalised, plus an optional linear skip term from the
 inputs (``action = mlp(x) + x @ skip``, so a model can predict offsets from the measured joints
-and still output absolute set points). ONNX is protocol buffers; the few messages an MLP needs
+and still output absolute set points), and an optional ``Reshape`` of the output into an action
+chunk ``[1, k, 7]``. ONNX is protocol buffers; the few messages an MLP needs
 (``ModelProto``, ``GraphProto``, ``NodeProto``, ``TensorProto``, ``ValueInfoProto``) are encoded
 here by field number, as onnx.proto (IR version 8, opset 17) defines them.
 """
@@ -23,6 +24,7 @@ F32 = npt.NDArray[np.float32]
 IR_VERSION = 8
 OPSET = 17
 _FLOAT = 1  # TensorProto.DataType.FLOAT
+_INT64 = 7  # TensorProto.DataType.INT64
 
 
 def _varint(n: int) -> bytes:
@@ -58,6 +60,11 @@ def _tensor(name: str, array: F32) -> bytes:
     a = np.ascontiguousarray(array, dtype="<f4")
     dims = b"".join(_int(1, d) for d in a.shape)
     return dims + _int(2, _FLOAT) + _str(8, name) + _bytes(9, a.tobytes())
+
+
+def _int64_tensor(name: str, values: Sequence[int]) -> bytes:
+    raw = np.asarray(values, dtype="<i8").tobytes()
+    return _int(1, len(values)) + _int(2, _INT64) + _str(8, name) + _bytes(9, raw)
 
 
 def _value_info(name: str, shape: Sequence[int]) -> bytes:
@@ -104,9 +111,12 @@ class Mlp:
         return y.astype(np.float32)
 
 
-def to_onnx(mlp: Mlp, inputs: Sequence[tuple[str, int]], output: str = "action") -> bytes:
+def to_onnx(
+    mlp: Mlp, inputs: Sequence[tuple[str, int]], output: str = "action", chunk: int = 1
+) -> bytes:
     """The ONNX model of ``mlp`` with float32 inputs ``[(name, width), ...]`` of shape
-    ``[1, width]`` (concatenated in that order) and one output ``[1, n]`` named ``output``."""
+    ``[1, width]`` (concatenated in that order) and one output named ``output``: ``[1, n]``, or
+    with ``chunk`` k > 1 the ``n`` values as a chunk ``[1, k, n / k]`` (row-major)."""
     nodes: list[bytes] = []
     inits: list[bytes] = []
     width = sum(n for _, n in inputs)
@@ -134,17 +144,24 @@ def to_onnx(mlp: Mlp, inputs: Sequence[tuple[str, int]], output: str = "action")
     inits.append(_tensor("y_std", mlp.y_std.reshape(1, n_out)))
     inits.append(_tensor("y_mean", mlp.y_mean.reshape(1, n_out)))
     nodes.append(_node("Mul", [h, "y_std"], ["y_scaled"]))
-    last = output if mlp.skip is None else "y"
+    if n_out % chunk:
+        raise ValueError(f"{n_out} outputs do not make a chunk of {chunk}")
+    flat = output if chunk == 1 else "flat"
+    last = flat if mlp.skip is None else "y"
     nodes.append(_node("Add", ["y_scaled", "y_mean"], [last]))
     if mlp.skip is not None:
         inits.append(_tensor("skip", mlp.skip))
         nodes.append(_node("MatMul", [x, "skip"], ["skipped"]))
-        nodes.append(_node("Add", ["y", "skipped"], [output]))
+        nodes.append(_node("Add", ["y", "skipped"], [flat]))
+    if chunk > 1:
+        inits.append(_int64_tensor("chunk_shape", [1, chunk, n_out // chunk]))
+        nodes.append(_node("Reshape", [flat, "chunk_shape"], [output]))
     graph = b"".join(_bytes(1, n) for n in nodes)
     graph += _str(2, "macrotree_mlp")
     graph += b"".join(_bytes(5, t) for t in inits)
     graph += b"".join(_bytes(11, _value_info(n, [1, w])) for n, w in inputs)
-    graph += _bytes(12, _value_info(output, [1, n_out]))
+    out_shape = [1, n_out] if chunk == 1 else [1, chunk, n_out // chunk]
+    graph += _bytes(12, _value_info(output, out_shape))
     model = _int(1, IR_VERSION) + _str(2, "macrotree") + _bytes(7, graph)
     model += _bytes(8, _str(1, "") + _int(2, OPSET))
     for k, v in sorted(mlp.metadata.items()):

@@ -46,6 +46,37 @@ def test_the_onnx_writer_computes_what_the_network_computes(tmp_path: Path, skip
     assert np.allclose(out[0], expected, rtol=1e-4, atol=1e-4), (out, expected)
 
 
+def test_the_onnx_writer_writes_an_action_chunk_the_leaf_reads_action_by_action(
+    tmp_path: Path,
+) -> None:
+    rng = np.random.default_rng(4)
+    n_in, k = STATE[1] + OBJECT[1], 3
+    sizes = [n_in, 16, 7 * k]
+    skip = np.zeros((n_in, 7 * k), np.float32)
+    for c in range(k):
+        skip[np.arange(6), 7 * c + np.arange(6)] = 1.0
+    mlp = Mlp(
+        weights=[rng.normal(size=(a, b)).astype(np.float32) for a, b in itertools.pairwise(sizes)],
+        biases=[rng.normal(size=b).astype(np.float32) for b in sizes[1:]],
+        x_mean=rng.normal(size=n_in).astype(np.float32),
+        x_std=(1.0 + rng.random(n_in)).astype(np.float32),
+        y_mean=rng.normal(size=7 * k).astype(np.float32),
+        y_std=(1.0 + rng.random(7 * k)).astype(np.float32),
+        skip=skip,
+    )
+    path = tmp_path / "chunk.onnx"
+    path.write_bytes(to_onnx(mlp, [STATE, OBJECT], chunk=k))
+    x = rng.normal(size=(1, n_in)).astype(np.float32)
+    out = macrotree.run_policy_model(
+        str(path),
+        {STATE[0]: x[0, : STATE[1]].tolist(), OBJECT[0]: x[0, STATE[1] :].tolist()},
+    )
+    expected = mlp.forward(x).reshape(k, 7)
+    assert np.allclose(np.asarray(out), expected, rtol=1e-4, atol=1e-4), (out, expected)
+    with pytest.raises(ValueError, match="do not make a chunk"):
+        to_onnx(mlp, [STATE, OBJECT], chunk=2)
+
+
 def test_a_model_that_does_not_fit_is_refused_with_what_is_wrong(tmp_path: Path) -> None:
     rng = np.random.default_rng(0)
     path = tmp_path / "m.onnx"
@@ -116,3 +147,33 @@ def test_training_fits_a_smooth_map() -> None:
     error = np.abs(pred - y).mean(0)
     baseline = np.abs(y - y.mean(0)).mean(0)
     assert (error < 0.5 * baseline).all(), (error, baseline)
+
+
+def test_training_a_chunk_adds_the_measured_joints_to_every_action() -> None:
+    # Labels for a chunk of two: offsets to the next set points, then twice the offsets.
+    rng = np.random.default_rng(2)
+    x = rng.normal(size=(2000, 25))
+    one = np.column_stack([np.tanh(x[:, :6]) * 0.05, 255.0 / (1.0 + np.exp(-4.0 * x[:, 20]))])
+    y = np.column_stack([one, 2 * one[:, :6], one[:, 6]])
+    d = bc.Demonstrations(x, y, np.zeros(len(x), np.int64))
+    mlp = bc.train(d, bc.TrainConfig(hidden=(64, 64), epochs=60, seed=0), log=False)
+    pred = mlp.forward(x.astype(np.float32)).reshape(len(x), 2, 7)
+    pred[:, :, :6] -= x[:, None, :6]  # the skip term adds the measured joints to each action
+    error = np.abs(pred.reshape(len(x), 14) - y).mean(0)
+    baseline = np.abs(y - y.mean(0)).mean(0)
+    assert (error < 0.5 * baseline).all(), (error, baseline)
+
+
+def test_checkpoints_are_the_network_after_their_epochs() -> None:
+    rng = np.random.default_rng(5)
+    x = rng.normal(size=(300, 25))
+    y = rng.normal(size=(300, 7))
+    d = bc.Demonstrations(x, y, np.zeros(len(x), np.int64))
+    saved: dict[int, Mlp] = {}
+    cfg = bc.TrainConfig(hidden=(8,), epochs=4, seed=0, checkpoints=(2, 4))
+    final = bc.train(d, cfg, log=False, checkpoint=saved.__setitem__)
+    # The last epoch is the model `train` returns, not a checkpoint.
+    assert list(saved) == [2]
+    two = bc.train(d, bc.TrainConfig(hidden=(8,), epochs=4, seed=0), log=False)
+    assert all(np.array_equal(a, b) for a, b in zip(final.weights, two.weights, strict=True))
+    assert not np.array_equal(saved[2].weights[0], final.weights[0])
