@@ -166,7 +166,10 @@ impl Scene {
         let xml = super::mjcf::cell_mjcf(SCENE_XML, spec);
         let (model, origin) = match cache {
             Some(dir) => cached_model(&xml, &ur5e, &gripper, menagerie, dir)?,
-            None => (compile_model(&xml, &ur5e, &gripper)?, ModelOrigin::Compiled),
+            None => (
+                Arc::new(compile_model(&xml, &ur5e, &gripper)?),
+                ModelOrigin::Compiled,
+            ),
         };
         let collision_model = CollisionModel::new(&xml, &ur5e, &gripper);
         Ok((Self::from_model(model, spec, placement, collision_model)?, origin))
@@ -184,7 +187,7 @@ impl Scene {
 
     /// The scene of `spec` around an already compiled `model` (of that scene).
     fn from_model(
-        model: MjModel,
+        model: Arc<MjModel>,
         spec: &SceneSpec,
         default_placement: Placement,
         collision_model: CollisionModel,
@@ -198,7 +201,7 @@ impl Scene {
         let arm_gains = ids.arm_act.map(|a| (gain[a][0], -bias[a][2]));
         let arm_ctrlrange = ids.arm_act.map(|a| range[a]);
         Ok(Self {
-            model: Arc::new(model),
+            model,
             spec: Arc::new(spec.clone()),
             objects,
             geom_parts,
@@ -236,6 +239,33 @@ pub enum ModelOrigin {
     CompiledAndStored,
     /// Compiled (no valid cache file); the cache could not be written.
     CompiledNotStored,
+    /// The model a live scene of this process already holds (the same cache key): shared, not
+    /// loaded again.
+    Shared,
+}
+
+/// The models live scenes of this process hold, by cache folder and key: a scene built again
+/// while another of the same model lives shares its model instead of loading a copy (tens of megabytes).
+/// Entries of dropped models are removed whenever one is added, so the map holds at most one
+/// entry per live model plus the one being added.
+static LIVE_MODELS: std::sync::Mutex<Vec<(String, std::sync::Weak<MjModel>)>> =
+    std::sync::Mutex::new(Vec::new());
+
+/// The live model of `key` (cache folder and key), if a scene of this process holds one.
+fn live_model(key: &str) -> Option<Arc<MjModel>> {
+    let live = LIVE_MODELS
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    live.iter().find(|(k, _)| k == key).and_then(|(_, m)| m.upgrade())
+}
+
+/// Remembers `model` as the live model of `key` (cache folder and key; see [`LIVE_MODELS`]).
+fn remember_model(key: &str, model: &Arc<MjModel>) {
+    let mut live = LIVE_MODELS
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    live.retain(|(k, m)| m.strong_count() > 0 && k != key);
+    live.push((key.to_string(), Arc::downgrade(model)));
 }
 
 /// The compiled model of `xml` with the Menagerie models, from the cache in `dir` when it holds
@@ -247,19 +277,31 @@ fn cached_model(
     gripper: &Path,
     menagerie: &Path,
     dir: &Path,
-) -> Result<(MjModel, ModelOrigin), SimError> {
+) -> Result<(Arc<MjModel>, ModelOrigin), SimError> {
     let key = match super::cache::model_key_stamped(xml, menagerie, dir) {
         Ok(key) => key,
         Err(e) => {
             tracing::debug!(error = %e, "model cache: cannot hash the model's files; compiling");
-            return Ok((compile_model(xml, ur5e, gripper)?, ModelOrigin::CompiledNotStored));
+            return Ok((
+                Arc::new(compile_model(xml, ur5e, gripper)?),
+                ModelOrigin::CompiledNotStored,
+            ));
         }
     };
+    // Scenes share a model only through the same cache folder (tests keep theirs apart).
+    let live_key = format!("{}\n{key}", dir.display());
+    if let Some(model) = live_model(&live_key) {
+        tracing::debug!(%key, "model cache: shared with a live scene");
+        return Ok((model, ModelOrigin::Shared));
+    }
     if let Some(model) = super::cache::load(dir, &key) {
         tracing::debug!(%key, "model cache: hit");
+        let model = Arc::new(model);
+        remember_model(&live_key, &model);
         return Ok((model, ModelOrigin::Cache));
     }
-    let model = compile_model(xml, ur5e, gripper)?;
+    let model = Arc::new(compile_model(xml, ur5e, gripper)?);
+    remember_model(&live_key, &model);
     let origin = match super::cache::store(dir, &key, &model) {
         Ok(path) => {
             tracing::debug!(path = %path.display(), "model cache: stored");

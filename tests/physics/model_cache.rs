@@ -64,6 +64,32 @@ fn a_cached_model_runs_the_episode_bit_for_bit_like_a_compiled_one() {
 }
 
 #[test]
+fn a_scene_built_while_another_of_its_model_lives_shares_the_model() {
+    let dir = scratch("model-cache-shared");
+    let spec = SceneSpec::builtin();
+    let (first, origin) = cached(&spec, &dir);
+    assert_eq!(origin, ModelOrigin::CompiledAndStored);
+    let (second, origin) = cached(&spec, &dir);
+    assert_eq!(origin, ModelOrigin::Shared);
+    assert!(
+        std::sync::Arc::ptr_eq(&first.model, &second.model),
+        "one model in memory"
+    );
+    let other = macrotree::scene::load_scene_file("scenes/sort_three.yaml".as_ref()).expect("scene");
+    let (third, origin) = cached(&other, &dir);
+    assert_eq!(
+        origin,
+        ModelOrigin::CompiledAndStored,
+        "another model is never shared"
+    );
+    assert!(!std::sync::Arc::ptr_eq(&first.model, &third.model));
+    assert!(episode(&second).success);
+    drop((first, second));
+    let (_, origin) = cached(&spec, &dir);
+    assert_eq!(origin, ModelOrigin::Cache, "a dropped model is read again");
+}
+
+#[test]
 fn another_scene_is_another_key_and_is_compiled() {
     let dir = scratch("model-cache-stale");
     let builtin = SceneSpec::builtin();
@@ -109,6 +135,8 @@ fn a_corrupt_cache_file_is_ignored_and_replaced() {
     let (scene, origin) = cached(&spec, &dir);
     assert_eq!(origin, ModelOrigin::CompiledAndStored, "a flipped bit is caught");
     assert!(episode(&scene).success);
+    // While it lives, a scene of the same model would share it instead of reading the file.
+    drop(scene);
     std::fs::write(&path, &bytes[..1000]).unwrap();
     let (_, origin) = cached(&spec, &dir);
     assert_eq!(
