@@ -4,8 +4,11 @@
 use pyo3::create_exception;
 use pyo3::prelude::*;
 
+// Named under `macrotree`, where the class is exported, so that an instance pickles: a Gymnasium
+// `AsyncVectorEnv` worker sends its exception to the caller that way (under `_native` the pickling
+// failed, the worker died and the caller waited for ever).
 create_exception!(
-    _native,
+    macrotree,
     MacrotreeError,
     pyo3::exceptions::PyException,
     "Invalid input (a tree, scene or leaf mapping that does not check, a number out of range): the message is located and says what to do."

@@ -107,6 +107,19 @@ fn installed() -> &'static Venv {
                 .args(["--force-reinstall", "./python"]),
             "pip install ./python",
         );
+        run(
+            venv.command("python")
+                .args([
+                    "-m",
+                    "pip",
+                    "install",
+                    "--quiet",
+                    "--no-deps",
+                    "--no-build-isolation",
+                ])
+                .args(["--force-reinstall", "./python/lerobot_env_macrotree"]),
+            "pip install ./python/lerobot_env_macrotree",
+        );
         venv
     })
 }
@@ -117,7 +130,12 @@ fn python_code_is_linted_formatted_and_typed() {
         return;
     }
     let venv = installed();
-    let dirs = ["python/macrotree", "python/tests", "examples/python"];
+    let dirs = [
+        "python/macrotree",
+        "python/tests",
+        "examples/python",
+        "python/lerobot_env_macrotree",
+    ];
     // One configuration for the package, its tests and the examples.
     let config = ["--config", "python/pyproject.toml"];
     run(
@@ -149,6 +167,29 @@ fn python_tests_pass() {
         venv.command("python")
             .args(["-m", "pytest", "-q", "-p", "no:cacheprovider", "python/tests"]),
         "pytest python/tests",
+    );
+    eprintln!("{out}");
+}
+
+/// The LeRobot env plugin's tests, without LeRobot: its features read from macrotree's spaces,
+/// one step per frame, and `is_success` in `final_info` of Gymnasium's `SyncVectorEnv` and
+/// `AsyncVectorEnv` built as `lerobot-eval` builds them.
+#[test]
+fn lerobot_plugin_tests_pass() {
+    if skip() {
+        return;
+    }
+    let venv = installed();
+    let out = run(
+        venv.command("python").args([
+            "-m",
+            "pytest",
+            "-q",
+            "-p",
+            "no:cacheprovider",
+            "python/lerobot_env_macrotree/tests",
+        ]),
+        "pytest python/lerobot_env_macrotree/tests",
     );
     eprintln!("{out}");
 }
@@ -227,6 +268,80 @@ fn torchrl_check_env_specs_passes() {
     );
     eprintln!("{out}");
     assert_eq!(out.matches(": passed").count(), 3, "{out}");
+}
+
+/// `lerobot-eval --env.type=macrotree` for real, in the Python that `MACROTREE_LEROBOT_PYTHON`
+/// names (one with lerobot 0.6: torch is too heavy for CI). The macrotree wheel is built here and
+/// installed there with the plugin; `check_lerobot.py` checks that LeRobot's plugin discovery
+/// registers the env type, and that `lerobot-eval` reports every episode of the task's own tree a
+/// success when it has the frames to finish, and none when it has not.
+#[test]
+fn lerobot_eval_reports_the_environments_success() {
+    let Ok(python) = std::env::var("MACROTREE_LEROBOT_PYTHON") else {
+        eprintln!("skipped: set MACROTREE_LEROBOT_PYTHON to a Python with lerobot 0.6");
+        return;
+    };
+    if skip() {
+        return;
+    }
+    let venv = installed();
+    let wheels = root().join("target/python-test/wheel-lerobot");
+    let _ = std::fs::remove_dir_all(&wheels);
+    run(
+        venv.command("python")
+            .args([
+                "-m",
+                "pip",
+                "wheel",
+                "--quiet",
+                "--no-deps",
+                "--no-build-isolation",
+            ])
+            .arg("./python")
+            .arg("./python/lerobot_env_macrotree")
+            .arg("-w")
+            .arg(&wheels),
+        "pip wheel ./python ./python/lerobot_env_macrotree",
+    );
+    let built: Vec<PathBuf> = std::fs::read_dir(&wheels)
+        .expect("wheel folder")
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "whl"))
+        .collect();
+    assert_eq!(built.len(), 2, "two wheels: {built:?}");
+    // Their dependencies as pip resolves them beside lerobot's pins, then these very wheels.
+    run(
+        Command::new(&python)
+            .args(["-m", "pip", "install", "--quiet"])
+            .args(&built),
+        "pip install the wheels into MACROTREE_LEROBOT_PYTHON",
+    );
+    run(
+        Command::new(&python)
+            .args([
+                "-m",
+                "pip",
+                "install",
+                "--quiet",
+                "--force-reinstall",
+                "--no-deps",
+            ])
+            .args(&built),
+        "pip install --force-reinstall the wheels into MACROTREE_LEROBOT_PYTHON",
+    );
+    let work = root().join("target/python-test/lerobot-eval");
+    let _ = std::fs::remove_dir_all(&work);
+    let out = run(
+        Command::new(&python)
+            .arg("python/lerobot_env_macrotree/tests/check_lerobot.py")
+            .arg(&work)
+            .current_dir(root())
+            .env_remove("PYTHONPATH"),
+        "python/lerobot_env_macrotree/tests/check_lerobot.py",
+    );
+    eprintln!("{out}");
+    assert_eq!(out.matches(": passed").count(), 4, "{out}");
 }
 
 /// The summary of `macrotree sweep ARGS --json` (exit code 0, or 1 when a scenario failed).
