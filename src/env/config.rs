@@ -40,6 +40,14 @@ pub struct EnvConfig {
     pub rewards_per_tick: bool,
 }
 
+/// Whether simulated time `now` has reached the time limit `limit` (seconds). MuJoCo adds its
+/// time step by step, so 3 330 steps of 2 ms read 6.659999…: within half a physics step of the
+/// limit counts as reached, so a limit of a whole number of control periods ends on the period
+/// that reaches it, not one later.
+pub(crate) fn time_limit_reached(now: f64, limit: f64) -> bool {
+    now >= limit - 0.5 * TIMESTEP
+}
+
 impl Default for EnvConfig {
     fn default() -> Self {
         Self {
@@ -107,5 +115,16 @@ mod tests {
             };
             assert!(c.check().unwrap_err().to_string().contains("max_sim_time"));
         }
+    }
+
+    #[test]
+    fn a_time_limit_of_whole_periods_is_reached_on_the_step_that_reaches_it_in_summed_time() {
+        // 333 periods of 20 ms, summed 2 ms step by step as MuJoCo does: 6.659999….
+        let mut now = 0.0;
+        for step in 1..=3330 {
+            now += TIMESTEP;
+            assert_eq!(time_limit_reached(now, 6.66), step == 3330, "step {step}: {now}");
+        }
+        assert!(now < 6.66, "summed time {now} reads below the limit");
     }
 }

@@ -70,6 +70,7 @@ use crate::plan::{Loader, Plan};
 use crate::runtime::TreeRunner;
 use crate::scene::Placement;
 use crate::sim::{Layout, Scene};
+use config::time_limit_reached;
 use step::{ControllerStepper, PlanStepper, Stepper};
 
 /// One simulated cell driven one macro action at a time (see the module docs). `Send`: it can
@@ -278,7 +279,8 @@ impl MacroEnv {
         let world = self.cell.world();
         let goal = crate::world::goal::evaluate(world);
         let holds = step::goal_holds(world);
-        let truncated = ran.truncated || (!ran.unstable && world.time >= self.config.max_sim_time);
+        let truncated =
+            ran.truncated || (!ran.unstable && time_limit_reached(world.time, self.config.max_sim_time));
         Ok(StepResult {
             observation: self.observe(),
             status: if ran.outcome.is_ok() {

@@ -9,6 +9,7 @@ use std::sync::Arc;
 use serde::Serialize;
 
 use super::action::{CheckedCtrl, clamp_to_limits};
+use super::config::time_limit_reached;
 use super::step::{Status, StepResult};
 use crate::episode::{DriverState, MacroDriver};
 use crate::error::Error;
@@ -143,7 +144,7 @@ impl super::MacroEnv {
         let mut truncated = false;
         let mut clamped = 0;
         let mut base_command = driver.cell().period_command();
-        if now >= self.config.max_sim_time {
+        if time_limit_reached(now, self.config.max_sim_time) {
             truncated = true;
             failure = Some(Failure::new(
                 FailureKind::TimeLimit,
@@ -214,7 +215,8 @@ impl super::MacroEnv {
                 Vec::new()
             },
             terminated: holds || self.unstable,
-            truncated: truncated || (!self.unstable && world.time >= self.config.max_sim_time),
+            truncated: truncated
+                || (!self.unstable && time_limit_reached(world.time, self.config.max_sim_time)),
             collisions,
             goal: crate::world::goal::evaluate(world),
             faults_fired: self.faults_fired(),

@@ -10,6 +10,7 @@ use crate::failure::{Failure, FailureKind};
 use crate::runtime::{TreeRunner, TreeStatus};
 use crate::world::goal::GoalValue;
 
+use super::config::time_limit_reached;
 use super::observation::Observation;
 
 /// How an action ended.
@@ -207,7 +208,7 @@ pub(super) fn run(
             break;
         }
         let now = d.cell().world().time;
-        if now >= max_sim_time {
+        if time_limit_reached(now, max_sim_time) {
             stepper.halt(d);
             ran.truncated = true;
             ran.outcome = Err(Failure::new(

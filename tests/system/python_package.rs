@@ -428,11 +428,10 @@ fn the_learning_loop_runs_end_to_end_and_its_model_is_reproducible() {
                     "subtree[pick]",
                     "--state",
                     "joints",
+                    "--chunk",
+                    "20",
                     "--epochs",
-                    "5",
-                    "--hidden",
-                    "64",
-                    "64",
+                    "30",
                 ])
                 .arg("--out")
                 .arg(out)
