@@ -37,6 +37,7 @@ mod config;
 #[cfg(feature = "render")]
 mod film;
 mod leaf;
+mod memory;
 mod observation;
 mod primitive;
 #[cfg(feature = "render")]
@@ -52,6 +53,7 @@ use std::sync::Arc;
 pub use action::{Action, CTRL_LIMITS, CtrlLimits};
 pub use config::{EnvConfig, MAX_CONTROL_PERIOD};
 pub use leaf::{LEAF_SOURCE_NAME, MAX_LEAF_TEXT, compile_leaf};
+pub use memory::ENV_MEMORY_BYTES;
 pub use observation::{Contact, ENVIRONMENT_VALUES_PER_OBJECT, ObjectObservation, Observation, STATE_NAMES};
 pub use primitive::{Duration, MAX_DURATION, MAX_REACH_DISTANCE, Primitive, REFERENCE_STEP};
 #[cfg(feature = "render")]

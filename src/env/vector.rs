@@ -94,6 +94,7 @@ impl VecEnv {
                 message: format!("a vector environment holds 1 … {MAX_ENVS} environments, not {n}"),
             });
         }
+        super::memory::check_fits(n, super::memory::available_memory())?;
         let mut envs = Vec::with_capacity(n);
         for _ in 0..n {
             let env = MacroEnv::new(app, scene.clone(), tree.clone(), config.clone())?;
