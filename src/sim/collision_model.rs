@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
 
 use mujoco_rs::prelude::*;
-use mujoco_rs::wrappers::mj_editing::MjSpec;
+use mujoco_rs::wrappers::mj_editing::{MjSpec, MjsMesh};
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion};
 
 use super::error::SimError;
@@ -107,12 +107,8 @@ pub fn compile_collision_model(
         mesh.with_refpos([0.0; 3]);
         mesh.with_refquat([1.0, 0.0, 0.0, 0.0]);
     }
-    delete_all(&mut spec, |s| {
-        s.material_iter_mut().next().map(|m| m as &mut dyn Deletable)
-    })?;
-    delete_all(&mut spec, |s| {
-        s.texture_iter_mut().next().map(|t| t as &mut dyn Deletable)
-    })?;
+    delete_all(&mut spec, |s| s.material_iter_mut().next())?;
+    delete_all(&mut spec, |s| s.texture_iter_mut().next())?;
     spec.compile()
         .map_err(|e| spec_err("compiling the cell's collision model", e))
 }
@@ -150,34 +146,16 @@ fn hull_vertices(whole: &MjModel, name: &str) -> Result<Vec<f32>, SimError> {
     Ok(out)
 }
 
-/// A spec element [`delete_all`] can delete.
-trait Deletable {
-    /// Deletes the element from its spec.
-    ///
-    /// # Safety
-    /// As `SpecObject::delete`: at most once, and no handle of it is used afterwards.
-    unsafe fn delete_now(&mut self) -> Result<(), MjEditError>;
-}
-
-impl<T: SpecObject> Deletable for T {
-    unsafe fn delete_now(&mut self) -> Result<(), MjEditError> {
-        // SAFETY: the caller's contract.
-        unsafe { self.delete() }
-    }
-}
-
 /// The first mesh of `spec` no collidable geom names, if any.
-fn first_unused_mesh<'a>(spec: &'a mut MjSpec, used: &HashSet<String>) -> Option<&'a mut dyn Deletable> {
-    spec.mesh_iter_mut()
-        .find(|m| !used.contains(m.name()))
-        .map(|m| m as &mut dyn Deletable)
+fn first_unused_mesh<'a>(spec: &'a mut MjSpec, used: &HashSet<String>) -> Option<&'a mut MjsMesh> {
+    spec.mesh_iter_mut().find(|m| !used.contains(m.name()))
 }
 
 /// Deletes the element `next` finds until it finds none (each deletion ends the iteration that
 /// found it, so no handle outlives its element); at most [`MAX_DELETED`] elements.
-fn delete_all(
+fn delete_all<T: SpecObject>(
     spec: &mut MjSpec,
-    mut next: impl FnMut(&mut MjSpec) -> Option<&mut dyn Deletable>,
+    mut next: impl FnMut(&mut MjSpec) -> Option<&mut T>,
 ) -> Result<(), SimError> {
     for _ in 0..MAX_DELETED {
         let Some(element) = next(spec) else {
@@ -185,7 +163,7 @@ fn delete_all(
         };
         // SAFETY: the element is deleted once, and its handle (borrowed from `spec` for this
         // statement only) is not used again: the next round looks elements up afresh.
-        unsafe { element.delete_now() }.map_err(|e| spec_err("leaving out what only shows", e))?;
+        unsafe { element.delete() }.map_err(|e| spec_err("leaving out what only shows", e))?;
     }
     Err(SimError::Scene(format!(
         "the cell's collision model: more than {MAX_DELETED} meshes, materials or textures to leave out"
