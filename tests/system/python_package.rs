@@ -217,6 +217,35 @@ fn ported_tutorial_passes_the_references_checks() {
     );
 }
 
+/// Wheels of the packages in `folders` (paths from the repository root), built with the test
+/// environment's pip into a fresh `target/python-test/<into>`, for another Python to install.
+fn wheels(into: &str, folders: &[&str]) -> Vec<PathBuf> {
+    let dir = root().join("target/python-test").join(into);
+    let _ = std::fs::remove_dir_all(&dir);
+    run(
+        installed()
+            .command("python")
+            .args([
+                "-m",
+                "pip",
+                "wheel",
+                "--quiet",
+                "--no-deps",
+                "--no-build-isolation",
+            ])
+            .args(folders)
+            .arg("-w")
+            .arg(&dir),
+        &format!("pip wheel {}", folders.join(" ")),
+    );
+    std::fs::read_dir(&dir)
+        .expect("wheel folder")
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "whl"))
+        .collect()
+}
+
 /// TorchRL's `check_env_specs` on the single environment (both action modes) and the vector
 /// environment, in the Python that `MACROTREE_TORCHRL_PYTHON` names (one with torchrl 0.14.1:
 /// torch is too heavy for CI). The package is built as a wheel here and installed there.
@@ -229,34 +258,13 @@ fn torchrl_check_env_specs_passes() {
     if skip() {
         return;
     }
-    let venv = installed();
-    let wheels = root().join("target/python-test/wheel");
-    let _ = std::fs::remove_dir_all(&wheels);
-    run(
-        venv.command("python")
-            .args([
-                "-m",
-                "pip",
-                "wheel",
-                "--quiet",
-                "--no-deps",
-                "--no-build-isolation",
-            ])
-            .arg("./python")
-            .arg("-w")
-            .arg(&wheels),
-        "pip wheel ./python",
-    );
-    let wheel = std::fs::read_dir(&wheels)
-        .expect("wheel folder")
-        .filter_map(Result::ok)
-        .map(|e| e.path())
-        .find(|p| p.extension().is_some_and(|x| x == "whl"))
-        .expect("a wheel");
+    let [wheel] = &wheels("wheel", &["./python"])[..] else {
+        panic!("one wheel");
+    };
     run(
         Command::new(&python)
             .args(["-m", "pip", "install", "--quiet", "--force-reinstall"])
-            .arg(&wheel),
+            .arg(wheel),
         "pip install the wheel into MACROTREE_TORCHRL_PYTHON",
     );
     let out = run(
@@ -284,31 +292,7 @@ fn lerobot_eval_reports_the_environments_success() {
     if skip() {
         return;
     }
-    let venv = installed();
-    let wheels = root().join("target/python-test/wheel-lerobot");
-    let _ = std::fs::remove_dir_all(&wheels);
-    run(
-        venv.command("python")
-            .args([
-                "-m",
-                "pip",
-                "wheel",
-                "--quiet",
-                "--no-deps",
-                "--no-build-isolation",
-            ])
-            .arg("./python")
-            .arg("./python/lerobot_env_macrotree")
-            .arg("-w")
-            .arg(&wheels),
-        "pip wheel ./python ./python/lerobot_env_macrotree",
-    );
-    let built: Vec<PathBuf> = std::fs::read_dir(&wheels)
-        .expect("wheel folder")
-        .filter_map(Result::ok)
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|x| x == "whl"))
-        .collect();
+    let built = wheels("wheel-lerobot", &["./python", "./python/lerobot_env_macrotree"]);
     assert_eq!(built.len(), 2, "two wheels: {built:?}");
     // Their dependencies as pip resolves them beside lerobot's pins, then these very wheels.
     run(
