@@ -13,8 +13,9 @@ use macrotree::actions::policy::PolicyModel;
 const MAX_VALUES: usize = 1 << 20;
 
 /// Runs the ONNX model at `path` once on `inputs` (input name → values, not normalised), as a
-/// `policy` leaf does: the actions (one list of 7 per chunk step: six joint set points in
-/// radians or offsets, the gripper command), un-normalised.
+/// `policy` leaf does: the actions, un-normalised, one list per chunk step in the model's own
+/// layout (7 values: six joint set points in radians or offsets and the gripper command; or
+/// 19: set points, velocities, accelerations and the gripper command).
 #[pyfunction]
 pub fn run_policy_model(
     py: Python<'_>,
@@ -40,7 +41,7 @@ pub fn run_policy_model(
             return Err(format!("`{extra}` is not an input of the model"));
         }
         let actions = model.evaluate(ordered)?;
-        Ok(actions.into_iter().map(|a| a.to_vec()).collect())
+        Ok(actions)
     })
     .map_err(|e: String| PyValueError::new_err(e))
 }

@@ -4,7 +4,9 @@
 
 use super::primitive::Primitive;
 use crate::error::Error;
-use crate::motion::{ArmCommand, CLOSED_CTRL, COMMAND_LEN, CellCommand, JOINT_LIMITS, OPEN_CTRL};
+use crate::motion::{
+    ArmCommand, CLOSED_CTRL, COMMAND_LEN, CTRL_LIMITS, CellCommand, ClampedCommand, JOINT_LIMITS, OPEN_CTRL,
+};
 
 /// One step's action. Every action runs to completion on simulated time, closed loop inside
 /// (the leaf's or primitive's controller acts every control period); the caller decides again
@@ -66,30 +68,6 @@ impl Action {
     }
 }
 
-/// The bounds a `ctrl` action's velocities and accelerations are clamped to.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CtrlLimits {
-    /// Largest joint speed, rad/s: the UR5e's rated π rad/s, which no leaf exceeds.
-    pub max_joint_speed: f64,
-    /// Largest joint acceleration, rad/s².
-    pub max_joint_acc: f64,
-}
-
-/// The limits of every `ctrl` action (see [`CtrlLimits`]'s fields).
-pub const CTRL_LIMITS: CtrlLimits = CtrlLimits {
-    max_joint_speed: crate::motion::plan::UR5E_RATED_JOINT_SPEED,
-    max_joint_acc: 40.0,
-};
-
-/// A checked `ctrl` command and how many of its values were clamped.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CheckedCtrl {
-    /// The command the physics runs.
-    pub command: CellCommand,
-    /// Values clamped to [`CTRL_LIMITS`] or to the largest step from `from`.
-    pub clamped: u32,
-}
-
 /// The `ctrl` vector a `ctrl` or `setpoint` action stands for, unchecked.
 #[derive(Clone, Copy)]
 pub(super) struct CtrlValues {
@@ -121,8 +99,8 @@ pub(super) fn ctrl_of(action: &Action) -> Option<CtrlValues> {
 
 /// A `ctrl` vector checked: finite, set points within the joint limits, the gripper command
 /// within 0 … 255 (else refused, naming the value as `name` does and the range); then clamped
-/// to the limits ([`clamp_to_limits`]).
-pub(super) fn check_ctrl(values: &CtrlValues, from: &[f64; 6], period: f64) -> Result<CheckedCtrl, Error> {
+/// to [`CTRL_LIMITS`].
+pub(super) fn check_ctrl(values: &CtrlValues, from: &[f64; 6], period: f64) -> Result<ClampedCommand, Error> {
     let CtrlValues { vector: u, name } = values;
     let bad = |message: String| Error::Action { message };
     if let Some(i) = u.iter().position(|v| !v.is_finite()) {
@@ -149,37 +127,7 @@ pub(super) fn check_ctrl(values: &CtrlValues, from: &[f64; 6], period: f64) -> R
             name(COMMAND_LEN - 1)
         )));
     }
-    Ok(clamp_to_limits(command, from, period))
-}
-
-/// `command` (finite values) clamped: set points to the joint limits and to within
-/// `max_joint_speed × period` of the arm's set point `from` (radians), so no command asks for
-/// a faster motion; velocities and accelerations to [`CTRL_LIMITS`]; the gripper command to
-/// 0 … 255. Counts the values changed.
-pub(super) fn clamp_to_limits(mut command: CellCommand, from: &[f64; 6], period: f64) -> CheckedCtrl {
-    let mut clamped = 0;
-    let mut clamp = |v: &mut f64, lo: f64, hi: f64| {
-        let c = v.clamp(lo, hi);
-        if c != *v {
-            clamped += 1;
-            *v = c;
-        }
-    };
-    let step = CTRL_LIMITS.max_joint_speed * period * (1.0 + 1e-9);
-    for i in 0..6 {
-        let (lo, hi) = JOINT_LIMITS[i];
-        // Within the joint limits first, then within one period's step (which wins: a set
-        // point the arm can reach from where it is commanded).
-        let q = command.arm.q[i].clamp(lo, hi);
-        let q = q.clamp(from[i] - step, from[i] + step);
-        clamp(&mut command.arm.q[i], q, q);
-        let v = CTRL_LIMITS.max_joint_speed;
-        clamp(&mut command.arm.qd[i], -v, v);
-        let a = CTRL_LIMITS.max_joint_acc;
-        clamp(&mut command.arm.qdd[i], -a, a);
-    }
-    clamp(&mut command.gripper, OPEN_CTRL, CLOSED_CTRL);
-    CheckedCtrl { command, clamped }
+    Ok(CTRL_LIMITS.clamp(command, from, period))
 }
 
 #[cfg(test)]

@@ -8,13 +8,12 @@ use std::sync::Arc;
 
 use serde::Serialize;
 
-use super::action::{CheckedCtrl, clamp_to_limits};
 use super::config::time_limit_reached;
 use super::step::{Status, StepResult};
 use crate::episode::{DriverState, MacroDriver};
 use crate::error::Error;
 use crate::failure::{Failure, FailureKind};
-use crate::motion::{COMMAND_LEN, CellCommand, JOINT_LIMITS};
+use crate::motion::{COMMAND_LEN, CTRL_LIMITS, CellCommand, ClampedCommand, JOINT_LIMITS};
 use crate::plan::Plan;
 use crate::runtime::{TreeRunner, TreeStatus};
 
@@ -51,7 +50,7 @@ pub(super) fn check(residual: &[f64; RESIDUAL_LEN]) -> Result<(), Error> {
 
 /// The command of a residual step: `base` with `residual` (checked finite) added to its set
 /// points and gripper command, the residual first clamped to [`RESIDUAL_LIMITS`], the sum then
-/// clamped like every `ctrl` command ([`clamp_to_limits`], from the set point `from` the last
+/// clamped like every `ctrl` command ([`CTRL_LIMITS`], from the set point `from` the last
 /// period ended at, radians, over `period` seconds). The base's velocities and accelerations
 /// stay. An all-zero residual gives `base` itself, unclamped.
 pub(super) fn compose(
@@ -59,9 +58,9 @@ pub(super) fn compose(
     residual: &[f64; RESIDUAL_LEN],
     from: &[f64; 6],
     period: f64,
-) -> CheckedCtrl {
+) -> ClampedCommand {
     if residual.iter().all(|&r| r == 0.0) {
-        return CheckedCtrl {
+        return ClampedCommand {
             command: *base,
             clamped: 0,
         };
@@ -78,7 +77,7 @@ pub(super) fn compose(
         *q = (*q + bounded(residual[i], RESIDUAL_LIMITS.max_joint_offset)).clamp(lo, hi);
     }
     command.gripper += bounded(residual[6], RESIDUAL_LIMITS.max_gripper_offset);
-    let mut checked = clamp_to_limits(command, from, period);
+    let mut checked = CTRL_LIMITS.clamp(command, from, period);
     checked.clamped += clamped;
     checked
 }

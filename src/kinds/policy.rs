@@ -62,7 +62,7 @@ pub struct Policy {
     )]
     #[schemars(range(min = 0.0, max = MAX_POLICY_PERIOD))]
     pub period: Option<f64>,
-    /// For a model that outputs a chunk of actions (`[1, k, 7]`): how many of them run before
+    /// For a model that outputs a chunk of actions (`[1, k, n]`): how many of them run before
     /// the model runs again (1 to k). Default: the whole chunk.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schemars(range(min = 1, max = MAX_ACTION_STEPS))]

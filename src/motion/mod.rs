@@ -13,9 +13,11 @@
 //! | [`trajectory`] | the [`Trajectory`] trait, [`JointMove`], [`CartesianMove`], [`Hold`], [`MotionLimits`] |
 //! | [`gripper`] | command ↔ opening calibration of the simulated 2F-85 |
 //! | [`command`] | [`ArmCommand`] and [`CellCommand`]: one control period's command, the one action |
+//! | [`command_limits`] | [`CommandLimits`]: the speeds and accelerations a command is clamped to ([`CTRL_LIMITS`]) |
 
 pub mod body;
 pub mod command;
+pub mod command_limits;
 pub mod gripper;
 pub mod ik;
 pub mod kinematics;
@@ -23,6 +25,7 @@ pub mod plan;
 pub mod trajectory;
 
 pub use command::{ArmCommand, COMMAND_LEN, COMMAND_NAMES, CellCommand};
+pub use command_limits::{CTRL_LIMITS, ClampedCommand, CommandLimits};
 pub use gripper::{CLOSED_CTRL, OPEN_CTRL, ctrl_for_width, width_for_ctrl};
 pub use ik::{IkError, down_pose, ik, ik_all, ik_benchmark, ik_down, ik_down_with_pose};
 pub use kinematics::{ARM_JOINTS, JOINT_LIMITS, fk, jacobian};

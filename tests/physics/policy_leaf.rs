@@ -2,6 +2,7 @@
 //! tests/fixtures/policy (make_models.py) drive the arm, end on their condition, fail typed, and
 //! bad models are refused where the tree names them.
 
+use macrotree::actions::CONTROL_PERIOD;
 use macrotree::episode::{EpisodeConfig, EpisodeReport, Goal};
 use macrotree::{App, FailureKind};
 
@@ -33,6 +34,7 @@ const AWAY: &str = "move_joints: {joints: [-1.2, -1.3, 1.4, -1.6, -1.57, 0.3]}";
 fn a_policy_leaf_drives_the_arm_to_its_models_set_points_until_its_condition_holds() {
     for (model, extra) in [
         ("home.onnx", ""),
+        ("command_home.onnx", ""),
         ("normalized_home.onnx", ""),
         ("object_home.onnx", ", object: cube"),
     ] {
@@ -87,6 +89,76 @@ fn a_policy_without_its_condition_times_out_and_a_fallback_takes_over() {
     assert_eq!(r.halts, 0);
 }
 
+#[test]
+fn a_full_command_is_held_over_the_models_period_with_its_velocity_feedforward() {
+    // command_drift.onnx answers, every 0.02 s: the set points where they are (relative zero),
+    // shoulder_pan at 0.2 rad/s. Only the velocity it carries can move the arm.
+    let app = App::new();
+    let plan = app
+        .compile_str(
+            "main: {policy: {model: command_drift.onnx, timeout: 1}}",
+            &format!("{FOLDER}/t.yaml"),
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+    let config = EpisodeConfig {
+        goal: Goal::Tree,
+        ..EpisodeConfig::default()
+    };
+    let mut rec = PanJoint::default();
+    let report = macrotree::episode::run_episode(
+        &app.simulator(&plan).unwrap(),
+        std::sync::Arc::new(plan),
+        app.factory(),
+        &config,
+        &mut rec,
+    );
+    assert_eq!(
+        report.failure_kind,
+        Some(FailureKind::Timeout),
+        "{:?}",
+        report.failure_reason
+    );
+    let pan: Vec<(f64, f64)> = rec.commanded.clone();
+    assert!(pan.len() > 200, "{} control periods", pan.len());
+    let moving = &pan[1..pan.len() - 1];
+    for &(_, qd) in moving {
+        assert!((qd - 0.2).abs() < 1e-6, "the velocity is the model's: {qd}");
+    }
+    // Every control period the set point advances by the velocity times the period (4 ms),
+    // inside a model period (the command's second-order hold) and across calls (relative).
+    for w in moving.windows(2) {
+        let advance = w[1].0 - w[0].0;
+        assert!((advance - 0.2 * CONTROL_PERIOD).abs() < 1e-6, "{advance}");
+    }
+    let travelled = moving.last().unwrap().0 - moving[0].0;
+    assert!((0.19..0.21).contains(&travelled), "{travelled} rad in about 1 s");
+    // The joint follows its set point.
+    let lag = moving.last().unwrap().0 - rec.measured;
+    assert!(lag.abs() < 0.01, "shoulder_pan {lag} rad behind its set point");
+}
+
+/// Records shoulder_pan's command (set point, velocity) each control period and its last
+/// measured angle, radians.
+#[derive(Default)]
+struct PanJoint {
+    commanded: Vec<(f64, f64)>,
+    measured: f64,
+}
+
+impl macrotree::episode::EpisodeObserver for PanJoint {
+    fn on_period_start(
+        &mut self,
+        _cell: &macrotree::actions::Cell,
+        command: &macrotree::motion::CellCommand,
+        _runner: &mut macrotree::runtime::TreeRunner,
+    ) {
+        self.commanded.push((command.arm.q[0], command.arm.qd[0]));
+    }
+    fn on_tick(&mut self, cell: &macrotree::actions::Cell, _runner: &mut macrotree::runtime::TreeRunner) {
+        self.measured = cell.world().arm_q[0];
+    }
+}
+
 /// The model calls in a `timeout` failure's reason ("… after N model calls").
 fn calls(r: &EpisodeReport) -> u32 {
     let reason = r.failure_reason.as_deref().unwrap_or("");
@@ -134,7 +206,10 @@ fn the_same_tree_and_model_give_the_same_episode() {
 fn a_model_that_does_not_fit_is_refused_at_its_model_value() {
     for (model, says) in [
         ("unknown_input.onnx", "input `obs` is not a feature"),
-        ("short_action.onnx", "expected the action, [1, 7]"),
+        (
+            "short_action.onnx",
+            "expected the action, [1, n] or a chunk [1, k, n], with n = 7",
+        ),
         ("missing.onnx", "cannot read `missing.onnx`"),
         ("../trees/pick_place.yaml", "outside the tree's folder"),
         ("make_models.py", "ONNX Runtime cannot load the model"),
@@ -161,4 +236,66 @@ fn an_unknown_object_in_until_is_refused_where_it_is_written() {
     assert!(e.contains("t.yaml:2:56"), "{e}");
     let e = load_error("main:\n  policy: {model: home.onnx, until: {in: {object: cube, container: cube}}}\n");
     assert!(e.contains("container"), "a block where a container belongs: {e}");
+}
+
+#[test]
+fn a_policy_tree_records_a_dataset_whose_actions_replay_to_the_same_outcome() {
+    use macrotree::dataset::{DEFAULT_FRAME_RATE, EpisodeRecorder};
+    use macrotree::env::{Action, EnvConfig, MacroEnv, Reset};
+    use macrotree::sweep::SweepConfig;
+
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/trees/learned_cube_to_bowl.yaml");
+    let plan = std::sync::Arc::new(
+        macrotree::plan::Loader::default()
+            .load(std::path::Path::new(path))
+            .expect("the learned tree is valid"),
+    );
+    let scene = crate::support::flagship::scene();
+    let sweep = SweepConfig {
+        seed: 7,
+        ..Default::default()
+    };
+    let fps = DEFAULT_FRAME_RATE;
+    let mut env = MacroEnv::new(
+        &App::new(),
+        scene.clone(),
+        None,
+        EnvConfig {
+            control_period: 1.0 / f64::from(fps),
+            ..EnvConfig::default()
+        },
+    )
+    .unwrap();
+    for index in 0..3 {
+        let s = sweep.scene_scenario(scene, index).unwrap();
+        let mut rec = EpisodeRecorder::new(plan.clone(), fps);
+        let report = macrotree::episode::run_episode(
+            scene,
+            plan.clone(),
+            &macrotree::factory::Factory::builtin(),
+            &sweep.scene_episode_config(&s),
+            &mut rec,
+        );
+        assert!(report.success, "scenario {index}: {:?}", report.failure_reason);
+        let frames = rec.finish().unwrap().frames;
+        let learned = frames.iter().filter(|f| f.active_kind == "policy").count();
+        assert!(
+            learned * 5 > frames.len(),
+            "scenario {index}: {learned} of {} frames are labelled with the policy leaf",
+            frames.len()
+        );
+        env.reset(&Reset::Scenario {
+            index,
+            sweep_seed: sweep.seed,
+        })
+        .unwrap();
+        for f in &frames {
+            env.step(&Action::Ctrl(f.action.map(f64::from))).unwrap();
+        }
+        let in_bowl = env.step(&Action::Leaf("goal_met: {}".into())).unwrap().success();
+        assert!(
+            in_bowl,
+            "scenario {index}: the dataset's actions replay the learned episode"
+        );
+    }
 }

@@ -337,17 +337,32 @@ fn a_break_pattern_that_matches_no_node_exits_2_before_serving() {
 
 #[test]
 fn record_writes_a_self_contained_replay() {
-    let dir = std::env::temp_dir().join(format!("macrotree-record-{}", std::process::id()));
+    record_and_check("trees/cube_to_bowl.yaml", "scripted");
+}
+
+#[test]
+fn a_policy_tree_records_a_self_contained_replay() {
+    let report = record_and_check("trees/learned_pick_alone.yaml", "policy");
+    let policy_ran = report["nodes"]
+        .as_array()
+        .expect("the report lists its nodes")
+        .iter()
+        .any(|n| {
+            n["path"]
+                .as_str()
+                .is_some_and(|p| p.ends_with("policy[approach and grasp]"))
+        });
+    assert!(policy_ran, "the learned pick is a node of the replayed episode");
+}
+
+/// Runs `tree` with `--record`, checks the replay holds the episode ([`check_replay`]) and
+/// returns the JSON report.
+fn record_and_check(tree: &str, name: &str) -> serde_json::Value {
+    let dir = std::env::temp_dir().join(format!("macrotree-record-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("episode.html");
     let mut cmd = macrotree();
-    cmd.args([
-        "run",
-        "trees/cube_to_bowl.yaml",
-        "--json",
-        "--record",
-        file.to_str().unwrap(),
-    ]);
+    cmd.args(["run", tree, "--json", "--record", file.to_str().unwrap()]);
     let out = output_within(cmd, Duration::from_secs(180));
     assert_eq!(
         out.status.code(),
@@ -367,6 +382,7 @@ fn record_writes_a_self_contained_replay() {
     let report: serde_json::Value =
         serde_json::from_str(stdout.lines().last().expect("a JSON report")).expect("the report is JSON");
     check_replay(&html, &report);
+    report
 }
 
 /// The replay really holds the episode: its metadata covers the episode's simulated time at its

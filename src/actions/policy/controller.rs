@@ -1,5 +1,6 @@
 //! [`PolicyAction`]: the `policy` leaf's controller — a model called every period, its set
-//! points reached linearly over the period, until the leaf's condition holds.
+//! points reached linearly over the period (or its full command held over it), until the
+//! leaf's condition holds.
 
 use std::collections::VecDeque;
 use std::path::Path;
@@ -8,14 +9,15 @@ use std::sync::Arc;
 use ort::session::Session;
 
 use super::features::Feature;
+use super::layout::{ActionLayout, ModelAction};
 use super::metadata::ActionMode;
-use super::model::{ACTION_LEN, PolicyModel};
+use super::model::PolicyModel;
 use crate::actions::cell::Cell;
 use crate::actions::macro_action::{MacroAction, Progress};
 use crate::actions::targets::object_index;
 use crate::failure::{Failure, FailureKind};
 use crate::kinds::{LeafCall, POLICY_OUTPUT_INVALID, Policy};
-use crate::motion::{ArmCommand, CLOSED_CTRL, JOINT_LIMITS, OPEN_CTRL};
+use crate::motion::{ArmCommand, COMMAND_LEN, CTRL_LIMITS, CellCommand, CommandLimits, JOINT_LIMITS};
 use crate::world::World;
 use crate::world::vectors::VALUES_PER_OBJECT;
 
@@ -31,7 +33,17 @@ pub struct PolicyAction {
     run: Option<Run>,
 }
 
-/// A started run: the model, its session, and the set point segment under way.
+/// How the arm moves over the current model period.
+#[derive(Debug, Clone, Copy)]
+enum Segment {
+    /// Linearly from one set point to another, radians (a [`ActionLayout::Setpoint`] action).
+    Linear { from: [f64; 6], to: [f64; 6] },
+    /// The full command given at the segment's start, held over it as
+    /// [`ArmCommand::at`] says (a [`ActionLayout::Command`] action).
+    Held(ArmCommand),
+}
+
+/// A started run: the model, its session, and the segment under way.
 struct Run {
     model: Arc<PolicyModel>,
     session: Option<Session>,
@@ -40,9 +52,8 @@ struct Run {
     periods: u32,
     /// Control periods of the current segment done.
     done: u32,
-    queue: VecDeque<[f32; ACTION_LEN]>,
-    from: [f64; 6],
-    to: [f64; 6],
+    queue: VecDeque<ModelAction>,
+    segment: Segment,
     calls: u64,
 }
 
@@ -109,39 +120,65 @@ impl PolicyAction {
         }
         let from = cell.arm_setpoint();
         let period = f64::from(run.periods) * cell.control_period();
-        let step = self.params.max_joint_speed * period;
-        let mut to = [0.0; 6];
-        for i in 0..6 {
-            let q = match run.model.info.mode {
+        let mut q = [0.0; 6];
+        for (i, q) in q.iter_mut().enumerate() {
+            *q = match run.model.info.mode {
                 ActionMode::Absolute => f64::from(a[i]),
                 ActionMode::Relative => from[i] + f64::from(a[i]),
             };
             let (lo, hi) = JOINT_LIMITS[i];
-            if !(lo..=hi).contains(&q) {
+            if !(lo..=hi).contains(q) {
                 return Err(Self::invalid(format!(
                     "the model asks joint {} ({}) for {q:.3} rad, outside its limits {lo:.3} … {hi:.3}",
                     i,
                     crate::motion::ARM_JOINTS[i]
                 )));
             }
-            to[i] = q.clamp(from[i] - step, from[i] + step);
         }
-        cell.set_gripper(f64::from(a[6]).clamp(OPEN_CTRL, CLOSED_CTRL));
-        run.from = from;
-        run.to = to;
+        let limits = CommandLimits {
+            max_joint_speed: self.params.max_joint_speed,
+            ..CTRL_LIMITS
+        };
+        let mut command = CellCommand {
+            arm: ArmCommand::hold(q),
+            gripper: f64::from(a[COMMAND_LEN - 1]),
+        };
+        if run.model.info.layout == ActionLayout::Command {
+            for i in 0..6 {
+                command.arm.qd[i] = f64::from(a[6 + i]);
+                command.arm.qdd[i] = f64::from(a[12 + i]);
+            }
+        }
+        let command = limits.clamp(command, &from, period).command;
+        cell.set_gripper(command.gripper);
         run.done = 0;
+        run.segment = match run.model.info.layout {
+            ActionLayout::Setpoint => Segment::Linear {
+                from,
+                to: command.arm.q,
+            },
+            ActionLayout::Command => Segment::Held(command.arm),
+        };
         Self::command(run, cell);
         Ok(())
     }
 
-    /// Commands the coming control period: along the segment, at its speed.
+    /// Commands the coming control period: along a linear segment, at its speed, or the held
+    /// command as far into its period as the segment is.
     fn command(run: &Run, cell: &mut Cell) {
+        let (from, to) = match run.segment {
+            Segment::Linear { from, to } => (from, to),
+            Segment::Held(c) => {
+                cell.command_arm(c.at(f64::from(run.done) * cell.control_period()));
+                return;
+            }
+        };
         let period = f64::from(run.periods) * cell.control_period();
         let s = f64::from(run.done) / f64::from(run.periods);
-        let mut c = ArmCommand::hold(run.from);
+        let mut c = ArmCommand::hold(from);
         for i in 0..6 {
-            let d = run.to[i] - run.from[i];
-            c.q[i] = run.from[i] + d * s;
+            let d = to[i] - from[i];
+            c.q[i] = from[i] + d * s;
             c.qd[i] = d / period;
         }
         cell.command_arm(c);
@@ -202,8 +239,7 @@ impl MacroAction for PolicyAction {
             periods: periods as u32,
             done: 0,
             queue: VecDeque::new(),
-            from,
-            to: from,
+            segment: Segment::Linear { from, to: from },
             calls: 0,
         });
         self.next_segment(cell)

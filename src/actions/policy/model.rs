@@ -11,11 +11,9 @@ use ort::session::Session;
 use ort::value::{Tensor, TensorElementType, ValueType};
 
 use super::features::Feature;
+use super::layout::{ActionLayout, ModelAction};
 use super::metadata::{ACTION_NAME, ActionMode, Metadata, Normalization};
 use super::runtime::environment;
-
-/// Values per action: six joint set points (radians) and the gripper command (0 … 255).
-pub const ACTION_LEN: usize = 7;
 
 /// Most models kept loaded at once; loading one more forgets the others.
 const MAX_CACHED: usize = 16;
@@ -40,9 +38,11 @@ pub struct ModelInfo {
     pub inputs: Vec<ModelInput>,
     /// The name of its action output (its first output).
     pub output: String,
-    /// `None` for a single action `[1, 7]`; the chunk length for `[1, k, 7]` (`None` inside
+    /// `None` for a single action `[1, n]`; the chunk length for `[1, k, n]` (`None` inside
     /// when `k` is dynamic).
     pub chunk: Option<Option<usize>>,
+    /// What an action holds (`n`: 7 or 19 values).
+    pub layout: ActionLayout,
     /// What the joint values mean.
     pub mode: ActionMode,
     /// The time between two calls the model declares, seconds.
@@ -109,7 +109,7 @@ impl PolicyModel {
     /// # Errors
     /// When ONNX Runtime cannot be opened, the file cannot be read or is not an ONNX model, an
     /// input's name is not a known [`Feature`] or its shape does not fit it, the first output is
-    /// not a float32 `[1, 7]` or `[1, k, 7]`, or the metadata is malformed.
+    /// not a float32 `[1, n]` or `[1, k, n]` (n = 7 or 19), or the metadata is malformed.
     pub fn load(path: &Path) -> Result<Arc<PolicyModel>, String> {
         let meta = std::fs::metadata(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
         let max = crate::spec::MAX_LEAF_FILE_BYTES;
@@ -171,12 +171,13 @@ impl PolicyModel {
     }
 
     /// Runs the model once on `inputs` (one vector per [`ModelInfo::inputs`], in order, not yet
-    /// normalised), as a `policy` leaf does: the actions, un-normalised, one per chunk step. For
-    /// checking an exported model against the network it came from.
+    /// normalised), as a `policy` leaf does: the actions, un-normalised, one per chunk step, each
+    /// in the model's own layout ([`ModelInfo::layout`]). For checking an exported model against
+    /// the network it came from.
     ///
     /// # Errors
     /// An input of the wrong length, or the model failing to run.
-    pub fn evaluate(&self, inputs: Vec<Vec<f32>>) -> Result<Vec<[f32; ACTION_LEN]>, String> {
+    pub fn evaluate(&self, inputs: Vec<Vec<f32>>) -> Result<Vec<Vec<f32>>, String> {
         if inputs.len() != self.info.inputs.len() {
             return Err(format!(
                 "the model takes {} inputs, {} were given",
@@ -197,7 +198,8 @@ impl PolicyModel {
         let mut session = self.session()?;
         let out = self.run(&mut session, inputs);
         self.give_back(session);
-        out
+        let layout = self.info.layout;
+        out.map(|actions| actions.iter().map(|a| layout.compact(a)).collect())
     }
 
     /// Runs the model on `inputs` (one vector per [`ModelInfo::inputs`], in order, not yet
@@ -206,7 +208,7 @@ impl PolicyModel {
         &self,
         session: &mut Session,
         inputs: Vec<Vec<f32>>,
-    ) -> Result<Vec<[f32; ACTION_LEN]>, String> {
+    ) -> Result<Vec<ModelAction>, String> {
         let mut feed = Vec::with_capacity(inputs.len());
         for (spec, mut values) in self.info.inputs.iter().zip(inputs) {
             if let Some(n) = &spec.normalization {
@@ -225,25 +227,27 @@ impl PolicyModel {
         let (shape, data) = value
             .try_extract_tensor::<f32>()
             .map_err(|e| format!("output `{}`: {e}", self.info.output))?;
+        let layout = self.info.layout;
+        let n = layout.width() as i64;
         let steps = match shape.len() {
-            2 if shape[0] == 1 && shape[1] == ACTION_LEN as i64 => 1,
-            3 if shape[0] == 1 && shape[2] == ACTION_LEN as i64 && shape[1] >= 1 => shape[1] as usize,
+            2 if shape[0] == 1 && shape[1] == n => 1,
+            3 if shape[0] == 1 && shape[2] == n && shape[1] >= 1 => shape[1] as usize,
             _ => {
                 return Err(format!(
-                    "output `{}` has shape {:?}; expected [1, {ACTION_LEN}] or [1, k, {ACTION_LEN}]",
+                    "output `{}` has shape {:?}; expected [1, {n}] or [1, k, {n}]",
                     self.info.output,
                     &shape[..]
                 ));
             }
         };
         let mut actions = Vec::with_capacity(steps);
-        for chunk in data.chunks_exact(ACTION_LEN).take(steps) {
-            let mut a = [0f32; ACTION_LEN];
-            a.copy_from_slice(chunk);
+        let mut values = vec![0f32; layout.width()];
+        for chunk in data.chunks_exact(layout.width()).take(steps) {
+            values.copy_from_slice(chunk);
             if let Some(n) = &self.info.action_normalization {
-                n.invert(&mut a);
+                n.invert(&mut values);
             }
-            actions.push(a);
+            actions.push(layout.expand(&values));
         }
         Ok(actions)
     }
@@ -320,35 +324,43 @@ fn inspect(session: &Session) -> Result<ModelInfo, String> {
             "the metadata has statistics for `{extra}`, which is not an input of the model (or `{ACTION_NAME}`)"
         ));
     }
-    if let Some(n) = &action_normalization
-        && n.len() != ACTION_LEN
-    {
-        return Err(format!(
-            "the statistics of `{ACTION_NAME}` have {} values; an action has {ACTION_LEN}",
-            n.len()
-        ));
-    }
     let Some(first) = session.outputs().first() else {
         return Err("the model has no output".into());
     };
     let shape = float_shape(&format!("output `{}`", first.name()), first.dtype())?;
-    let a = ACTION_LEN as i64;
-    let chunk = match shape[..] {
-        [b, n] if (b == 1 || b == -1) && n == a => None,
-        [b, k, n] if (b == 1 || b == -1) && n == a && (k >= 1 || k == -1) => {
-            Some((k >= 1).then_some(k as usize))
+    let layout_of = |n: i64| usize::try_from(n).ok().and_then(ActionLayout::of_len);
+    let (layout, chunk) = match shape[..] {
+        [b, n] if (b == 1 || b == -1) && layout_of(n).is_some() => (layout_of(n), None),
+        [b, k, n] if (b == 1 || b == -1) && layout_of(n).is_some() && (k >= 1 || k == -1) => {
+            (layout_of(n), Some((k >= 1).then_some(k as usize)))
         }
-        _ => {
-            return Err(format!(
-                "the model's first output `{}` has shape {shape:?}; expected the action, [1, {ACTION_LEN}] or a chunk [1, k, {ACTION_LEN}] (six joint set points, radians, and the gripper command 0 … 255)",
-                first.name()
-            ));
-        }
+        _ => (None, None),
     };
+    let Some(layout) = layout else {
+        let [set, full] = ActionLayout::ALL.map(|l| (l.width(), l.describe()));
+        return Err(format!(
+            "the model's first output `{}` has shape {shape:?}; expected the action, [1, n] or a chunk [1, k, n], with n = {} ({}) or n = {} ({})",
+            first.name(),
+            set.0,
+            set.1,
+            full.0,
+            full.1
+        ));
+    };
+    if let Some(n) = &action_normalization
+        && n.len() != layout.width()
+    {
+        return Err(format!(
+            "the statistics of `{ACTION_NAME}` have {} values; the model's action has {}",
+            n.len(),
+            layout.width()
+        ));
+    }
     Ok(ModelInfo {
         inputs,
         output: first.name().to_string(),
         chunk,
+        layout,
         mode: metadata.action,
         period: metadata.period,
         action_normalization,
