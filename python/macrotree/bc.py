@@ -6,9 +6,12 @@ reads a LeRobot dataset that ``macrotree sweep --dataset`` wrote (best with ``--
 demonstrations, whose labels are the clean commands), keeps the frames whose running leaf's path
 contains ``--leaf``, and fits a multilayer perceptron from what the `policy` leaf feeds a model
 (``observation.state`` and ``observation.object``, the named object's pose relative to the
-gripper) to the commanded set points and gripper commands of the next ``--chunk`` frames (an
-action chunk ``[1, k, 7]``; the tree's ``n_action_steps`` says how many of them run before the
-model is called again). The network predicts offsets from the measured joints; the exported
+gripper) to the commands of the next ``--chunk`` frames (an action chunk ``[1, k, n]``; the
+tree's ``n_action_steps`` says how many of them run before the model is called again): with
+``--action setpoint`` (the default) n = 7, the set points and gripper commands; with ``--action
+command`` n = 19, the whole recorded command — set points, joint velocities, accelerations and
+the gripper command — which the leaf holds with the servos' feedforward, as the demonstrations
+ran it. The network predicts offsets from the measured joints; the exported
 graph adds them back (``action`` is absolute set points, ``macrotree.action = absolute``), bakes
 the normalisation in, and records the dataset's digest, the segment and the training settings
 in its metadata. Reading Parquet needs ``pyarrow``; training needs only numpy (two CPU cores,
@@ -45,10 +48,17 @@ STATE_LEN = 20
 OBJECT_LEN = 5
 #: Values per object in ``observation.environment_state``.
 VALUES_PER_OBJECT = 7
-#: Values of one action the `policy` leaf takes: six joint set points and the gripper command.
-ACTION_LEN = 7
-#: Index of the gripper command in a dataset's 19-value ``action``.
+#: Values of a dataset's ``action`` (the `policy` leaf's full command): six joint set points,
+#: six velocities, six accelerations, the gripper command.
+COMMAND_LEN = 19
+#: Index of the gripper command in a dataset's ``action``.
 GRIPPER_IN_ACTION = 18
+#: The dataset ``action`` columns each ``--action`` layout keeps, in the order the `policy` leaf
+#: reads them (the first six, set points, are learned as offsets from the measured joints).
+ACTION_LAYOUTS: dict[str, list[int]] = {
+    "setpoint": [*range(6), GRIPPER_IN_ACTION],
+    "command": list(range(COMMAND_LEN)),
+}
 #: Commands a model predicts by default (``--chunk``): 0.4 s at 50 fps, longer than the
 #: flagship's pick holds still at its pre-grasp pose.
 DEFAULT_CHUNK = 20
@@ -90,11 +100,17 @@ class Demonstrations:
 
 
 def load_dataset(
-    path: str, leaf: str, object_index: int, drop_holds: bool = False, chunk: int = 1
+    path: str,
+    leaf: str,
+    object_index: int,
+    drop_holds: bool = False,
+    chunk: int = 1,
+    layout: str = "setpoint",
 ) -> tuple[Demonstrations, dict[str, object]]:
     """The demonstrations of the frames whose running leaf's path contains ``leaf``, and the
     dataset's ``meta/info.json``. Frame k's labels are the commands of frames k + 1 … k +
-    ``chunk`` (the last frame of the episode repeated past its end), 7 values each.
+    ``chunk`` (the last frame of the episode repeated past its end), each the ``action`` columns
+    of ``ACTION_LAYOUTS[layout]``, set points as offsets from the measured joints.
 
     With ``drop_holds``, frames where the arm only holds still (the next command's joint
     velocities all zero and the gripper command unchanged) are left out — an attempt at the
@@ -135,9 +151,10 @@ def load_dataset(
         # The last frame of each frame's episode: a chunk running past it repeats it.
         starts = np.r_[0, np.nonzero(episode[1:] != episode[:-1])[0] + 1, len(episode)]
         last = np.repeat(starts[1:] - 1, np.diff(starts))
+        columns = ACTION_LAYOUTS[layout]
         y = np.column_stack(
             [
-                np.column_stack([action[j, :6] - state[idx, :6], action[j, GRIPPER_IN_ACTION]])
+                np.column_stack([action[j, :6] - state[idx, :6], action[j][:, columns[6:]]])
                 for j in (np.minimum(idx + step, last[idx]) for step in range(1, chunk + 1))
             ]
         )
@@ -179,8 +196,57 @@ class TrainConfig:
     lr: float = 1e-3
     seed: int = 0
     state: str = "all"
+    #: Values per action of the labels (``len(ACTION_LAYOUTS[...])``: 7 or 19).
+    action_len: int = len(ACTION_LAYOUTS["setpoint"])
     #: Epochs after which ``train`` hands the network to its ``checkpoint`` callback.
     checkpoints: tuple[int, ...] = ()
+
+
+@dataclass
+class Normalised:
+    """Demonstrations as a trainer sees them: the ``used`` input columns and the labels, each
+    normalised (float32), with the statistics the exported graph undoes."""
+
+    x: F32
+    y: F32
+    used: npt.NDArray[np.int64]
+    x_mean: F64
+    x_std: F64
+    y_mean: F64
+    y_std: F64
+
+    def export(self, d: Demonstrations, action_len: int, ws: list[F32], bs: list[F32]) -> Mlp:
+        """The trained weights ``ws`` and biases ``bs`` as the exported MLP."""
+        return _mlp(
+            d, action_len, self.used, ws, bs, self.x_mean, self.x_std, self.y_mean, self.y_std
+        )
+
+
+def normalise(d: Demonstrations, cfg: TrainConfig) -> Normalised:
+    """``d`` normalised for training: inputs by mean and spread (at least ``MIN_STD``) over the
+    columns ``cfg.state`` keeps, labels by mean and spread."""
+    used = np.array([*STATE_CHOICES[cfg.state], *range(STATE_LEN, STATE_LEN + OBJECT_LEN)])
+    x_mean = np.zeros(d.x.shape[1])
+    x_std = np.ones(d.x.shape[1])
+    x_mean[used] = d.x[:, used].mean(0)
+    x_std[used] = np.maximum(d.x[:, used].std(0), MIN_STD)
+    y_mean = d.y.mean(0)
+    y_std = np.maximum(d.y.std(0), 1e-6)
+    return Normalised(
+        x=((d.x[:, used] - x_mean[used]) / x_std[used]).astype(np.float32),
+        y=((d.y - y_mean) / y_std).astype(np.float32),
+        used=used,
+        x_mean=x_mean,
+        x_std=x_std,
+        y_mean=y_mean,
+        y_std=y_std,
+    )
+
+
+def cosine_lr(cfg: TrainConfig, epoch: int) -> np.float64:
+    """The learning rate of ``epoch`` (from 0): ``cfg.lr`` on a half cosine down to 0."""
+    lr: np.float64 = cfg.lr * 0.5 * (1 + np.cos(np.pi * epoch / cfg.epochs))
+    return lr
 
 
 def train(
@@ -192,15 +258,8 @@ def train(
     """Fits an MLP (ReLU, Adam, mean squared error on normalised labels) to ``d``; calls
     ``checkpoint(epoch, mlp)`` after each epoch listed in ``cfg.checkpoints``."""
     rng = np.random.default_rng(cfg.seed)
-    used = np.array([*STATE_CHOICES[cfg.state], *range(STATE_LEN, STATE_LEN + OBJECT_LEN)])
-    x_mean = np.zeros(d.x.shape[1])
-    x_std = np.ones(d.x.shape[1])
-    x_mean[used] = d.x[:, used].mean(0)
-    x_std[used] = np.maximum(d.x[:, used].std(0), MIN_STD)
-    y_mean = d.y.mean(0)
-    y_std = np.maximum(d.y.std(0), 1e-6)
-    x = ((d.x[:, used] - x_mean[used]) / x_std[used]).astype(np.float32)
-    y = ((d.y - y_mean) / y_std).astype(np.float32)
+    nd = normalise(d, cfg)
+    x, y = nd.x, nd.y
     sizes = [x.shape[1], *cfg.hidden, y.shape[1]]
     ws = [
         (rng.standard_normal((a, b)) * np.sqrt(2.0 / a)).astype(np.float32)
@@ -233,7 +292,7 @@ def train(
                 if k > 0:
                     g = (g @ ws[k].T) * (hs[k] > 0)
             step += 1
-            lr = cfg.lr * 0.5 * (1 + np.cos(np.pi * epoch / cfg.epochs))
+            lr = cosine_lr(cfg, epoch)
             for j, (p, gr) in enumerate(zip(params, [*grads_w, *grads_b], strict=True)):
                 m[j] = b1 * m[j] + (1 - b1) * gr
                 v[j] = b2 * v[j] + (1 - b2) * gr * gr
@@ -245,12 +304,13 @@ def train(
                 f"epoch {epoch + 1}/{cfg.epochs}: mse {total / n / y.shape[1]:.4f}", file=sys.stderr
             )
         if checkpoint is not None and epoch + 1 in cfg.checkpoints and epoch + 1 < cfg.epochs:
-            checkpoint(epoch + 1, _mlp(d, used, ws, bs, x_mean, x_std, y_mean, y_std))
-    return _mlp(d, used, ws, bs, x_mean, x_std, y_mean, y_std)
+            checkpoint(epoch + 1, nd.export(d, cfg.action_len, ws, bs))
+    return nd.export(d, cfg.action_len, ws, bs)
 
 
 def _mlp(
     d: Demonstrations,
+    action_len: int,
     used: npt.NDArray[np.int64],
     ws: list[F32],
     bs: list[F32],
@@ -262,9 +322,9 @@ def _mlp(
     """The network of weights ``ws`` and biases ``bs`` (over the ``used`` inputs) as the
     exported MLP: every input, the normalisation, the skip term (copies of the current values)."""
     skip = np.zeros((d.x.shape[1], d.y.shape[1]), np.float32)
-    for c in range(d.y.shape[1] // ACTION_LEN):
+    for c in range(d.y.shape[1] // action_len):
         # offsets from the measured joints → set points, for each action of a chunk
-        skip[np.arange(6), c * ACTION_LEN + np.arange(6)] = 1.0
+        skip[np.arange(6), c * action_len + np.arange(6)] = 1.0
     first = np.zeros((d.x.shape[1], ws[0].shape[1]), np.float32)
     first[used] = ws[0]  # unused inputs get zero weights
     return Mlp(
@@ -278,14 +338,15 @@ def _mlp(
     )
 
 
-def write_model(mlp: Mlp, out: str) -> None:
+def write_model(mlp: Mlp, out: str, action_len: int) -> None:
     """Writes ``mlp`` as the `policy` leaf's ONNX model at ``out``, through an exclusive
     temporary file beside it (an existing file is replaced only once the new one is whole): one
-    action ``[1, 7]``, or a chunk ``[1, k, 7]`` when the network has 7 k outputs."""
+    action ``[1, n]``, or a chunk ``[1, k, n]`` when the network has n k outputs (n =
+    ``action_len``)."""
     data = to_onnx(
         mlp,
         [("observation.state", STATE_LEN), ("observation.object", OBJECT_LEN)],
-        chunk=mlp.y_mean.size // ACTION_LEN,
+        chunk=mlp.y_mean.size // action_len,
     )
     folder = os.path.dirname(os.path.abspath(out))
     fd, tmp = tempfile.mkstemp(prefix=".policy-", suffix=".onnx", dir=folder)
@@ -332,9 +393,24 @@ def main(argv: Sequence[str] | None = None) -> int:
         type=int,
         default=DEFAULT_CHUNK,
         metavar="K",
-        help=f"predict the next K commands, a chunk [1, K, 7] (1: one action [1, 7]; "
+        help=f"predict the next K commands, a chunk [1, K, n] (1: one action [1, n]; "
         f"default {DEFAULT_CHUNK})",
     )
+    p.add_argument(
+        "--action",
+        choices=sorted(ACTION_LAYOUTS),
+        default="setpoint",
+        help="what an action holds: set points and the gripper (7 values), or the whole "
+        "recorded command with velocities and accelerations (19)",
+    )
+    p.add_argument(
+        "--trainer",
+        choices=["numpy", "torch"],
+        default="numpy",
+        help="numpy (the default: two CPU cores, minutes) or PyTorch (installed beside macrotree; "
+        "the same network, loss, optimiser and export)",
+    )
+    p.add_argument("--device", default="cpu", help="the PyTorch device of --trainer torch")
     p.add_argument(
         "--checkpoints",
         type=int,
@@ -348,7 +424,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         p.error("--epochs is 1 … 10000, --hidden widths 1 … 4096, --lr in (0, 1)")
     if not 1 <= a.chunk <= 1000:
         p.error("--chunk is 1 … 1000")
-    d, info = load_dataset(a.dataset, a.leaf, a.object, a.drop_holds, a.chunk)
+    d, info = load_dataset(a.dataset, a.leaf, a.object, a.drop_holds, a.chunk, a.action)
     fps = info.get("fps")
     if not isinstance(fps, (int, float)) or fps <= 0:
         raise SystemExit(f"{a.dataset}/meta/info.json has no valid `fps`")
@@ -358,6 +434,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         lr=a.lr,
         seed=a.seed,
         state=a.state,
+        action_len=len(ACTION_LAYOUTS[a.action]),
         checkpoints=tuple(a.checkpoints),
     )
     print(
@@ -381,16 +458,27 @@ def main(argv: Sequence[str] | None = None) -> int:
                     "state": cfg.state,
                     "drop_holds": a.drop_holds,
                     "chunk": a.chunk,
+                    "action": a.action,
+                    "trainer": a.trainer,
                     "frames": len(d.x),
                 }
             ),
             "macrotree.inputs": "observation.state,observation.object",
         }
-        write_model(mlp, out)
+        write_model(mlp, out, cfg.action_len)
         print(f"wrote {out}", file=sys.stderr)
 
     stem, ext = os.path.splitext(a.out)
-    mlp = train(d, cfg, checkpoint=lambda e, m: save(e, m, f"{stem}-e{e}{ext or '.onnx'}"))
+
+    def checkpoint(epoch: int, mlp: Mlp) -> None:
+        save(epoch, mlp, f"{stem}-e{epoch}{ext or '.onnx'}")
+
+    if a.trainer == "torch":
+        from .bc_torch import train_torch
+
+        mlp = train_torch(d, cfg, checkpoint=checkpoint, device=a.device)
+    else:
+        mlp = train(d, cfg, checkpoint=checkpoint)
     save(cfg.epochs, mlp, a.out)
     return 0
 

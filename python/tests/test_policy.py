@@ -177,3 +177,33 @@ def test_checkpoints_are_the_network_after_their_epochs() -> None:
     two = bc.train(d, bc.TrainConfig(hidden=(8,), epochs=4, seed=0), log=False)
     assert all(np.array_equal(a, b) for a, b in zip(final.weights, two.weights, strict=True))
     assert not np.array_equal(saved[2].weights[0], final.weights[0])
+
+
+def test_a_full_command_model_is_trained_and_read_as_19_values_per_action(
+    tmp_path: Path,
+) -> None:
+    # Labels for a chunk of two full commands: set-point offsets, velocities, accelerations,
+    # the gripper command.
+    rng = np.random.default_rng(6)
+    x = rng.normal(size=(1500, 25))
+    one = np.column_stack(
+        [np.tanh(x[:, :6]) * 0.05, np.tanh(x[:, 6:18]), 255.0 / (1.0 + np.exp(-4.0 * x[:, 20]))]
+    )
+    y = np.column_stack([one, one])
+    d = bc.Demonstrations(x, y, np.zeros(len(x), np.int64))
+    cfg = bc.TrainConfig(hidden=(32,), epochs=5, seed=0, action_len=19)
+    mlp = bc.train(d, cfg, log=False)
+    assert mlp.skip is not None
+    # The measured joints are added back to the set points of each action, and to nothing else.
+    rows, cols = np.nonzero(mlp.skip)
+    assert rows.tolist() == [0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 5, 5]
+    assert sorted(cols.tolist()) == [*range(6), *range(19, 25)]
+    path = tmp_path / "command.onnx"
+    bc.write_model(mlp, str(path), cfg.action_len)
+    probe = rng.normal(size=(1, 25)).astype(np.float32)
+    out = macrotree.run_policy_model(
+        str(path), {STATE[0]: probe[0, :20].tolist(), OBJECT[0]: probe[0, 20:].tolist()}
+    )
+    assert [len(a) for a in out] == [19, 19]
+    expected = mlp.forward(probe).reshape(2, 19)
+    assert np.allclose(np.asarray(out), expected, rtol=1e-4, atol=1e-4), (out, expected)

@@ -278,6 +278,60 @@ fn torchrl_check_env_specs_passes() {
     assert_eq!(out.matches(": passed").count(), 3, "{out}");
 }
 
+/// `python -m macrotree.bc --trainer torch` in the Python that `MACROTREE_TORCH_PYTHON` names
+/// (one with PyTorch: too heavy for CI): the package is built as a wheel here and installed
+/// there with its `policy` extra and pytest, and `python/tests/test_bc_torch.py` runs there —
+/// the PyTorch trainer fits as the numpy one does, repeats itself with its seed, and exports a
+/// model the `policy` leaf runs.
+#[test]
+fn the_pytorch_trainer_tests_pass() {
+    let Ok(python) = std::env::var("MACROTREE_TORCH_PYTHON") else {
+        eprintln!("skipped: set MACROTREE_TORCH_PYTHON to a Python with torch");
+        return;
+    };
+    if skip() {
+        return;
+    }
+    let [wheel] = &wheels("wheel-torch", &["./python"])[..] else {
+        panic!("one wheel");
+    };
+    run(
+        Command::new(&python)
+            .args(["-m", "pip", "install", "--quiet", "pytest", "onnxruntime==1.32.0"])
+            .arg(wheel),
+        "pip install the wheel, onnxruntime and pytest into MACROTREE_TORCH_PYTHON",
+    );
+    run(
+        Command::new(&python)
+            .args([
+                "-m",
+                "pip",
+                "install",
+                "--quiet",
+                "--force-reinstall",
+                "--no-deps",
+            ])
+            .arg(wheel),
+        "pip install --force-reinstall the wheel into MACROTREE_TORCH_PYTHON",
+    );
+    let out = run(
+        Command::new(&python)
+            .args([
+                "-m",
+                "pytest",
+                "-q",
+                "-p",
+                "no:cacheprovider",
+                "python/tests/test_bc_torch.py",
+            ])
+            .current_dir(root())
+            .env_remove("PYTHONPATH"),
+        "pytest python/tests/test_bc_torch.py",
+    );
+    eprintln!("{out}");
+    assert!(out.contains("2 passed"), "{out}");
+}
+
 /// `lerobot-eval --env.type=macrotree` for real, in the Python that `MACROTREE_LEROBOT_PYTHON`
 /// names (one with lerobot 0.6: torch is too heavy for CI). The macrotree wheel is built here and
 /// installed there with the plugin; `check_lerobot.py` checks that LeRobot's plugin discovery
