@@ -11,9 +11,7 @@ pub const MAX_SPEED: f64 = 1000.0;
 /// Most scenarios in one sweep (before sharding): about a week of one core at the flagship
 /// tree's ~1000 scenarios per minute. Split bigger studies by `--seed`.
 pub const MAX_SCENARIOS: u64 = 10_000_000;
-/// Most worker threads of `sweep --jobs` and `test --jobs` (each holds one simulation; more
-/// threads than this only cost start-up time and memory).
-pub const MAX_JOBS: u64 = 1024;
+pub use crate::sweep::MAX_JOBS;
 /// Most repetitions of `bench --repeat` (each runs the whole episode twice).
 pub const MAX_REPEAT: usize = 1000;
 
@@ -81,7 +79,7 @@ pub fn scenarios(s: &str) -> Result<u64, String> {
 /// `--jobs J`: 1 ≤ J ≤ [`MAX_JOBS`].
 pub fn jobs(s: &str) -> Result<u64, String> {
     match s.trim().parse::<u64>() {
-        Ok(n) if (1..=MAX_JOBS).contains(&n) => Ok(n),
+        Ok(n) if (1..=MAX_JOBS as u64).contains(&n) => Ok(n),
         _ => Err(format!(
             "must be a whole number of worker threads between 1 and {MAX_JOBS}, got {s}"
         )),

@@ -1,5 +1,7 @@
 //! `macrotree report FILE.jsonl…`: merges the `--out` files of sharded sweeps or `macrotree
-//! test` runs into the summary (and, for tests, the JUnit report) of one unsharded run.
+//! test` runs into the summary (and, for tests, the JUnit report) of one unsharded run. A sweep's
+//! wall time, jobs and physics and planning shares come from the timing files beside its
+//! files (`FILE.timing.json`, written by `sweep --out`).
 //!
 //! Exit codes as for `sweep` / `test`: 0 when every scenario succeeded (every expectation held),
 //! 1 when not, 2 on bad input (unreadable or mixed files, missing or duplicate scenarios).
@@ -11,7 +13,7 @@ use clap::Args;
 use super::CliError;
 use super::outputs::check_output;
 use crate::suite::{SuiteOutcome, load_scenario_file};
-use crate::sweep::{Summary, merge_results};
+use crate::sweep::{Source, Summary, Timings, Total, merge_results};
 
 /// Arguments of `report`.
 #[derive(Debug, Args)]
@@ -25,6 +27,25 @@ pub struct ReportArgs {
     /// For `macrotree test` results: write the JUnit XML report here.
     #[arg(long, value_name = "FILE.xml")]
     pub junit: Option<PathBuf>,
+}
+
+/// The timings of the files a sweep's lines came from, put together: `None` unless every file
+/// has a timing file beside it that covers exactly its lines (a missing one, or one left by a
+/// run that did not write all of them, cannot give the run's times).
+fn timing_of(sources: &[Source]) -> Result<Option<Total>, CliError> {
+    let mut total: Option<Total> = None;
+    for source in sources {
+        let timings = Timings::read(&Timings::path_beside(&source.path))
+            .map_err(|e| CliError::Input(format!("error: {e}")))?;
+        let Some(t) = timings
+            .filter(|t| t.lines() == source.lines)
+            .and_then(|t| t.total())
+        else {
+            return Ok(None);
+        };
+        total = Some(total.map_or(t, |sum| sum.beside(t)));
+    }
+    Ok(total)
 }
 
 /// Runs `macrotree report`.
@@ -41,7 +62,10 @@ pub fn report(app: &crate::App, args: ReportArgs) -> Result<(), CliError> {
             ));
         }
         let m = &merged[0];
-        let summary = Summary::new(&m.config.tree, &m.config, &m.results, 0.0, 0);
+        let mut summary = Summary::new(&m.config.tree, &m.config, &m.results, 0.0, 0);
+        if let Some(total) = timing_of(&m.sources)? {
+            summary = summary.with_timing(&total);
+        }
         super::human::say_text!(args.json, summary.to_text());
         if args.json {
             println!("{}", serde_json::to_string(&summary).expect("summary serializes"));

@@ -13,7 +13,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use super::{CliError, load_task};
 use crate::episode::Goal;
 use crate::faults::FaultKind;
-use crate::sweep::{SweepConfig, run_sweep_streaming};
+use crate::sweep::{RunTiming, SweepConfig, Timings, run_sweep_streaming};
 
 /// Arguments of `sweep`.
 #[derive(Debug, Args)]
@@ -45,7 +45,8 @@ pub struct SweepArgs {
     /// one (failure kind `collision`).
     #[arg(long, value_parser = super::limits::collisions(), default_value = "count")]
     pub collisions: crate::episode::CollisionPolicy,
-    /// Write one JSON line per scenario here, in scenario order (a regular file or a new path).
+    /// Write one JSON line per scenario here, in scenario order (a regular file or a new path);
+    /// the run's times go beside it, to FILE.jsonl.timing.json, for `report`.
     #[arg(long, value_name = "FILE.jsonl")]
     pub out: Option<PathBuf>,
     /// Keep the complete results already in --out (from an interrupted run of this same sweep)
@@ -175,7 +176,7 @@ pub fn sweep(app: &crate::App, args: SweepArgs) -> Result<(), CliError> {
         None => None,
     };
     let mut out = prepared.as_ref().map(|p| p.start()).transpose()?;
-    let resumed = prepared.map(|p| p.resumed).unwrap_or_default();
+    let (resumed, timing_out) = prepared.map_or_else(Default::default, |p| (p.resumed, p.timing));
     let done = resumed.count;
     let bar = if std::io::stderr().is_terminal() {
         ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr())
@@ -250,9 +251,20 @@ pub fn sweep(app: &crate::App, args: SweepArgs) -> Result<(), CliError> {
     if let Some(d) = dataset {
         d.finish()?;
     }
-    let summary = tally
-        .finish(run.wall_time_s, run.jobs)
-        .with_physics(run.physics_time_s, super::process_elapsed_s());
+    let summary = tally.finish(run.wall_time_s, run.jobs);
+    let timing = RunTiming {
+        lines: summary.scenarios.saturating_sub(done),
+        jobs: run.jobs,
+        wall_time_s: run.wall_time_s,
+        process_wall_time_s: super::process_elapsed_s(),
+        physics_time_s: run.physics_time_s,
+        planning_time_s: summary.planning.wall_time_s,
+    };
+    if let Some(t) = timing_out {
+        t.write(timing)?;
+    }
+    let total = Timings::default().then(timing).total().expect("one run");
+    let summary = summary.with_timing(&total);
     super::human::say_text!(args.json, summary.to_text());
     if args.json {
         println!("{}", serde_json::to_string(&summary).expect("summary serializes"));

@@ -1,5 +1,6 @@
 //! The JSONL file of `sweep --out`, and `--resume`: checked and locked before the sweep starts,
-//! installed safely (see [`crate::output`]), then written one whole line per scenario.
+//! installed safely (see [`crate::output`]), then written one whole line per scenario; and its
+//! timing file beside it ([`Timings`]), written when the sweep ends.
 
 use std::fs::File;
 use std::path::Path;
@@ -10,9 +11,9 @@ use super::outputs::output_error;
 use crate::output::{LineFile, OutputFile};
 use crate::plan::Plan;
 use crate::sim::Scene;
-use crate::sweep::SweepConfig;
 use crate::sweep::resume::{Resumed, read_existing, spot_check};
 use crate::sweep::tally::Tally;
+use crate::sweep::{RunTiming, SweepConfig, Timings};
 
 /// The checked (and locked) output of a sweep, not yet touched: [`Prepared::start`] installs it.
 pub(super) struct Prepared {
@@ -21,11 +22,43 @@ pub(super) struct Prepared {
     held: Option<Arc<File>>,
     /// The results kept from the interrupted run (`--resume`).
     pub resumed: Resumed,
+    /// The timing file beside it (`None` when the output is a stream).
+    pub timing: Option<TimingOut>,
+}
+
+/// The timing file of a sweep's `--out` file, checked before the sweep starts.
+pub(super) struct TimingOut {
+    out: OutputFile,
+    /// The runs that wrote the kept lines (`--resume`), when their timing file covers them all.
+    before: Option<Timings>,
+}
+
+impl TimingOut {
+    /// Writes the timing file: the earlier runs' (when they cover the kept lines) and `run`.
+    pub(super) fn write(self, run: RunTiming) -> Result<(), CliError> {
+        let timings = self.before.unwrap_or_default().then(run);
+        self.out
+            .write_all(timings.to_json().as_bytes())
+            .map_err(output_error)
+    }
 }
 
 impl Prepared {
-    /// Installs the file (holding the kept results) and opens it for the new lines.
+    /// Installs the file (holding the kept results) and opens it for the new lines. A timing
+    /// file left beside it by an earlier run is removed: it no longer describes the lines.
     pub(super) fn start(&self) -> Result<LineFile, CliError> {
+        if let Some(t) = &self.timing {
+            match std::fs::remove_file(t.out.path()) {
+                Ok(()) => {}
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+                Err(e) => {
+                    return Err(CliError::Input(format!(
+                        "error: cannot remove the stale timing file {}: {e}",
+                        t.out.path().display()
+                    )));
+                }
+            }
+        }
         match &self.held {
             Some(file) if self.resumed.kept_len > 0 => self
                 .out
@@ -105,5 +138,29 @@ pub(super) fn prepare(
             Resumed::default()
         }
     };
-    Ok(Prepared { out, held, resumed })
+    let timing = if out.is_stream() {
+        None
+    } else {
+        let sidecar = Timings::path_beside(path);
+        let timing_out = OutputFile::check(&sidecar, &inputs).map_err(output_error)?;
+        // A timing file that does not cover exactly the kept lines is not carried on.
+        let before = if resumed.count > 0 {
+            Timings::read(&sidecar)
+                .ok()
+                .flatten()
+                .filter(|t| t.lines() == resumed.count)
+        } else {
+            None
+        };
+        Some(TimingOut {
+            out: timing_out,
+            before,
+        })
+    };
+    Ok(Prepared {
+        out,
+        held,
+        resumed,
+        timing,
+    })
 }

@@ -12,6 +12,10 @@ use crate::scene::{Placement, PlacementError};
 use crate::sim::Scene;
 use crate::sweep::{Scenario, ScenarioIndices, ScenarioLayout, Shard};
 
+/// Most worker threads of a sweep (`sweep --jobs`, `test --jobs`): each holds one simulation;
+/// more threads than this only cost start-up time and memory.
+pub const MAX_JOBS: usize = 1024;
+
 /// What to sweep.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SweepConfig {

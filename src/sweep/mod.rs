@@ -28,12 +28,13 @@ mod run;
 mod shard;
 mod summary;
 pub mod tally;
+mod timing;
 
 use crate::episode::scenario as layout;
-pub use config::{SceneScenario, SweepConfig};
+pub use config::{MAX_JOBS, SceneScenario, SweepConfig};
 pub use indices::ScenarioIndices;
 pub use layout::{Region, Scenario, ScenarioLayout, sample_scenario, sample_scenario_in};
-pub use report::{MAX_LINES, MergeError, Merged, merge_results};
+pub use report::{MAX_LINES, MergeError, Merged, Source, merge_results};
 pub use result::ScenarioResult;
 pub(crate) use result::shell_quote;
 pub use run::{
@@ -42,3 +43,4 @@ pub use run::{
 };
 pub use shard::{MAX_AUTO_SHARDS, Shard, ShardSpec};
 pub use summary::{Coverage, Failure, FailureGroup, NodeTotals, Summary, percentile, wilson_interval};
+pub use timing::{MAX_RUNS, MAX_TIMING_BYTES, RunTiming, Timings, Total};

@@ -37,6 +37,17 @@ pub struct Merged {
     pub config: SweepConfig,
     /// All its results, by index.
     pub results: Vec<ScenarioResult>,
+    /// The files its lines came from, in the order given, with how many lines each held.
+    pub sources: Vec<Source>,
+}
+
+/// A file some of a merged run's lines came from.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Source {
+    /// The file, as given.
+    pub path: PathBuf,
+    /// Its result lines of this run.
+    pub lines: u64,
 }
 
 /// Where a line came from.
@@ -82,8 +93,9 @@ fn identity(r: &ScenarioResult) -> Vec<(&'static str, String)> {
 /// (naming what differs), duplicate scenarios and missing ones (naming them).
 pub fn merge_results(files: &[PathBuf]) -> Result<Vec<Merged>, MergeError> {
     let mut groups: BTreeMap<Option<String>, Vec<(Origin, ScenarioResult)>> = BTreeMap::new();
+    let mut per_file: BTreeMap<(Option<String>, usize), u64> = BTreeMap::new();
     let mut total = 0usize;
-    for file in files {
+    for (file_index, file) in files.iter().enumerate() {
         let text = read(file)?;
         for (i, line) in text.lines().enumerate() {
             let origin = Origin {
@@ -109,6 +121,7 @@ pub fn merge_results(files: &[PathBuf]) -> Result<Vec<Merged>, MergeError> {
                     "{origin}: not exactly what this version writes (edited, or written by another version)"
                 )));
             }
+            *per_file.entry((r.suite.clone(), file_index)).or_default() += 1;
             groups.entry(r.suite.clone()).or_default().push((origin, r));
         }
     }
@@ -120,10 +133,26 @@ pub fn merge_results(files: &[PathBuf]) -> Result<Vec<Merged>, MergeError> {
             "the files mix sweep results and `macrotree test` results; report them separately".into(),
         ));
     }
-    groups.into_values().map(merge_group).collect()
+    groups
+        .into_iter()
+        .map(|(suite, g)| {
+            let sources = files
+                .iter()
+                .enumerate()
+                .filter_map(|(i, path)| {
+                    let lines = *per_file.get(&(suite.clone(), i))?;
+                    Some(Source {
+                        path: path.clone(),
+                        lines,
+                    })
+                })
+                .collect();
+            merge_group(g, sources)
+        })
+        .collect()
 }
 
-fn merge_group(mut lines: Vec<(Origin, ScenarioResult)>) -> Result<Merged, MergeError> {
+fn merge_group(mut lines: Vec<(Origin, ScenarioResult)>, sources: Vec<Source>) -> Result<Merged, MergeError> {
     let (first_origin, first) = lines[0].clone();
     let want = identity(&first);
     let what = first
@@ -195,6 +224,7 @@ fn merge_group(mut lines: Vec<(Origin, ScenarioResult)>) -> Result<Merged, Merge
     Ok(Merged {
         config,
         results: lines.into_iter().map(|(_, r)| r).collect(),
+        sources,
     })
 }
 

@@ -6,6 +6,7 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 
+use super::timing::Total;
 use super::{ScenarioResult, SweepConfig};
 use crate::episode::Goal;
 use crate::faults::FaultKind;
@@ -83,7 +84,7 @@ pub struct Summary {
     /// Scenarios per minute of wall-clock time.
     pub scenarios_per_minute: f64,
     /// Wall-clock time the workers spent inside `mj_step`, summed over workers, seconds (`None`
-    /// until [`Summary::with_physics`] sets it).
+    /// until [`Summary::with_timing`] sets it).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub physics_time_s: Option<f64>,
     /// Wall-clock time of the whole process up to the end of the sweep (start-up, loading and
@@ -102,7 +103,7 @@ pub struct Summary {
     /// for `--goal scene` on a scene without a goal.
     pub goal_checked: String,
     /// Wall-clock time the workers spent checking and planning motions, summed over workers,
-    /// seconds (`None` until [`Summary::with_physics`] sets it).
+    /// seconds (`None` until [`Summary::with_timing`] sets it).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub planning_time_s: Option<f64>,
     /// `planning_time_s / (jobs × process_wall_time_s)`: the share of the workers' time
@@ -215,24 +216,34 @@ impl Summary {
         tally.finish(wall_time_s, jobs)
     }
 
-    /// Adds how much of the sweep was physics: `physics_time_s` (time inside `mj_step`, summed
-    /// over the workers) over `jobs × process_wall_time_s` (the whole process up to now).
+    /// Adds how long the sweep took, from its run's (or merged runs') [`Total`]: wall time
+    /// and jobs, scenarios per minute, and how much of the workers' time (jobs × the whole
+    /// process's wall time) was physics (`mj_step`) and motion planning.
     #[must_use]
-    pub fn with_physics(mut self, physics_time_s: f64, process_wall_time_s: f64) -> Self {
-        self.physics_time_s = Some(physics_time_s);
-        self.process_wall_time_s = Some(process_wall_time_s);
-        let capacity = self.jobs as f64 * process_wall_time_s;
-        self.physics_share = Some(if capacity > 0.0 {
-            physics_time_s / capacity
+    pub fn with_timing(mut self, t: &Total) -> Self {
+        self.jobs = t.jobs;
+        self.wall_time_s = t.wall_time_s;
+        self.scenarios_per_minute = if t.wall_time_s > 0.0 {
+            self.scenarios as f64 * 60.0 / t.wall_time_s
+        } else {
+            0.0
+        };
+        let share = |x: f64| {
+            if t.worker_time_s > 0.0 {
+                x / t.worker_time_s
+            } else {
+                0.0
+            }
+        };
+        self.physics_time_s = Some(t.physics_time_s);
+        self.process_wall_time_s = Some(if t.jobs > 0 {
+            t.worker_time_s / t.jobs as f64
         } else {
             0.0
         });
-        self.planning_time_s = Some(self.planning.wall_time_s);
-        self.planning_share = Some(if capacity > 0.0 {
-            self.planning.wall_time_s / capacity
-        } else {
-            0.0
-        });
+        self.physics_share = Some(share(t.physics_time_s));
+        self.planning_time_s = Some(t.planning_time_s);
+        self.planning_share = Some(share(t.planning_time_s));
         self
     }
 
@@ -282,11 +293,11 @@ impl Summary {
             self.median_sim_time_s, self.p95_sim_time_s
         );
         if self.jobs == 0 {
-            // `macrotree report`: the lines carry results only (they are the same bytes for any
-            // machine and `--jobs`), not the time they took.
+            // `macrotree report` without timing files: the lines carry results only (they are
+            // the same bytes for any machine and `--jobs`), not the time they took.
             let _ = writeln!(
                 s,
-                "  wall time, physics and planning shares: not in the lines (each run's own summary has them)"
+                "  wall time, physics and planning shares: unknown (not every file has its FILE.timing.json, written by `sweep --out`, beside it)"
             );
         } else {
             let _ = writeln!(
@@ -324,12 +335,12 @@ impl Summary {
                 share, self.jobs
             );
         }
-        if let Some(share) = self.planning_share {
+        if let (Some(share), Some(time)) = (self.planning_share, self.planning_time_s) {
             let p = &self.planning;
             let _ = writeln!(
                 s,
-                "  planning share {share:.4}: {:.3} s checking {} motions and planning {} ({} failed, in {} scenario(s))",
-                p.wall_time_s, p.motions_checked, p.plans, p.plan_failures, p.scenarios_planned
+                "  planning share {share:.4}: {time:.3} s checking {} motions and planning {} ({} failed, in {} scenario(s))",
+                p.motions_checked, p.plans, p.plan_failures, p.scenarios_planned
             );
         }
         if self.goal_checked.contains("no goal") {

@@ -11,21 +11,11 @@ const TREE: &str = "trees/cube_to_bowl.yaml";
 /// The `--json` summary without what depends on the machine and the run (wall time, jobs).
 fn summary(out: &Output) -> serde_json::Value {
     let stdout = String::from_utf8_lossy(&out.stdout);
-    let mut v: serde_json::Value = serde_json::from_str(stdout.lines().last().unwrap()).unwrap();
-    // Measurements of this run's wall clock, not results.
-    for k in [
-        "wall_time_s",
-        "scenarios_per_minute",
-        "jobs",
-        "physics_time_s",
-        "process_wall_time_s",
-        "physics_share",
-        "planning_time_s",
-        "planning_share",
-    ] {
-        v.as_object_mut().unwrap().remove(k).expect("summary field");
+    let v: serde_json::Value = serde_json::from_str(stdout.lines().last().unwrap()).unwrap();
+    for k in TIMING_KEYS {
+        assert!(v.get(k).is_some(), "the summary has {k}");
     }
-    v
+    results_only(v)
 }
 
 fn sweep(extra: &[&str], out: &Path, more: &[&str]) -> Output {
@@ -172,5 +162,69 @@ fn sweep_resume_without_a_file_runs_the_whole_sweep() {
     assert_eq!(text.lines().count(), 3);
     let out = macrotree(&["sweep", TREE, "--scenarios", "3", "--resume"]);
     assert_eq!(out.status.code(), Some(2), "--resume needs --out");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_resumed_sweeps_timing_file_holds_every_run_that_wrote_its_lines() {
+    let dir = scratch("resume-timing");
+    let opts = ["--scenarios", "6", "--seed", "3"];
+    let full = dir.join("full.jsonl");
+    assert_eq!(sweep(&opts, &full, &["--jobs", "2"]).status.code(), Some(0));
+    let bytes = std::fs::read(&full).unwrap();
+    let three = bytes
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| **b == b'\n')
+        .nth(2)
+        .unwrap()
+        .0
+        + 1;
+    let part = dir.join("part.jsonl");
+    let timing = dir.join("part.jsonl.timing.json");
+    let earlier = serde_json::json!({"runs": [{
+        "lines": 3, "jobs": 1, "wall_time_s": 100.0, "process_wall_time_s": 101.0,
+        "physics_time_s": 50.0, "planning_time_s": 1.0
+    }]});
+    for (covers_the_kept_lines, written) in [
+        (true, earlier.clone()),
+        (false, {
+            let mut e = earlier.clone();
+            e["runs"][0]["lines"] = 2.into();
+            e
+        }),
+    ] {
+        std::fs::write(&part, &bytes[..three]).unwrap();
+        std::fs::write(&timing, written.to_string()).unwrap();
+        let resumed = sweep(&opts, &part, &["--jobs", "2", "--resume"]);
+        assert_eq!(
+            resumed.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&resumed.stderr)
+        );
+        let t: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&timing).unwrap()).unwrap();
+        let runs = t["runs"].as_array().unwrap();
+        let report = macrotree(&["report", "--json", s(&part)]);
+        let merged: serde_json::Value =
+            serde_json::from_str(String::from_utf8_lossy(&report.stdout).lines().last().unwrap()).unwrap();
+        if covers_the_kept_lines {
+            // The earlier run, then this one: together they made the file.
+            assert_eq!(runs.len(), 2, "{t}");
+            assert_eq!(runs[0], earlier["runs"][0]);
+            assert_eq!(runs[1]["lines"], 3);
+            assert_eq!(runs[1]["jobs"], 2);
+            let wall = merged["wall_time_s"].as_f64().unwrap();
+            assert!(wall > 100.0, "the runs' wall times add up: {wall}");
+            assert_eq!(merged["jobs"], 2);
+        } else {
+            // A timing file that does not describe the kept lines is not carried on, and the
+            // report does not pretend to know the file's times.
+            assert_eq!(runs.len(), 1, "{t}");
+            assert_eq!(runs[0]["lines"], 3);
+            let text = String::from_utf8_lossy(&report.stderr);
+            assert!(text.contains("shares: unknown"), "{text}");
+        }
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -42,3 +42,38 @@ pub fn scratch(name: &str) -> PathBuf {
 pub fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
+
+/// The keys of a sweep summary that measure the run (how long it took, on how many jobs)
+/// rather than its results: the same results give different values on every run.
+pub const TIMING_KEYS: [&str; 8] = [
+    "wall_time_s",
+    "jobs",
+    "scenarios_per_minute",
+    "physics_share",
+    "physics_time_s",
+    "process_wall_time_s",
+    "planning_time_s",
+    "planning_share",
+];
+
+/// A sweep summary (JSON) without its [`TIMING_KEYS`].
+pub fn results_only(mut summary: serde_json::Value) -> serde_json::Value {
+    if let Some(o) = summary.as_object_mut() {
+        for k in TIMING_KEYS {
+            o.remove(k);
+        }
+    }
+    summary
+}
+
+/// A sweep summary's text without its timing lines (wall time, physics and planning shares).
+pub fn text_without_timings(text: &str) -> String {
+    text.lines()
+        .filter(|l| {
+            !["  wall time", "  physics share", "  planning share"]
+                .iter()
+                .any(|p| l.starts_with(p))
+        })
+        .map(|l| format!("{l}\n"))
+        .collect()
+}
