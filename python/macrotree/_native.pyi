@@ -38,8 +38,8 @@ class Env:
         fault: str | None,
         cameras: list[str],
         image_size: tuple[int, int],
-        frame_rate: float | None,
-        render_camera: str | None,
+        frame_rate: float | None = None,
+        render_camera: str | None = None,
         noise: str | None = None,
     ) -> None: ...
     def reset(
