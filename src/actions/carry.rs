@@ -35,6 +35,14 @@ const MIN_LIFT: f64 = 0.05;
 /// Bisection steps finding how high a straight lift stays reachable (0.15 m / 2¹⁰: under 0.2 mm).
 const LIFT_BISECTIONS: u32 = 10;
 
+/// How far in front of its place a block that goes under something is brought before it is
+/// slid in, along the hand's horizontal approach, metres (the stand-off of a side grasp).
+pub const INSERT_STAND_OFF: f64 = 0.12;
+
+/// How far above its place a block that goes under something slides in, metres: it is lowered
+/// this last bit straight down.
+const INSERT_LIFT: f64 = 0.01;
+
 /// Re-plans of the transfer allowed in one carry.
 const MAX_REPLANS: u32 = 3;
 
@@ -67,6 +75,9 @@ type PackedSpot = (Vector2<f64>, f64, (usize, f64, f64));
 enum Phase {
     Lift,
     Transfer,
+    /// A place under something (a shelf's upper board): the block slides in horizontally, just
+    /// above its place, from [`INSERT_STAND_OFF`] in front of it.
+    Insert,
     Lower,
 }
 
@@ -75,6 +86,7 @@ impl Phase {
         match self {
             Phase::Lift => "lift",
             Phase::Transfer => "transfer",
+            Phase::Insert => "insert",
             Phase::Lower => "lower",
         }
     }
@@ -117,6 +129,11 @@ pub struct Carry {
     /// The spot chosen in the container takes the tool turned by this much about the vertical
     /// through the block (radians): turned when the lift ends.
     spot_turn: f64,
+    /// The object a spot's block rests on (its `on:`), by name; `None`: whatever is under it.
+    support: Option<String>,
+    /// The hand's horizontal approach (unit, world) when the place is under something and the
+    /// block is slid in along it; `None`: set down from above.
+    insert: Option<Vector3<f64>>,
 }
 
 impl Carry {
@@ -140,16 +157,58 @@ impl Carry {
             turn_to: None,
             spot_local: None,
             spot_turn: 0.0,
+            support: None,
+            insert: None,
         }
     }
 
+    /// The hand's horizontal approach when the block must slide in under something to reach
+    /// `place` (block centre): an object other than the block and its support is over the place
+    /// (within the fingers' reach) with its underside above the set-down block's top and below
+    /// the transfer height `above_z` (block centre, metres). `Ok(None)` when the place is open
+    /// from above; `Err` when it is not and the block is held from above (the hand cannot go
+    /// under).
+    fn under(&self, w: &World, place: &Vector3<f64>, above_z: f64) -> Result<Option<Vector3<f64>>, Failure> {
+        let dest = self.destination(w);
+        let reach = self.finger_reach();
+        let over = (0..w.objects.len()).find(|&j| {
+            j != self.held
+                && Some(j) != dest
+                && w.from_footprint(j, place).norm() <= reach
+                && w.bottom(j) > place.z + self.half
+                && w.bottom(j) < above_z + self.half
+        });
+        let Some(j) = over else {
+            return Ok(None);
+        };
+        if !held_from_side(&self.rotation) {
+            return Err(Failure::new(
+                FailureKind::GoalInCollision,
+                format!(
+                    "the place is under `{}`, and a block held from above cannot be set down under it; grasp the block from the side (`reach: {{approach: side}}`) to slide it in",
+                    w.name(j)
+                ),
+            ));
+        }
+        let axis = self.rotation * Vector3::z();
+        Ok(Some(Vector3::new(axis.x, axis.y, 0.0).normalize()))
+    }
+
+    /// Where a block slid in under something starts, in front of `place` along `along`, and
+    /// where the slide ends, above the place (block centres, metres).
+    fn insert_path(place: &Vector3<f64>, along: &Vector3<f64>) -> [Vector3<f64>; 2] {
+        let end = place + Vector3::new(0.0, 0.0, INSERT_LIFT);
+        [end - along * INSERT_STAND_OFF, end]
+    }
+
     /// The controller `place` runs: `spec.to` is a point whose height is ignored, the block is
-    /// set down on the surface under it (`spec.place_height` above it), turned to `yaw`
-    /// (radians, modulo a quarter turn; `None`: as held).
-    pub fn placing(spec: CarrySpec, yaw: Option<f64>) -> Self {
+    /// set down on the surface under it (`spec.place_height` above it; on the object named
+    /// `on` when given), turned to `yaw` (radians, modulo a quarter turn; `None`: as held).
+    pub fn placing(spec: CarrySpec, yaw: Option<f64>, on: Option<String>) -> Self {
         Self {
             surface: true,
             turn_to: yaw,
+            support: on,
             ..Self::new(spec)
         }
     }
@@ -157,6 +216,12 @@ impl Carry {
     /// The held block (valid once started).
     pub fn held(&self) -> usize {
         self.held
+    }
+
+    /// The hand's horizontal approach (unit, world) when the block was slid in under something
+    /// (a release retreats back out along its opposite); `None` when it was set down from above.
+    pub fn slid_in_along(&self) -> Option<Vector3<f64>> {
+        self.insert
     }
 
     /// The set-down at block centre `centre` with the tool as it is planned now.
@@ -180,6 +245,9 @@ impl Carry {
     /// object the block would come down on (the one with the highest support under the point).
     fn destination(&self, w: &World) -> Option<usize> {
         match (&self.spec.to, self.surface) {
+            (crate::kinds::Target::Point(_), true) if self.support.is_some() => {
+                self.support.as_deref().and_then(|n| w.index_of(n))
+            }
             (crate::kinds::Target::Point(p), true) => {
                 let at = Vector3::new(p[0], p[1], 0.0);
                 (0..w.objects.len())
@@ -499,10 +567,14 @@ impl Carry {
             // Lift and set-down stay straight; only real contact counts, with the destination
             // intended (its floor, the block it goes on).
             let intended: Vec<String> = match phase {
-                Phase::Lower => self.set_down_intended(cell.world()),
+                Phase::Lower | Phase::Insert => self.set_down_intended(cell.world()),
                 _ => Vec::new(),
             };
-            let what = if phase == Phase::Lift { "lift" } else { "set-down" };
+            let what = match phase {
+                Phase::Lift => "lift",
+                Phase::Insert => "insert",
+                _ => "set-down",
+            };
             check_straight(cell, what, mv.as_ref(), &intended);
         }
         self.goal_q = mv.end();
@@ -566,7 +638,9 @@ impl Carry {
         place: &Vector3<f64>,
     ) -> Result<crate::motion::plan::PlannedMotion, Failure> {
         let mut all: Vec<(f64, usize, [f64; 6])> = Vec::new();
-        for k in 0..4 {
+        // A block slid in under something keeps the hand's approach: no quarter turns.
+        let turns = if self.insert.is_some() { 1 } else { 4 };
+        for k in 0..turns {
             let (rotation, offset) = self.turned(k);
             let pose = Isometry3::from_parts(Translation3::from(end + offset), rotation);
             for q in crate::motion::plan::GoalSet::pose(&pose, from).configs {
@@ -666,9 +740,17 @@ impl Carry {
                     self.pinch_from_block = r * self.pinch_from_block;
                 }
                 let place = self.place(w)?;
-                let above = Vector3::new(place.x, place.y, above_z.max(place.z));
-                self.start_phase(cell, Phase::Transfer, above)
+                self.insert = self.under(w, &place, above_z)?;
+                let end = match &self.insert {
+                    Some(along) => Self::insert_path(&place, along)[0],
+                    None => Vector3::new(place.x, place.y, above_z.max(place.z)),
+                };
+                self.start_phase(cell, Phase::Transfer, end)
             }
+            Phase::Transfer if let Some(along) = self.insert => {
+                self.start_phase(cell, Phase::Insert, Self::insert_path(&place, &along)[1])
+            }
+            Phase::Insert => self.start_phase(cell, Phase::Lower, place),
             Phase::Transfer if (above.xy() - self.phase_end.xy()).norm() > GOAL_MOVED => {
                 self.replans += 1;
                 if self.replans > MAX_REPLANS {
@@ -698,6 +780,7 @@ impl MacroAction for Carry {
             self.spec.to = crate::kinds::Target::Point([spot.x, spot.y, 0.0]);
             self.surface = true;
             self.turn_to = Some(spot.yaw);
+            self.support = spot.on.clone();
         }
         let Some(held) = w.held_block(Tolerances::GRASP_OFF_AXIS) else {
             return Err(Failure::new(
@@ -718,6 +801,9 @@ impl MacroAction for Carry {
         let place = self.place(w)?;
         let lift_z = self.transfer_z(w, pos.xy(), place.xy()).max(pos.z);
         let lift = Vector3::new(pos.x, pos.y, lift_z);
+        // A place under something that a hand from above cannot reach is refused before
+        // anything moves.
+        self.under(w, &place, lift_z.max(place.z))?;
         if held_from_side(&self.rotation) {
             let held_name = w.name(held).to_string();
             let surface = self

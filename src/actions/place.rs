@@ -1,5 +1,7 @@
 //! `place`: set the held block down at a point or a named spot, turned to a yaw, on whatever
-//! surface is under it, then open the fingers just enough to let go and retreat straight up.
+//! surface is under it (or the spot's `on:`), then open the fingers just enough to let go and
+//! retreat straight up — or back out the way the hand came, when the block was slid in under
+//! something.
 //!
 //! The transfer and the set-down are `carry`'s ([`Carry::placing`]: the same lift, planned
 //! transfer, clearance check and straight set-down); the letting go is `release`'s, opened to
@@ -21,23 +23,42 @@ pub const DROP: f64 = 0.002;
 /// Time the fingers get to open and the arm to retreat after the set-down, seconds.
 const RELEASE_TIME: f64 = 3.0;
 
-/// Where a `place` goes: the point `[x, y]` (world metres) and the block's yaw there
-/// (radians; `None`: as held). A spot the scene does not have is a failure of kind `other`
-/// that lists the spots it has.
-pub fn place_target(scene: &SceneSpec, spec: &PlaceSpec) -> Result<([f64; 2], Option<f64>), Failure> {
+/// Where a `place` goes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlaceTarget {
+    /// The point `[x, y]`, world frame, metres.
+    pub point: [f64; 2],
+    /// The block's yaw there, radians; `None`: as held.
+    pub yaw: Option<f64>,
+    /// What the block rests on there, by name (a spot's `on:`); `None`: whatever is under the
+    /// point with the highest top.
+    pub on: Option<String>,
+}
+
+/// Where a `place` goes. A spot the scene does not have is a failure of kind `other` that lists
+/// the spots it has.
+pub fn place_target(scene: &SceneSpec, spec: &PlaceSpec) -> Result<PlaceTarget, Failure> {
     let explicit = match spec.yaw {
         Some(Yaw::Angle(a)) => Some(Some(a)),
         Some(Yaw::Keep) | Some(Yaw::Object) => Some(None),
         None => None,
     };
-    if let Some(p) = spec.point {
-        return Ok((p, explicit.flatten()));
+    if let Some(point) = spec.point {
+        return Ok(PlaceTarget {
+            point,
+            yaw: explicit.flatten(),
+            on: None,
+        });
     }
     let Some(named) = &spec.spot else {
         return Err(Failure::other("`place` has neither a point nor a spot"));
     };
     let spot = super::targets::spot(named, scene)?;
-    Ok(([spot.x, spot.y], explicit.unwrap_or(Some(spot.yaw))))
+    Ok(PlaceTarget {
+        point: [spot.x, spot.y],
+        yaw: explicit.unwrap_or(Some(spot.yaw)),
+        on: spot.on.clone(),
+    })
 }
 
 /// Executes a [`PlaceSpec`]: a carry to the place, then a release to the checked opening.
@@ -60,11 +81,16 @@ impl Place {
     /// The set-down has ended: open to the width the clearance check allowed for, and retreat.
     fn let_go(&mut self, cell: &mut Cell) -> Result<(), Failure> {
         let half = self.carry.as_ref().map_or(0.0, |c| cell.world().half(c.held()));
-        let mut release = Release::new(ReleaseSpec {
+        let spec = ReleaseSpec {
             width: Some(release_opening(half)),
             retreat: self.spec.retreat,
             timeout: RELEASE_TIME,
-        });
+        };
+        // Slid in under something, the hand backs out the way it came.
+        let mut release = match self.carry.as_ref().and_then(Carry::slid_in_along) {
+            Some(along) => Release::retreating_along(spec, -along),
+            None => Release::new(spec),
+        };
         release.start(cell)?;
         self.release = Some(release);
         Ok(())
@@ -73,7 +99,11 @@ impl Place {
 
 impl MacroAction for Place {
     fn start(&mut self, cell: &mut Cell) -> Result<(), Failure> {
-        let ([x, y], yaw) = place_target(&cell.world().scene, &self.spec)?;
+        let PlaceTarget {
+            point: [x, y],
+            yaw,
+            on,
+        } = place_target(&cell.world().scene, &self.spec)?;
         let spec = CarrySpec {
             to: Target::Point([x, y, 0.0]),
             lift: self.spec.lift,
@@ -83,7 +113,7 @@ impl MacroAction for Place {
             max_checks: self.spec.max_checks,
             plan_time_cap: self.spec.plan_time_cap,
         };
-        let mut carry = Carry::placing(spec, yaw);
+        let mut carry = Carry::placing(spec, yaw, on);
         self.release = None;
         let started = carry.start(cell);
         self.carry = Some(carry);
@@ -149,8 +179,13 @@ mod tests {
             x: 0.45,
             y: -0.1,
             yaw: 0.3,
+            on: None,
         });
         s
+    }
+
+    fn at(point: [f64; 2], yaw: Option<f64>) -> PlaceTarget {
+        PlaceTarget { point, yaw, on: None }
     }
 
     #[test]
@@ -158,15 +193,15 @@ mod tests {
         let s = scene_with_spot();
         assert_eq!(
             place_target(&s, &spec(None, Some("kit_a"), None)).unwrap(),
-            ([0.45, -0.1], Some(0.3))
+            at([0.45, -0.1], Some(0.3))
         );
         assert_eq!(
             place_target(&s, &spec(None, Some("kit_a"), Some(Yaw::Keep))).unwrap(),
-            ([0.45, -0.1], None)
+            at([0.45, -0.1], None)
         );
         assert_eq!(
             place_target(&s, &spec(None, Some("kit_a"), Some(Yaw::Angle(1.0)))).unwrap(),
-            ([0.45, -0.1], Some(1.0))
+            at([0.45, -0.1], Some(1.0))
         );
     }
 
@@ -175,11 +210,11 @@ mod tests {
         let s = scene_with_spot();
         assert_eq!(
             place_target(&s, &spec(Some([0.5, 0.1]), None, None)).unwrap(),
-            ([0.5, 0.1], None)
+            at([0.5, 0.1], None)
         );
         assert_eq!(
             place_target(&s, &spec(Some([0.5, 0.1]), None, Some(Yaw::Angle(-0.2)))).unwrap(),
-            ([0.5, 0.1], Some(-0.2))
+            at([0.5, 0.1], Some(-0.2))
         );
     }
 

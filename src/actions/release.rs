@@ -26,6 +26,8 @@ pub struct Release {
     t0: f64,
     stalled: u32,
     retreating: bool,
+    /// The unit direction of the retreat, world frame (straight up unless told otherwise).
+    retreat_along: Vector3<f64>,
     goal_q: [f64; 6],
     arrival: Arrival,
 }
@@ -39,8 +41,18 @@ impl Release {
             t0: 0.0,
             stalled: 0,
             retreating: false,
+            retreat_along: Vector3::z(),
             goal_q: [0.0; 6],
             arrival: Arrival::default(),
+        }
+    }
+
+    /// A release that retreats along `along` (unit, world frame) instead of straight up: back
+    /// out the way the hand came, from under something.
+    pub fn retreating_along(spec: ReleaseSpec, along: Vector3<f64>) -> Self {
+        Self {
+            retreat_along: along,
+            ..Self::new(spec)
         }
     }
 }
@@ -115,7 +127,7 @@ impl MacroAction for Release {
             }
             let from = cell.arm_setpoint();
             let mut pose = crate::motion::fk(&from);
-            pose.translation.vector += Vector3::new(0.0, 0.0, self.spec.retreat);
+            pose.translation.vector += self.retreat_along * self.spec.retreat;
             match CartesianMove::new(from, pose, &MotionLimits::default()) {
                 Ok(mv) => {
                     self.goal_q = mv.end();
@@ -125,7 +137,15 @@ impl MacroAction for Release {
                 Err(e) => {
                     return Progress::Failed(Failure::new(
                         FailureKind::Unreachable,
-                        format!("cannot retreat {:.3} m up: {e}", self.spec.retreat),
+                        format!(
+                            "cannot retreat {:.3} m {}: {e}",
+                            self.spec.retreat,
+                            if self.retreat_along == Vector3::z() {
+                                "up"
+                            } else {
+                                "back out"
+                            }
+                        ),
                     ));
                 }
             }

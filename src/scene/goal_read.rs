@@ -556,12 +556,14 @@ mod tests {
                 x: 0.40,
                 y: -0.10,
                 yaw: std::f64::consts::FRAC_PI_2,
+                on: None,
             },
             Spot {
                 name: "slot_b".into(),
                 x: 0.40,
                 y: 0.10,
                 yaw: 0.0,
+                on: None,
             },
         ];
         let mut sources = Sources::new();

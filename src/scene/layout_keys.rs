@@ -74,7 +74,62 @@ fn name_of<'a>(k: &'a Value, what: &str, scene: &SceneSpec, issues: &mut Vec<Iss
     Some(name)
 }
 
-/// `spots: {NAME: [x, y] | [x, y, yaw]}`: each point on the table within the arm's reach.
+/// A spot written as a mapping: where, and what a block set down there rests on.
+#[derive(Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SpotOnRaw {
+    /// The point `[x, y]` or `[x, y, yaw]` (metres; yaw in radians or `deg(..)`).
+    pub at: TablePose,
+    /// The obstacle or block under the point that a block set down there rests on (the lower
+    /// board of a two-level shelf, where the upper board is also over the point).
+    pub on: String,
+}
+
+/// One `spots:` value: a point, or a point on a named support.
+#[derive(Deserialize, JsonSchema)]
+#[serde(untagged)]
+pub enum SpotRaw {
+    /// `[x, y]` or `[x, y, yaw]`: on whatever is under the point with the highest top.
+    Point(TablePose),
+    /// `{at: [x, y, yaw], on: NAME}`.
+    On(SpotOnRaw),
+}
+
+/// Why spot `name`'s `on:` cannot hold a block at `(x, y)`, if it cannot: it must name an
+/// obstacle or a block of the scene whose fixed footprint (when it has one) covers the point.
+fn check_spot_support(scene: &SceneSpec, name: &str, on: &str, x: f64, y: f64) -> Option<(String, String)> {
+    let Some(o) = scene.object(on) else {
+        let names: Vec<&str> = scene
+            .objects
+            .iter()
+            .filter(|o| matches!(o.kind(), ObjectKind::Obstacle | ObjectKind::Block))
+            .map(|o| o.name.as_str())
+            .collect();
+        return Some((
+            format!("spot `{name}` is `on: {on}`, which is not an object of this scene"),
+            format!("name one of its obstacles or blocks: {}", names.join(", ")),
+        ));
+    };
+    if o.kind() == ObjectKind::Container {
+        return Some((
+            format!("spot `{name}` is `on: {on}`, a container"),
+            "a spot in a container needs no `on:`: write the point alone (a block set down there rests on the floor)".into(),
+        ));
+    }
+    if let Some(pose) = &o.pose
+        && o.random.is_none()
+        && o.shape.footprint(pose).distance_to_point([x, y]) > 0.0
+    {
+        return Some((
+            format!("spot `{name}` at ({x}, {y}) is not over `{on}`"),
+            format!("move the spot onto `{on}`'s top, or name the object under it"),
+        ));
+    }
+    None
+}
+
+/// `spots: {NAME: [x, y] | [x, y, yaw] | {at: [x, y, yaw], on: SUPPORT}}`: each point on the
+/// table within the arm's reach.
 pub(super) fn read_spots(v: &Value, scene: &mut SceneSpec, issues: &mut Vec<Issue>) {
     let Some(entries) = v.as_map() else {
         issues.push(
@@ -104,12 +159,33 @@ pub(super) fn read_spots(v: &Value, scene: &mut SceneSpec, issues: &mut Vec<Issu
         let Some(name) = name_of(k, "spot", scene, issues) else {
             continue;
         };
-        let p: TablePose = match from_value(body) {
+        let (pose_v, on) = match body.as_map() {
+            Some(_) => match from_value::<SpotOnRaw>(body) {
+                Ok(raw) => {
+                    let entry = |key: &str| {
+                        body.as_map()
+                            .and_then(|m| m.iter().find(|(k, _)| k.as_str() == Some(key)))
+                            .map_or(body, |(_, v)| v)
+                    };
+                    (entry("at"), Some((raw.on, entry("on").loc)))
+                }
+                Err(e) => {
+                    let mut issue = e
+                        .into_issue(body.loc, |l| format!("{l:?}"))
+                        .help_or("a spot on a support is `{at: [x, y, yaw], on: NAME}`");
+                    issue.message = format!("{} in spot `{name}`", issue.message);
+                    issues.push(issue);
+                    continue;
+                }
+            },
+            None => (body, None),
+        };
+        let p: TablePose = match from_value(pose_v) {
             Ok(p) => p,
             Err(e) => {
-                let mut issue = e
-                    .into_issue(body.loc, |l| format!("{l:?}"))
-                    .help_or("a spot is `[x, y]` or `[x, y, yaw]` (metres; yaw in radians or `deg(..)`)");
+                let mut issue = e.into_issue(pose_v.loc, |l| format!("{l:?}")).help_or(
+                    "a spot is `[x, y]` or `[x, y, yaw]` (metres; yaw in radians or `deg(..)`), or `{at: [x, y, yaw], on: NAME}`",
+                );
                 issue.message = format!("{} in spot `{name}`", issue.message);
                 issues.push(issue);
                 continue;
@@ -133,11 +209,18 @@ pub(super) fn read_spots(v: &Value, scene: &mut SceneSpec, issues: &mut Vec<Issu
             issues.push(issue);
             continue;
         }
+        if let Some((support, loc)) = &on
+            && let Some((message, help)) = check_spot_support(scene, name, support, x, y)
+        {
+            issues.push(Issue::new(*loc, message).help(help));
+            continue;
+        }
         scene.spots.push(Spot {
             name: name.to_string(),
             x,
             y,
             yaw: p.yaw.unwrap_or(0.0),
+            on: on.map(|(support, _)| support),
         });
     }
 }

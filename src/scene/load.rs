@@ -174,9 +174,10 @@ pub struct SceneFileSchema {
     #[serde(default)]
     pub sampler: SamplerRaw,
     /// Named points on the table: `NAME: [x, y]` or `[x, y, yaw]` (metres; yaw in radians or
-    /// `deg(..)`), each 0.22 … 0.72 m from the robot's base.
+    /// `deg(..)`), each 0.22 … 0.72 m from the robot's base; or `{at: [x, y, yaw], on: NAME}`
+    /// for a point on a named obstacle or block (a shelf's lower board).
     #[serde(default)]
-    pub spots: BTreeMap<String, TablePose>,
+    pub spots: BTreeMap<String, super::layout_keys::SpotRaw>,
     /// Named boxes on the table: `NAME: {x: [lo, hi], y: [lo, hi], role: keep_out | allowed}`.
     #[serde(default)]
     pub regions: BTreeMap<String, super::layout_keys::RegionRaw>,

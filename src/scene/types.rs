@@ -249,6 +249,10 @@ pub struct Spot {
     pub y: f64,
     /// Yaw about world z, radians.
     pub yaw: f64,
+    /// The obstacle or block a block set down at the spot rests on (`on:`), when the scene names
+    /// one: the lower board of a two-level shelf, under the upper one. `None`: whatever is
+    /// under the point with the highest top (or the table).
+    pub on: Option<String>,
 }
 
 /// A loaded, validated scene.

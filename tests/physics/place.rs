@@ -128,6 +128,7 @@ fn place_at_a_spot_takes_its_point_and_its_yaw() {
         x: 0.42,
         y: 0.14,
         yaw: (-20.0f64).to_radians(),
+        on: None,
     };
     let objects = block("red", 0.45, -0.15, 10.0);
     let main = sequence(&format!("{}      - place: {{spot: kit_a}}\n", pick("red")));

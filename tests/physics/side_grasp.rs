@@ -3,7 +3,9 @@
 //! touching the shelf; set down upright on a pedestal; `approach: auto` choosing the side under
 //! the board and the top where it is free; a block too deep under the board refused before
 //! anything moves; a side-held block refused a set-down on the table before anything moves;
-//! and the loader's checks of `approach` with the other parameters.
+//! a side-held block slid in under the upper board onto a spot of the lower one, and a block
+//! held from above refused there; and the loader's checks of `approach` with the other
+//! parameters.
 
 use macrotree::App;
 use macrotree::env::{Action, EnvConfig, MacroEnv, Reset, Status, StepResult};
@@ -22,7 +24,8 @@ const HALF: f64 = 0.02;
 
 /// A two-level shelf (boards 0.10 m deep, the lower one's top 0.12 m high, the upper one's
 /// underside 0.22 m: 6 cm above a 4 cm block), `low` on the lower board (at `low_x`, turned
-/// 10°), `free` on the table, a 3 cm pedestal with the `stage` spot on it, an `on_table` spot.
+/// 10°), `free` on the table, a 3 cm pedestal with the `stage` spot on it, an `on_table` spot
+/// and a `shelved` spot on the lower board.
 fn shelf(low_x: f64) -> MacroEnv {
     let yaml = format!(
         "
@@ -37,6 +40,7 @@ objects:
 spots:
   stage: [0.48, -0.33]
   on_table: [0.40, 0.15]
+  shelved: {{at: [0.60, -0.10], on: low_board}}
 "
     );
     let spec = SceneSpec::from_str(&yaml, "shelf.yaml").unwrap_or_else(|d| panic!("{}", d[0]));
@@ -274,4 +278,80 @@ fn assert_arm_still(before: &[f64], after: &[f64]) {
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f64::max);
     assert!(moved < 0.01, "the arm moved {moved} rad");
+}
+
+#[test]
+fn a_side_held_block_is_slid_in_under_the_upper_board_and_set_down_on_its_spot() {
+    let mut env = shelf(0.60);
+    ok(&mut env, "release: {width: 0.065, retreat: 0}");
+    ok(
+        &mut env,
+        "reach: {target: low, approach: side, offset: [0, 0, 0.12]}",
+    );
+    ok(&mut env, "reach: {target: low, approach: side, path: cartesian}");
+    ok(&mut env, "grasp: {object: low}");
+    ok(
+        &mut env,
+        "reach: {target: low, approach: side, offset: [0, 0.01, 0.12], path: cartesian}",
+    );
+    // Back under the upper board, 16 cm along the board: slid in along the hand's approach just
+    // above the spot, set down, let go, the hand backed out the way it came.
+    ok(&mut env, "place: {spot: shelved, retreat: 0.12}");
+    let (end, q) = block(&env, "low");
+    assert!(
+        (end.xy() - nalgebra::Vector2::new(0.60, -0.10)).norm() < 0.01,
+        "the block rests at {end}, not on the spot"
+    );
+    assert!(
+        (end.z - (BOARD_TOP + HALF)).abs() < 0.004,
+        "the block's centre is at {} m, not on the lower board",
+        end.z
+    );
+    assert!(
+        tilt(&q) < 3f64.to_radians(),
+        "set down tilted {:.1}°",
+        tilt(&q).to_degrees()
+    );
+    let p = env.cell().world().pinch_pos;
+    assert!(
+        p.x < BOARD_FRONT - 0.05,
+        "the hand is still under the board: pinch at {p}"
+    );
+    assert!(
+        p.z < 0.22,
+        "the hand backed out level, not up through the board: pinch at {p}"
+    );
+    let r = env.step(&Action::Leaf("grasped: {object: low}".into())).unwrap();
+    assert_eq!(r.status, Status::Failure, "the fingers let go of it");
+    let r = env
+        .step(&Action::Leaf("at: {object: low, spot: shelved}".into()))
+        .unwrap();
+    assert_eq!(r.status, Status::Success, "the `at` condition holds on the board");
+}
+
+#[test]
+fn a_block_held_from_above_is_refused_a_spot_under_a_board_with_what_to_do() {
+    let mut env = shelf(0.60);
+    ok(&mut env, "release: {width: 0.065, retreat: 0}");
+    ok(&mut env, "reach: {target: free, offset: [0, 0, 0.12]}");
+    ok(&mut env, "reach: {target: free, path: cartesian}");
+    ok(&mut env, "grasp: {object: free}");
+    let (before, _) = block(&env, "free");
+    let r = env.step(&Action::Leaf("place: {spot: shelved}".into())).unwrap();
+    assert_eq!(r.status, Status::Failure);
+    let f = r.failure.expect("a failure");
+    assert_eq!(f.kind, FailureKind::GoalInCollision, "{f:?}");
+    assert!(
+        f.message.contains("under `top_board`") && f.message.contains("approach: side"),
+        "{}",
+        f.message
+    );
+    // Refused before anything moved: the block is where the grasp left it.
+    let (after, _) = block(&env, "free");
+    assert!(
+        (after - before).norm() < 0.002,
+        "the block moved from {before} to {after}"
+    );
+    let r = env.step(&Action::Leaf("grasped: {object: free}".into())).unwrap();
+    assert_eq!(r.status, Status::Success, "still held");
 }

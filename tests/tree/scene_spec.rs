@@ -183,6 +183,46 @@ fn a_refused_declaration_names_its_field_and_causes_no_follow_on_errors() {
     );
 }
 
+/// A spot may name what a block set down there rests on (`{at: [x, y, yaw], on: NAME}`): an
+/// obstacle or block under the point. Anything else is refused at the `on:` value, saying what
+/// to write.
+#[test]
+fn a_spot_on_a_support_names_an_obstacle_or_block_under_it() {
+    let base = "objects:\n  board: {obstacle: {size: [0.10, 0.40, 0.02]}, pose: [0.60, 0.0], z: 0.10}\n  top: {obstacle: {size: [0.10, 0.40, 0.02]}, pose: [0.60, 0.0], z: 0.22}\n  bin: {container: {inner: [0.2, 0.2], wall_height: 0.06}, pose: [0.35, 0.3]}\n  a: {block: {size: 0.04}, pose: [0.4, -0.2]}\nspots:\n";
+    let spec = SceneSpec::from_str(
+        &format!("{base}  slot: {{at: [0.60, 0.05, deg(90)], on: board}}\n"),
+        "cell.yaml",
+    )
+    .unwrap();
+    let slot = spec.spot("slot").unwrap();
+    assert_eq!((slot.x, slot.y, slot.on.as_deref()), (0.60, 0.05, Some("board")));
+    assert!((slot.yaw - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+    for (spot, says, help) in [
+        (
+            "{at: [0.60, 0.05], on: bord}",
+            "not an object of this scene",
+            "board, top, a",
+        ),
+        ("{at: [0.35, 0.30], on: bin}", "a container", "needs no `on:`"),
+        (
+            "{at: [0.45, 0.05], on: board}",
+            "is not over `board`",
+            "move the spot onto",
+        ),
+    ] {
+        let d = scene_errors(&format!("{base}  slot: {spot}\n"));
+        let e = find(&d, says);
+        assert_eq!(
+            (e.line, e.column),
+            (7, 9 + spot.find("on:").unwrap() as u32 + 4),
+            "{e}"
+        );
+        assert!(e.help.as_deref().unwrap_or("").contains(help), "{e}");
+    }
+    let d = scene_errors(&format!("{base}  slot: {{at: [0.60, 0.05], under: board}}\n"));
+    assert!(d.iter().any(|e| e.message.contains("under")), "{d:#?}");
+}
+
 #[test]
 fn sorted_by_color_needs_one_bin_per_block_colour() {
     let d = scene_errors(
