@@ -178,6 +178,10 @@ INTERRUPTED_STEP = """
 import json, os, signal, sys, threading
 import macrotree
 
+# Ctrl-C as in an interactive Python: a process started in the background by a shell without job
+# control inherits SIGINT ignored, and then no Ctrl-C reaches it at all.
+signal.signal(signal.SIGINT, signal.default_int_handler)
+
 slow = {"control_period": 0.1, "max_sim_time": 3600.0}
 env = macrotree.MacroEnv(sys.argv[1], **slow)
 env.reset(seed=0)
