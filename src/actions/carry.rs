@@ -37,7 +37,7 @@ const LIFT_BISECTIONS: u32 = 10;
 
 /// How far in front of its place a block that goes under something is brought before it is
 /// slid in, along the hand's horizontal approach, metres (the stand-off of a side grasp).
-pub const INSERT_STAND_OFF: f64 = 0.12;
+const INSERT_STAND_OFF: f64 = 0.12;
 
 /// How far above its place a block that goes under something slides in, metres: it is lowered
 /// this last bit straight down.

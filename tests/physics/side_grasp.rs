@@ -242,17 +242,7 @@ fn approach_side_needs_a_block_and_a_stand_off_and_auto_only_a_stand_off() {
 #[test]
 fn a_side_held_block_carried_onto_the_table_put_the_gripper_into_it() {
     let mut env = shelf(0.60);
-    ok(&mut env, "release: {width: 0.065, retreat: 0}");
-    ok(
-        &mut env,
-        "reach: {target: low, approach: side, offset: [0, 0, 0.12]}",
-    );
-    ok(&mut env, "reach: {target: low, approach: side, path: cartesian}");
-    ok(&mut env, "grasp: {object: low}");
-    ok(
-        &mut env,
-        "reach: {target: low, approach: side, offset: [0, 0.01, 0.12], path: cartesian}",
-    );
+    hold_low_from_the_side(&mut env);
     let before = env.observe().joint_pos;
     let r = env.step(&Action::Leaf("place: {spot: on_table}".into())).unwrap();
     assert_eq!(r.status, Status::Failure);
@@ -270,6 +260,18 @@ fn a_side_held_block_carried_onto_the_table_put_the_gripper_into_it() {
     ok(&mut env, "place: {spot: stage}");
 }
 
+/// Grasps `low` from the side and pulls it out 12 cm the way the hand came, 1 cm up.
+fn hold_low_from_the_side(env: &mut MacroEnv) {
+    ok(env, "release: {width: 0.065, retreat: 0}");
+    ok(env, "reach: {target: low, approach: side, offset: [0, 0, 0.12]}");
+    ok(env, "reach: {target: low, approach: side, path: cartesian}");
+    ok(env, "grasp: {object: low}");
+    ok(
+        env,
+        "reach: {target: low, approach: side, offset: [0, 0.01, 0.12], path: cartesian}",
+    );
+}
+
 /// Asserts the arm's joints moved less than 0.01 rad from `before` to `after`.
 fn assert_arm_still(before: &[f64], after: &[f64]) {
     let moved = before
@@ -283,17 +285,7 @@ fn assert_arm_still(before: &[f64], after: &[f64]) {
 #[test]
 fn a_side_held_block_is_slid_in_under_the_upper_board_and_set_down_on_its_spot() {
     let mut env = shelf(0.60);
-    ok(&mut env, "release: {width: 0.065, retreat: 0}");
-    ok(
-        &mut env,
-        "reach: {target: low, approach: side, offset: [0, 0, 0.12]}",
-    );
-    ok(&mut env, "reach: {target: low, approach: side, path: cartesian}");
-    ok(&mut env, "grasp: {object: low}");
-    ok(
-        &mut env,
-        "reach: {target: low, approach: side, offset: [0, 0.01, 0.12], path: cartesian}",
-    );
+    hold_low_from_the_side(&mut env);
     // Back under the upper board, 16 cm along the board: slid in along the hand's approach just
     // above the spot, set down, let go, the hand backed out the way it came.
     ok(&mut env, "place: {spot: shelved, retreat: 0.12}");

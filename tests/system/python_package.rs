@@ -246,34 +246,66 @@ fn wheels(into: &str, folders: &[&str]) -> Vec<PathBuf> {
         .collect()
 }
 
+/// The Python an optional check runs in, named by the environment variable `var`; `None` (the
+/// check is skipped, saying what it needs) when `var` is unset or the Python tests are skipped.
+fn optional_python(var: &str, needs: &str) -> Option<String> {
+    let Ok(python) = std::env::var(var) else {
+        eprintln!("skipped: set {var} to a Python with {needs}");
+        return None;
+    };
+    (!skip()).then_some(python)
+}
+
+/// Installs `built` (wheels) into `python` as a user would: their dependencies as pip resolves
+/// them beside what is there, with the packages `extra`, then these very wheels over any
+/// earlier build of them.
+fn install_wheels(python: &str, built: &[PathBuf], extra: &[&str]) {
+    run(
+        Command::new(python)
+            .args(["-m", "pip", "install", "--quiet"])
+            .args(extra)
+            .args(built),
+        &format!("pip install {extra:?} and the wheels into {python}"),
+    );
+    run(
+        Command::new(python)
+            .args([
+                "-m",
+                "pip",
+                "install",
+                "--quiet",
+                "--force-reinstall",
+                "--no-deps",
+            ])
+            .args(built),
+        &format!("pip install --force-reinstall the wheels into {python}"),
+    );
+}
+
+/// Runs `python ARGS…` from the repository root, without `PYTHONPATH` (the installed packages
+/// only); its output.
+fn run_python(python: &str, args: &[&std::ffi::OsStr]) -> String {
+    run(
+        Command::new(python)
+            .args(args)
+            .current_dir(root())
+            .env_remove("PYTHONPATH"),
+        &format!("{python} {args:?}"),
+    )
+}
+
 /// TorchRL's `check_env_specs` on the single environment (both action modes) and the vector
 /// environment, in the Python that `MACROTREE_TORCHRL_PYTHON` names (one with torchrl 0.14.1:
 /// torch is too heavy for CI). The package is built as a wheel here and installed there.
 #[test]
 fn torchrl_check_env_specs_passes() {
-    let Ok(python) = std::env::var("MACROTREE_TORCHRL_PYTHON") else {
-        eprintln!("skipped: set MACROTREE_TORCHRL_PYTHON to a Python with torchrl 0.14.1");
+    let Some(python) = optional_python("MACROTREE_TORCHRL_PYTHON", "torchrl 0.14.1") else {
         return;
     };
-    if skip() {
-        return;
-    }
-    let [wheel] = &wheels("wheel", &["./python"])[..] else {
-        panic!("one wheel");
-    };
-    run(
-        Command::new(&python)
-            .args(["-m", "pip", "install", "--quiet", "--force-reinstall"])
-            .arg(wheel),
-        "pip install the wheel into MACROTREE_TORCHRL_PYTHON",
-    );
-    let out = run(
-        Command::new(&python)
-            .arg("python/tests/check_torchrl.py")
-            .current_dir(root())
-            .env_remove("PYTHONPATH"),
-        "python/tests/check_torchrl.py",
-    );
+    let built = wheels("wheel", &["./python"]);
+    assert_eq!(built.len(), 1, "one wheel: {built:?}");
+    install_wheels(&python, &built, &[]);
+    let out = run_python(&python, &["python/tests/check_torchrl.py".as_ref()]);
     eprintln!("{out}");
     assert_eq!(out.matches(": passed").count(), 3, "{out}");
 }
@@ -285,49 +317,21 @@ fn torchrl_check_env_specs_passes() {
 /// model the `policy` leaf runs.
 #[test]
 fn the_pytorch_trainer_tests_pass() {
-    let Ok(python) = std::env::var("MACROTREE_TORCH_PYTHON") else {
-        eprintln!("skipped: set MACROTREE_TORCH_PYTHON to a Python with torch");
+    let Some(python) = optional_python("MACROTREE_TORCH_PYTHON", "torch") else {
         return;
     };
-    if skip() {
-        return;
-    }
-    let [wheel] = &wheels("wheel-torch", &["./python"])[..] else {
-        panic!("one wheel");
-    };
-    run(
-        Command::new(&python)
-            .args(["-m", "pip", "install", "--quiet", "pytest", "onnxruntime==1.32.0"])
-            .arg(wheel),
-        "pip install the wheel, onnxruntime and pytest into MACROTREE_TORCH_PYTHON",
-    );
-    run(
-        Command::new(&python)
-            .args([
-                "-m",
-                "pip",
-                "install",
-                "--quiet",
-                "--force-reinstall",
-                "--no-deps",
-            ])
-            .arg(wheel),
-        "pip install --force-reinstall the wheel into MACROTREE_TORCH_PYTHON",
-    );
-    let out = run(
-        Command::new(&python)
-            .args([
-                "-m",
-                "pytest",
-                "-q",
-                "-p",
-                "no:cacheprovider",
-                "python/tests/test_bc_torch.py",
-            ])
-            .current_dir(root())
-            .env_remove("PYTHONPATH"),
-        "pytest python/tests/test_bc_torch.py",
-    );
+    let built = wheels("wheel-torch", &["./python"]);
+    assert_eq!(built.len(), 1, "one wheel: {built:?}");
+    install_wheels(&python, &built, &["pytest", "onnxruntime==1.32.0"]);
+    let args = [
+        "-m",
+        "pytest",
+        "-q",
+        "-p",
+        "no:cacheprovider",
+        "python/tests/test_bc_torch.py",
+    ];
+    let out = run_python(&python, &args.map(std::ffi::OsStr::new));
     eprintln!("{out}");
     assert!(out.contains("2 passed"), "{out}");
 }
@@ -339,44 +343,20 @@ fn the_pytorch_trainer_tests_pass() {
 /// success when it has the frames to finish, and none when it has not.
 #[test]
 fn lerobot_eval_reports_the_environments_success() {
-    let Ok(python) = std::env::var("MACROTREE_LEROBOT_PYTHON") else {
-        eprintln!("skipped: set MACROTREE_LEROBOT_PYTHON to a Python with lerobot 0.6");
+    let Some(python) = optional_python("MACROTREE_LEROBOT_PYTHON", "lerobot 0.6") else {
         return;
     };
-    if skip() {
-        return;
-    }
     let built = wheels("wheel-lerobot", &["./python", "./python/lerobot_env_macrotree"]);
     assert_eq!(built.len(), 2, "two wheels: {built:?}");
-    // Their dependencies as pip resolves them beside lerobot's pins, then these very wheels.
-    run(
-        Command::new(&python)
-            .args(["-m", "pip", "install", "--quiet"])
-            .args(&built),
-        "pip install the wheels into MACROTREE_LEROBOT_PYTHON",
-    );
-    run(
-        Command::new(&python)
-            .args([
-                "-m",
-                "pip",
-                "install",
-                "--quiet",
-                "--force-reinstall",
-                "--no-deps",
-            ])
-            .args(&built),
-        "pip install --force-reinstall the wheels into MACROTREE_LEROBOT_PYTHON",
-    );
+    install_wheels(&python, &built, &[]);
     let work = root().join("target/python-test/lerobot-eval");
     let _ = std::fs::remove_dir_all(&work);
-    let out = run(
-        Command::new(&python)
-            .arg("python/lerobot_env_macrotree/tests/check_lerobot.py")
-            .arg(&work)
-            .current_dir(root())
-            .env_remove("PYTHONPATH"),
-        "python/lerobot_env_macrotree/tests/check_lerobot.py",
+    let out = run_python(
+        &python,
+        &[
+            "python/lerobot_env_macrotree/tests/check_lerobot.py".as_ref(),
+            work.as_os_str(),
+        ],
     );
     eprintln!("{out}");
     assert_eq!(out.matches(": passed").count(), 4, "{out}");
