@@ -1,7 +1,8 @@
 //! The motion planner's benchmark: `cargo bench --bench motion` (add `-- N` for N queries per
 //! family, default 40; `-- coarse` checks joint steps only, without the displacement bound;
 //! `-- shortcuts=N` sets the random shortcut attempts; `-- only=NAME` runs one family; `-- noplain`
-//! skips the MuJoCo-only comparison, e.g. for a profiler). Families in the spirit of MotionBenchMaker on the real cell (Menagerie
+//! skips the MuJoCo-only comparison, e.g. for a profiler; `-- dump=FILE` writes every query's
+//! outcome, check count and path, exactly, to compare two builds byte for byte). Families in the spirit of MotionBenchMaker on the real cell (Menagerie
 //! UR5e + 2F-85, MuJoCo collision checking with the default 5 mm margin): open table, deep bin,
 //! tall obstacle between, clutter, a shelf opening, a wrist-singular transfer, infeasible
 //! queries whose reason must be right, and a check budget too small for a search. Queries are
@@ -311,6 +312,10 @@ fn main() {
     // `only=NAME`: run one family (for profiling); `noplain`: skip the MuJoCo-only comparison.
     let only: Option<String> = std::env::args().find_map(|a| a.strip_prefix("only=").map(str::to_string));
     let with_plain = !std::env::args().any(|a| a == "noplain");
+    // `dump=FILE`: each query's outcome, checks and path (shortest round-trip decimals).
+    let mut dump: Option<std::io::BufWriter<std::fs::File>> = std::env::args()
+        .find_map(|a| a.strip_prefix("dump=").map(str::to_string))
+        .map(|path| std::io::BufWriter::new(std::fs::File::create(path).expect("dump file")));
 
     let families = [
         Family {
@@ -473,6 +478,25 @@ fn main() {
             let cpu0 = thread_cpu();
             let out = plan(&mut checker, &q.start, &goals, &config);
             cpu.push((thread_cpu() - cpu0) * 1e3);
+            if let Some(w) = dump.as_mut() {
+                use std::io::Write;
+                let line = match &out {
+                    Ok(m) => format!(
+                        "{} {k} ok checks={} raw={:?} waypoints={:?}",
+                        f.name,
+                        m.stats.collision_checks,
+                        m.raw_path,
+                        m.trajectory.waypoints()
+                    ),
+                    Err(e) => format!(
+                        "{} {k} {} checks={}",
+                        f.name,
+                        e.reason.name(),
+                        e.stats.collision_checks
+                    ),
+                };
+                writeln!(w, "{line}").expect("dump write");
+            }
             let stats = match &out {
                 Ok(m) => m.stats.clone(),
                 Err(e) => (*e.stats).clone(),

@@ -70,7 +70,7 @@ pub struct Policy {
     /// Fastest joint motion the leaf commands, rad/s (> 0, at most the UR5e's rated π); faster
     /// set points are clamped. Default 3, the scripted leaves' limit.
     #[serde(default = "d_max_joint_speed", deserialize_with = "units::speed")]
-    #[schemars(range(min = 0.0, max = crate::motion::plan::UR5E_RATED_JOINT_SPEED))]
+    #[schemars(range(min = 0.0, max = crate::motion::ur5e::RATED_JOINT_SPEED))]
     pub max_joint_speed: f64,
 }
 

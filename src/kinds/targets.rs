@@ -8,7 +8,7 @@ use schemars::{JsonSchema, Schema, SchemaGenerator, json_schema};
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize};
 
-use crate::motion::kinematics::SHOULDER_HEIGHT;
+use crate::motion::ur5e::SHOULDER_HEIGHT;
 use crate::yaml::suggest::did_you_mean;
 use crate::yaml::units::{Angle, Coordinate, bare_angle, parse_angle_text, within_reach};
 

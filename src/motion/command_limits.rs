@@ -4,7 +4,7 @@
 
 use super::command::CellCommand;
 use super::gripper::{CLOSED_CTRL, OPEN_CTRL};
-use super::kinematics::JOINT_LIMITS;
+use super::ur5e::JOINT_LIMITS;
 
 /// The bounds a command's velocities, accelerations and set-point steps are clamped to.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -19,7 +19,7 @@ pub struct CommandLimits {
 /// The limits of every `ctrl` action: the UR5e's rated π rad/s, which no leaf exceeds, and
 /// 40 rad/s².
 pub const CTRL_LIMITS: CommandLimits = CommandLimits {
-    max_joint_speed: super::plan::UR5E_RATED_JOINT_SPEED,
+    max_joint_speed: super::ur5e::RATED_JOINT_SPEED,
     max_joint_acc: 40.0,
 };
 

@@ -26,9 +26,9 @@ use std::fmt;
 
 use nalgebra::{Isometry3, Matrix3, Matrix6, Rotation3, Translation3, UnitQuaternion, Vector3, Vector6};
 
-use super::kinematics::{
-    ARM_JOINTS, FOREARM, JOINT_LIMITS, LATERAL_OFFSET, SHOULDER_HEIGHT, TOOL_LENGTH, UPPER_ARM, WRIST_1_TO_2,
-    WRIST_2_TO_3, chain, jacobian_of, rotation_vector,
+use super::kinematics::{TOOL_LENGTH, chain, jacobian_of, rotation_vector};
+use super::ur5e::{
+    ARM_JOINTS, FOREARM, JOINT_LIMITS, LATERAL_OFFSET, SHOULDER_HEIGHT, UPPER_ARM, WRIST_1_TO_2, WRIST_2_TO_3,
 };
 
 /// Largest accepted position residual of a solution, metres.

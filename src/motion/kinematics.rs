@@ -1,19 +1,12 @@
 //! Forward kinematics and the geometric Jacobian of the 2F-85 pinch point on the Menagerie UR5e,
 //! in closed form (pure nalgebra, no MuJoCo).
 //!
-//! The chain is read off `universal_robots_ur5e/ur5e.xml` and `robotiq_2f85/2f85.xml` (both
-//! unmodified, the gripper attached at `ur5e/attachment_site` through MjSpec):
+//! The arm's chain and dimensions are the UR5e's facts ([`ur5e`](super::ur5e)); the gripper is
+//! read off `robotiq_2f85/2f85.xml` (unmodified, attached at `ur5e/attachment_site` through
+//! MjSpec):
 //!
 //! | body | position in parent (m) | rotation in parent | joint axis |
 //! |---|---|---|---|
-//! | `base` | (0, 0, 0) in world | 180° about z (quat 0 0 0 −1) | — |
-//! | `shoulder_link` | (0, 0, 0.163) | — | z (`shoulder_pan`) |
-//! | `upper_arm_link` | (0, 0.138, 0) | +90° about y | y (`shoulder_lift`) |
-//! | `forearm_link` | (0, −0.131, 0.425) | — | y (`elbow`) |
-//! | `wrist_1_link` | (0, 0, 0.392) | +90° about y | y (`wrist_1`) |
-//! | `wrist_2_link` | (0, 0.127, 0) | — | z (`wrist_2`) |
-//! | `wrist_3_link` | (0, 0, 0.1) | — | y (`wrist_3`) |
-//! | `attachment_site` | (0, 0.1, 0) | −90° about x (quat −1 1 0 0) | — |
 //! | gripper `base_mount` | (0, 0, 0.007) | — | — |
 //! | gripper `base` | (0, 0, 0.0038) | −90° about z (quat 1 0 0 −1) | — |
 //! | site `pinch` | (0, 0, 0.145) | — | — |
@@ -24,47 +17,11 @@
 
 use nalgebra::{Isometry3, Matrix3, Matrix6, Rotation3, Translation3, UnitQuaternion, Vector3};
 
-/// Height of the shoulder-pan joint above the robot base (world origin), metres.
-pub const SHOULDER_HEIGHT: f64 = 0.163;
-/// Upper-arm length (shoulder-lift axis to elbow axis), metres.
-pub const UPPER_ARM: f64 = 0.425;
-/// Forearm length (elbow axis to wrist-1 axis), metres.
-pub const FOREARM: f64 = 0.392;
-/// Net lateral offset along the shoulder-lift axis from the shoulder-pan axis to the wrist-2
-/// axis (0.138 − 0.131 + 0.127), metres.
-pub const LATERAL_OFFSET: f64 = 0.134;
-/// Wrist-2 origin to wrist-3 origin along the wrist-2 axis, metres.
-pub const WRIST_2_TO_3: f64 = 0.1;
-/// Wrist-2 origin to wrist-1 origin offset along the shoulder-lift axis, metres.
-pub(crate) const WRIST_1_TO_2: f64 = 0.127;
+use super::ur5e::{FOREARM, SHOULDER_HEIGHT, UPPER_ARM, WRIST_1_TO_2, WRIST_2_TO_3};
+
 /// Wrist-3 origin to the pinch site along the wrist-3 axis (attachment 0.1 + base_mount 0.007
 /// + base 0.0038 + pinch 0.145), metres.
 pub const TOOL_LENGTH: f64 = 0.1 + 0.007 + 0.0038 + 0.145;
-
-/// Names of the UR5e arm joints, base to wrist (Menagerie names without the `_joint` suffix;
-/// the position actuators carry the same names).
-pub const ARM_JOINTS: [&str; 6] = [
-    "shoulder_pan",
-    "shoulder_lift",
-    "elbow",
-    "wrist_1",
-    "wrist_2",
-    "wrist_3",
-];
-
-/// Joint limits used by IK and trajectories, radians: the position servos' `ctrlrange` in the
-/// Menagerie UR5e (±6.2831 for every joint, ±3.1415 for the elbow), which is a hair inside the
-/// joint `range` (±6.28319, elbow ±3.1415) — so every solution is a command the servos accept
-/// without clamping. These are the Menagerie's literal values, not 2π / π.
-#[allow(clippy::approx_constant)]
-pub const JOINT_LIMITS: [(f64, f64); 6] = [
-    (-6.2831, 6.2831),
-    (-6.2831, 6.2831),
-    (-3.1415, 3.1415),
-    (-6.2831, 6.2831),
-    (-6.2831, 6.2831),
-    (-6.2831, 6.2831),
-];
 
 #[inline]
 fn rot_y(q: f64) -> Matrix3<f64> {

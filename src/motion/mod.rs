@@ -6,7 +6,8 @@
 //!
 //! | module | what |
 //! |---|---|
-//! | [`kinematics`] | [`fk`], [`jacobian`], the chain's dimensions and [`JOINT_LIMITS`] |
+//! | [`ur5e`] | the UR5e's facts: joints, [`JOINT_LIMITS`], rated speed, dimensions, [`HOME_Q`], lever arms |
+//! | [`kinematics`] | [`fk`], [`jacobian`] of the pinch, the tool's length |
 //! | [`body`] | the arm's and gripper's links as capsules along the chain ([`body::arm_capsules`]) |
 //! | [`mod@ik`] | closed-form [`ik()`] with nearest-to-seed branch choice, every branch ([`ik_all`]), [`ik_down`], [`down_pose`], [`IkError`], [`ik_benchmark`] |
 //! | [`mod@plan`] | collision-aware joint-space planning: RRT-Connect to goal sets, shortcutting, blends, timing, typed failure reasons |
@@ -23,22 +24,12 @@ pub mod ik;
 pub mod kinematics;
 pub mod plan;
 pub mod trajectory;
+pub mod ur5e;
 
 pub use command::{ArmCommand, COMMAND_LEN, COMMAND_NAMES, CellCommand};
 pub use command_limits::{CTRL_LIMITS, ClampedCommand, CommandLimits};
 pub use gripper::{CLOSED_CTRL, OPEN_CTRL, ctrl_for_width, width_for_ctrl};
 pub use ik::{IkError, down_pose, ik, ik_all, ik_benchmark, ik_down, ik_down_with_pose};
-pub use kinematics::{ARM_JOINTS, JOINT_LIMITS, fk, jacobian};
+pub use kinematics::{fk, jacobian};
 pub use trajectory::{ACC_DIFF_STEP, CartesianMove, Hold, JointMove, MotionLimits, Trajectory};
-
-/// Home joint angles of the UR5e (Menagerie keyframe `home`), radians — the same values as
-/// `sim::HOME_Q`, repeated here so this layer stays MuJoCo-free. At home the pinch is at
-/// (−0.134, 0.492, 0.3322) m pointing straight down, its x axis along world +y.
-pub const HOME_Q: [f64; 6] = [
-    -std::f64::consts::FRAC_PI_2,
-    -std::f64::consts::FRAC_PI_2,
-    std::f64::consts::FRAC_PI_2,
-    -std::f64::consts::FRAC_PI_2,
-    -std::f64::consts::FRAC_PI_2,
-    0.0,
-];
+pub use ur5e::{ARM_JOINTS, HOME_Q, JOINT_LIMITS};

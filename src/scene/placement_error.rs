@@ -163,7 +163,7 @@ impl PlacementError {
                 let pinch = crate::motion::fk(&crate::motion::HOME_Q).translation.vector;
                 format!(
                     "move `{object}` (or its `random:` region) clear of the arm at home, or make it lower: at home the upper arm rises beside the base to {:.2} m and the forearm reaches over to the gripper, which hangs down to ({:.2}, {:.2}, {:.2}) m",
-                    crate::motion::kinematics::SHOULDER_HEIGHT + crate::motion::kinematics::UPPER_ARM,
+                    crate::motion::ur5e::SHOULDER_HEIGHT + crate::motion::ur5e::UPPER_ARM,
                     pinch.x,
                     pinch.y,
                     pinch.z

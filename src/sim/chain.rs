@@ -141,26 +141,6 @@ impl ArmChain {
         let (r, t) = &frames[j];
         (r * self.links[j].anchor + t, r * self.links[j].axis)
     }
-
-    /// How far `spheres` reach from each joint's axis at the link frames `frames`
-    /// ([`ArmChain::link_poses`]), metres: for joint `j`, the largest distance from its axis of a
-    /// point of the spheres of links `j..6` (world centre and radius, metres; a negative radius:
-    /// no sphere). Those links are all joint `j` turns, so no point of theirs inside a sphere is
-    /// farther from the axis.
-    pub(crate) fn axis_reach(&self, frames: &[Frame; 6], spheres: &[([f64; 3], f64); 6]) -> [f64; 6] {
-        let mut reach = [0.0f64; 6];
-        for j in 0..6 {
-            let (a, u) = self.joint_axis(frames, j);
-            for (c, radius) in &spheres[j..] {
-                if *radius < 0.0 {
-                    continue;
-                }
-                let d = Vector3::new(c[0] - a.x, c[1] - a.y, c[2] - a.z);
-                reach[j] = reach[j].max(d.cross(&u).norm() + radius);
-            }
-        }
-        reach
-    }
 }
 
 /// The collidable geoms the arm moves (every one of arm group 1..=6: on a link, the gripper at

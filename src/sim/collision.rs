@@ -29,8 +29,9 @@ use super::margin::MarginPairs;
 use super::scene::{ARM_JOINTS, Scene};
 use super::screen::{Build, PAD, Screen};
 use crate::motion::fk;
-use crate::motion::plan::config::{HELD_BLOCK_REACH, UR5E_LEVER_ARMS};
+use crate::motion::plan::config::HELD_BLOCK_REACH;
 use crate::motion::plan::{Collision, CollisionChecker, JointSpare};
+use crate::motion::ur5e::LEVER_ARMS as UR5E_LEVER_ARMS;
 use crate::scene::OBJECT_PREFIX;
 
 /// Default clearance margin, metres: the arm, gripper and held block must stay this far from
@@ -556,16 +557,15 @@ impl CollisionChecker for SceneChecker {
         moving.pose(q, &mut self.data);
         for u in screen.undecided() {
             let counts = self.margin.min(u.gap - PAD);
-            let (lo, hi) = u.range;
-            let wanted = if lo <= hi { caps.get(lo, hi) } else { 0.0 };
+            let wanted = u.range.map_or(0.0, |r| caps.get(r.first, r.last));
             let d = self
                 .data
                 .geom_distance(u.geoms.0, u.geoms.1, u.gap + u.kappa * wanted, None);
             if d < counts {
                 return (Some(false), JointSpare::NONE);
             }
-            if lo <= hi {
-                spare.tighten(lo, hi, (d - u.gap) / u.kappa);
+            if let Some(r) = u.range {
+                spare.tighten(r.first, r.last, (d - u.gap) / u.kappa);
             }
         }
         (Some(true), spare)

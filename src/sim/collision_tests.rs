@@ -7,13 +7,14 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::{SPARE_TOLERANCE, SceneChecker};
-use crate::motion::plan::config::UR5E_LEVER_ARMS;
-use crate::motion::plan::shapes::{Shape, clearance};
 use crate::motion::plan::{Collision, CollisionChecker, JointSpare, SPARE_CAP};
+use crate::motion::ur5e::LEVER_ARMS as UR5E_LEVER_ARMS;
 use crate::motion::{HOME_Q, JOINT_LIMITS, down_pose, fk, ik};
 use crate::scene::SceneSpec;
 use crate::sim::chain::ArmChain;
 use crate::sim::pair_filter::PairFilter;
+use crate::sim::screen::shapes::{Shape, separation};
+use crate::sim::screen::{PairMove, TurnedBound};
 use crate::sim::{Scene, Sim};
 
 /// Posts, a bin and a shelf board close to the arm, a block to hold.
@@ -432,7 +433,7 @@ fn the_chain_poses_the_links_as_mujoco_does() {
 /// surface to the second box (every point of it is at least the distance away).
 fn distance_at_most(x: &Shape, y: &Shape) -> f64 {
     let (Shape::Box { center, axes, half }, Shape::Box { .. }) = (x, y) else {
-        return clearance(x, y);
+        return separation(x, y).clearance();
     };
     let mut least = f64::INFINITY;
     for face in 0..6 {
@@ -451,7 +452,7 @@ fn distance_at_most(x: &Shape, y: &Shape) -> f64 {
                     b: p,
                     radius: 0.0,
                 };
-                least = least.min(clearance(&point, y));
+                least = least.min(separation(&point, y).clearance());
             }
         }
     }
@@ -470,7 +471,7 @@ fn the_arms_own_pairs_keep_their_turned_bound_at_any_joints() {
         let (mut bounded, mut tight) = (0, 0);
         for _ in 0..60 {
             let (q, q2) = (drawn(&mut r), drawn(&mut r));
-            for (bound, x, y) in screen.turned_bounds(&q, &q2) {
+            for TurnedBound { bound, x, y } in screen.turned_bounds(&q, &q2) {
                 if bound <= 0.0 {
                     continue;
                 }
@@ -528,7 +529,7 @@ fn a_pairs_lever_ratio_bounds_how_far_its_parts_move_relative_to_each_other() {
             // Small steps and whole swings.
             let scale = if i % 2 == 0 { 0.05 } else { 2.0 };
             let q2: [f64; 6] = std::array::from_fn(|j| q[j] + scale * r.random_range(-1.0..1.0));
-            for (kappa, moved, bound) in screen.pair_moves(&q, &q2) {
+            for PairMove { kappa, moved, bound } in screen.pair_moves(&q, &q2) {
                 assert!(kappa > 0.0 && kappa <= 1.0, "{kappa}");
                 assert!(
                     moved <= bound + 1e-9,

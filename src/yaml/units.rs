@@ -11,9 +11,8 @@ use schemars::{JsonSchema, Schema, SchemaGenerator, json_schema};
 use serde::de::{self, Deserializer, Visitor};
 use serde::{Deserialize, Serialize};
 
-use crate::motion::kinematics::{
-    FOREARM, JOINT_LIMITS, LATERAL_OFFSET, SHOULDER_HEIGHT, TOOL_LENGTH, UPPER_ARM, WRIST_2_TO_3,
-};
+use crate::motion::kinematics::TOOL_LENGTH;
+use crate::motion::ur5e::{FOREARM, JOINT_LIMITS, LATERAL_OFFSET, SHOULDER_HEIGHT, UPPER_ARM, WRIST_2_TO_3};
 use crate::motion::{ARM_JOINTS, gripper};
 
 /// Upper bound on any length a tree names, metres (≈ 1.31): the UR5e's links laid end to end

@@ -284,7 +284,7 @@ fn each_reason_on_the_real_cell() {
 
 #[test]
 fn the_lever_arms_bound_every_robot_geom_at_random_joints() {
-    use macrotree::motion::plan::config::UR5E_LEVER_ARMS;
+    use macrotree::motion::ur5e::LEVER_ARMS as UR5E_LEVER_ARMS;
     use rand::{Rng, SeedableRng};
     let scene = cube_bowl();
     let m = &scene.model;

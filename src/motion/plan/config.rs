@@ -3,23 +3,11 @@
 
 use std::time::Duration;
 
-use crate::motion::kinematics::JOINT_LIMITS;
 use crate::motion::trajectory::MotionLimits;
-
-/// The UR5e's rated joint speed, rad/s: 180 °/s for every joint (base, shoulder, elbow and the
-/// three wrists), from Universal Robots' UR5e technical specifications / user manual. UR publishes
-/// no joint acceleration rating.
-pub const UR5E_RATED_JOINT_SPEED: f64 = std::f64::consts::PI;
-
-/// Lever arms of the UR5e with the 2F-85 and a held block of up to 7 cm, metres: an upper bound
-/// on the distance of any point of the moving robot from each joint's axis, base to wrist 3.
-/// Measured on the Menagerie models (`tests/physics/motion_collision.rs`: the largest distance of a
-/// collision geom's bounding sphere from each axis, over the stretched arm and random joints,
-/// is 1.08, 1.11, 0.70, 0.31, 0.27, 0.10 m), plus a held block's 6.1 cm half diagonal.
-pub const UR5E_LEVER_ARMS: [f64; 6] = [1.16, 1.19, 0.77, 0.38, 0.34, 0.12];
+use crate::motion::ur5e::{JOINT_LIMITS, LEVER_ARMS, RATED_JOINT_SPEED};
 
 /// How far from the pinch point (metres) every point of a held block may lie for
-/// [`UR5E_LEVER_ARMS`] to cover it: the half diagonal of a 7 cm cube held at its centre. A
+/// [`LEVER_ARMS`] to cover it: the half diagonal of a 7 cm cube held at its centre. A
 /// checker holding a block that reaches farther measures no spare clearance (the planner then
 /// asks it about every configuration).
 pub const HELD_BLOCK_REACH: f64 = 0.061;
@@ -27,7 +15,7 @@ pub const HELD_BLOCK_REACH: f64 = 0.061;
 /// Per-joint speed and acceleration limits a planned trajectory keeps, base to wrist 3.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct JointLimits {
-    /// Largest speed of each joint, rad/s; at most [`UR5E_RATED_JOINT_SPEED`].
+    /// Largest speed of each joint, rad/s; at most [`RATED_JOINT_SPEED`].
     pub velocity: [f64; 6],
     /// Largest acceleration of each joint, rad/s².
     pub acceleration: [f64; 6],
@@ -50,9 +38,9 @@ impl JointLimits {
     pub fn check(&self) -> Result<(), String> {
         for j in 0..6 {
             let (v, a) = (self.velocity[j], self.acceleration[j]);
-            if !(v.is_finite() && v > 0.0 && v <= UR5E_RATED_JOINT_SPEED) {
+            if !(v.is_finite() && v > 0.0 && v <= RATED_JOINT_SPEED) {
                 return Err(format!(
-                    "joint {} speed limit {v} rad/s: use a value in (0, {UR5E_RATED_JOINT_SPEED:.4}] (the UR5e's rated 180 °/s)",
+                    "joint {} speed limit {v} rad/s: use a value in (0, {RATED_JOINT_SPEED:.4}] (the UR5e's rated 180 °/s)",
                     j + 1
                 ));
             }
@@ -93,7 +81,7 @@ pub struct PlannerConfig {
     /// is 5 mm), nothing touches between checks either. `f64::INFINITY` turns the bound off.
     pub max_displacement: f64,
     /// Lever arm of each joint, metres: an upper bound on how far any point of the moving robot
-    /// (and a held block) lies from the joint's axis. Default [`UR5E_LEVER_ARMS`].
+    /// (and a held block) lies from the joint's axis. Default [`LEVER_ARMS`].
     pub lever_arms: [f64; 6],
     /// Longest step the search tree grows by in one extension, radians (Euclidean in joint
     /// space). Default 1.0 rad.
@@ -145,7 +133,7 @@ pub struct PlannerConfig {
 }
 
 impl Default for PlannerConfig {
-    /// Seed 0, 0.05 rad and 0.01 m resolution with [`UR5E_LEVER_ARMS`], 1.0 rad range, 2000
+    /// Seed 0, 0.05 rad and 0.01 m resolution with [`LEVER_ARMS`], 1.0 rad range, 2000
     /// iterations, 20 000 nodes, 20 000 checks, 16 shortcuts that save at least 2 %, 0.1 rad
     /// blends, the joint limits as bounds, [`JointLimits::default`], no tool speed
     /// bound, no time cap.
@@ -154,7 +142,7 @@ impl Default for PlannerConfig {
             seed: 0,
             resolution: 0.05,
             max_displacement: 0.01,
-            lever_arms: UR5E_LEVER_ARMS,
+            lever_arms: LEVER_ARMS,
             range: 1.0,
             max_iterations: 2000,
             max_nodes: 20_000,

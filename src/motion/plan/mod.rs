@@ -26,7 +26,6 @@
 //! | [`stats`] | [`PlanStats`] and joint-space distances |
 //! | [`planner`] | [`plan`]: one query, stage by stage |
 //! | [`boxes`] | [`JointBoxes`]: obstacles as boxes in joint space, for tests and benchmarks |
-//! | [`shapes`] | capsules, boxes, half-spaces and conservative nearness tests (the screen's geometry) |
 
 pub mod blend;
 pub mod boxes;
@@ -38,7 +37,6 @@ pub mod planner;
 pub mod reason;
 mod rng;
 pub mod rrt;
-pub mod shapes;
 pub mod shortcut;
 pub mod spare;
 pub mod stats;
@@ -49,7 +47,7 @@ mod tests;
 
 pub use boxes::{JointBox, JointBoxes};
 pub use checker::{Collision, CollisionChecker};
-pub use config::{JointLimits, PlannerConfig, UR5E_RATED_JOINT_SPEED};
+pub use config::{JointLimits, PlannerConfig};
 pub use goal::GoalSet;
 pub use planner::{PlannedMotion, SPARE_CAP, plan};
 pub use reason::{PlanError, PlanFailure, SearchBudget};

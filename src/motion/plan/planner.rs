@@ -110,11 +110,11 @@ enum Attempt {
 pub const SPARE_CAP: f64 = 0.15;
 
 /// The lever arms the final re-check's vouching uses, metres: the configured ones, and never
-/// less than [`UR5E_LEVER_ARMS`](super::config::UR5E_LEVER_ARMS) (a setting that bounds fewer
+/// less than [`LEVER_ARMS`](crate::motion::ur5e::LEVER_ARMS) (a setting that bounds fewer
 /// joints or shorter arms only coarsens the search's edges; it never lets the re-check skip a
 /// configuration the documented bound does not cover).
 fn vouching_arms(res: &super::edge::Resolution) -> [f64; 6] {
-    std::array::from_fn(|j| res.lever_arms[j].max(super::config::UR5E_LEVER_ARMS[j]))
+    std::array::from_fn(|j| res.lever_arms[j].max(crate::motion::ur5e::LEVER_ARMS[j]))
 }
 
 /// The exact re-check of a path the screen helped find: every vertex of `path` and every
