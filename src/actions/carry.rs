@@ -288,7 +288,7 @@ impl Carry {
                         l
                     }
                 };
-                let (s, co) = crate::world::snapshot::yaw_of(&w.objects[c].quat).sin_cos();
+                let (s, co) = crate::world::angles::yaw_of(&w.objects[c].quat).sin_cos();
                 w.objects[c].pos.xy() + Vector2::new(co * local.x - s * local.y, s * local.x + co * local.y)
             }
             _ => goal.xy(),
@@ -323,8 +323,8 @@ impl Carry {
         // fingers along one of the container's axes, then the other, then a quarter turn from
         // the hold.
         let closing = self.set_down(Vector3::zeros()).closing;
-        let bin_x = crate::world::snapshot::yaw_of(&w.objects[c].quat);
-        let square = crate::world::snapshot::fold_quarter_turn(bin_x - closing.y.atan2(closing.x));
+        let bin_x = crate::world::angles::yaw_of(&w.objects[c].quat);
+        let square = crate::world::angles::fold_quarter_turn(bin_x - closing.y.atan2(closing.x));
         let quarter = std::f64::consts::FRAC_PI_2;
         let turns = [0.0, square, square + quarter, quarter];
         let first = turns.iter().find_map(|&turn| {
@@ -408,7 +408,7 @@ impl Carry {
             return vec![centre];
         };
         let usable = inner_half.map(|h| (h - self.half).max(0.0));
-        let (s, co) = crate::world::snapshot::yaw_of(&w.objects[c].quat).sin_cos();
+        let (s, co) = crate::world::angles::yaw_of(&w.objects[c].quat).sin_cos();
         let n = steps / 2;
         let mut candidates: Vec<Vector2<f64>> = Vec::with_capacity((steps * steps) as usize);
         for i in -n..=n {
@@ -716,7 +716,7 @@ impl Carry {
             return;
         };
         let now = w.yaw(self.held);
-        let by = crate::world::snapshot::fold_quarter_turn(yaw - now);
+        let by = crate::world::angles::fold_quarter_turn(yaw - now);
         let r = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), by);
         self.rotation = r * self.rotation;
         self.pinch_from_block = r * self.pinch_from_block;

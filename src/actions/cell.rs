@@ -7,7 +7,7 @@ use crate::sim::collision::{DEFAULT_MARGIN, SceneChecker};
 use crate::sim::{Layout, Scene, Sim, TIMESTEP};
 use crate::world::World;
 
-pub use super::planning::{PlanCounts, PlanningTally};
+use super::planning_tally::PlanningTally;
 
 /// Default control period: the tree is ticked every 4 ms of simulated time (2 physics steps).
 pub const CONTROL_PERIOD: f64 = 0.004;

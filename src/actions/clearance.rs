@@ -223,7 +223,7 @@ impl SetDown {
             return None;
         }
         let o = &w.objects[j];
-        let yaw = crate::world::snapshot::yaw_of(&o.quat);
+        let yaw = crate::world::angles::yaw_of(&o.quat);
         let r = Rect {
             centre: o.pos.xy(),
             axis: Vector2::new(yaw.cos(), yaw.sin()),

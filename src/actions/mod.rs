@@ -11,12 +11,14 @@ mod cell;
 mod checks;
 mod clearance;
 mod grasp;
+mod grasp_yaw;
 mod joints;
 mod macro_action;
 mod packing;
 mod place;
 mod plan_help;
 mod planning;
+mod planning_tally;
 #[cfg(feature = "policy")]
 pub mod policy;
 mod reach;
@@ -28,14 +30,13 @@ mod targets;
 mod tilted;
 
 pub(crate) use carry::Carry as CarryAction;
-pub use cell::{
-    CONTROL_PERIOD, Cell, MAX_CONTROL_PERIOD, PlanCounts, PlanningTally, StepObserver, check_control_period,
-};
+pub use cell::{CONTROL_PERIOD, Cell, MAX_CONTROL_PERIOD, StepObserver, check_control_period};
 pub use checks::{Checks, ChecksRecorder, pad_block_distance};
 pub(crate) use grasp::Grasp as GraspAction;
 pub(crate) use joints::MoveJoints as MoveJointsAction;
 pub use macro_action::{Arrival, MacroAction, Progress};
 pub(crate) use place::Place as PlaceAction;
+pub use planning_tally::{PlanCounts, PlanningTally};
 pub(crate) use reach::Reach as ReachAction;
 pub(crate) use release::Release as ReleaseAction;
 pub use targets::{

@@ -89,7 +89,7 @@ impl Lookahead {
                 budget: std::cell::Cell::new(WORK_BUDGET),
             };
         };
-        let yaw = crate::world::snapshot::yaw_of(&w.objects[c].quat);
+        let yaw = crate::world::angles::yaw_of(&w.objects[c].quat);
         let to_world = Rotation2::new(yaw);
         let centre = w.objects[c].pos.xy();
         let axes = [to_world * Vector2::x(), to_world * Vector2::y()];

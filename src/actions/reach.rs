@@ -3,6 +3,7 @@
 use nalgebra::{Isometry3, Translation3, Vector3};
 
 use super::cell::Cell;
+use super::grasp_yaw::block_grasp_yaw;
 use super::macro_action::{Arrival, MacroAction, Progress};
 use super::plan_help::PlanFor;
 use super::planning::{arm_link, check_motion, check_straight, describe, look_ahead_clear, plan_motion};
@@ -443,40 +444,6 @@ impl MacroAction for Reach {
     }
 }
 
-/// Distance from another object's footprint within which the finger axis is chosen for
-/// clearance, metres: an open 2F-85 reaches about 6 cm from the pinch along its finger axis.
-const NEAR_CLEARANCE: f64 = 0.08;
-
-/// Tool yaw for grasping block `b` and whether its quarter turns are equivalent.
-///
-/// The fingers must straddle two opposite faces, so the finger axis is the block's yaw or a
-/// quarter turn from it. Far from other objects either will do (the IK picks the one nearest the
-/// wrist); within [`NEAR_CLEARANCE`] of one (a container's wall, an obstacle, another block), the
-/// one whose fingers point most across the direction to the nearest is taken, so the open
-/// fingertips do not land on it.
-pub(super) fn block_grasp_yaw(w: &crate::world::World, b: usize) -> (f64, bool) {
-    let yaw = w.yaw(b);
-    let p = w.objects[b].pos;
-    let nearest = (0..w.objects.len())
-        .filter(|&j| j != b)
-        .map(|j| {
-            // The offset from object j's footprint, turned back into the world frame.
-            let local = w.from_footprint(j, &p);
-            let (s, c) = crate::world::snapshot::yaw_of(&w.objects[j].quat).sin_cos();
-            nalgebra::Vector2::new(c * local.x - s * local.y, s * local.x + c * local.y)
-        })
-        .filter(|away| away.norm() > 0.0)
-        .min_by(|a, b| a.norm().total_cmp(&b.norm()));
-    let Some(away) = nearest.filter(|a| a.norm() < NEAR_CLEARANCE) else {
-        return (yaw, true);
-    };
-    let toward = away.normalize();
-    // At tool yaw ψ the pads separate along (cos ψ, sin ψ) in the table plane.
-    let along = |psi: f64| (psi.cos() * toward.x + psi.sin() * toward.y).abs();
-    let other = yaw + std::f64::consts::FRAC_PI_2;
-    (if along(yaw) <= along(other) { yaw } else { other }, false)
-}
-
 /// The tool yaw that joint solution `q` gives, radians.
 fn yaw_of_solution(q: &[f64; 6]) -> f64 {
     tool_yaw(crate::motion::fk(q).rotation.to_rotation_matrix().matrix())
@@ -485,7 +452,7 @@ fn yaw_of_solution(q: &[f64; 6]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::world::conditions::tests_support::resting;
+    use crate::world::tests_support::resting;
 
     fn q_at(x: f64, y: f64, z: f64) -> [f64; 6] {
         ik_down(&Vector3::new(x, y, z), 0.0, false, &crate::motion::HOME_Q).expect("reachable")

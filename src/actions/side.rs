@@ -189,7 +189,7 @@ pub(crate) fn top_free_goals(cell: &mut Cell, b: usize, standoff: f64, from: &[f
     let w = cell.world();
     let centre = w.objects[b].pos;
     let pre = centre + Vector3::new(0.0, 0.0, standoff);
-    let (yaw, quarter) = super::reach::block_grasp_yaw(w, b);
+    let (yaw, quarter) = super::grasp_yaw::block_grasp_yaw(w, b);
     let goals = GoalSet::down(&pre, yaw, quarter, from);
     let intended = intended(w, b);
     let start = cell.arm_setpoint();

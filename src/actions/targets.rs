@@ -97,7 +97,7 @@ pub fn target_object(target: &crate::kinds::Target, w: &World) -> Option<usize> 
     }
 }
 
-pub use crate::world::snapshot::tool_yaw;
+pub use crate::world::angles::tool_yaw;
 
 /// Distance from `p` to the segment `a`–`b` in the table plane, metres.
 pub(crate) fn segment_distance(

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use super::CliError;
-use super::sweep::SweepArgs;
+use super::sweep_args::SweepArgs;
 use crate::actions::Cell;
 use crate::dataset::{EpisodeRecorder, Recording};
 use crate::plan::Plan;

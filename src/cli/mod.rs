@@ -23,6 +23,7 @@ mod scenario_check;
 mod schema;
 mod signals;
 mod sweep;
+mod sweep_args;
 mod sweep_out;
 mod test;
 mod validate;
@@ -62,7 +63,7 @@ pub enum Command {
     /// Run an episode, then replay its controls with bare mj_step, and compare wall times.
     Bench(bench::BenchArgs),
     /// Run a tree over many seeded random layouts in parallel (optionally with a fault) and summarize.
-    Sweep(sweep::SweepArgs),
+    Sweep(sweep_args::SweepArgs),
     /// Print the JSON Schema of tree files (for editors; same as schema/tree.schema.json).
     Schema(schema::SchemaArgs),
     /// Print a tree as a Graphviz DOT or Mermaid diagram.

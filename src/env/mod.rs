@@ -60,8 +60,8 @@ pub use primitive::{Duration, MAX_DURATION, MAX_REACH_DISTANCE, Primitive, REFER
 #[cfg(feature = "render")]
 pub use render::Image;
 pub use reset::Reset;
-pub use residual::{BaseStep, RESIDUAL_LEN, RESIDUAL_LIMITS, ResidualLimits};
-pub use step::{Status, StepResult};
+pub use residual::{RESIDUAL_LEN, RESIDUAL_LIMITS, ResidualLimits};
+pub use step::{BaseStep, Status, StepResult};
 pub use vector::{Finished, INTERRUPT_POLL, MAX_ENVS, SPIN_WAIT, VecEnv};
 
 use crate::actions::Cell;

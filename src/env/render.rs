@@ -27,25 +27,6 @@ impl super::MacroEnv {
     pub fn render(&self, camera: &str, width: u32, height: u32) -> Result<Image, Error> {
         render_cell(self.cell(), camera, width, height)
     }
-
-    /// Films the steps from now on: frames of `camera` at `width × height`, one now (and one at
-    /// every reset), then one every `1 / rate` simulated seconds, held until
-    /// [`take_frames`](Self::take_frames).
-    ///
-    /// # Errors
-    /// As [`render`](Self::render), and [`Error::Action`] for a rate out of range.
-    pub fn film(&mut self, camera: &str, width: u32, height: u32, rate: f64) -> Result<(), Error> {
-        let mut film = super::film::Film::new(camera.to_string(), width, height, rate)?;
-        film.restart(self.cell().world().time);
-        film.tick(self.cell())?;
-        self.film = Some(film);
-        Ok(())
-    }
-
-    /// The frames filmed since the last call (empty when not filming), oldest first.
-    pub fn take_frames(&mut self) -> Vec<Image> {
-        self.film.as_mut().map(|f| f.take().0).unwrap_or_default()
-    }
 }
 
 /// Renders `camera` of `cell` at `width × height` (see [`super::MacroEnv::render`]).

@@ -6,14 +6,12 @@
 
 use std::sync::Arc;
 
-use serde::Serialize;
-
 use super::config::time_limit_reached;
-use super::step::{Status, StepResult};
+use super::step::{BaseStep, Status, StepResult};
 use crate::episode::{DriverState, MacroDriver};
 use crate::error::Error;
 use crate::failure::{Failure, FailureKind};
-use crate::motion::{COMMAND_LEN, CTRL_LIMITS, CellCommand, ClampedCommand, JOINT_LIMITS};
+use crate::motion::{CTRL_LIMITS, CellCommand, ClampedCommand, JOINT_LIMITS};
 use crate::plan::Plan;
 use crate::runtime::{TreeRunner, TreeStatus};
 
@@ -101,17 +99,6 @@ impl BaseRun {
             status: TreeStatus::Running,
         }
     }
-}
-
-/// The base tree's part of a residual step's result.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct BaseStep {
-    /// The command the base tree gave for this control period, before the residual
-    /// ([`CellCommand::to_vector`]'s layout: set points in radians, velocities in rad/s,
-    /// accelerations in rad/s², the gripper command); after the tree has finished, its hold.
-    pub command: [f64; COMMAND_LEN],
-    /// The base tree's status after its tick (it stays at its end once finished).
-    pub status: TreeStatus,
 }
 
 impl super::MacroEnv {

@@ -70,7 +70,19 @@ pub struct StepResult {
     /// 0 for other actions.
     pub ctrl_clamped: u32,
     /// For a residual step: the base tree's command and status; `None` for other actions.
-    pub base: Option<super::residual::BaseStep>,
+    pub base: Option<BaseStep>,
+}
+
+/// The base tree's part of a residual step's result.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BaseStep {
+    /// The command the base tree gave for this control period, before the residual
+    /// ([`CellCommand::to_vector`](crate::motion::CellCommand::to_vector)'s layout: set points in
+    /// radians, velocities in rad/s, accelerations in rad/s², the gripper command); after the tree
+    /// has finished, its hold.
+    pub command: [f64; crate::motion::COMMAND_LEN],
+    /// The base tree's status after its tick (it stays at its end once finished).
+    pub status: TreeStatus,
 }
 
 impl StepResult {

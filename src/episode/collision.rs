@@ -262,7 +262,7 @@ mod tests {
         }
     }
 
-    use crate::world::conditions::tests_support::{held, resting};
+    use crate::world::tests_support::{held, resting};
     use crate::world::{Part, Piece};
     use nalgebra::Vector3;
 

@@ -268,7 +268,7 @@ mod tests {
 
     use super::*;
     use crate::actions::ChecksRecorder;
-    use crate::world::conditions::tests_support::{HALF, resting};
+    use crate::world::tests_support::{HALF, resting};
 
     /// The reports of one episode that ended in `w` with the tree's success, judged by `goal`.
     fn judged(w: &World, goal: Goal) -> EpisodeReport {

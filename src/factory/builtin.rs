@@ -146,7 +146,7 @@ mod tests {
 
     use super::*;
     use crate::kinds::{Leaf, Registry};
-    use crate::world::conditions::tests_support::{HALF, held, resting};
+    use crate::world::tests_support::{HALF, held, resting};
 
     /// The answer of the condition `yaml` (`{kind: {params}}`) in `w`.
     fn ask(w: &World, yaml: &str) -> Result<bool, crate::failure::Failure> {

@@ -9,6 +9,8 @@
 //! `crate::factory` binds each action's controller and each condition's check to the declared
 //! name.
 
+use std::sync::OnceLock;
+
 use super::control::{
     ChildParams, CompositeParams, ControlKind, ForEachParams, GuardParams, RepeatParams, RetryParams,
     SubtreeParams, TimeoutParams,
@@ -42,6 +44,21 @@ pub(super) fn registry() -> Registry {
     let mut r = Registry::empty();
     register(&mut r).expect("the built-in node kinds register (names unique, docs complete)");
     r
+}
+
+impl Registry {
+    /// The built-in node kinds (composites, decorators, actions, conditions, `wait`, `select`).
+    pub fn builtin() -> Registry {
+        static BUILTIN: OnceLock<Registry> = OnceLock::new();
+        BUILTIN.get_or_init(registry).clone()
+    }
+}
+
+impl Default for Registry {
+    /// The built-in node kinds.
+    fn default() -> Self {
+        Self::builtin()
+    }
 }
 
 fn register(r: &mut Registry) -> Result<(), crate::error::Error> {

@@ -23,6 +23,7 @@ pub mod leaves;
 pub mod objects;
 mod param_error;
 mod params;
+mod parse_leaf;
 mod policy;
 mod registry;
 mod role;

@@ -3,17 +3,15 @@
 //! parameter type.
 
 use std::fmt;
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
 use schemars::JsonSchema;
 use schemars::generate::SchemaGenerator;
 use serde::Serialize;
 
-use super::builtin;
 use super::catalog::parse_node_doc;
 use super::control::{Control, ControlKind, ControlParams};
-use super::leaf_call::LeafCall;
-use super::leaves::{Leaf, Select, Wait};
+use super::leaves::{Select, Wait};
 use super::objects::ObjectRole;
 use super::params::{DynParams, Params};
 use super::role::ActionRole;
@@ -50,7 +48,7 @@ impl Category {
     }
 }
 
-type ParseParams = fn(&Value) -> Result<Arc<dyn DynParams>, DeError>;
+pub(super) type ParseParams = fn(&Value) -> Result<Arc<dyn DynParams>, DeError>;
 
 fn parse_params<P: Params>(v: &Value) -> Result<Arc<dyn DynParams>, DeError> {
     crate::yaml::de::from_value::<P>(v).map(|p| Arc::new(p) as Arc<dyn DynParams>)
@@ -64,7 +62,7 @@ fn schema_of<P: JsonSchema>(g: &mut SchemaGenerator) -> String {
 
 /// How a leaf kind's parameters are read, and what they declare.
 pub(crate) struct LeafImp {
-    parse: ParseParams,
+    pub(super) parse: ParseParams,
     schema: fn(&mut SchemaGenerator) -> String,
     objects: &'static [(&'static str, ObjectRole)],
     files: &'static [&'static str],
@@ -180,24 +178,6 @@ impl NodeType {
         }
     }
 
-    /// Reads a leaf of this kind from its YAML body (without `name:`); `None` for composites and
-    /// decorators.
-    pub(crate) fn parse_leaf(self: &Arc<Self>, body: &Value) -> Option<Result<Leaf, DeError>> {
-        let call = |parse: ParseParams| {
-            parse(body).map(|params| LeafCall {
-                ty: self.clone(),
-                params,
-            })
-        };
-        Some(match &self.imp {
-            Imp::Control(_) => return None,
-            Imp::Action(l) => call(l.parse).map(Leaf::Action),
-            Imp::Condition(l) => call(l.parse).map(Leaf::Condition),
-            Imp::Wait => crate::yaml::de::from_value::<Wait>(body).map(Leaf::Wait),
-            Imp::Select => crate::yaml::de::from_value::<Select>(body).map(Leaf::Select),
-        })
-    }
-
     /// What an action kind does in the pick-and-place cycle ([`ActionRole::Other`] for every
     /// other kind).
     pub fn role(&self) -> ActionRole {
@@ -261,23 +241,10 @@ pub struct Registry {
 /// what to do, and is reported at the parameter's value.
 pub type FileCheck = fn(&std::path::Path) -> Result<(), String>;
 
-impl Default for Registry {
-    /// The built-in node kinds.
-    fn default() -> Self {
-        Self::builtin()
-    }
-}
-
 /// Longest node kind name, bytes.
 const MAX_KIND_LEN: usize = 40;
 
 impl Registry {
-    /// The built-in node kinds (composites, decorators, actions, conditions, `wait`, `select`).
-    pub fn builtin() -> Registry {
-        static BUILTIN: OnceLock<Registry> = OnceLock::new();
-        BUILTIN.get_or_init(builtin::registry).clone()
-    }
-
     pub(super) fn empty() -> Registry {
         Registry {
             types: Vec::new(),

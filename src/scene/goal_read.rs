@@ -10,8 +10,8 @@ use serde::{Deserialize, Deserializer};
 use super::goal::{
     AT_MAX_TOLERANCE, AT_MAX_YAW_TOLERANCE, AT_TOLERANCE, AT_YAW_TOLERANCE, Goal, GoalAtom, GoalPlace,
 };
-use super::load::loc_at;
 use super::types::{ObjectKind, ObjectSpec, SceneSpec, reach_limits};
+use super::value_loc::loc_at;
 use crate::yaml::de::from_value;
 use crate::yaml::diag::{Issue, Loc};
 use crate::yaml::suggest::did_you_mean;

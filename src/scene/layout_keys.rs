@@ -7,7 +7,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use schemars::JsonSchema;
 use serde::Deserialize;
 
-use super::load::is_object_name;
+use super::object_name::is_object_name;
 use super::types::{ObjectKind, ObjectSpec, Region, RegionRole, SceneSpec, Spot, reach_limits};
 use crate::yaml::TablePose;
 use crate::yaml::de::from_value;

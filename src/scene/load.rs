@@ -10,8 +10,10 @@ use serde::Deserialize;
 use super::color::Color;
 use super::goal::Goal;
 use super::goal_read::{GoalRaw, Rejected, read_goal};
+use super::object_name::is_object_name;
 use super::sample::{Placement, sample_placement};
 use super::types::{ObjectKind, ObjectSpec, Pose, RandomPlacement, Sampler, SceneSpec, Shape};
+use super::value_loc::loc_at;
 use crate::yaml::TablePose;
 use crate::yaml::de::from_value;
 use crate::yaml::diag::{Diagnostic, Issue, Loc, Sources};
@@ -266,26 +268,6 @@ fn stem(file_name: &str) -> String {
         .and_then(|s| s.to_str())
         .unwrap_or("scene")
         .to_string()
-}
-
-/// True for object names: `[a-z][a-z0-9_]*`, at most 32 characters.
-pub fn is_object_name(s: &str) -> bool {
-    let mut c = s.chars();
-    matches!(c.next(), Some(f) if f.is_ascii_lowercase())
-        && c.all(|x| x.is_ascii_lowercase() || x.is_ascii_digit() || x == '_')
-        && s.len() <= 32
-}
-
-/// The location of the value at `path` under `v` (or `v`'s own when absent).
-pub(super) fn loc_at(v: &Value, path: &[&str]) -> Loc {
-    let mut cur = v;
-    for k in path {
-        match cur.get(k) {
-            Some(next) => cur = next,
-            None => break,
-        }
-    }
-    cur.loc
 }
 
 /// Whether `v` is meant as a scene: a mapping with at least one of the scene file's keys.

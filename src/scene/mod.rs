@@ -23,16 +23,19 @@ mod goal;
 mod goal_read;
 mod layout_keys;
 mod load;
+mod object_name;
 mod placement_error;
 mod sample;
 mod types;
+mod value_loc;
 
 pub use color::{COLOR_NAMES, Color};
 pub use footprint::Rect;
 pub use goal::{
     AT_MAX_TOLERANCE, AT_MAX_YAW_TOLERANCE, AT_TOLERANCE, AT_YAW_TOLERANCE, Goal, GoalAtom, GoalPlace,
 };
-pub use load::{BUILTIN_CUBE_BOWL, SceneFileSchema, is_object_name, load_scene_file};
+pub use load::{BUILTIN_CUBE_BOWL, SceneFileSchema, load_scene_file};
+pub use object_name::is_object_name;
 pub use sample::{MAX_DRAWS, Placement, PlacementError, placement_order, sample_placement, support_of};
 pub use types::{
     CONTAINER_FLOOR, CONTAINER_WALL, ObjectKind, ObjectSpec, Pose, ROBOT_BASE_RADIUS, RandomPlacement,

@@ -23,8 +23,8 @@ use mujoco_rs::prelude::*;
 use mujoco_rs::wrappers::mj_editing::{MjSpec, MjsMesh};
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion};
 
+use super::cell_spec::{cell_spec, spec_err};
 use super::error::SimError;
-use super::scene::{cell_spec, spec_err};
 
 /// Radius of the sphere that stands in for a geom that cannot collide, metres (it only gives its
 /// body a mass and inertia MuJoCo's compiler accepts; nothing collides with it).

@@ -2,6 +2,7 @@
 //! Nothing outside this module (and the viewer) touches MuJoCo types.
 
 pub mod cache;
+mod cell_spec;
 mod chain;
 pub mod collision;
 pub mod collision_model;

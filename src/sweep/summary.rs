@@ -6,8 +6,8 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 
+use super::ScenarioResult;
 use super::timing::Total;
-use super::{ScenarioResult, SweepConfig};
 use crate::episode::Goal;
 use crate::faults::FaultKind;
 
@@ -201,21 +201,6 @@ pub struct FailureGroup {
 }
 
 impl Summary {
-    /// Summarizes `results` of a sweep of `tree` with `config` that took `wall_time_s` on `jobs` workers.
-    pub fn new(
-        tree: &str,
-        config: &SweepConfig,
-        results: &[ScenarioResult],
-        wall_time_s: f64,
-        jobs: usize,
-    ) -> Self {
-        let mut tally = super::tally::Tally::new(tree, config);
-        for r in results {
-            tally.add(r);
-        }
-        tally.finish(wall_time_s, jobs)
-    }
-
     /// Adds how long the sweep took, from its run's (or merged runs') [`Total`]: wall time
     /// and jobs, scenarios per minute, and how much of the workers' time (jobs × the whole
     /// process's wall time) was physics (`mj_step`) and motion planning.

@@ -245,6 +245,23 @@ impl Tally {
     }
 }
 
+impl Summary {
+    /// Summarizes `results` of a sweep of `tree` with `config` that took `wall_time_s` on `jobs` workers.
+    pub fn new(
+        tree: &str,
+        config: &SweepConfig,
+        results: &[ScenarioResult],
+        wall_time_s: f64,
+        jobs: usize,
+    ) -> Self {
+        let mut tally = Tally::new(tree, config);
+        for r in results {
+            tally.add(r);
+        }
+        tally.finish(wall_time_s, jobs)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -55,7 +55,7 @@ pub fn at(
     let pos = w.objects[i].pos;
     let near = (pos.x - point[0]).hypot(pos.y - point[1]) <= tolerance;
     let turned =
-        yaw.is_none_or(|target| super::snapshot::fold_quarter_turn(w.yaw(i) - target).abs() <= yaw_tolerance);
+        yaw.is_none_or(|target| super::angles::fold_quarter_turn(w.yaw(i) - target).abs() <= yaw_tolerance);
     let resting = match w.container_of(i) {
         Some(c) => {
             w.bottom(i) - w.support_height(c) <= Tolerances::ON_TABLE_HEIGHT
@@ -104,75 +104,12 @@ pub fn at_home(w: &World, tolerance: f64) -> bool {
     home_error(w) <= tolerance
 }
 
-/// Hand-built worlds for unit tests.
-#[cfg(test)]
-pub(crate) mod tests_support {
-    use std::sync::Arc;
-
-    use nalgebra::{Matrix3, UnitQuaternion, Vector3};
-
-    use crate::scene::SceneSpec;
-    use crate::world::{ObjectState, World};
-
-    /// A still object at `pos`.
-    pub fn still(pos: Vector3<f64>) -> ObjectState {
-        ObjectState {
-            pos,
-            quat: UnitQuaternion::identity(),
-            linvel: Vector3::zeros(),
-            angvel: Vector3::zeros(),
-            left_pad_contact: false,
-            right_pad_contact: false,
-        }
-    }
-
-    /// Half the edge of the cube of the `cube_bowl` scene, metres.
-    pub const HALF: f64 = 0.022;
-
-    /// A cube resting on the table at (0.45, −0.18), open gripper far above it, bowl at (0.45, 0.08)
-    /// (the built-in `cube_bowl` scene: `objects[0]` is the cube, `objects[1]` the bowl).
-    pub fn resting() -> World {
-        World {
-            time: 0.0,
-            arm_q: [0.0; 6],
-            arm_qd: [0.0; 6],
-            arm_cmd: [0.0; 6],
-            gripper_width: 0.085,
-            gripper_speed: 0.0,
-            pinch_pos: Vector3::new(0.45, -0.18, 0.3),
-            pinch_rot: Matrix3::identity(),
-            left_pad_pos: Vector3::new(0.40, -0.18, 0.3),
-            right_pad_pos: Vector3::new(0.50, -0.18, 0.3),
-            home_q: [0.0; 6],
-            scene: Arc::new(SceneSpec::builtin()),
-            objects: vec![
-                still(Vector3::new(0.45, -0.18, HALF)),
-                still(Vector3::new(0.45, 0.08, 0.0)),
-            ],
-            touches: Vec::new(),
-        }
-    }
-
-    /// The same cube held between the pads 10 cm above the table.
-    pub fn held() -> World {
-        let mut w = resting();
-        w.objects[0].pos = Vector3::new(0.45, -0.18, 0.10 + HALF);
-        w.left_pad_pos = Vector3::new(0.45 - HALF - 0.004, -0.18, 0.125);
-        w.right_pad_pos = Vector3::new(0.45 + HALF + 0.004, -0.18, 0.125);
-        w.gripper_width = 2.0 * HALF;
-        w.objects[0].left_pad_contact = true;
-        w.objects[0].right_pad_contact = true;
-        w
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use nalgebra::{UnitQuaternion, Vector3};
 
-    use super::tests_support::{HALF, held, resting};
     use super::*;
-    use crate::world::goal::rests_in;
+    use crate::world::tests_support::{HALF, held, resting};
 
     #[test]
     fn grasped_needs_both_pads_and_the_block_between_them() {
@@ -202,40 +139,6 @@ mod tests {
         tilted.objects[0].quat = UnitQuaternion::from_euler_angles(std::f64::consts::FRAC_PI_4, 0.0, 0.0);
         assert!((tilted.bottom(0) - 0.03).abs() < 1e-12);
         assert!(lifted(&tilted, 0, 0.029) && !lifted(&tilted, 0, 0.031));
-    }
-
-    #[test]
-    fn in_means_inside_the_walls_below_the_rim_released_and_at_rest() {
-        let mut w = resting();
-        w.objects[0].pos = Vector3::new(0.47, 0.06, 0.01 + HALF);
-        let v = Tolerances::REST_SPEED;
-        assert!(rests_in(&w, 0, 1, v));
-        assert!(!on_table(&w, 0, 0.01, v));
-        let mut moving = w.clone();
-        moving.objects[0].linvel = Vector3::new(0.0, 0.0, -0.3);
-        assert!(!rests_in(&moving, 0, 1, v));
-        let mut above = w.clone();
-        above.objects[0].pos.z = 0.2;
-        assert!(!rests_in(&above, 0, 1, v));
-        let mut squeezed = w.clone();
-        squeezed.objects[0].left_pad_contact = true;
-        squeezed.objects[0].right_pad_contact = true;
-        assert!(!rests_in(&squeezed, 0, 1, v), "a held cube is not in the bowl");
-        let mut on_rim = w.clone();
-        on_rim.objects[0].pos.x = 0.45 + 0.08;
-        assert!(!rests_in(&on_rim, 0, 1, v));
-        // The whole cube must fit between the walls: its centre at most 0.075 − 0.022 m from the
-        // bowl's centre (issue 13, item 15: the centre alone within 0.075 m was accepted).
-        let bowl_x = w.objects[1].pos.x;
-        let mut flush = w.clone();
-        flush.objects[0].pos.x = bowl_x + 0.075 - HALF - 1e-9;
-        assert!(rests_in(&flush, 0, 1, v));
-        let mut in_wall = w.clone();
-        in_wall.objects[0].pos.x = bowl_x + 0.075 - HALF + 0.001;
-        assert!(!rests_in(&in_wall, 0, 1, v));
-        in_wall.objects[0].pos.x = bowl_x + 0.074;
-        assert!(!rests_in(&in_wall, 0, 1, v));
-        assert!(!rests_in(&resting(), 0, 1, v));
     }
 
     #[test]

@@ -58,7 +58,7 @@ mod tests {
     use std::sync::Arc;
 
     use crate::scene::SceneSpec;
-    use crate::world::conditions::tests_support::resting;
+    use crate::world::tests_support::resting;
 
     #[test]
     fn the_legacy_names_resolve_to_the_only_block_and_container() {

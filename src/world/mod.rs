@@ -52,12 +52,15 @@
 //! # let _ = upright;
 //! ```
 
+pub mod angles;
 pub mod conditions;
 pub mod goal;
 mod legacy;
 pub mod objects;
 pub mod query;
 pub mod snapshot;
+#[cfg(test)]
+pub(crate) mod tests_support;
 pub mod vectors;
 
 pub use objects::{ObjectState, Part, Piece, Touch};

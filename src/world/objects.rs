@@ -6,7 +6,7 @@ use nalgebra::{UnitQuaternion, Vector2, Vector3};
 use serde::Serialize;
 
 use super::World;
-use super::snapshot::{fold_quarter_turn, yaw_of};
+use super::angles::{fold_quarter_turn, yaw_of};
 use crate::scene::{CONTAINER_FLOOR, ObjectKind, ObjectSpec, Shape};
 
 /// One object's state. For a block, `pos` is its centre; for a container or an obstacle, the

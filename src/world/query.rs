@@ -150,3 +150,36 @@ pub fn matches(w: &World, q: &Query) -> Vec<usize> {
 pub fn select(w: &World, q: &Query) -> Option<usize> {
     matches(w, q).into_iter().next()
 }
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::Vector3;
+
+    use super::*;
+    use crate::world::tests_support::{HALF, two_blocks};
+
+    #[test]
+    fn done_and_on_table_leave_out_a_block_placed_but_still_in_the_gripper() {
+        // `a` and `b` swapped places, `b` still in the gripper: not done, and `done` does not
+        // select it.
+        let mut w = two_blocks(
+            "  - at: {object: a, point: [0.40, 0.10]}\n  - at: {object: b, point: [0.40, -0.10]}\n",
+        );
+        w.objects[0].pos = Vector3::new(0.40, 0.10, HALF);
+        w.objects[1].pos = Vector3::new(0.40, -0.10, HALF);
+        w.objects[1].left_pad_contact = true;
+        w.objects[1].right_pad_contact = true;
+        let q = Query {
+            kind: KindFilter::default(),
+            color: None,
+            filters: vec![Filter::Done],
+            order: Order::Scene,
+        };
+        assert_eq!(matches(&w, &q), vec![0]);
+        let q = Query {
+            filters: vec![Filter::OnTable],
+            ..q
+        };
+        assert_eq!(matches(&w, &q), vec![0], "a held block is not `on_table`");
+    }
+}

@@ -2,7 +2,7 @@
 
 use std::sync::Arc;
 
-use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Vector3};
 
 use super::objects::{ObjectState, Touch};
 use crate::scene::SceneSpec;
@@ -45,32 +45,18 @@ pub struct World {
     pub touches: Vec<Touch>,
 }
 
-/// Rotation about world z of a quaternion (the yaw of its x axis), radians in (-π, π].
-pub fn yaw_of(q: &UnitQuaternion<f64>) -> f64 {
-    let x = q * Vector3::x();
-    x.y.atan2(x.x)
-}
-
-/// Yaw of the tool about world z, in the convention of `motion::ik_down` (0 at home, where the
-/// pinch x axis points along world +y), radians in (-π, π].
-pub fn tool_yaw(pinch_rot: &nalgebra::Matrix3<f64>) -> f64 {
-    let x = pinch_rot.column(0);
-    (-x[0]).atan2(x[1])
-}
-
-/// Folds an angle into [-π/4, π/4): the yaw of a square seen from above.
-pub fn fold_quarter_turn(a: f64) -> f64 {
-    let q = std::f64::consts::FRAC_PI_2;
-    (a + q / 2.0).rem_euclid(q) - q / 2.0
-}
+// Declared in `angles`; kept at these paths too.
+pub use super::angles::{fold_quarter_turn, tool_yaw, yaw_of};
 
 #[cfg(test)]
 mod tests {
+    use nalgebra::UnitQuaternion;
+
     use super::*;
 
     #[test]
     fn a_blocks_yaw_is_read_from_the_side_faces_whatever_face_it_rests_on() {
-        let mut w = crate::world::conditions::tests_support::resting();
+        let mut w = crate::world::tests_support::resting();
         for yaw_deg in [-40.0f64, -10.0, 0.0, 20.6, 44.0] {
             let yaw = yaw_deg.to_radians();
             // Upright, then tipped onto a side face (90° about its own x or y axis) and turned.
@@ -87,20 +73,6 @@ mod tests {
                     got.to_degrees()
                 );
             }
-        }
-    }
-
-    #[test]
-    fn quarter_turn_folding_stays_in_range() {
-        for i in -100..100 {
-            let a = i as f64 * 0.07;
-            let f = fold_quarter_turn(a);
-            assert!(
-                (-std::f64::consts::FRAC_PI_4..std::f64::consts::FRAC_PI_4).contains(&f),
-                "{a} -> {f}"
-            );
-            let k = ((a - f) / std::f64::consts::FRAC_PI_2).round();
-            assert!((a - f - k * std::f64::consts::FRAC_PI_2).abs() < 1e-9);
         }
     }
 }

@@ -137,14 +137,14 @@ pub const OBJECT_NAMES: [&str; OBJECT_LEN] = [
 
 /// `observation.object`: where object `i` is relative to the gripper — its centre minus the
 /// pinch point (metres, world frame), then sin and cos of four times its yaw (the rotation of
-/// its x axis about world z) minus the tool's yaw ([`crate::world::snapshot::tool_yaw`]; a square
+/// its x axis about world z) minus the tool's yaw ([`crate::world::angles::tool_yaw`]; a square
 /// block looks the same every quarter turn), as `f32`.
 /// Names: [`OBJECT_NAMES`].
 pub fn object_vector(world: &crate::world::World, i: usize) -> [f32; OBJECT_LEN] {
     let o = &world.objects[i];
     let d = o.pos - world.pinch_pos;
-    let tool_yaw = crate::world::snapshot::tool_yaw(&world.pinch_rot);
-    let rel = 4.0 * (crate::world::snapshot::yaw_of(&o.quat) - tool_yaw);
+    let tool_yaw = crate::world::angles::tool_yaw(&world.pinch_rot);
+    let rel = 4.0 * (crate::world::angles::yaw_of(&o.quat) - tool_yaw);
     [d.x, d.y, d.z, rel.sin(), rel.cos()].map(|v| v as f32)
 }
 

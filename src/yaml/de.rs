@@ -600,27 +600,4 @@ mod tests {
         let loc = e.loc.unwrap();
         assert_eq!((loc.line, loc.col), (3, 12), "{e:?}");
     }
-
-    /// Bug (issue 18): read warnings lived in per-thread storage until the next tree load took
-    /// them, so a scene file read between two trees leaked its warnings into the next tree, and
-    /// reads outside a tree load piled up for the life of the thread.
-    #[test]
-    fn warnings_belong_to_the_read_that_raised_them() {
-        let v = parse_yaml("yaw: 5", 0).unwrap();
-        let yaw = |v: &Value| from_value::<std::collections::BTreeMap<String, crate::yaml::units::Angle>>(v);
-        // Outside a collecting call: dropped, not kept for later.
-        assert!(yaw(&v).is_ok());
-        let ((), w) = collect_warnings(|| ());
-        assert!(w.is_empty(), "{w:?}");
-        // Inside: collected, and a nested call keeps its own.
-        let ((inner, r), outer) = collect_warnings(|| {
-            let _ = yaw(&v);
-            let (r, inner) = collect_warnings(|| yaw(&v));
-            (inner, r)
-        });
-        assert!(r.is_ok());
-        assert_eq!(inner.len(), 1, "{inner:?}");
-        assert_eq!(outer.len(), 1, "{outer:?}");
-        assert_eq!(outer[0].loc, inner[0].loc);
-    }
 }

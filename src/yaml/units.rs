@@ -423,4 +423,29 @@ mod tests {
         assert!(parse_angle_text("[1, 2]").is_err());
         assert!(parse_angle_text(".inf").is_err());
     }
+
+    /// Bug (issue 18): read warnings lived in per-thread storage until the next tree load took
+    /// them, so a scene file read between two trees leaked its warnings into the next tree, and
+    /// reads outside a tree load piled up for the life of the thread.
+    #[test]
+    fn warnings_belong_to_the_read_that_raised_them() {
+        use crate::yaml::de::{collect_warnings, from_value};
+        use crate::yaml::value::{Value, parse_yaml};
+        let v = parse_yaml("yaw: 5", 0).unwrap();
+        let yaw = |v: &Value| from_value::<std::collections::BTreeMap<String, Angle>>(v);
+        // Outside a collecting call: dropped, not kept for later.
+        assert!(yaw(&v).is_ok());
+        let ((), w) = collect_warnings(|| ());
+        assert!(w.is_empty(), "{w:?}");
+        // Inside: collected, and a nested call keeps its own.
+        let ((inner, r), outer) = collect_warnings(|| {
+            let _ = yaw(&v);
+            let (r, inner) = collect_warnings(|| yaw(&v));
+            (inner, r)
+        });
+        assert!(r.is_ok());
+        assert_eq!(inner.len(), 1, "{inner:?}");
+        assert_eq!(outer.len(), 1, "{outer:?}");
+        assert_eq!(outer[0].loc, inner[0].loc);
+    }
 }

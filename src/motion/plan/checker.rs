@@ -2,8 +2,7 @@
 
 use std::fmt;
 
-use super::planner::SPARE_CAP;
-use super::spare::JointSpare;
+use super::spare::{JointSpare, SPARE_CAP};
 
 /// A collision model of the arm in its cell, queried one joint configuration at a time.
 ///

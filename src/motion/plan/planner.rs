@@ -14,6 +14,9 @@ use super::shortcut::shortcut;
 use super::stats::{PlanStats, distance, path_length};
 use super::timing::PathTrajectory;
 
+// Declared with the spare clearance it bounds; kept at this path too.
+pub use super::spare::SPARE_CAP;
+
 /// Goal configurations whose collisions are asked for when every goal is blocked.
 const NAMED_GOALS: usize = 8;
 
@@ -102,12 +105,6 @@ enum Attempt {
     /// (the checks spent, and how many of them the screen answered).
     ScreenWrong { checks: u64, screened: u64 },
 }
-
-/// Widest spare clearance the planner asks a checker for, metres
-/// ([`CollisionChecker::exact_spare`], [`CollisionChecker::screen_spare`]): a configuration
-/// measured with this much to spare vouches for those up to this far (in the lever-arm
-/// displacement bound) along a segment.
-pub const SPARE_CAP: f64 = 0.15;
 
 /// The lever arms the final re-check's vouching uses, metres: the configured ones, and never
 /// less than [`LEVER_ARMS`](crate::motion::ur5e::LEVER_ARMS) (a setting that bounds fewer

@@ -1,6 +1,13 @@
 //! [`JointSpare`]: how much clearance a free configuration has to spare, by joint range, and
 //! how far the joints may move from it before the spare is used up.
 
+/// Widest spare clearance the planner asks a checker for, metres
+/// ([`CollisionChecker::exact_spare`](super::CollisionChecker::exact_spare),
+/// [`CollisionChecker::screen_spare`](super::CollisionChecker::screen_spare)): a configuration
+/// measured with this much to spare vouches for those up to this far (in the lever-arm
+/// displacement bound) along a segment.
+pub const SPARE_CAP: f64 = 0.15;
+
 /// Spare clearance by joint range, metres: for each range of arm joints `lo..=hi` (0 = base …
 /// 5 = wrist 3), a lower bound on how much farther than the clearance margin every pair of
 /// parts that only those joints move relative to each other is. The fixed cell and a part of

@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use tungstenite::Bytes;
 use tungstenite::protocol::{Role, WebSocket, WebSocketConfig};
 
-use super::client::run_client;
+use super::client::{GOODBYE_DEADLINE, incoming_limits, run_client};
 use super::hub::Hub;
 use crate::viewer::guard::Authority;
 use crate::viewer::http::{Request, Response, TimedStream, read_request};
@@ -23,8 +23,6 @@ const ACCEPT_BACKOFF_MIN: Duration = Duration::from_millis(10);
 const ACCEPT_BACKOFF_MAX: Duration = Duration::from_secs(1);
 /// Least time between two warnings about failed `accept`s.
 const ACCEPT_WARN_INTERVAL: Duration = Duration::from_secs(60);
-/// Time given to a refusal or a closing handshake to reach the client's socket.
-pub(super) const GOODBYE_DEADLINE: Duration = Duration::from_millis(500);
 
 /// What the server serves (the page, scripts and style) and the rules it serves by.
 #[derive(Debug)]
@@ -294,11 +292,6 @@ fn upgrade_to_websocket(
     let config = incoming_limits(WebSocketConfig::default(), site.limits.max_client_message);
     let ws = WebSocket::from_partially_read(stream, req.rest, Role::Server, Some(config));
     run_client(ws, hub, &site.limits)
-}
-
-/// `config` accepting client messages and frames of at most `max` bytes.
-pub(super) fn incoming_limits(config: WebSocketConfig, max: usize) -> WebSocketConfig {
-    config.max_message_size(Some(max)).max_frame_size(Some(max))
 }
 
 #[cfg(test)]

@@ -6,16 +6,17 @@ use std::io;
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
-use tungstenite::protocol::WebSocket;
+use tungstenite::protocol::{WebSocket, WebSocketConfig};
 use tungstenite::{Bytes, Message};
 
-use super::acceptor::{GOODBYE_DEADLINE, incoming_limits};
 use super::hub::{Client, Hub, take_batch};
 use crate::viewer::http::TimedStream;
 use crate::viewer::limits::ServerLimits;
 
 /// Messages read from a client per poll, so that a chatty client cannot starve its writes.
 const MAX_READS_PER_POLL: usize = 64;
+/// Time given to a refusal or a closing handshake to reach the client's socket.
+pub(super) const GOODBYE_DEADLINE: Duration = Duration::from_millis(500);
 
 /// How far behind a client is. After written data the client is pinged (at most every
 /// [`ServerLimits::ping_interval`]); each ping is stamped with when the oldest data before it
@@ -211,4 +212,9 @@ fn poll_input(ws: &mut WebSocket<TimedStream>, hub: &Hub, client: u64, lag: &mut
     }
     ws.get_ref().get_ref().set_nonblocking(false)?;
     read
+}
+
+/// `config` accepting client messages and frames of at most `max` bytes.
+pub(super) fn incoming_limits(config: WebSocketConfig, max: usize) -> WebSocketConfig {
+    config.max_message_size(Some(max)).max_frame_size(Some(max))
 }
