@@ -46,13 +46,12 @@ pub struct World {
 }
 
 // Declared in `angles`; kept at these paths too.
-pub use super::angles::{fold_quarter_turn, tool_yaw, yaw_of};
 
 #[cfg(test)]
 mod tests {
     use nalgebra::UnitQuaternion;
 
-    use super::*;
+    use crate::world::angles::fold_quarter_turn;
 
     #[test]
     fn a_blocks_yaw_is_read_from_the_side_faces_whatever_face_it_rests_on() {

@@ -15,7 +15,6 @@ use super::stats::{PlanStats, distance, path_length};
 use super::timing::PathTrajectory;
 
 // Declared with the spare clearance it bounds; kept at this path too.
-pub use super::spare::SPARE_CAP;
 
 /// Goal configurations whose collisions are asked for when every goal is blocked.
 const NAMED_GOALS: usize = 8;
