@@ -27,7 +27,9 @@ use crate::failure::Failure;
 use crate::kinds::PlanBudget;
 use crate::motion::Trajectory;
 use crate::motion::plan::edge::{Resolution, steps};
-use crate::motion::plan::{Collision, CollisionChecker, GoalSet, JointSpare, PlannedMotion, PlannerConfig};
+use crate::motion::plan::{
+    Collision, CollisionChecker, FastChecks, GoalSet, JointSpare, PlannedMotion, PlannerConfig,
+};
 use crate::sim::collision::SceneChecker;
 
 /// True when the robot–scene pair `c` names object `name` (the object itself or one of its
@@ -113,7 +115,9 @@ impl CollisionChecker for Allowing<'_> {
         all.retain(|c| self.counts(c));
         all
     }
+}
 
+impl FastChecks for Allowing<'_> {
     /// The inner checker's "certainly free" (what keeps the margin from everything is free
     /// whatever is allowed; its "blocked" may be an allowed pair). Counted as a check.
     fn screen(&mut self, q: &[f64; 6]) -> Option<bool> {

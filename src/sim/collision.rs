@@ -30,7 +30,7 @@ use super::scene::{ARM_JOINTS, Scene};
 use super::screen::{Build, PAD, Screen};
 use crate::motion::fk;
 use crate::motion::plan::config::HELD_BLOCK_REACH;
-use crate::motion::plan::{Collision, CollisionChecker, JointSpare};
+use crate::motion::plan::{Collision, CollisionChecker, FastChecks, JointSpare};
 use crate::motion::ur5e::LEVER_ARMS as UR5E_LEVER_ARMS;
 use crate::scene::OBJECT_PREFIX;
 
@@ -38,7 +38,7 @@ use crate::scene::OBJECT_PREFIX;
 /// everything they must not touch.
 pub const DEFAULT_MARGIN: f64 = 0.005;
 
-/// What the spare clearance ([`CollisionChecker::exact_spare`]) leaves for MuJoCo's own
+/// What the spare clearance ([`FastChecks::exact_spare`]) leaves for MuJoCo's own
 /// tolerances, metres: its `mj_geomDistance` and `mj_collision`'s contact distances of the same
 /// pair differ by the convex-hull iterations' tolerance (about 1e-6 m); the screen's
 /// [`PAD`] again.
@@ -86,7 +86,7 @@ pub struct SceneChecker {
     /// What is derived from the current snapshot (the [`Screen`], the moving geoms' frames),
     /// built on first use after a change.
     derived: Option<Derived>,
-    /// Whether [`CollisionChecker::screen`] asks the screen (default true).
+    /// Whether [`FastChecks::screen`] asks the screen (default true).
     screen_on: bool,
     /// Body and joint ids of the six arm links.
     arm_links: ([usize; 6], [usize; 6]),
@@ -516,6 +516,31 @@ impl CollisionChecker for SceneChecker {
         self.detect(q) == 0
     }
 
+    fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
+        if !q.iter().all(|v| v.is_finite()) {
+            return Vec::new();
+        }
+        self.detect(q);
+        let mut out: Vec<Collision> = Vec::new();
+        for (g1, g2, dist) in self.margin_pairs.1.clone() {
+            // The moving part first (the higher arm group: nearer the tool).
+            let (a, b) = if self.group_of(g1) >= self.group_of(g2) {
+                (g1, g2)
+            } else {
+                (g2, g1)
+            };
+            let (a, b) = (self.labels[a].clone(), self.labels[b].clone());
+            match out.iter_mut().find(|o| o.a == a && o.b == b) {
+                Some(o) => o.distance = o.distance.min(dist),
+                None => out.push(Collision { a, b, distance: dist }),
+            }
+        }
+        out.sort_by(|x, y| x.distance.total_cmp(&y.distance));
+        out
+    }
+}
+
+impl FastChecks for SceneChecker {
     /// The [`Screen`]'s verdict ([`Screen::classify`]); `None` when the screen is off or the
     /// cell has geometry it cannot bound.
     fn screen(&mut self, q: &[f64; 6]) -> Option<bool> {
@@ -583,29 +608,6 @@ impl CollisionChecker for SceneChecker {
         let (least, reach) = self.least_distance(q, wide)?;
         let spare = least - self.margin - SPARE_TOLERANCE;
         (spare >= 0.0).then(|| JointSpare::uniform(spare.min(cap)).with_reach(reach))
-    }
-
-    fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
-        if !q.iter().all(|v| v.is_finite()) {
-            return Vec::new();
-        }
-        self.detect(q);
-        let mut out: Vec<Collision> = Vec::new();
-        for (g1, g2, dist) in self.margin_pairs.1.clone() {
-            // The moving part first (the higher arm group: nearer the tool).
-            let (a, b) = if self.group_of(g1) >= self.group_of(g2) {
-                (g1, g2)
-            } else {
-                (g2, g1)
-            };
-            let (a, b) = (self.labels[a].clone(), self.labels[b].clone());
-            match out.iter_mut().find(|o| o.a == a && o.b == b) {
-                Some(o) => o.distance = o.distance.min(dist),
-                None => out.push(Collision { a, b, distance: dist }),
-            }
-        }
-        out.sort_by(|x, y| x.distance.total_cmp(&y.distance));
-        out
     }
 }
 

@@ -7,7 +7,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::{SPARE_TOLERANCE, SceneChecker};
-use crate::motion::plan::{Collision, CollisionChecker, JointSpare, SPARE_CAP};
+use crate::motion::plan::{Collision, CollisionChecker, FastChecks, JointSpare, SPARE_CAP};
 use crate::motion::ur5e::LEVER_ARMS as UR5E_LEVER_ARMS;
 use crate::motion::{HOME_Q, JOINT_LIMITS, down_pose, fk, ik};
 use crate::scene::SceneSpec;

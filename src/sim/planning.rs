@@ -10,9 +10,7 @@
 //! | `invalid_query` (a bad setting or start: a bug of the caller) | [`FailureKind::Other`] |
 
 use crate::failure::{Failure, FailureKind};
-use crate::motion::plan::{
-    CollisionChecker, GoalSet, PlanError, PlanFailure, PlannedMotion, PlannerConfig, plan,
-};
+use crate::motion::plan::{FastChecks, GoalSet, PlanError, PlanFailure, PlannedMotion, PlannerConfig, plan};
 
 /// The failure kind of a planner reason (see the module table).
 pub fn failure_kind(reason: &PlanFailure) -> FailureKind {
@@ -46,7 +44,7 @@ pub fn plan_failure(e: &PlanError) -> Failure {
 /// # Errors
 /// The planner's [`PlanError`] when there is no motion ([`plan_failure`] makes it a typed
 /// [`Failure`]; a leaf adds what to change).
-pub fn plan_in_cell<C: CollisionChecker + ?Sized>(
+pub fn plan_in_cell<C: FastChecks + ?Sized>(
     checker: &mut C,
     start: &[f64; 6],
     goals: &GoalSet,

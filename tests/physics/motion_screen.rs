@@ -1,10 +1,10 @@
-//! The collision screen (`sim::screen::Screen`, asked through `CollisionChecker::screen`)
+//! The collision screen (`sim::screen::Screen`, asked through `FastChecks::screen`)
 //! against MuJoCo on the real cell: whatever MuJoCo finds in contact the screen never calls
 //! free, and what it calls blocked MuJoCo finds in contact, over thousands of seeded configurations drawn near the
 //! obstacles (on the boundary between free and blocked), with and without a held block, at
 //! several margins; and the planner with the screen gives the same paths as without it.
 
-use macrotree::motion::plan::{CollisionChecker, GoalSet, PlannerConfig, plan};
+use macrotree::motion::plan::{CollisionChecker, FastChecks, GoalSet, PlannerConfig, plan};
 use macrotree::motion::{JOINT_LIMITS, down_pose, fk, ik};
 use macrotree::scene::SceneSpec;
 use macrotree::sim::collision::{DEFAULT_MARGIN, SceneChecker};
@@ -102,7 +102,7 @@ fn compare(checker: &mut SceneChecker, r: &mut ChaCha8Rng, pairs: usize, what: &
         proven: 0,
     };
     let ask = |c: &mut SceneChecker, q: &[f64; 6], t: &mut Tally| -> bool {
-        let screen = CollisionChecker::screen(c, q);
+        let screen = FastChecks::screen(c, q);
         let exact = c.is_free(q);
         assert!(
             screen != Some(true) || exact,

@@ -3,7 +3,7 @@
 //! uses), each arc at most a given deviation from its corner, collision-checked at the edge
 //! resolution and shrunk until free. A corner left unblended (or a reversal) is a stop.
 
-use super::checker::CollisionChecker;
+use super::checker::FastChecks;
 use super::edge::Resolution;
 use super::stats::distance;
 
@@ -152,7 +152,7 @@ pub(crate) fn arc_steps(arc: &Piece, res: &Resolution) -> usize {
 }
 
 /// True when the arc is free at `res` (its ends lie on the checked segments).
-fn arc_free<C: CollisionChecker + ?Sized>(checker: &mut C, arc: &Piece, res: &Resolution) -> bool {
+fn arc_free<C: FastChecks + ?Sized>(checker: &mut C, arc: &Piece, res: &Resolution) -> bool {
     let n = arc_steps(arc, res);
     (1..n).all(|k| checker.is_free(&arc.eval(arc.len() * k as f64 / n as f64).0))
 }
@@ -162,7 +162,7 @@ const HALVINGS: usize = 3;
 
 /// Smooths `path` (consecutive duplicates allowed): every corner blended with the largest of
 /// `deviation`, `deviation/2`, …, `deviation/8` whose arc is free, else left as a stop.
-pub(crate) fn smooth<C: CollisionChecker + ?Sized>(
+pub(crate) fn smooth<C: FastChecks + ?Sized>(
     checker: &mut C,
     path: &[[f64; 6]],
     deviation: f64,
@@ -242,6 +242,7 @@ pub(crate) fn smooth<C: CollisionChecker + ?Sized>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::motion::plan::CollisionChecker;
 
     struct Free;
     impl CollisionChecker for Free {
@@ -249,6 +250,8 @@ mod tests {
             true
         }
     }
+
+    impl FastChecks for Free {}
 
     #[test]
     fn a_corner_arc_is_tangent_to_both_segments_and_within_the_deviation() {
@@ -321,6 +324,8 @@ mod tests {
                 q[0].abs() < 1e-9 || (q[1] - 1.0).abs() < 1e-9 || q[1].abs() < 1e-9
             }
         }
+
+        impl FastChecks for OnlyTheCorner {}
         let path = [
             [0.0; 6],
             [0.0, 1.0, 0.0, 0.0, 0.0, 0.0],

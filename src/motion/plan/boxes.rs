@@ -1,7 +1,7 @@
 //! A synthetic collision model: named axis-aligned boxes in joint space. For tests and
 //! benchmarks of the planner without physics; a configuration collides when it lies inside a box.
 
-use super::checker::{Collision, CollisionChecker};
+use super::checker::{Collision, CollisionChecker, FastChecks};
 
 /// An obstacle in joint space: every configuration with `lo ≤ q ≤ hi` (radians, per joint) is
 /// in collision.
@@ -90,3 +90,5 @@ impl CollisionChecker for JointBoxes {
             .collect()
     }
 }
+
+impl FastChecks for JointBoxes {}

@@ -20,8 +20,17 @@ pub trait CollisionChecker {
     fn collisions(&mut self, _q: &[f64; 6]) -> Vec<Collision> {
         Vec::new()
     }
+}
 
-    /// A fast screen, asked before [`is_free`](Self::is_free): `Some(true)` only when `q`
+/// What a checker may offer the planner beyond state validity, to decide configurations without
+/// its exact test: a conservative screen, spare clearances that vouch for the configurations
+/// near a free one, and how far a verdict reaches along a line. Every method has a default
+/// that offers nothing, so a checker with none of them implements it empty
+/// (`impl FastChecks for MyChecker {}`); the planner then asks
+/// [`is_free`](CollisionChecker::is_free) about every configuration. (OMPL keeps state validity
+/// and motion validation apart the same way.)
+pub trait FastChecks: CollisionChecker {
+    /// A fast screen, asked before [`is_free`](CollisionChecker::is_free): `Some(true)` only when `q`
     /// (radians) is certainly free (e.g. a model that bounds every part of the robot and the
     /// scene keeps the margin), `Some(false)` only when it is certainly blocked (exact shapes
     /// deeper than the margin), `None` when it cannot tell (the default: no screen). The
@@ -60,7 +69,7 @@ pub trait CollisionChecker {
     /// (`step`: a joint change, radians). A reach beyond `want` steps is of no use to the
     /// caller and need not be measured. The planner's segment check
     /// ([`check_segment`](super::edge::check_segment)) does not ask about those configurations.
-    /// The default knows no reach: [`is_free`](Self::is_free), and `k = 0`.
+    /// The default knows no reach: [`is_free`](CollisionChecker::is_free), and `k = 0`.
     fn free_reach(&mut self, q: &[f64; 6], _step: &[f64; 6], _want: f64) -> Option<f64> {
         self.is_free(q).then_some(0.0)
     }
@@ -82,6 +91,9 @@ impl<C: CollisionChecker + ?Sized> CollisionChecker for &mut C {
     fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
         (**self).collisions(q)
     }
+}
+
+impl<C: FastChecks + ?Sized> FastChecks for &mut C {
     fn screen(&mut self, q: &[f64; 6]) -> Option<bool> {
         (**self).screen(q)
     }
@@ -131,15 +143,15 @@ impl fmt::Display for Collision {
 /// A checker that counts the configurations it is asked about (the planner's statistics) and,
 /// while a budget is set, answers "blocked" without asking once the budget is used (a refusal
 /// never lets a collision through; it only ends the search). While `screen` is on, the inner
-/// checker's [`screen`](CollisionChecker::screen) answers first: its "free" is taken, its
+/// checker's [`screen`](FastChecks::screen) answers first: its "free" is taken, its
 /// "blocked" too; each check counts once either way. With `vouch_arms` set, the verdicts come
 /// with a spare clearance (the screen's while `screen` is on, the exact checker's while it is
-/// off), [`free_reach`](CollisionChecker::free_reach) turns it into the samples it vouches for
+/// off), [`free_reach`](FastChecks::free_reach) turns it into the samples it vouches for
 /// along a segment, and while the screen is off a configuration a remembered exact spare covers
 /// is free without asking. (The screen's spares are not remembered: asked only up to what a
 /// move wants of each range, they seldom cover another segment's configurations, and looking
 /// them up cost more than it saved.)
-pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
+pub(crate) struct Counting<'a, C: FastChecks + ?Sized> {
     pub(crate) inner: &'a mut C,
     pub(crate) checks: u64,
     /// Checks at most (`u64::MAX`: none).
@@ -150,8 +162,8 @@ pub(crate) struct Counting<'a, C: CollisionChecker + ?Sized> {
     /// or vouched for along a segment.
     pub(crate) screened: u64,
     /// Lever arms (metres) to vouch with a measured spare clearance for configurations near
-    /// the measured one: the exact checker's ([`CollisionChecker::exact_spare`]) while the
-    /// screen is off, the screen's ([`CollisionChecker::screen_spare`]) while it is on; `None`:
+    /// the measured one: the exact checker's ([`FastChecks::exact_spare`]) while the
+    /// screen is off, the screen's ([`FastChecks::screen_spare`]) while it is on; `None`:
     /// every configuration is asked.
     pub(crate) vouch_arms: Option<[f64; 6]>,
     /// Configurations the exact checker measured, with their spare clearance.
@@ -205,7 +217,7 @@ impl Balls {
     }
 }
 
-impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
+impl<'a, C: FastChecks + ?Sized> Counting<'a, C> {
     pub(crate) fn new(inner: &'a mut C) -> Self {
         Self {
             inner,
@@ -268,13 +280,16 @@ impl<'a, C: CollisionChecker + ?Sized> Counting<'a, C> {
     }
 }
 
-impl<C: CollisionChecker + ?Sized> CollisionChecker for Counting<'_, C> {
+impl<C: FastChecks + ?Sized> CollisionChecker for Counting<'_, C> {
     fn is_free(&mut self, q: &[f64; 6]) -> bool {
         self.verdict(q, &JointSpare::uniform(SPARE_CAP)).is_some()
     }
     fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
         self.inner.collisions(q)
     }
+}
+
+impl<C: FastChecks + ?Sized> FastChecks for Counting<'_, C> {
     /// The steps of `step` (radians per step) within the spare the verdict at `q` comes with
     /// ([`JointSpare::steps_along`] through the vouching lever arms; none without them). Each
     /// range's spare is measured up to what `want` steps need of it ([`JointSpare::wanted`],

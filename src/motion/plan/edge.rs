@@ -1,7 +1,7 @@
 //! Straight joint-space segments checked at a resolution: between two checked configurations
 //! no joint turns more than a set angle and no point of the robot moves more than a set distance.
 
-use super::checker::CollisionChecker;
+use super::checker::FastChecks;
 
 /// How finely motions are checked.
 ///
@@ -76,10 +76,10 @@ pub fn lerp(a: &[f64; 6], b: &[f64; 6], k: usize, n: usize) -> [f64; 6] {
 /// `res`, is free; `a` and `b` themselves are the caller's (checked before). The samples are
 /// visited in bisection order (the middle, then the quarters, …) so a blocked segment is usually
 /// found after few checks; a sample the checker finds free with a reach
-/// ([`CollisionChecker::free_reach`]) vouches for its neighbours within it, which are not
+/// ([`FastChecks::free_reach`]) vouches for its neighbours within it, which are not
 /// asked: each unvouched stretch is bisected in turn. On a hit, returns the blocked
 /// configuration in `Err`.
-pub fn check_segment<C: CollisionChecker + ?Sized>(
+pub fn check_segment<C: FastChecks + ?Sized>(
     checker: &mut C,
     a: &[f64; 6],
     b: &[f64; 6],
@@ -132,6 +132,7 @@ pub fn check_segment<C: CollisionChecker + ?Sized>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::motion::plan::CollisionChecker;
 
     /// Records every configuration it is asked about; all free.
     struct Log(Vec<[f64; 6]>);
@@ -141,6 +142,8 @@ mod tests {
             true
         }
     }
+
+    impl FastChecks for Log {}
 
     #[test]
     fn every_interior_step_is_checked_once_middle_first() {
@@ -173,6 +176,9 @@ mod tests {
         fn is_free(&mut self, q: &[f64; 6]) -> bool {
             !(self.blocked.0..=self.blocked.1).contains(&q[0])
         }
+    }
+
+    impl FastChecks for Reach {
         fn free_reach(&mut self, q: &[f64; 6], step: &[f64; 6], _want: f64) -> Option<f64> {
             self.asked.push(q[0]);
             let x = q[0];

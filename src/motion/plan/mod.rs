@@ -46,7 +46,7 @@ pub mod timing;
 mod tests;
 
 pub use boxes::{JointBox, JointBoxes};
-pub use checker::{Collision, CollisionChecker};
+pub use checker::{Collision, CollisionChecker, FastChecks};
 pub use config::{JointLimits, PlannerConfig};
 pub use goal::GoalSet;
 pub use planner::{PlannedMotion, plan};

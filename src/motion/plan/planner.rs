@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use super::blend::smooth;
-use super::checker::{CollisionChecker, Counting};
+use super::checker::{CollisionChecker, Counting, FastChecks};
 use super::config::PlannerConfig;
 use super::edge::check_segment;
 use super::goal::GoalSet;
@@ -55,21 +55,21 @@ fn in_bounds(q: &[f64; 6], config: &PlannerConfig) -> bool {
 /// configuration the arm passes through was checked, at the edge resolution
 /// ([`PlannerConfig::edge_resolution`]) along segments and arcs.
 ///
-/// The search and the shortcuts ask the checker's [`screen`](CollisionChecker::screen) first
+/// The search and the shortcuts ask the checker's [`screen`](FastChecks::screen) first
 /// and `is_free` only when it cannot tell; when the screen helped find the path, every vertex
 /// and every segment of the shortcut path is then checked again with the exact checker alone,
 /// at the edge resolution (so are the corner arcs), and if one is blocked the query is planned
 /// again with `is_free` alone ([`PlanStats::screen_fallback`]). The start, the goals and the
 /// direct segments are checked with `is_free` alone. Along a segment, a configuration found
 /// free with a spare clearance vouches for its neighbours within the lever-arm reach of it
-/// ([`CollisionChecker::free_reach`]): the exact checker's
-/// ([`exact_spare`](CollisionChecker::exact_spare)) wherever the screen is off, the screen's by
-/// joint range ([`screen_spare`](CollisionChecker::screen_spare)) wherever it is on (see
+/// ([`FastChecks::free_reach`]): the exact checker's
+/// ([`exact_spare`](FastChecks::exact_spare)) wherever the screen is off, the screen's by
+/// joint range ([`screen_spare`](FastChecks::screen_spare)) wherever it is on (see
 /// `docs/motion.md`).
 ///
 /// # Errors
 /// A [`PlanError`]: the typed reason, and the statistics of the attempt.
-pub fn plan<C: CollisionChecker + ?Sized>(
+pub fn plan<C: FastChecks + ?Sized>(
     checker: &mut C,
     start: &[f64; 6],
     goals: &GoalSet,
@@ -117,7 +117,7 @@ fn vouching_arms(res: &super::edge::Resolution) -> [f64; 6] {
 /// segment at the edge resolution `res`, with `checker`'s screen off, in the order of the path
 /// (the exact checker's spare clearance at one configuration vouches for the next ones within
 /// its reach). True when all are free.
-fn revalidate<C: CollisionChecker + ?Sized>(
+fn revalidate<C: FastChecks + ?Sized>(
     checker: &mut Counting<'_, C>,
     path: &[[f64; 6]],
     res: &super::edge::Resolution,
@@ -130,7 +130,7 @@ fn revalidate<C: CollisionChecker + ?Sized>(
 }
 
 /// One planning attempt, with the checker's screen asked first (`screen`) or not.
-fn attempt<C: CollisionChecker + ?Sized>(
+fn attempt<C: FastChecks + ?Sized>(
     checker: &mut C,
     start: &[f64; 6],
     goals: &GoalSet,

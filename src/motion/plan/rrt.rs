@@ -5,7 +5,7 @@
 
 use std::time::Instant;
 
-use super::checker::{CollisionChecker, Counting};
+use super::checker::{CollisionChecker, Counting, FastChecks};
 use super::config::PlannerConfig;
 use super::edge::{Resolution, check_segment};
 use super::rng::Stream;
@@ -108,14 +108,14 @@ impl SearchLog {
     }
 }
 
-struct Grower<'a, 'b, C: CollisionChecker + ?Sized> {
+struct Grower<'a, 'b, C: FastChecks + ?Sized> {
     checker: &'a mut Counting<'b, C>,
     config: &'a PlannerConfig,
     res: Resolution,
     log: SearchLog,
 }
 
-impl<C: CollisionChecker + ?Sized> Grower<'_, '_, C> {
+impl<C: FastChecks + ?Sized> Grower<'_, '_, C> {
     /// True when the query has used its collision-check budget.
     fn spent(&self) -> bool {
         self.checker.spent()
@@ -186,7 +186,7 @@ impl<C: CollisionChecker + ?Sized> Grower<'_, '_, C> {
 /// at least one), until it connects them or uses `config.max_iterations`, `config.max_nodes` or
 /// `config.max_checks` (collision checks of the whole query, counted by `checker`). `Found` paths run start → goal and contain only checked configurations and
 /// segments checked at the configured resolution.
-pub(crate) fn rrt_connect<C: CollisionChecker + ?Sized>(
+pub(crate) fn rrt_connect<C: FastChecks + ?Sized>(
     checker: &mut Counting<'_, C>,
     start: &[f64; 6],
     goals: &[[f64; 6]],

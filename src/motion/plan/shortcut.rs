@@ -2,7 +2,7 @@
 //! vertices), each new segment checked at the edge resolution, then a sweep that drops every vertex
 //! its neighbours see each other past.
 
-use super::checker::CollisionChecker;
+use super::checker::FastChecks;
 use super::edge::{Resolution, check_segment};
 use super::rng::Stream;
 use super::stats::distance;
@@ -38,11 +38,7 @@ fn cumulative(path: &[[f64; 6]]) -> Vec<f64> {
 /// Keeps, from each kept vertex, the farthest later vertex the straight segment reaches free
 /// (tried from the end backwards): a path whose segments are each checked once, before the
 /// random shortcuts refine its corners.
-fn greedy<C: CollisionChecker + ?Sized>(
-    checker: &mut C,
-    path: Vec<[f64; 6]>,
-    res: &Resolution,
-) -> Vec<[f64; 6]> {
+fn greedy<C: FastChecks + ?Sized>(checker: &mut C, path: Vec<[f64; 6]>, res: &Resolution) -> Vec<[f64; 6]> {
     let n = path.len();
     if n < 3 {
         return path;
@@ -65,7 +61,7 @@ fn greedy<C: CollisionChecker + ?Sized>(
 /// checked only when its segment is shorter than `1 − min_gain` times the path between its ends
 /// (radians); the others are skipped, their draws spent all the same. Every segment of the
 /// result is free at `res`, given the input's segments were.
-pub(crate) fn shortcut<C: CollisionChecker + ?Sized>(
+pub(crate) fn shortcut<C: FastChecks + ?Sized>(
     checker: &mut C,
     path: Vec<[f64; 6]>,
     attempts: usize,

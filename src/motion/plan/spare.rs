@@ -2,8 +2,8 @@
 //! how far the joints may move from it before the spare is used up.
 
 /// Widest spare clearance the planner asks a checker for, metres
-/// ([`CollisionChecker::exact_spare`](super::CollisionChecker::exact_spare),
-/// [`CollisionChecker::screen_spare`](super::CollisionChecker::screen_spare)): a configuration
+/// ([`FastChecks::exact_spare`](super::FastChecks::exact_spare),
+/// [`FastChecks::screen_spare`](super::FastChecks::screen_spare)): a configuration
 /// measured with this much to spare vouches for those up to this far (in the lever-arm
 /// displacement bound) along a segment.
 pub const SPARE_CAP: f64 = 0.15;

@@ -33,7 +33,7 @@ pub struct PlanStats {
     /// Wall-clock time the query took (for reports only; no decision uses it).
     pub planning_time: Duration,
     /// Checks decided without the checker's exact test while its screen was on: answered by the
-    /// screen ([`screen`](super::CollisionChecker::screen)), or vouched for along a segment by a
+    /// screen ([`screen`](super::FastChecks::screen)), or vouched for along a segment by a
     /// neighbour's spare clearance.
     pub screened: u64,
     /// True when the exact re-check of the final path found a configuration the screen had

@@ -507,6 +507,9 @@ impl CollisionChecker for Screened {
     fn collisions(&mut self, q: &[f64; 6]) -> Vec<Collision> {
         self.inner.collisions(q)
     }
+}
+
+impl FastChecks for Screened {
     fn screen(&mut self, q: &[f64; 6]) -> Option<bool> {
         self.asked += 1;
         if self.lies {
