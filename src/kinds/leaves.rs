@@ -76,6 +76,48 @@ fn d_point_tol() -> f64 {
     crate::scene::AT_TOLERANCE
 }
 
+/// Most collision checks a leaf's `max_checks` may give one plan.
+pub const MAX_PLAN_CHECKS: u64 = 10_000_000;
+
+/// Declares the parameters of a leaf that plans: the struct as written, with the planning
+/// budget's two fields appended (`max_checks`, `plan_time_cap`: declared once here, with their
+/// documentation and ranges), and its [`PlanBudget`].
+macro_rules! planning_leaf {
+    ($(#[$meta:meta])* pub struct $name:ident { $($body:tt)* }) => {
+        $(#[$meta])*
+        pub struct $name {
+            $($body)*
+            /// Collision checks the planner may spend when the leaf's direct motion would
+            /// collide (1 to 10 000 000); a search that uses them up fails with `no_path`.
+            /// Default: the planner's own budget (20 000).
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            #[schemars(range(min = 1, max = MAX_PLAN_CHECKS))]
+            pub max_checks: Option<u64>,
+            /// Wall-clock seconds a plan may take before it fails with `no_path` (0.001 to 60).
+            /// The only outcome that depends on the machine's speed; `max_checks` ends searches
+            /// first on any machine not stalled tenfold. Default 2.
+            #[serde(
+                default,
+                deserialize_with = "units::opt_plan_time_cap",
+                skip_serializing_if = "Option::is_none"
+            )]
+            #[schemars(range(min = units::PLAN_TIME_CAP_RANGE.0, max = units::PLAN_TIME_CAP_RANGE.1))]
+            pub plan_time_cap: Option<f64>,
+        }
+
+        impl $name {
+            /// The leaf's planning budget (its `max_checks` and `plan_time_cap`).
+            pub fn plan_budget(&self) -> PlanBudget {
+                PlanBudget {
+                    max_checks: self.max_checks,
+                    time_cap: self.plan_time_cap,
+                }
+            }
+        }
+    };
+}
+
+planning_leaf! {
 #[doc = include_str!("../../docs/nodes/reach.md")]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -107,24 +149,10 @@ pub struct Reach {
     #[serde(default = "d_5", deserialize_with = "units::time_limit")]
     #[schemars(range(min = 0.0))]
     pub timeout: f64,
-    /// Collision checks the planner may spend when the direct motion would collide (1 to
-    /// 10 000 000); a search that uses them up fails with `no_path`. Default: the planner's
-    /// own budget (20 000).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schemars(range(min = 1, max = 10_000_000))]
-    pub max_checks: Option<u64>,
-    /// Wall-clock seconds a plan may take before it fails with `no_path` (0.001 to 60). The
-    /// only outcome that depends on the machine's speed; `max_checks` ends searches first on
-    /// any machine not stalled tenfold. Default 2.
-    #[serde(
-        default,
-        deserialize_with = "units::opt_plan_time_cap",
-        skip_serializing_if = "Option::is_none"
-    )]
-    #[schemars(range(min = 0.001, max = 60.0))]
-    pub plan_time_cap: Option<f64>,
+}
 }
 
+planning_leaf! {
 #[doc = include_str!("../../docs/nodes/move_joints.md")]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -137,24 +165,10 @@ pub struct MoveJoints {
     #[serde(default = "d_6", deserialize_with = "units::time_limit")]
     #[schemars(range(min = 0.0))]
     pub timeout: f64,
-    /// Collision checks the planner may spend when the direct move would collide (1 to
-    /// 10 000 000); a search that uses them up fails with `no_path`. Default: the planner's
-    /// own budget (20 000).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schemars(range(min = 1, max = 10_000_000))]
-    pub max_checks: Option<u64>,
-    /// Wall-clock seconds a plan may take before it fails with `no_path` (0.001 to 60). The
-    /// only outcome that depends on the machine's speed; `max_checks` ends searches first on
-    /// any machine not stalled tenfold. Default 2.
-    #[serde(
-        default,
-        deserialize_with = "units::opt_plan_time_cap",
-        skip_serializing_if = "Option::is_none"
-    )]
-    #[schemars(range(min = 0.001, max = 60.0))]
-    pub plan_time_cap: Option<f64>,
+}
 }
 
+planning_leaf! {
 #[doc = include_str!("../../docs/nodes/home.md")]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -163,22 +177,7 @@ pub struct Home {
     #[serde(default = "d_6", deserialize_with = "units::time_limit")]
     #[schemars(range(min = 0.0))]
     pub timeout: f64,
-    /// Collision checks the planner may spend when the direct move would collide (1 to
-    /// 10 000 000); a search that uses them up fails with `no_path`. Default: the planner's
-    /// own budget (20 000).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schemars(range(min = 1, max = 10_000_000))]
-    pub max_checks: Option<u64>,
-    /// Wall-clock seconds a plan may take before it fails with `no_path` (0.001 to 60). The
-    /// only outcome that depends on the machine's speed; `max_checks` ends searches first on
-    /// any machine not stalled tenfold. Default 2.
-    #[serde(
-        default,
-        deserialize_with = "units::opt_plan_time_cap",
-        skip_serializing_if = "Option::is_none"
-    )]
-    #[schemars(range(min = 0.001, max = 60.0))]
-    pub plan_time_cap: Option<f64>,
+}
 }
 
 impl Default for Home {
@@ -218,6 +217,7 @@ impl Default for Grasp {
     }
 }
 
+planning_leaf! {
 #[doc = include_str!("../../docs/nodes/carry.md")]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -244,22 +244,7 @@ pub struct Carry {
     #[serde(default = "d_10", deserialize_with = "units::time_limit")]
     #[schemars(range(min = 0.0))]
     pub timeout: f64,
-    /// Collision checks the planner may spend when the direct transfer would collide (1 to
-    /// 10 000 000); a search that uses them up fails with `no_path`. Default: the planner's
-    /// own budget (20 000).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schemars(range(min = 1, max = 10_000_000))]
-    pub max_checks: Option<u64>,
-    /// Wall-clock seconds a plan may take before it fails with `no_path` (0.001 to 60). The
-    /// only outcome that depends on the machine's speed; `max_checks` ends searches first on
-    /// any machine not stalled tenfold. Default 2.
-    #[serde(
-        default,
-        deserialize_with = "units::opt_plan_time_cap",
-        skip_serializing_if = "Option::is_none"
-    )]
-    #[schemars(range(min = 0.001, max = 60.0))]
-    pub plan_time_cap: Option<f64>,
+}
 }
 
 fn d_15() -> f64 {
@@ -271,6 +256,7 @@ fn opt_point<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>,
     units::vec2(d).map(Some)
 }
 
+planning_leaf! {
 #[doc = include_str!("../../docs/nodes/place.md")]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -310,22 +296,7 @@ pub struct Place {
     #[serde(default = "d_15", deserialize_with = "units::time_limit")]
     #[schemars(range(min = 0.0))]
     pub timeout: f64,
-    /// Collision checks the planner may spend when the direct transfer would collide (1 to
-    /// 10 000 000); a search that uses them up fails with `no_path`. Default: the planner's
-    /// own budget (20 000).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schemars(range(min = 1, max = 10_000_000))]
-    pub max_checks: Option<u64>,
-    /// Wall-clock seconds a plan may take before it fails with `no_path` (0.001 to 60). The
-    /// only outcome that depends on the machine's speed; `max_checks` ends searches first on
-    /// any machine not stalled tenfold. Default 2.
-    #[serde(
-        default,
-        deserialize_with = "units::opt_plan_time_cap",
-        skip_serializing_if = "Option::is_none"
-    )]
-    #[schemars(range(min = 0.001, max = 60.0))]
-    pub plan_time_cap: Option<f64>,
+}
 }
 
 #[doc = include_str!("../../docs/nodes/release.md")]
@@ -824,27 +795,12 @@ pub struct PlanBudget {
     pub time_cap: Option<f64>,
 }
 
-macro_rules! plan_budget {
-    ($($leaf:ty),*) => {$(
-        impl $leaf {
-            /// The leaf's planning budget (its `max_checks` and `plan_time_cap`).
-            pub fn plan_budget(&self) -> PlanBudget {
-                PlanBudget {
-                    max_checks: self.max_checks,
-                    time_cap: self.plan_time_cap,
-                }
-            }
-        }
-    )*};
-}
-plan_budget!(Reach, MoveJoints, Home, Carry, Place);
-
 /// The `max_checks` parameter of a leaf that plans: 1 to 10 000 000 collision checks.
 fn check_max_checks(max_checks: Option<u64>) -> Result<(), ParamError> {
     match max_checks {
-        Some(n) if !(1..=10_000_000).contains(&n) => Err(ParamError::at(
+        Some(n) if !(1..=MAX_PLAN_CHECKS).contains(&n) => Err(ParamError::at(
             "max_checks",
-            format!("`max_checks` must be between 1 and 10000000 collision checks, found {n}"),
+            format!("`max_checks` must be between 1 and {MAX_PLAN_CHECKS} collision checks, found {n}"),
         )),
         _ => Ok(()),
     }
