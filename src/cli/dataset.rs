@@ -12,7 +12,7 @@ use crate::dataset::{EpisodeRecorder, Recording};
 use crate::plan::Plan;
 use crate::render::FrameSize;
 use crate::sim::Scene;
-use crate::sweep::{ScenarioResult, SweepConfig, run_scene_scenario_observed};
+use crate::sweep::{ScenarioResult, SweepConfig, run_scenario};
 
 /// What each worker needs to record an episode (shared by the workers).
 pub(super) struct DatasetRecorder {
@@ -46,7 +46,7 @@ impl DatasetRecorder {
                 }
             }
         }
-        let result = run_scene_scenario_observed(cell, plan, factory, config, index, &mut rec);
+        let result = run_scenario(cell, plan, factory, config, index, &mut rec);
         let recording = match start_error {
             Some(e) => Err(e),
             None => rec.finish(),

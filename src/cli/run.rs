@@ -182,7 +182,7 @@ impl EpisodeArgs {
                 seed: self.sweep_seed,
                 ..crate::sweep::SweepConfig::default()
             };
-            let s = sweep.scene_scenario(scene, k).map_err(|e| {
+            let s = sweep.scenario(scene, k).map_err(|e| {
                 CliError::Input(format!("error: scenario {k} of seed {}: {e}", self.sweep_seed))
             })?;
             config.seed = s.seed;

@@ -113,7 +113,14 @@ pub fn sweep(app: &crate::App, args: SweepArgs) -> Result<(), CliError> {
             (r, Some(recording))
         }
         None => (
-            crate::sweep::run_scene_scenario(cell, &plan, app.factory(), &config, index),
+            crate::sweep::run_scenario(
+                cell,
+                &plan,
+                app.factory(),
+                &config,
+                index,
+                &mut crate::episode::NoObserver,
+            ),
             None,
         ),
     };

@@ -79,8 +79,10 @@ impl ScenarioLayout {
     }
 }
 
-/// One scenario of a sweep: its layout and the episode seed.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+/// Scenario `index` of sweep seed `sweep_seed` on a scene, as [`draw`] draws it: the episode
+/// seed and every object's starting pose. The one scenario type of sweeps, `run --scenario K
+/// --sweep-seed S` and the step-wise environment's `Reset::Scenario`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Scenario {
     /// The sweep seed `S`.
     pub sweep_seed: u64,
@@ -88,21 +90,26 @@ pub struct Scenario {
     pub index: u64,
     /// The episode seed (fault timing and magnitude), drawn from the scenario's stream.
     pub seed: u64,
-    /// Where the cube and the bowl start.
-    pub layout: ScenarioLayout,
+    /// Every object's starting pose, scene order (x, y in metres, yaw in radians).
+    pub placement: Placement,
+    /// The tutorial's cube/bowl layout, for a `sampler: tutorial` scene (metres and degrees).
+    pub layout: Option<ScenarioLayout>,
 }
 
-/// Scenario `index` of sweep seed `sweep_seed` in the task region ([`Region::TASK`]).
-pub fn sample_scenario(sweep_seed: u64, index: u64) -> Scenario {
-    sample_scenario_in(&Region::TASK, sweep_seed, index)
+/// The task-region sampler's draw for scenario `index` of sweep seed `sweep_seed`
+/// ([`Region::TASK`]): the episode seed and where the cube and the bowl start (metres and
+/// degrees).
+pub fn sample_layout(sweep_seed: u64, index: u64) -> (u64, ScenarioLayout) {
+    sample_layout_in(&Region::TASK, sweep_seed, index)
 }
 
-/// Scenario `index` of sweep seed `sweep_seed` in `region`.
+/// The sampler's draw for scenario `index` of sweep seed `sweep_seed` in `region`: the episode
+/// seed and where the cube and the bowl start (metres and degrees).
 ///
 /// # Panics
 /// If no layout is found after a million draws (the region cannot hold two centres
 /// `min_separation` apart).
-pub fn sample_scenario_in(region: &Region, sweep_seed: u64, index: u64) -> Scenario {
+pub fn sample_layout_in(region: &Region, sweep_seed: u64, index: u64) -> (u64, ScenarioLayout) {
     let mut rng = ChaCha8Rng::seed_from_u64(sweep_seed);
     rng.set_stream(index);
     let seed = rng.next_u64();
@@ -112,12 +119,7 @@ pub fn sample_scenario_in(region: &Region, sweep_seed: u64, index: u64) -> Scena
         let bowl = [draw(region.x), draw(region.y)];
         let layout = ScenarioLayout { cube, bowl };
         if layout.separation() >= region.min_separation && cube[2] < region.yaw_deg[1] {
-            return Scenario {
-                sweep_seed,
-                index,
-                seed,
-                layout,
-            };
+            return (seed, layout);
         }
     }
     panic!(
@@ -126,39 +128,31 @@ pub fn sample_scenario_in(region: &Region, sweep_seed: u64, index: u64) -> Scena
     )
 }
 
-/// Scenario `index` of sweep seed `sweep_seed` on `scene`: its episode seed and every object's
-/// starting pose.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ScenarioDraw {
-    /// The episode seed (fault timing and magnitude).
-    pub seed: u64,
-    /// Every object's starting pose, scene order.
-    pub placement: Placement,
-    /// The tutorial's cube/bowl layout, for a `sampler: tutorial` scene.
-    pub layout: Option<ScenarioLayout>,
-}
-
 /// Scenario `index` of sweep seed `sweep_seed` on `scene`. A scene with `sampler: tutorial`
 /// (the built-in `cube_bowl`) draws its cube and bowl with the documented task-region sampler
-/// ([`sample_scenario`]); every other scene draws its own randomization
+/// ([`sample_layout`]); every other scene draws its own randomization
 /// ([`crate::scene::sample_placement`]).
 ///
 /// # Errors
 /// When the scene's randomization cannot place its objects.
-pub fn draw(scene: &Scene, sweep_seed: u64, index: u64) -> Result<ScenarioDraw, PlacementError> {
-    if scene.spec.sampler == Sampler::Tutorial {
-        let s = sample_scenario(sweep_seed, index);
-        return Ok(ScenarioDraw {
-            seed: s.seed,
-            placement: scene.placement_from_layout(&s.layout.to_layout()),
-            layout: Some(s.layout),
-        });
-    }
-    let (seed, placement) = sample_placement(&scene.spec, sweep_seed, index)?;
-    Ok(ScenarioDraw {
+pub fn draw(scene: &Scene, sweep_seed: u64, index: u64) -> Result<Scenario, PlacementError> {
+    let (seed, placement, layout) = if scene.spec.sampler == Sampler::Tutorial {
+        let (seed, layout) = sample_layout(sweep_seed, index);
+        (
+            seed,
+            scene.placement_from_layout(&layout.to_layout()),
+            Some(layout),
+        )
+    } else {
+        let (seed, placement) = sample_placement(&scene.spec, sweep_seed, index)?;
+        (seed, placement, None)
+    };
+    Ok(Scenario {
+        sweep_seed,
+        index,
         seed,
         placement,
-        layout: None,
+        layout,
     })
 }
 
@@ -173,8 +167,8 @@ mod tests {
 
     #[test]
     fn a_scenario_depends_only_on_seed_and_index() {
-        assert_eq!(sample_scenario(7, 3), sample_scenario(7, 3));
-        assert_ne!(sample_scenario(7, 3).layout, sample_scenario(7, 4).layout);
-        assert_ne!(sample_scenario(7, 3).layout, sample_scenario(8, 3).layout);
+        assert_eq!(sample_layout(7, 3), sample_layout(7, 3));
+        assert_ne!(sample_layout(7, 3).1, sample_layout(7, 4).1);
+        assert_ne!(sample_layout(7, 3).1, sample_layout(8, 3).1);
     }
 }

@@ -2,15 +2,13 @@
 
 use std::sync::Arc;
 
-use serde::Serialize;
-
 use crate::actions::CONTROL_PERIOD;
 use crate::episode::{EpisodeConfig, Goal};
 use crate::faults::FaultKind;
 use crate::runtime::substitute::{Resolved, Substitution};
-use crate::scene::{Placement, PlacementError};
+use crate::scene::PlacementError;
 use crate::sim::Scene;
-use crate::sweep::{Scenario, ScenarioIndices, ScenarioLayout, Shard};
+use crate::sweep::{Scenario, ScenarioIndices, Shard};
 
 /// Most worker threads of a sweep (`sweep --jobs`, `test --jobs`): each holds one simulation;
 /// more threads than this only cost start-up time and memory.
@@ -89,24 +87,22 @@ impl SweepConfig {
     }
 
     /// Scenario `index` of this sweep on `scene`, drawn by [`crate::episode::scenario::draw`]
-    /// (the draw the step-wise environment's resets use too). A scene with `sampler: tutorial`
-    /// (the built-in `cube_bowl`) draws its cube and bowl with the documented task-region sampler
-    /// ([`crate::sweep::sample_scenario`]), so its sweeps and reproduction commands (`--cube …
-    /// --bowl …`) are those of earlier releases; every other scene draws its own randomization
-    /// ([`crate::scene::sample_placement`]).
-    pub fn scene_scenario(&self, scene: &Scene, index: u64) -> Result<SceneScenario, PlacementError> {
-        let draw = crate::episode::scenario::draw(scene, self.seed, index)?;
-        Ok(SceneScenario {
-            sweep_seed: self.seed,
-            index,
-            seed: draw.seed,
-            placement: draw.placement,
-            layout: draw.layout,
-        })
+    /// (the draw `run --scenario K` and the step-wise environment's resets use too). A scene
+    /// with `sampler: tutorial` (the built-in `cube_bowl`) draws its cube and bowl with the
+    /// documented task-region sampler ([`crate::sweep::sample_layout`]), so its sweeps and
+    /// reproduction commands (`--cube … --bowl …`) are those of earlier releases; every other
+    /// scene draws its own randomization ([`crate::scene::sample_placement`]).
+    ///
+    /// # Errors
+    /// When the scene's randomization cannot place its objects.
+    pub fn scenario(&self, scene: &Scene, index: u64) -> Result<Scenario, PlacementError> {
+        crate::episode::scenario::draw(scene, self.seed, index)
     }
 
-    /// The episode configuration of a scenario of any scene (see [`Self::scene_scenario`]).
-    pub fn scene_episode_config(&self, scenario: &SceneScenario) -> EpisodeConfig {
+    /// The episode configuration of `scenario` (see [`Self::scenario`]): for a `sampler:
+    /// tutorial` scene, exactly what `macrotree run` builds from the reproduction command
+    /// [`ScenarioResult::reproduce`](crate::sweep::ScenarioResult::reproduce) prints.
+    pub fn episode_config(&self, scenario: &Scenario) -> EpisodeConfig {
         EpisodeConfig {
             placement: Some(scenario.placement.clone()),
             seed: scenario.seed,
@@ -120,37 +116,4 @@ impl SweepConfig {
             collisions: self.collisions,
         }
     }
-
-    /// The episode configuration of `scenario` of a `sampler: tutorial` scene (`scene`): exactly
-    /// what `macrotree run` builds from the reproduction command [`ScenarioResult::reproduce`](crate::sweep::ScenarioResult::reproduce)
-    /// prints.
-    pub fn episode_config(&self, scene: &Scene, scenario: &Scenario) -> EpisodeConfig {
-        EpisodeConfig {
-            placement: Some(scene.placement_from_layout(&scenario.layout.to_layout())),
-            seed: scenario.seed,
-            max_sim_time: self.max_sim_time,
-            control_period: CONTROL_PERIOD,
-            fault: self.fault,
-            noise: self.noise,
-            goal: self.goal,
-            substitutions: self.substitutions.clone(),
-            resolved: self.resolved.clone(),
-            collisions: self.collisions,
-        }
-    }
-}
-
-/// A scenario of a sweep on any scene: the episode seed and every object's starting pose.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct SceneScenario {
-    /// The sweep seed `S`.
-    pub sweep_seed: u64,
-    /// The scenario index `k`.
-    pub index: u64,
-    /// The episode seed (fault timing and magnitude).
-    pub seed: u64,
-    /// Every object's starting pose, scene order.
-    pub placement: Placement,
-    /// The tutorial's cube/bowl layout, for a `sampler: tutorial` scene.
-    pub layout: Option<ScenarioLayout>,
 }

@@ -1,7 +1,7 @@
 //! Sweeps: a tree run over many seeded, randomized layouts (optionally with a fault), in
 //! parallel, with results in scenario order — the library behind `macrotree sweep`.
 //!
-//! Scenario `k` of sweep seed `S` ([`sample_scenario`]) depends only on `(S, k)`, so a sweep gives
+//! Scenario `k` of sweep seed `S` ([`SweepConfig::scenario`]) depends only on `(S, k)`, so a sweep gives
 //! the same results for any number of jobs, and the shards `K/M` of a sweep (the scenarios with
 //! `k ≡ K mod M`) concatenate into the full sweep. One [`Cell`](crate::actions::Cell) (one `MjData` of the shared model)
 //! per worker thread is reset before every scenario.
@@ -31,15 +31,14 @@ pub mod tally;
 mod timing;
 
 use crate::episode::scenario as layout;
-pub use config::{MAX_JOBS, SceneScenario, SweepConfig};
+pub use config::{MAX_JOBS, SweepConfig};
 pub use indices::ScenarioIndices;
-pub use layout::{Region, Scenario, ScenarioLayout, sample_scenario, sample_scenario_in};
+pub use layout::{Region, Scenario, ScenarioLayout, sample_layout, sample_layout_in};
 pub use report::{MAX_LINES, MergeError, Merged, Source, merge_results};
 pub use result::ScenarioResult;
 pub(crate) use result::shell_quote;
 pub use run::{
-    REORDER_WINDOW, SweepRun, run_scenario, run_scene_scenario, run_scene_scenario_observed, run_sweep,
-    run_sweep_from, run_sweep_streaming, run_sweep_with,
+    REORDER_WINDOW, SweepRun, run_scenario, run_sweep, run_sweep_from, run_sweep_streaming, run_sweep_with,
 };
 pub use shard::{MAX_AUTO_SHARDS, Shard, ShardSpec};
 pub use summary::{Coverage, Failure, FailureGroup, NodeTotals, Summary, percentile, wilson_interval};

@@ -8,7 +8,7 @@ use crate::episode::{EpisodeConfig, EpisodeReport, Goal, NodeReport, ObjectRepor
 use crate::failure::FailureKind;
 use crate::faults::FaultKind;
 use crate::runtime::substitute::Substitution;
-use crate::sweep::{Scenario, ScenarioLayout, SceneScenario, SweepConfig};
+use crate::sweep::{Scenario, ScenarioLayout, SweepConfig};
 use crate::world::goal::GoalValue;
 
 /// One line of the sweep's JSONL: the scenario and its episode's outcome (the fields of
@@ -102,24 +102,8 @@ pub struct ScenarioResult {
 }
 
 impl ScenarioResult {
-    /// The result of `scenario` (of a `sampler: tutorial` scene) of the sweep `config` from its
-    /// episode report.
+    /// The result of `scenario` of the sweep `config` from its episode report.
     pub fn new(scenario: &Scenario, config: &SweepConfig, r: EpisodeReport) -> Self {
-        Self::of(config, scenario.index, scenario.seed, Some(scenario.layout), r)
-    }
-
-    /// The result of a scenario of any scene of the sweep `config` from its episode report.
-    pub fn of_scene(scenario: &SceneScenario, config: &SweepConfig, r: EpisodeReport) -> Self {
-        Self::of(config, scenario.index, scenario.seed, scenario.layout, r)
-    }
-
-    fn of(
-        config: &SweepConfig,
-        index: u64,
-        seed: u64,
-        layout: Option<ScenarioLayout>,
-        r: EpisodeReport,
-    ) -> Self {
         Self {
             suite: config.suite.clone(),
             tree: config.tree.clone(),
@@ -129,11 +113,11 @@ impl ScenarioResult {
             max_sim_time: config.max_sim_time,
             substitutions: config.substitutions.clone(),
             collision_policy: config.collisions,
-            index,
+            index: scenario.index,
             sweep_seed: config.seed,
-            seed,
+            seed: scenario.seed,
             fault: config.fault,
-            layout,
+            layout: scenario.layout,
             success: r.success,
             tree_status: r.tree_status,
             failure_reason: r.failure_reason,

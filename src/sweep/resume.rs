@@ -12,7 +12,7 @@
 //! - line `n` is scenario `n` of this sweep's (shard's) indices: the scenario count and the
 //!   shard match;
 //! - its `sweep_seed`, `fault`, episode `seed` and `layout` are those of that scenario of this
-//!   sweep seed ([`super::sample_scenario`]): the seed matches;
+//!   sweep seed ([`SweepConfig::scenario`](super::SweepConfig::scenario)): the seed matches;
 //! - its `success` agrees with its `tree_status` and `checks.in_bowl` under this `--goal`;
 //! - its `tree`, `scenarios`, `sweep_goal`, `max_sim_time`, `scene_file`, `substitutions`, `collision_policy` (and `suite`
 //!   for `macrotree test`) are this sweep's;
@@ -28,7 +28,7 @@ use std::sync::Arc;
 
 use serde_json::Value;
 
-use super::{ScenarioResult, SweepConfig, run_scene_scenario};
+use super::{ScenarioResult, SweepConfig, run_scenario};
 use crate::actions::{CONTROL_PERIOD, Cell, Checks};
 use crate::episode::Goal;
 use crate::faults::FaultKind;
@@ -164,7 +164,14 @@ pub fn spot_check(
         return Ok(());
     };
     let mut cell = Cell::new(scene, &Layout::default(), CONTROL_PERIOD);
-    let again = run_scene_scenario(&mut cell, plan, factory, config, last.index);
+    let again = run_scenario(
+        &mut cell,
+        plan,
+        factory,
+        config,
+        last.index,
+        &mut crate::episode::NoObserver,
+    );
     if again.to_jsonl() == last.to_jsonl() {
         Ok(())
     } else {
@@ -246,7 +253,7 @@ fn check_result(
         return Err(format!("fault {}, not {}", name(r.fault), name(config.fault)));
     }
     let s = config
-        .scene_scenario(scene, index)
+        .scenario(scene, index)
         .map_err(|e| format!("scenario {index} cannot be drawn: {e}"))?;
     let initial: Vec<[f64; 3]> = r
         .objects

@@ -12,36 +12,38 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use crate::actions::{CONTROL_PERIOD, Cell};
-use crate::episode::{NoObserver, run_in_cell};
+use crate::episode::{EpisodeObserver, NoObserver, run_in_cell};
 use crate::factory::Factory;
 use crate::failure::FailureKind;
 use crate::plan::Plan;
 use crate::sim::{Layout, Scene};
-use crate::sweep::{Scenario, ScenarioResult, SweepConfig};
+use crate::sweep::{ScenarioResult, SweepConfig};
 
-/// Runs scenario `scenario` (of a `sampler: tutorial` scene, such as the built-in one) of
-/// `config` in `cell` (reset first).
+/// Runs scenario `index` of `config` on the cell's scene in `cell` (reset first), with
+/// `observer` seeing every control tick (a dataset recorder; [`NoObserver`] for none). A
+/// scenario whose layout cannot be drawn is a `layout` failure that did not run.
 pub fn run_scenario(
     cell: &mut Cell,
     plan: &Arc<Plan>,
     factory: &Factory,
     config: &SweepConfig,
-    scenario: &Scenario,
-) -> ScenarioResult {
-    let episode = config.episode_config(cell.sim().scene(), scenario);
-    let report = run_in_cell(cell, plan.clone(), factory, &episode, &mut NoObserver);
-    ScenarioResult::new(scenario, config, report)
-}
-
-/// Runs scenario `index` of `config` on the cell's scene (reset first).
-pub fn run_scene_scenario(
-    cell: &mut Cell,
-    plan: &Arc<Plan>,
-    factory: &Factory,
-    config: &SweepConfig,
     index: u64,
+    observer: &mut dyn EpisodeObserver,
 ) -> ScenarioResult {
-    run_scene_scenario_observed(cell, plan, factory, config, index, &mut NoObserver)
+    match config.scenario(cell.sim().scene(), index) {
+        Ok(scenario) => {
+            let episode = config.episode_config(&scenario);
+            let report = run_in_cell(cell, plan.clone(), factory, &episode, observer);
+            ScenarioResult::new(&scenario, config, report)
+        }
+        Err(e) => ScenarioResult::not_run(
+            config,
+            index,
+            0,
+            None,
+            crate::failure::Failure::new(FailureKind::Layout, format!("layout: {e}")),
+        ),
+    }
 }
 
 /// Most scenarios a sweep runs ahead of the first one not yet handed to its callback (at least
@@ -92,35 +94,14 @@ pub fn run_sweep_from(
         scene,
         config,
         skip,
-        |cell, index| (run_scene_scenario(cell, plan, factory, config, index), ()),
+        |cell, index| {
+            (
+                run_scenario(cell, plan, factory, config, index, &mut NoObserver),
+                (),
+            )
+        },
         |r, _| on_result(r),
     )
-}
-
-/// Runs scenario `index` of `config` on the cell's scene (reset first), with `observer` seeing
-/// every control tick (e.g. a dataset recorder).
-pub fn run_scene_scenario_observed(
-    cell: &mut Cell,
-    plan: &Arc<Plan>,
-    factory: &Factory,
-    config: &SweepConfig,
-    index: u64,
-    observer: &mut dyn crate::episode::EpisodeObserver,
-) -> ScenarioResult {
-    match config.scene_scenario(cell.sim().scene(), index) {
-        Ok(scenario) => {
-            let episode = config.scene_episode_config(&scenario);
-            let report = run_in_cell(cell, plan.clone(), factory, &episode, observer);
-            ScenarioResult::of_scene(&scenario, config, report)
-        }
-        Err(e) => ScenarioResult::not_run(
-            config,
-            index,
-            0,
-            None,
-            crate::failure::Failure::new(FailureKind::Layout, format!("layout: {e}")),
-        ),
-    }
 }
 
 /// [`run_sweep_from`] with a per-episode payload: `episode` runs scenario `index` in a worker's
@@ -200,7 +181,7 @@ pub fn run_sweep_streaming<T: Send>(
                         Ok((r, t)) => (r, Some(t)),
                         Err(payload) => {
                             *cell = new_cell();
-                            let s = config.scene_scenario(scene, index).ok();
+                            let s = config.scenario(scene, index).ok();
                             let r = ScenarioResult::not_run(
                                 config,
                                 index,

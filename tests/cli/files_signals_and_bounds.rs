@@ -752,12 +752,13 @@ fn a_slow_scenario_does_not_let_results_pile_up_behind_it() {
                 started_meanwhile.fetch_add(1, Ordering::SeqCst);
             }
             (
-                macrotree::sweep::run_scene_scenario(
+                macrotree::sweep::run_scenario(
                     cell,
                     &plan,
                     &macrotree::factory::Factory::builtin(),
                     &config,
                     index,
+                    &mut macrotree::episode::NoObserver,
                 ),
                 (),
             )

@@ -80,8 +80,8 @@ fn noisy_demonstrations_of_the_flagship_still_succeed() {
     let scenarios = 20;
     let successes = (0..scenarios)
         .filter(|&k| {
-            let s = sweep.scene_scenario(scene, k).unwrap();
-            let (report, _) = record(&sweep.scene_episode_config(&s));
+            let s = sweep.scenario(scene, k).unwrap();
+            let (report, _) = record(&sweep.episode_config(&s));
             report.success
         })
         .count();

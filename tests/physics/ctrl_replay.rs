@@ -48,7 +48,7 @@ fn an_episodes_commands_replayed_through_ctrl_give_its_physics_bit_for_bit() {
             ..Default::default()
         };
         let config = match index {
-            Some(k) => sweep.scene_episode_config(&sweep.scene_scenario(flagship::scene(), k).unwrap()),
+            Some(k) => sweep.episode_config(&sweep.scenario(flagship::scene(), k).unwrap()),
             None => EpisodeConfig::default(),
         };
         let mut rec = Commands::default();
@@ -101,13 +101,13 @@ fn a_dataset_at_its_frame_rate_replays_through_ctrl_to_the_same_outcome() {
     let (mut same, mut successes) = (0, 0);
     let scenarios = 50;
     for index in 0..scenarios {
-        let s = sweep.scene_scenario(scene, index).unwrap();
+        let s = sweep.scenario(scene, index).unwrap();
         let mut rec = EpisodeRecorder::new(flagship::plan(), fps);
         let report = run_episode(
             scene,
             flagship::plan(),
             &macrotree::factory::Factory::builtin(),
-            &sweep.scene_episode_config(&s),
+            &sweep.episode_config(&s),
             &mut rec,
         );
         let frames = rec.finish().unwrap().frames;

@@ -116,12 +116,12 @@ fn the_replay_holds_on_a_swept_scenario_too() {
         seed: 1,
         ..Default::default()
     };
-    let s = sweep.scene_scenario(scene, 5).unwrap();
+    let s = sweep.scenario(scene, 5).unwrap();
     replay(
         Reset::Scenario {
             index: 5,
             sweep_seed: 1,
         },
-        sweep.scene_episode_config(&s),
+        sweep.episode_config(&s),
     );
 }

@@ -32,7 +32,7 @@ fn a_zero_residual_runs_the_scripted_episode_bit_for_bit() {
         ..Default::default()
     };
     for index in [0, 3] {
-        let config = sweep.scene_episode_config(&sweep.scene_scenario(flagship::scene(), index).unwrap());
+        let config = sweep.episode_config(&sweep.scenario(flagship::scene(), index).unwrap());
         let mut rec = Commands::default();
         let report = run_episode(
             flagship::scene(),

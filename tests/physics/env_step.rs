@@ -191,7 +191,7 @@ fn resets_place_objects_as_run_scenario_does_and_refuse_bad_placements() {
         seed: 9,
         ..Default::default()
     };
-    let s = sweep.scene_scenario(scene, 4).unwrap();
+    let s = sweep.scenario(scene, 4).unwrap();
     env.reset(&Reset::Scenario {
         index: 4,
         sweep_seed: 9,
@@ -200,10 +200,7 @@ fn resets_place_objects_as_run_scenario_does_and_refuse_bad_placements() {
     assert_eq!(env.placement(), &s.placement);
     assert_eq!(env.episode_seed(), s.seed);
     env.reset(&Reset::Seed(9)).unwrap();
-    assert_eq!(
-        env.placement(),
-        &sweep.scene_scenario(scene, 0).unwrap().placement
-    );
+    assert_eq!(env.placement(), &sweep.scenario(scene, 0).unwrap().placement);
     let mut p = scene.default_placement();
     p.poses[0].x = f64::NAN;
     let e = env.reset(&Reset::Placement(p)).unwrap_err();

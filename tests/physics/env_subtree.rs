@@ -84,13 +84,13 @@ fn the_whole_tree_as_one_step_is_run_episode_bit_for_bit() {
         seed: 7,
         ..Default::default()
     };
-    let s = sweep.scene_scenario(flagship::scene(), 2).unwrap();
+    let s = sweep.scenario(flagship::scene(), 2).unwrap();
     let mut states = States::default();
     let report = run_episode(
         flagship::scene(),
         flagship::plan(),
         &macrotree::factory::Factory::builtin(),
-        &sweep.scene_episode_config(&s),
+        &sweep.episode_config(&s),
         &mut states,
     );
     assert!(report.success);

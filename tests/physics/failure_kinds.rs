@@ -25,7 +25,7 @@ use macrotree::runtime::{LeafOutcome, NodeStatus, TreeRunner, TreeStatus};
 use macrotree::sim::collision::SceneChecker;
 use macrotree::sim::planning::{plan_failure, plan_in_cell};
 use macrotree::sim::{Layout, Scene, Sim};
-use macrotree::sweep::{SweepConfig, run_scene_scenario, run_sweep_with};
+use macrotree::sweep::{SweepConfig, run_scenario, run_sweep_with};
 use macrotree::world::World;
 use macrotree::{App, Failure, FailureKind, Params};
 use schemars::JsonSchema;
@@ -421,12 +421,13 @@ fn a_layout_the_sweep_cannot_draw_is_layout() {
         goal: Goal::Tree,
         ..SweepConfig::default()
     };
-    let r = run_scene_scenario(
+    let r = run_scenario(
         &mut cell,
         &plan("main: {home: {}}"),
         &Factory::builtin(),
         &config,
         0,
+        &mut NoObserver,
     );
     assert!(!r.success);
     assert_eq!(r.failure_kind, Some(FailureKind::Layout));
@@ -449,7 +450,7 @@ fn an_episode_that_panics_is_panicked_and_the_sweep_carries_on() {
         |cell, index| {
             assert!(index != 0, "scenario 0 panics (on purpose)");
             (
-                run_scene_scenario(cell, &p, &Factory::builtin(), &config, index),
+                run_scenario(cell, &p, &Factory::builtin(), &config, index, &mut NoObserver),
                 (),
             )
         },
@@ -680,7 +681,7 @@ fn a_resumed_sweep_reads_the_kind_back_from_the_file_custom_kinds_included() {
         ..SweepConfig::default()
     };
     let mut cell = Cell::new(scene(), &Layout::default(), CONTROL_PERIOD);
-    let r = run_scene_scenario(&mut cell, &plan, app.factory(), &config, 0);
+    let r = run_scenario(&mut cell, &plan, app.factory(), &config, 0, &mut NoObserver);
     assert_eq!(r.failure_kind, Some(FailureKind::Custom("jammed")));
     let line = serde_json::to_string(&r).unwrap();
     let back = macrotree::sweep::resume::parse_line(&line).unwrap();

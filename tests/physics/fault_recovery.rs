@@ -8,7 +8,7 @@ use macrotree::episode::{EpisodeConfig, EpisodeObserver, run_in_cell};
 use macrotree::faults::{FaultKind, injector_with_log};
 use macrotree::runtime::TreeRunner;
 use macrotree::sim::Layout;
-use macrotree::sweep::{SweepConfig, sample_scenario};
+use macrotree::sweep::{SweepConfig, sample_layout};
 use nalgebra::Vector3;
 
 use crate::support::flagship;
@@ -63,10 +63,10 @@ impl Track {
 /// Runs scenario `index` of sweep seed 2024 with `kind` injected, in a fresh cell; returns the
 /// cell, the report, the fault's firing and the track.
 fn episode(kind: FaultKind, index: u64) -> Episode {
-    let scenario = sample_scenario(2024, index);
+    let (seed, layout) = sample_layout(2024, index);
     let config = EpisodeConfig {
-        placement: Some(scene().placement_from_layout(&scenario.layout.to_layout())),
-        seed: scenario.seed,
+        placement: Some(scene().placement_from_layout(&layout.to_layout())),
+        seed,
         ..EpisodeConfig::default()
     };
     let mut cell = Cell::new(scene(), &Layout::default(), CONTROL_PERIOD);

@@ -7,7 +7,7 @@ use macrotree::episode::{EpisodeConfig, EpisodeObserver, run_in_cell};
 use macrotree::faults::{FaultKind, injector_with_log};
 use macrotree::runtime::{NodeStatus, Transition, TreeRunner};
 use macrotree::sim::Layout;
-use macrotree::sweep::{SweepConfig, sample_scenario};
+use macrotree::sweep::{SweepConfig, sample_layout};
 use nalgebra::Vector3;
 
 /// Half the edge of the 44 mm cube of the built-in scene, metres.
@@ -39,10 +39,10 @@ fn leaf(t: &Transition) -> &str {
 
 #[test]
 fn a_slip_drops_the_cube_and_the_tree_picks_it_up_where_it_fell() {
-    let scenario = sample_scenario(1, 0);
+    let (seed, layout) = sample_layout(1, 0);
     let config = EpisodeConfig {
-        placement: Some(scene().placement_from_layout(&scenario.layout.to_layout())),
-        seed: scenario.seed,
+        placement: Some(scene().placement_from_layout(&layout.to_layout())),
+        seed,
         ..EpisodeConfig::default()
     };
     let mut cell = Cell::new(scene(), &Layout::default(), CONTROL_PERIOD);

@@ -34,13 +34,13 @@ fn run_scenario(
         fault,
         ..SweepConfig::default()
     };
-    let scenario = sweep.scene_scenario(&scene, k).expect("a placement");
+    let scenario = sweep.scenario(&scene, k).expect("a placement");
     let mut cell = Cell::new(&scene, &Layout::default(), CONTROL_PERIOD);
     let r = run_in_cell(
         &mut cell,
         plan,
         &macrotree::factory::Factory::builtin(),
-        &sweep.scene_episode_config(&scenario),
+        &sweep.episode_config(&scenario),
         &mut NoObserver,
     );
     oracle::assert_no_warning(cell.sim(), &format!("{tree} #{k}"));
@@ -241,15 +241,15 @@ fn the_tutorial_sampler_follows_the_scene_setting_not_the_scene_name() {
         ..SweepConfig::default()
     };
     let copy = Scene::load_spec(&SceneSpec::from_str(&text, "my_cell.yaml").unwrap()).unwrap();
-    let s = sweep.scene_scenario(&copy, 3).unwrap();
-    let expected = macrotree::sweep::sample_scenario(11, 3);
-    assert_eq!(s.layout, Some(expected.layout));
-    assert_eq!(s.seed, expected.seed);
+    let s = sweep.scenario(&copy, 3).unwrap();
+    let (seed, layout) = macrotree::sweep::sample_layout(11, 3);
+    assert_eq!(s.layout, Some(layout));
+    assert_eq!(s.seed, seed);
     let cube = copy.spec.legacy_cube().unwrap();
-    assert_eq!(s.placement.poses[cube].x, expected.layout.cube[0]);
+    assert_eq!(s.placement.poses[cube].x, layout.cube[0]);
     let plain = text.replace("\nsampler: tutorial\n", "\n");
     let plain = Scene::load_spec(&SceneSpec::from_str(&plain, "cube_bowl.yaml").unwrap()).unwrap();
-    let s = sweep.scene_scenario(&plain, 3).unwrap();
+    let s = sweep.scenario(&plain, 3).unwrap();
     assert_eq!(s.layout, None, "no tutorial layout without the setting");
     let (seed, placement) = macrotree::scene::sample_placement(&plain.spec, 11, 3).unwrap();
     assert_eq!((s.seed, s.placement), (seed, placement));

@@ -267,13 +267,13 @@ fn a_policy_tree_records_a_dataset_whose_actions_replay_to_the_same_outcome() {
     )
     .unwrap();
     for index in 0..3 {
-        let s = sweep.scene_scenario(scene, index).unwrap();
+        let s = sweep.scenario(scene, index).unwrap();
         let mut rec = EpisodeRecorder::new(plan.clone(), fps);
         let report = macrotree::episode::run_episode(
             scene,
             plan.clone(),
             &macrotree::factory::Factory::builtin(),
-            &sweep.scene_episode_config(&s),
+            &sweep.episode_config(&s),
             &mut rec,
         );
         assert!(report.success, "scenario {index}: {:?}", report.failure_reason);

@@ -11,9 +11,7 @@ use macrotree::episode::{Goal, NoObserver, run_episode};
 use macrotree::faults::FaultKind;
 use macrotree::plan::Plan;
 use macrotree::sim::Layout;
-use macrotree::sweep::{
-    ScenarioResult, Shard, Summary, SweepConfig, run_scenario, run_sweep, sample_scenario,
-};
+use macrotree::sweep::{ScenarioResult, Shard, Summary, SweepConfig, run_scenario, run_sweep, sample_layout};
 
 const TREE: &str = "trees/cube_to_bowl.yaml";
 
@@ -134,7 +132,10 @@ fn parse_run_command(cmd: &str) -> macrotree::episode::EpisodeConfig {
 #[test]
 fn the_printed_command_reproduces_the_scenario_bit_for_bit() {
     let plan = plan();
-    let config = SweepConfig::default();
+    let config = SweepConfig {
+        seed: 77,
+        ..SweepConfig::default()
+    };
     let mut cell = Cell::new(scene(), &Layout::default(), CONTROL_PERIOD);
     // A worker cell that already ran another scenario, as in a sweep.
     run_scenario(
@@ -142,21 +143,23 @@ fn the_printed_command_reproduces_the_scenario_bit_for_bit() {
         &plan,
         &macrotree::factory::Factory::builtin(),
         &config,
-        &sample_scenario(77, 0),
+        0,
+        &mut NoObserver,
     );
     for index in [1, 2] {
-        let scenario = sample_scenario(77, index);
+        let scenario = config.scenario(scene(), index).expect("a layout");
         let swept = run_scenario(
             &mut cell,
             &plan,
             &macrotree::factory::Factory::builtin(),
             &config,
-            &scenario,
+            index,
+            &mut NoObserver,
         );
         let cmd = swept.reproduce(TREE, &config);
         let parsed = parse_run_command(&cmd);
         // Bit-exact: the same layout (floats compared with ==), seed, limits.
-        assert_eq!(parsed, config.episode_config(scene(), &scenario), "{cmd}");
+        assert_eq!(parsed, config.episode_config(&scenario), "{cmd}");
         // And the same episode, run the way `macrotree run` runs it (a fresh cell).
         let report = run_episode(
             scene(),
@@ -172,20 +175,22 @@ fn the_printed_command_reproduces_the_scenario_bit_for_bit() {
 
 #[test]
 fn reproduction_commands_spell_the_fault_the_goal_and_the_time_limit() {
-    let scenario = sample_scenario(3, 4);
     let config = SweepConfig {
+        seed: 3,
         fault: Some(FaultKind::LateBowl),
         goal: Goal::Tree,
         max_sim_time: 12.5,
         ..SweepConfig::default()
     };
+    let scenario = config.scenario(scene(), 4).expect("a layout");
     let mut cell = Cell::new(scene(), &Layout::default(), CONTROL_PERIOD);
     let r = run_scenario(
         &mut cell,
         &plan(),
         &macrotree::factory::Factory::builtin(),
         &config,
-        &scenario,
+        4,
+        &mut NoObserver,
     );
     let cmd = r.reproduce(TREE, &config);
     assert!(
@@ -201,10 +206,7 @@ fn reproduction_commands_spell_the_fault_the_goal_and_the_time_limit() {
         .episode
         .config_on(scene())
         .unwrap_or_else(|_| panic!("bad input"));
-    assert_eq!(
-        parsed.placement,
-        config.episode_config(scene(), &scenario).placement
-    );
+    assert_eq!(parsed.placement, config.episode_config(&scenario).placement);
     assert_eq!(parsed.seed, scenario.seed);
     assert_eq!(parsed.max_sim_time, 12.5);
     assert_eq!(parsed.goal, Goal::Tree);
@@ -214,7 +216,7 @@ fn reproduction_commands_spell_the_fault_the_goal_and_the_time_limit() {
 /// (Regression: `EpisodeArgs::config` once dropped `--fault`.)
 #[test]
 fn run_fault_option_reaches_the_episode() {
-    let cmd = sample_scenario(3, 4).layout;
+    let (_, cmd) = sample_layout(3, 4);
     let words = [
         "macrotree".to_string(),
         "run".into(),
