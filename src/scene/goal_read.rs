@@ -11,7 +11,6 @@ use super::goal::{
     AT_MAX_TOLERANCE, AT_MAX_YAW_TOLERANCE, AT_TOLERANCE, AT_YAW_TOLERANCE, Goal, GoalAtom, GoalPlace,
 };
 use super::types::{ObjectKind, ObjectSpec, SceneSpec, reach_limits};
-use super::value_loc::loc_at;
 use crate::yaml::de::from_value;
 use crate::yaml::diag::{Issue, Loc};
 use crate::yaml::suggest::did_you_mean;
@@ -208,7 +207,7 @@ pub(super) fn read_goal(
             let at = if key.is_empty() {
                 body.loc
             } else {
-                loc_at(body, &[key])
+                body.loc_at(&[key])
             };
             want_at(scene, rejected, name, at, kinds, issues)
         };
@@ -442,9 +441,9 @@ fn read_place(
 ) -> Option<GoalPlace> {
     let before = issues.len();
     let point = match (&raw.point, &raw.spot) {
-        (Some(p), None) => Some((*p, loc_at(body, &["point"]))),
+        (Some(p), None) => Some((*p, body.loc_at(&["point"]))),
         (None, Some(name)) => {
-            let at = loc_at(body, &["spot"]);
+            let at = body.loc_at(&["spot"]);
             match scene.spot(name) {
                 Some(s) => Some(([s.x, s.y], at)),
                 None if rejected.contains(name.as_str()) => None,
@@ -468,7 +467,7 @@ fn read_place(
         }
         (Some(_), Some(_)) => {
             issues.push(
-                Issue::new(loc_at(body, &["spot"]), "give `point` or `spot`, not both")
+                Issue::new(body.loc_at(&["spot"]), "give `point` or `spot`, not both")
                     .label("a spot already has a point")
                     .help("remove `point:` to use the spot, or `spot:` to use the point"),
             );
@@ -503,7 +502,7 @@ fn read_place(
     if !(raw.tolerance > 0.0 && raw.tolerance <= AT_MAX_TOLERANCE) {
         issues.push(
             Issue::new(
-                loc_at(body, &["tolerance"]),
+                body.loc_at(&["tolerance"]),
                 format!(
                     "`tolerance` must be > 0 and at most {AT_MAX_TOLERANCE} m, found {}",
                     raw.tolerance
@@ -516,7 +515,7 @@ fn read_place(
     if !(raw.yaw_tolerance > 0.0 && raw.yaw_tolerance <= AT_MAX_YAW_TOLERANCE + 1e-12) {
         issues.push(
             Issue::new(
-                loc_at(body, &["yaw_tolerance"]),
+                body.loc_at(&["yaw_tolerance"]),
                 format!(
                     "`yaw_tolerance` must be > 0 and at most 45° (a cube's yaw is compared modulo 90°), found {:.1}°",
                     raw.yaw_tolerance.to_degrees()

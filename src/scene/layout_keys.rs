@@ -292,17 +292,7 @@ pub(super) fn read_regions(v: &Value, scene: &mut SceneSpec, issues: &mut Vec<Is
 
 /// The location of `objects.NAME.path…` (or of the object when absent).
 fn at(objects_v: &Value, name: &str, path: &[&str]) -> Loc {
-    let mut cur = match objects_v.get(name) {
-        Some(v) => v,
-        None => return objects_v.loc,
-    };
-    for k in path {
-        match cur.get(k) {
-            Some(next) => cur = next,
-            None => break,
-        }
-    }
-    cur.loc
+    objects_v.get(name).map_or(objects_v.loc, |v| v.loc_at(path))
 }
 
 /// What each block rests on and which regions its `random:` names: names known and of the

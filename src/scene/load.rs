@@ -13,7 +13,6 @@ use super::goal_read::{GoalRaw, Rejected, read_goal};
 use super::object_name::is_object_name;
 use super::sample::{Placement, sample_placement};
 use super::types::{ObjectKind, ObjectSpec, Pose, RandomPlacement, Sampler, SceneSpec, Shape};
-use super::value_loc::loc_at;
 use crate::yaml::TablePose;
 use crate::yaml::de::from_value;
 use crate::yaml::diag::{Diagnostic, Issue, Loc, Sources};
@@ -388,7 +387,7 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
     {
         let at = e
             .object()
-            .map_or(objects_key, |n| loc_at(objects_v, &[n, "random"]));
+            .map_or(objects_key, |n| objects_v.loc_at(&[n, "random"]));
         issues.push(Issue::new(at, format!("the randomization cannot be met: {e}")).help(e.hint()));
     }
     if issues.is_empty() || !scene.objects.is_empty() {
@@ -506,7 +505,7 @@ fn check_range(
     }
     issues.push(
         Issue::new(
-            loc_at(v, path),
+            v.loc_at(path),
             format!("{what} must be within {lo} … {hi}, found {x}"),
         )
         .label(format!("expected {lo} … {hi}")),
@@ -637,7 +636,7 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
         Some(z) if kind == ObjectKind::Block => {
             issues.push(
                 Issue::new(
-                    loc_at(body, &["z"]),
+                    body.loc_at(&["z"]),
                     format!("block `{name}` takes no `z: {z}`: a block's height comes from what it rests on"),
                 )
                 .label("expected no `z:` on a block")
@@ -661,7 +660,7 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
     if raw.on.is_some() && kind != ObjectKind::Block {
         issues.push(
             Issue::new(
-                loc_at(body, &["on"]),
+                body.loc_at(&["on"]),
                 format!("{kind} `{name}` cannot rest on another object: only blocks take `on:`"),
             )
             .label(format!(
@@ -676,7 +675,7 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
             (Some(a), Some(b)) => {
                 issues.push(
                     Issue::new(
-                        loc_at(body, &["random"]),
+                        body.loc_at(&["random"]),
                         "`random:` takes `in:` or `on:`, not both",
                     )
                     .label("expected `in: CONTAINER` or `on: OBSTACLE_OR_BLOCK`"),
@@ -689,7 +688,7 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
             if kind != ObjectKind::Block {
                 issues.push(
                     Issue::new(
-                        loc_at(body, &["random"]),
+                        body.loc_at(&["random"]),
                         format!("{kind} `{name}` cannot be drawn in or on another object: only blocks can"),
                     )
                     .label("expected `x:` and `y:` ranges")
@@ -698,7 +697,7 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
             } else if r.x.is_some() || r.y.is_some() {
                 issues.push(
                     Issue::new(
-                        loc_at(body, &["random", if r.x.is_some() { "x" } else { "y" }]),
+                        body.loc_at(&["random", if r.x.is_some() { "x" } else { "y" }]),
                         format!("`{name}` is drawn over `{s}`: its x and y come from `{s}`'s top"),
                     )
                     .label("expected no `x:`/`y:` beside `in:`/`on:`")
@@ -708,7 +707,7 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
             match &on {
                 Some(o) if o != s => issues.push(
                     Issue::new(
-                        loc_at(body, &["on"]),
+                        body.loc_at(&["on"]),
                         format!("`{name}` rests on `{o}` but is drawn over `{s}`"),
                     )
                     .label("a block rests on one thing")
@@ -733,7 +732,7 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
                     if !ok {
                         issues.push(
                             Issue::new(
-                                loc_at(body, &["random", key]),
+                                body.loc_at(&["random", key]),
                                 format!(
                                     "`{key}` must be a range [lo, hi] with lo ≤ hi, within ±1 m of the robot"
                                 ),
@@ -747,7 +746,7 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
                     if need {
                         issues.push(
                             Issue::new(
-                                loc_at(body, &["random"]),
+                                body.loc_at(&["random"]),
                                 format!("`random:` of `{name}` has no `{key}:` range"),
                             )
                             .label(format!(
@@ -766,7 +765,7 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
         {
             issues.push(
                 Issue::new(
-                    loc_at(body, &["random", "yaw"]),
+                    body.loc_at(&["random", "yaw"]),
                     "`yaw` must be a range [lo, hi] with lo ≤ hi, at most one turn wide",
                 )
                 .label("expected e.g. [deg(-45), deg(45)]"),
@@ -817,7 +816,7 @@ fn check_fixed_poses(scene: &SceneSpec, objects_v: &Value, issues: &mut Vec<Issu
             if let Some(p) = o.pose
                 && let Err(e) = Placement::check_one(scene, i, &p)
             {
-                issues.push(Issue::new(loc_at(objects_v, &[&o.name, "pose"]), e.to_string()).help(e.hint()));
+                issues.push(Issue::new(objects_v.loc_at(&[&o.name, "pose"]), e.to_string()).help(e.hint()));
             }
         }
         return;
@@ -826,7 +825,7 @@ fn check_fixed_poses(scene: &SceneSpec, objects_v: &Value, issues: &mut Vec<Issu
     if let Err(e) = placement.check(scene) {
         let at = e
             .object()
-            .map_or(objects_v.loc, |n| loc_at(objects_v, &[n, "pose"]));
+            .map_or(objects_v.loc, |n| objects_v.loc_at(&[n, "pose"]));
         issues.push(Issue::new(at, e.to_string()).help(e.hint()));
     }
 }

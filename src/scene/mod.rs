@@ -27,7 +27,6 @@ mod object_name;
 mod placement_error;
 mod sample;
 mod types;
-mod value_loc;
 
 pub use color::{COLOR_NAMES, Color};
 pub use footprint::Rect;

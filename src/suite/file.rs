@@ -350,16 +350,7 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>, custom_kinds: &[&str]) 
             return None;
         }
     };
-    let at = |keys: &[&str]| -> Loc {
-        let mut cur = v;
-        for k in keys {
-            match cur.get(k) {
-                Some(x) => cur = x,
-                None => break,
-            }
-        }
-        cur.loc
-    };
+    let at = |keys: &[&str]| v.loc_at(keys);
     if !(1..=MAX_COUNT).contains(&raw.count) {
         issues.push(
             Issue::new(

@@ -91,6 +91,19 @@ impl Value {
             .map(|(_, v)| v)
     }
 
+    /// Where the value under the mapping keys `path` is (the deepest one present; the value's
+    /// own location when even the first is absent), for located issues.
+    pub fn loc_at(&self, path: &[&str]) -> Loc {
+        let mut cur = self;
+        for k in path {
+            match cur.get(k) {
+                Some(next) => cur = next,
+                None => break,
+            }
+        }
+        cur.loc
+    }
+
     /// A short description of the value's type for messages ("a mapping", "the string `x`").
     pub fn describe(&self) -> String {
         match &self.kind {
