@@ -14,8 +14,9 @@ use crate::world::goal::{GoalValue, evaluate};
 /// What happened in one episode. Lengths in metres, times in seconds.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EpisodeReport {
-    /// The episode met its [`Goal`]: by default the tree succeeded and the cube rests in the
-    /// bowl; with `Goal::Tree`, the tree succeeded.
+    /// The episode met its [`Goal`]: by default the tree succeeded and the scene's goal holds;
+    /// with `Goal::Bowl`, the tree succeeded and the scene's cube rests in its bowl; with
+    /// `Goal::Tree`, the tree succeeded.
     pub success: bool,
     /// Final status of the tree: "success", "failure", or "running" when the time limit hit.
     pub tree_status: &'static str,

@@ -49,8 +49,8 @@ pub struct ScenarioResult {
     /// `run --cube X,Y,YAW --bowl X,Y` takes it); other scenes list every object in `objects`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub layout: Option<ScenarioLayout>,
-    /// The episode met the sweep's goal (by default: the tree succeeded and the cube rests in
-    /// the bowl; see [`Goal`]).
+    /// The episode met the sweep's goal (by default: the tree succeeded and the scene's goal
+    /// holds; see [`Goal`]).
     pub success: bool,
     /// Final status of the tree.
     pub tree_status: &'static str,
