@@ -58,8 +58,9 @@ pub struct EpisodeConfig {
     pub substitutions: Vec<crate::runtime::substitute::Substitution>,
     /// `substitutions` already resolved against the plan this configuration runs
     /// ([`crate::runtime::substitute::resolve`]): a command resolves its substitutions once and
-    /// every episode reuses them. `None` (or a resolution of another plan, with another number
-    /// of leaves): the episode resolves `substitutions` itself.
+    /// every episode reuses them. `None`, or a resolution of other rules or of a plan with other
+    /// leaves ([`Resolved::is_for`](crate::runtime::substitute::Resolved::is_for)): the episode
+    /// resolves `substitutions` itself.
     pub resolved: Option<Arc<crate::runtime::substitute::Resolved>>,
     /// What a contact that should not happen does: counted (default), or an episode failure of
     /// kind `collision` (`--collisions fail`).
@@ -211,7 +212,7 @@ pub fn run_in_cell(
     }
     let dt = cell.control_period();
     let resolved = match &config.resolved {
-        Some(r) if r.by_leaf.len() == plan.leaves.len() => Ok(Resolved::clone(r)),
+        Some(r) if r.is_for(&plan, &config.substitutions) => Ok(Resolved::clone(r)),
         _ => crate::runtime::substitute::resolve(&plan, &config.substitutions),
     };
     let (subs, bad_subs) = match resolved {

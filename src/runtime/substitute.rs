@@ -243,6 +243,39 @@ impl std::error::Error for SubstitutionError {}
 pub struct Resolved {
     /// Indexed like `plan.leaves`.
     pub by_leaf: Vec<Option<Scripted>>,
+    /// What this resolution is for: the rules, and the leaf paths of the plan they were
+    /// resolved against (a leaf's path names its kind).
+    key: ResolvedFor,
+}
+
+/// The inputs a [`Resolved`] depends on, compared before it is reused.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+struct ResolvedFor {
+    rules: Vec<Substitution>,
+    leaves: Vec<String>,
+}
+
+impl ResolvedFor {
+    fn new(plan: &Plan, rules: &[Substitution]) -> Self {
+        Self {
+            rules: rules.to_vec(),
+            leaves: plan.leaves.iter().map(|l| l.path.clone()).collect(),
+        }
+    }
+
+    fn matches(&self, plan: &Plan, rules: &[Substitution]) -> bool {
+        self.rules == rules
+            && self.leaves.len() == plan.leaves.len()
+            && self.leaves.iter().zip(&plan.leaves).all(|(a, b)| *a == b.path)
+    }
+}
+
+impl Resolved {
+    /// Whether this is the resolution of `rules` against `plan` (a plan with the same leaves
+    /// at the same paths), so that it can be reused instead of resolving again.
+    pub fn is_for(&self, plan: &Plan, rules: &[Substitution]) -> bool {
+        self.key.matches(plan, rules)
+    }
 }
 
 /// Resolves `subs` against `plan`: every rule must match at least one substitutable leaf, no
@@ -314,7 +347,10 @@ pub fn resolve(plan: &Plan, subs: &[Substitution]) -> Result<Resolved, Substitut
             return Err(err(reason, close_paths(plan, &sub.pattern)));
         }
     }
-    Ok(Resolved { by_leaf })
+    Ok(Resolved {
+        by_leaf,
+        key: ResolvedFor::new(plan, subs),
+    })
 }
 
 /// Up to five leaf paths closest to `pattern` (by edit distance of the last segments).

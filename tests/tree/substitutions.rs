@@ -226,3 +226,23 @@ fn rules_that_do_not_fit_are_refused_with_close_paths() {
             .contains("also matched")
     );
 }
+
+#[test]
+fn a_resolution_is_reused_only_for_its_own_rules_and_a_plan_with_the_same_leaves() {
+    let plan = plan();
+    let rules: Vec<Substitution> = vec!["main/**/grasp[again]=failure".parse().unwrap()];
+    let resolved = resolve(&plan, &rules).unwrap_or_else(|e| panic!("{e}"));
+    assert!(resolved.is_for(&plan, &rules));
+    // The same tree compiled again: another plan, the same leaves.
+    assert!(resolved.is_for(&self::plan(), &rules));
+    // Other rules against the same plan.
+    let other: Vec<Substitution> = vec!["main/**/grasp[again]=success".parse().unwrap()];
+    assert!(!resolved.is_for(&plan, &other));
+    assert!(!resolved.is_for(&plan, &[]));
+    // A plan with as many leaves as this one, at other paths.
+    let renamed = Loader::default()
+        .compile_str(&TREE.replace("name: again", "name: twice"), "t.yaml")
+        .unwrap_or_else(|d| panic!("{}", d[0]));
+    assert_eq!(renamed.leaves.len(), plan.leaves.len());
+    assert!(!resolved.is_for(&renamed, &rules));
+}
