@@ -6,8 +6,45 @@ use mujoco_rs::prelude::*;
 use mujoco_rs::wrappers::mj_model::traits::ModelType;
 use nalgebra::{Matrix3, Quaternion, Unit, UnitQuaternion, Vector3};
 
-/// A rotation (row-major `xmat` read as a matrix) and a translation, metres.
-pub(crate) type Frame = (Matrix3<f64>, Vector3<f64>);
+/// A body's pose in the world: the rotation from its frame to the world's (MuJoCo's row-major
+/// `xmat` read as a matrix) and its origin (metres).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    /// Rotation, body to world.
+    pub rot: Matrix3<f64>,
+    /// Origin, world frame (metres).
+    pub pos: Vector3<f64>,
+}
+
+impl Frame {
+    /// The pose of body `body` in `data` (posed by `mj_kinematics`).
+    pub(crate) fn of_body<M: ModelType>(data: &MjData<M>, body: usize) -> Self {
+        Self {
+            rot: mat(&data.xmat()[body]),
+            pos: Vector3::from(data.xpos()[body]),
+        }
+    }
+}
+
+/// A joint's axis in the world: a point on it and its unit direction (metres).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct JointAxis {
+    /// A point of the axis, world frame (metres).
+    pub(crate) point: Vector3<f64>,
+    /// The axis's unit direction, world frame.
+    pub(crate) direction: Vector3<f64>,
+}
+
+/// A moving geom: fixed in its link's frame.
+#[derive(Clone, Copy, Debug)]
+struct LinkedGeom {
+    /// MuJoCo geom id.
+    geom: usize,
+    /// The arm link (0..6) that carries it.
+    link: usize,
+    /// Its pose in the link's frame.
+    in_link: Frame,
+}
 
 /// One arm link: its body's offset from its parent (rotation, translation, metres) and its
 /// hinge (unit axis and anchor in the body frame, the joint's reference angle in radians).
@@ -99,7 +136,7 @@ impl ArmChain {
             }
         }
         let p0 = parent[link_bodies[0]] as usize;
-        let base = (mat(&data.xmat()[p0]), Vector3::from(data.xpos()[p0]));
+        let base = Frame::of_body(data, p0);
         let links = std::array::from_fn(|k| {
             let (body, j) = (link_bodies[k], joints[k]);
             let (p, q) = (m.body_pos()[body], m.body_quat()[body]);
@@ -126,20 +163,23 @@ impl ArmChain {
     /// World poses of the six arm links at joints `q` (radians), as `mj_kinematics` computes
     /// them: parent pose · body offset · rotation about the joint axis through its anchor.
     pub fn link_poses(&self, q: &[f64; 6]) -> [Frame; 6] {
-        let (mut r, mut t) = self.base;
+        let Frame { mut rot, mut pos } = self.base;
         std::array::from_fn(|k| {
             let l = &self.links[k];
-            l.frame(&mut r, &mut t, q[k] - l.qpos0);
-            (r, t)
+            l.frame(&mut rot, &mut pos, q[k] - l.qpos0);
+            Frame { rot, pos }
         })
     }
 
-    /// The axis of joint `j` at the link frames `frames` ([`ArmChain::link_poses`]): a point on
-    /// it and its unit direction, world frame (metres).
-    pub(crate) fn joint_axis(&self, frames: &[Frame; 6], j: usize) -> (Vector3<f64>, Vector3<f64>) {
+    /// The axis of joint `j` at the link frames `frames` ([`ArmChain::link_poses`]).
+    #[inline]
+    pub(crate) fn joint_axis(&self, frames: &[Frame; 6], j: usize) -> JointAxis {
         // The axis is fixed in link j's frame: through the anchor, along the axis.
-        let (r, t) = &frames[j];
-        (r * self.links[j].anchor + t, r * self.links[j].axis)
+        let Frame { rot, pos } = &frames[j];
+        JointAxis {
+            point: rot * self.links[j].anchor + pos,
+            direction: rot * self.links[j].axis,
+        }
     }
 }
 
@@ -150,8 +190,8 @@ impl ArmChain {
 #[derive(Clone, Debug)]
 pub(crate) struct MovingGeoms {
     chain: ArmChain,
-    /// Geom id, link index (0..6), and the geom's pose in the link's frame.
-    geoms: Vec<(usize, usize, Frame)>,
+    /// Each moving geom and where its link holds it.
+    geoms: Vec<LinkedGeom>,
 }
 
 impl MovingGeoms {
@@ -171,11 +211,17 @@ impl MovingGeoms {
             .filter(|&(g, &k)| k != 0 && (ct[g] != 0 || ca[g] != 0))
             .map(|(g, &k)| {
                 let link = k as usize - 1;
-                let body = link_bodies[link];
-                let lr = mat(&data.xmat()[body]).transpose();
-                let lt = Vector3::from(data.xpos()[body]);
+                let body = Frame::of_body(data, link_bodies[link]);
+                let lr = body.rot.transpose();
                 let (gr, gt) = (mat(&data.geom_xmat()[g]), Vector3::from(data.geom_xpos()[g]));
-                (g, link, (lr * gr, lr * (gt - lt)))
+                LinkedGeom {
+                    geom: g,
+                    link,
+                    in_link: Frame {
+                        rot: lr * gr,
+                        pos: lr * (gt - body.pos),
+                    },
+                }
             })
             .collect();
         Self { chain, geoms }
@@ -194,9 +240,14 @@ impl MovingGeoms {
 
     /// [`MovingGeoms::pose`] at the link frames `frames` ([`MovingGeoms::frames`]).
     pub(crate) fn pose_at<M: ModelType>(&self, frames: &[Frame; 6], data: &mut MjData<M>) {
-        for &(g, link, (rel_r, rel_t)) in &self.geoms {
-            let (r, t) = &frames[link];
-            let (x, p) = (r * rel_r, r * rel_t + t);
+        for &LinkedGeom {
+            geom: g,
+            link,
+            in_link,
+        } in &self.geoms
+        {
+            let Frame { rot: r, pos: t } = &frames[link];
+            let (x, p) = (r * in_link.rot, r * in_link.pos + t);
             data.geom_xpos_mut()[g] = [p.x, p.y, p.z];
             // `geom_xmat` is row-major.
             data.geom_xmat_mut()[g] = [

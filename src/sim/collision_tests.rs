@@ -11,7 +11,7 @@ use crate::motion::plan::{Collision, CollisionChecker, FastChecks, JointSpare, S
 use crate::motion::ur5e::LEVER_ARMS as UR5E_LEVER_ARMS;
 use crate::motion::{HOME_Q, JOINT_LIMITS, down_pose, fk, ik};
 use crate::scene::SceneSpec;
-use crate::sim::chain::ArmChain;
+use crate::sim::chain::{ArmChain, Frame};
 use crate::sim::pair_filter::PairFilter;
 use crate::sim::screen::shapes::{Shape, separation};
 use crate::sim::screen::{PairMove, TurnedBound};
@@ -410,7 +410,7 @@ fn the_chain_poses_the_links_as_mujoco_does() {
     for _ in 0..300 {
         let q = drawn(&mut r);
         c.detect_pose(&q);
-        for (k, (rot, t)) in chain.link_poses(&q).iter().enumerate() {
+        for (k, Frame { rot, pos: t }) in chain.link_poses(&q).iter().enumerate() {
             let (xpos, xmat) = (c.data.xpos()[bodies[k]], c.data.xmat()[bodies[k]]);
             for i in 0..3 {
                 assert!(

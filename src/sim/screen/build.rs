@@ -37,9 +37,7 @@ impl Screen {
         let d = b.data;
         let ngeom = m.ffi().ngeom as usize;
         let chain = b.chain.clone();
-        let link_pose: [Frame; 6] = b
-            .link_bodies
-            .map(|l| (mat(&d.xmat()[l]), Vector3::from(d.xpos()[l])));
+        let link_pose: [Frame; 6] = b.link_bodies.map(|l| Frame::of_body(d, l));
         let (ct, ca) = (m.geom_contype(), m.geom_conaffinity());
         let collidable = |g: usize| ct[g] != 0 || ca[g] != 0;
         // Index of each geom's shape: moving ones first, then fixed ones.
@@ -79,9 +77,9 @@ impl Screen {
                     return None;
                 };
                 let link = &link_pose[k as usize - 1];
-                let lr = link.0.transpose();
+                let lr = link.rot.transpose();
                 let rel_r = lr * gr;
-                let rel_t = lr * (gt - link.1);
+                let rel_t = lr * (gt - link.pos);
                 *slot = Some(moving.len());
                 let local = l.moved(&rel_r, &rel_t);
                 moving.push(MovingShape {

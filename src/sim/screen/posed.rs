@@ -90,8 +90,8 @@ impl MovingShape {
     /// The shape posed at the link frames `frames`, with its bounding sphere.
     #[inline]
     pub(super) fn pose(&self, frames: &[Frame; 6]) -> Posed {
-        let (r, t) = &frames[self.link];
-        let shape = self.local.posed(r, t);
+        let Frame { rot, pos } = &frames[self.link];
+        let shape = self.local.posed(rot, pos);
         let centre = match &shape {
             Shape::Capsule { a, b, .. } => [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0, (a[2] + b[2]) / 2.0],
             Shape::Box { center, .. } => *center,

@@ -130,9 +130,9 @@ impl Screen {
                 };
                 let k = self.moving[far].link;
                 let in_near = |f: &[Frame; 6], x: &Vector3<f64>| {
-                    let w = f[k].0 * x + f[k].1;
+                    let w = f[k].rot * x + f[k].pos;
                     match near_link {
-                        Some(n) => f[n].0.transpose() * (w - f[n].1),
+                        Some(n) => f[n].rot.transpose() * (w - f[n].pos),
                         None => w,
                     }
                 };

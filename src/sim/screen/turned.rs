@@ -5,7 +5,7 @@ use nalgebra::Vector3;
 
 use super::posed::MovingShape;
 use super::shapes::{Shape, V3, segment_box_dist2, segment_segment_dist2};
-use crate::sim::chain::{ArmChain, Frame};
+use crate::sim::chain::{ArmChain, Frame, JointAxis};
 
 /// Where a shape lies about an axis: the range of its points' heights along the axis and the
 /// range of their distances from it (metres).
@@ -76,8 +76,8 @@ fn range_gap(x: [f64; 2], y: [f64; 2]) -> f64 {
 pub(super) fn axial_places(chain: &ArmChain, frames: &[Frame; 6], m: &MovingShape) -> Places {
     let shape = m.pose(frames).shape;
     let about = |j: usize| {
-        let (o, u) = chain.joint_axis(frames, j);
-        about_axis(&shape, &o, &u)
+        let axis = chain.joint_axis(frames, j);
+        about_axis(&shape, &axis.point, &axis.direction)
     };
     Places {
         own: about(m.link),
@@ -110,10 +110,16 @@ pub(super) fn turned_apart(
     // Joint by joint towards the nearer link: the ball about the last axis's point at
     // mid-height holds every turn of what lies beyond it, and turns about the axis before.
     for j in (near.0 + 1..far.0).rev() {
-        let (o, u) = chain.joint_axis(frames, j + 1);
+        let JointAxis {
+            point: o,
+            direction: u,
+        } = chain.joint_axis(frames, j + 1);
         let centre = o + u * ((h[0] + h[1]) / 2.0);
         let radius = ((h[1] - h[0]) / 2.0).hypot(r[1]);
-        let (o, u) = chain.joint_axis(frames, j);
+        let JointAxis {
+            point: o,
+            direction: u,
+        } = chain.joint_axis(frames, j);
         let d = centre - o;
         let (hc, rc) = (d.dot(&u), (d - u * d.dot(&u)).norm());
         h = [hc - radius, hc + radius];

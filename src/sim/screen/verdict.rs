@@ -5,7 +5,7 @@ use super::pairs::{Group, Partner};
 use super::shapes::{Shape, Sphere, separation, surely_beyond};
 use super::{Screen, Undecided};
 use crate::motion::plan::JointSpare;
-use crate::sim::chain::Frame;
+use crate::sim::chain::{Frame, JointAxis};
 
 /// Two geom ids (MuJoCo's).
 pub type GeomPair = (usize, usize);
@@ -166,7 +166,10 @@ impl Screen {
         let spheres = self.world_spheres(frames);
         let mut reach = [0.0f64; 6];
         for (j, out) in reach.iter_mut().enumerate() {
-            let (a, u) = self.chain.joint_axis(frames, j);
+            let JointAxis {
+                point: a,
+                direction: u,
+            } = self.chain.joint_axis(frames, j);
             for s in spheres[j..].iter().flatten() {
                 let c = &s.centre;
                 let d = nalgebra::Vector3::new(c[0] - a.x, c[1] - a.y, c[2] - a.z);
@@ -181,7 +184,7 @@ impl Screen {
     fn world_spheres(&self, frames: &[Frame; 6]) -> [Option<Sphere>; 6] {
         std::array::from_fn(|k| {
             self.link_spheres[k].map(|s| {
-                let w = frames[k].0 * nalgebra::Vector3::from(s.centre) + frames[k].1;
+                let w = frames[k].rot * nalgebra::Vector3::from(s.centre) + frames[k].pos;
                 Sphere {
                     centre: [w.x, w.y, w.z],
                     radius: s.radius,
@@ -196,7 +199,7 @@ impl Screen {
         std::array::from_fn(|k| {
             self.link_capsules[k]
                 .as_ref()
-                .map(|l| l.posed(&frames[k].0, &frames[k].1))
+                .map(|l| l.posed(&frames[k].rot, &frames[k].pos))
         })
     }
 
