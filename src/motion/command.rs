@@ -7,6 +7,8 @@
 //! servos track `q + q̇ τ + ½ q̈ τ²` at `q̇ + q̈ τ` with feedforward `q̈`
 //! ([`ArmCommand::at`]). Units: radians, rad/s, rad/s²; the gripper in actuator units.
 
+use super::ur5e::{arm_joint_names, joined_names};
+
 /// The arm's command at the start of a control period: joint set points, velocities and
 /// accelerations (the servos' feedforward).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -48,27 +50,12 @@ impl ArmCommand {
 pub const COMMAND_LEN: usize = 19;
 
 /// Names of the values of a flat command vector, in order (the dataset's `action` names).
-pub const COMMAND_NAMES: [&str; COMMAND_LEN] = [
-    "shoulder_pan.pos",
-    "shoulder_lift.pos",
-    "elbow.pos",
-    "wrist_1.pos",
-    "wrist_2.pos",
-    "wrist_3.pos",
-    "shoulder_pan.vel",
-    "shoulder_lift.vel",
-    "elbow.vel",
-    "wrist_1.vel",
-    "wrist_2.vel",
-    "wrist_3.vel",
-    "shoulder_pan.acc",
-    "shoulder_lift.acc",
-    "elbow.acc",
-    "wrist_1.acc",
-    "wrist_2.acc",
-    "wrist_3.acc",
-    "gripper",
-];
+pub const COMMAND_NAMES: [&str; COMMAND_LEN] = joined_names(&[
+    &arm_joint_names!(".pos"),
+    &arm_joint_names!(".vel"),
+    &arm_joint_names!(".acc"),
+    &["gripper"],
+]);
 
 /// One control period's command of the whole cell: the arm's and the gripper's.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -19,16 +19,44 @@
 //! [`kinematics`](super::kinematics) ([`TOOL_LENGTH`](super::kinematics::TOOL_LENGTH)), its
 //! calibration in [`gripper`](super::gripper).
 
+/// The UR5e arm joints' names, base to wrist, each followed by `$suffix` (a string literal):
+/// `arm_joint_names!("")` is [`ARM_JOINTS`], `arm_joint_names!(".vel")` names six velocities.
+/// Every list of per-joint names is made with it, so the names are written once.
+macro_rules! arm_joint_names {
+    ($suffix:literal) => {
+        [
+            concat!("shoulder_pan", $suffix),
+            concat!("shoulder_lift", $suffix),
+            concat!("elbow", $suffix),
+            concat!("wrist_1", $suffix),
+            concat!("wrist_2", $suffix),
+            concat!("wrist_3", $suffix),
+        ]
+    };
+}
+pub(crate) use arm_joint_names;
+
 /// Names of the UR5e arm joints, base to wrist (Menagerie names without the `_joint` suffix;
 /// the position actuators carry the same names).
-pub const ARM_JOINTS: [&str; 6] = [
-    "shoulder_pan",
-    "shoulder_lift",
-    "elbow",
-    "wrist_1",
-    "wrist_2",
-    "wrist_3",
-];
+pub const ARM_JOINTS: [&str; 6] = arm_joint_names!("");
+
+/// The name lists `parts` one after the other, as one list of `N` names; a sum of lengths
+/// other than `N` fails the build (the function runs in `const` items).
+pub(crate) const fn joined_names<const N: usize>(parts: &[&[&'static str]]) -> [&'static str; N] {
+    let mut out = [""; N];
+    let (mut k, mut i) = (0, 0);
+    while i < parts.len() {
+        let mut j = 0;
+        while j < parts[i].len() {
+            out[k] = parts[i][j];
+            k += 1;
+            j += 1;
+        }
+        i += 1;
+    }
+    assert!(k == N, "the parts' lengths do not add up to the list's");
+    out
+}
 
 /// Joint limits used by IK and trajectories, radians: the position servos' `ctrlrange` in the
 /// Menagerie UR5e (±6.2831 for every joint, ±3.1415 for the elbow), which is a hair inside the

@@ -2,34 +2,22 @@
 //! LeRobot dataset (`observation.state`, `action`, `observation.environment_state`) and the
 //! step-wise environment's observation.
 
+use crate::motion::ur5e::{arm_joint_names, joined_names};
+
 /// Values in a state vector ([`state_vector`]).
 pub const STATE_LEN: usize = 20;
 
 /// Names of the [`STATE_LEN`] values of a state vector ([`state_vector`]): the UR5e's joint
 /// angles, the gripper closure, the joint velocities, then the pinch frame's position and
 /// orientation. A command vector's are [`crate::motion::COMMAND_NAMES`].
-pub const STATE_NAMES: [&str; STATE_LEN] = [
-    "shoulder_pan",
-    "shoulder_lift",
-    "elbow",
-    "wrist_1",
-    "wrist_2",
-    "wrist_3",
-    "gripper",
-    "shoulder_pan_vel",
-    "shoulder_lift_vel",
-    "elbow_vel",
-    "wrist_1_vel",
-    "wrist_2_vel",
-    "wrist_3_vel",
-    "pinch_x",
-    "pinch_y",
-    "pinch_z",
-    "pinch_qw",
-    "pinch_qx",
-    "pinch_qy",
-    "pinch_qz",
-];
+pub const STATE_NAMES: [&str; STATE_LEN] = joined_names(&[
+    &arm_joint_names!(""),
+    &["gripper"],
+    &arm_joint_names!("_vel"),
+    &[
+        "pinch_x", "pinch_y", "pinch_z", "pinch_qw", "pinch_qx", "pinch_qy", "pinch_qz",
+    ],
+]);
 
 /// What a state vector is made of. Units: radians, rad/s, metres; quaternion `[w, x, y, z]`
 /// in the world frame.
