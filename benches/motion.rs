@@ -16,7 +16,7 @@ use std::time::Duration;
 use macrotree::motion::plan::{Collision, CollisionChecker, GoalSet, PlanFailure, PlannerConfig, plan};
 use macrotree::motion::{HOME_Q, Trajectory, down_pose, ik};
 use macrotree::scene::SceneSpec;
-use macrotree::sim::collision::{DEFAULT_MARGIN, SceneChecker};
+use macrotree::sim::{DEFAULT_MARGIN, SceneChecker};
 use macrotree::sim::{Scene, Sim};
 use nalgebra::{Isometry3, Unit, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};

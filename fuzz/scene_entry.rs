@@ -28,7 +28,7 @@ pub fn load_scene(data: &[u8]) -> Result<SceneSpec, Vec<Diagnostic>> {
                 let drawn = sample_placement(scene, 0x5eed, 3);
                 std::hint::black_box(drawn.map_err(|e| e.to_string()).err());
             }
-            std::hint::black_box(macrotree::sim::mjcf::objects_mjcf(scene));
+            std::hint::black_box(macrotree::sim::objects_mjcf(scene));
             for atom in &scene.goal.atoms {
                 std::hint::black_box(atom.to_string());
             }

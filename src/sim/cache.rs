@@ -233,7 +233,7 @@ pub fn load(dir: &Path, key: &str) -> Option<MjModel> {
     Some(model)
 }
 
-/// Removes the least recently used models of `dir` beyond [`MAX_MODELS`] and [`MAX_BYTES`]
+/// Removes the least recently used models of `dir` beyond [`MAX_MODELS`] and `MAX_BYTES`
 /// (never `keep`), and temporary files whose writer is gone. Returns the models removed.
 pub fn evict(dir: &Path, keep: &Path) -> Vec<PathBuf> {
     crate::cleanup::reclaim(dir, std::ffi::OsStr::new(".model-"), ".tmp", false);

@@ -133,7 +133,7 @@ fn label(m: &MjModel, g: usize) -> String {
 impl SceneChecker {
     /// A checker of `scene` with its current state taken from `data` (a running simulation's
     /// data of the same scene: block, container and obstacle poses, the gripper's opening) and a
-    /// clearance `margin` in metres (0 to [`MAX_MARGIN`]).
+    /// clearance `margin` in metres (0 to `MAX_MARGIN`).
     ///
     /// # Errors
     /// A margin out of range, or `data` not of this scene's model.
@@ -393,7 +393,7 @@ impl SceneChecker {
         self.margin
     }
 
-    /// Sets the clearance margin, metres (0 to [`MAX_MARGIN`]).
+    /// Sets the clearance margin, metres (0 to `MAX_MARGIN`).
     ///
     /// # Errors
     /// A margin out of range (the old one stays).
@@ -541,7 +541,7 @@ impl CollisionChecker for SceneChecker {
 }
 
 impl FastChecks for SceneChecker {
-    /// The [`Screen`]'s verdict ([`Screen::classify`]); `None` when the screen is off or the
+    /// The `Screen`'s verdict (`Screen::classify`); `None` when the screen is off or the
     /// cell has geometry it cannot bound.
     fn screen(&mut self, q: &[f64; 6]) -> Option<bool> {
         if !self.screen_on || !q.iter().all(|v| v.is_finite()) {
@@ -550,13 +550,13 @@ impl FastChecks for SceneChecker {
         self.screen_model()?.classify(q)
     }
 
-    /// The [`Screen`]'s verdict and spare clearance ([`Screen::free_spare`]), settled where the
+    /// The `Screen`'s verdict and spare clearance (`Screen::free_spare`), settled where the
     /// screen cannot tell by measuring its undecided pairs alone with `mj_geomDistance` (the
     /// moving geoms posed from the arm's link frames, `sim::chain::MovingGeoms`): blocked when
     /// one is closer than the margin, else free with their exact clearances in the spare. Every other
     /// pair keeps the margin by the screen's bound, so the verdict is the one a full MuJoCo pass
     /// gives (up to MuJoCo's own tolerances, about 1e-6 m), at a few pairs' cost instead of
-    /// the whole cell's. With a held block beyond [`HELD_BLOCK_REACH`] of the pinch, the
+    /// the whole cell's. With a held block beyond `HELD_BLOCK_REACH` of the pinch, the
     /// screen's verdict alone.
     fn screen_spare(&mut self, q: &[f64; 6], caps: &JointSpare) -> (Option<bool>, JointSpare) {
         if !self.screen_on || !q.iter().all(|v| v.is_finite()) {
@@ -597,8 +597,8 @@ impl FastChecks for SceneChecker {
     }
 
     /// The least distance of the tested pairs (`least_distance`) up to `cap` metres beyond the
-    /// margin, less the margin and [`SPARE_TOLERANCE`], the same for every joint range; `None`
-    /// when a pair is closer than that, and with a held block beyond [`HELD_BLOCK_REACH`] of the
+    /// margin, less the margin and `SPARE_TOLERANCE`, the same for every joint range; `None`
+    /// when a pair is closer than that, and with a held block beyond `HELD_BLOCK_REACH` of the
     /// pinch (see the trait).
     fn exact_spare(&mut self, q: &[f64; 6], cap: f64) -> Option<JointSpare> {
         if !(q.iter().all(|v| v.is_finite()) && cap.is_finite() && cap > 0.0 && self.spare_covered()) {

@@ -1,23 +1,26 @@
 //! The MuJoCo adapter: scene composition, layouts, stepping and world extraction.
 //! Nothing outside this module (and the viewer) touches MuJoCo types.
 
-pub mod cache;
+pub(crate) mod cache;
 mod cell_spec;
 mod chain;
-pub mod collision;
-pub mod collision_model;
-pub mod error;
-pub mod layout;
+pub(crate) mod collision;
+pub(crate) mod collision_model;
+pub(crate) mod error;
+pub(crate) mod layout;
 mod margin;
-pub mod mjcf;
+pub(crate) mod mjcf;
 mod pair_filter;
-pub mod planning;
-pub mod scene;
-pub mod screen;
-pub mod simulator;
+pub(crate) mod planning;
+pub(crate) mod scene;
+pub(crate) mod screen;
+pub(crate) mod simulator;
 
-pub use collision::SceneChecker;
+pub use cache::{MAX_MODELS, evict, model_key, model_key_stamped, model_path};
+pub use collision::{DEFAULT_MARGIN, SceneChecker};
 pub use error::SimError;
 pub use layout::Layout;
-pub use scene::{ARM_PREFIX, ModelOrigin, ObjectIds, Scene};
+pub use mjcf::{cell_mjcf, objects_mjcf};
+pub use planning::{plan_failure, plan_in_cell};
+pub use scene::{ARM_PREFIX, ModelOrigin, ObjectIds, SCENE_XML, Scene, menagerie_dir};
 pub use simulator::{HOME_Q, Sim, TIMESTEP};

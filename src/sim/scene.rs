@@ -35,7 +35,7 @@ pub fn menagerie_dir() -> PathBuf {
     }
 }
 
-pub use super::cell_spec::{ARM_PREFIX, WRIST_CAMERA};
+pub use super::cell_spec::ARM_PREFIX;
 pub use crate::motion::ARM_JOINTS;
 
 /// Indices into the compiled model that the simulator reads every step.
@@ -129,7 +129,7 @@ impl Scene {
     }
 
     /// Compiles `spec` with the Menagerie models found in `menagerie`, or loads the compiled
-    /// model from the cache ([`super::cache::cache_dir`]) when it holds this exact model.
+    /// model from the cache (`cache_dir`) when it holds this exact model.
     pub fn build(spec: &SceneSpec, menagerie: &Path) -> Result<Self, SimError> {
         Self::build_with_cache(spec, menagerie, super::cache::cache_dir().as_deref()).map(|(s, _)| s)
     }
@@ -177,7 +177,7 @@ impl Scene {
     }
 
     /// The model the collision checker copies: this scene's bodies, joints, sites and geoms with
-    /// the same ids, without what only shows ([`super::collision_model`]), compiled on the
+    /// the same ids, without what only shows (`sim::collision_model`), compiled on the
     /// first call and shared by every clone of this scene.
     ///
     /// # Errors

@@ -13,16 +13,16 @@
 mod guard;
 mod http;
 pub mod limits;
-pub mod monitor;
-pub mod observer;
+pub(crate) mod monitor;
+pub(crate) mod observer;
 pub mod page;
-pub mod panel;
+pub(crate) mod panel;
 pub mod proto;
-pub mod record;
+pub(crate) mod record;
 pub mod scene;
 mod server;
 mod slots;
-pub mod tree;
+pub(crate) mod tree;
 
 use std::net::{IpAddr, Ipv4Addr, SocketAddr, TcpListener};
 use std::path::PathBuf;
@@ -35,9 +35,9 @@ use rmpv::Value;
 use tungstenite::Bytes;
 
 pub use limits::ServerLimits;
-pub use monitor::{BreakSpec, BreakWhen, Monitor, MonitorCommand};
+pub use monitor::{BreakSpec, BreakWhen, ForcedRecord, Monitor, MonitorCommand};
 pub use observer::{PUBLISH_HZ, ViewObserver, tree_view};
-pub use panel::TreeNodeView;
+pub use panel::{EVENT_HISTORY, TreeNodeView};
 pub use record::Recorder;
 pub use scene::SceneLayout;
 pub use server::ClientStats;

@@ -215,7 +215,7 @@ impl Monitor {
         self.breakpoints.get(&node).copied()
     }
 
-    /// Sets or clears a breakpoint (at most [`MAX_BREAKPOINTS`]).
+    /// Sets or clears a breakpoint (at most `MAX_BREAKPOINTS`).
     pub fn set_breakpoint(&mut self, node: usize, when: Option<BreakWhen>) {
         match when {
             Some(w) if self.breakpoints.len() < MAX_BREAKPOINTS || self.breakpoints.contains_key(&node) => {

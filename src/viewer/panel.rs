@@ -40,9 +40,6 @@ pub struct TreeNodeView {
     pub source: String,
 }
 
-/// The statuses a node can show.
-pub const STATUSES: [&str; 5] = ["idle", "running", "success", "failure", "halted"];
-
 /// The current value of one blackboard variable, as the panel's table shows it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct BlackboardEntry {
@@ -127,11 +124,6 @@ impl PanelState {
             t: event.get("t").and_then(Value::as_f64).unwrap_or(0.0),
         };
         self.blackboard.insert(var.to_owned(), entry);
-    }
-
-    /// The current blackboard, by variable name.
-    pub fn blackboard(&self) -> impl Iterator<Item = &BlackboardEntry> {
-        self.blackboard.values()
     }
 
     /// The `status` message for a reader that has seen events up to (excluding) `seen`; returns

@@ -44,7 +44,7 @@ pub struct Recorder {
 }
 
 impl Recorder {
-    /// A recorder sampling at [`DEFAULT_FPS`].
+    /// A recorder sampling at `DEFAULT_FPS`.
     pub fn new(model: &MjModel) -> Self {
         Self::with_fps(model, DEFAULT_FPS)
     }

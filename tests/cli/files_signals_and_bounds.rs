@@ -886,7 +886,7 @@ fn sweep_jobs_and_bench_repeat_are_range_checked() {
 
 #[test]
 fn the_model_cache_evicts_the_least_recently_used_and_removes_stale_temporaries() {
-    use macrotree::sim::cache::{MAX_MODELS, evict};
+    use macrotree::sim::{MAX_MODELS, evict};
     let dir = scratch("h3-cache");
     let t0 = std::time::SystemTime::now() - Duration::from_secs(10_000);
     let mut paths = Vec::new();

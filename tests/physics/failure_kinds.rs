@@ -22,9 +22,7 @@ use macrotree::plan::{Loader, Plan};
 use macrotree::runtime::scripted::ScriptedDriver;
 use macrotree::runtime::substitute::{Substitution, resolve};
 use macrotree::runtime::{LeafOutcome, NodeStatus, TreeRunner, TreeStatus};
-use macrotree::sim::collision::SceneChecker;
-use macrotree::sim::planning::{plan_failure, plan_in_cell};
-use macrotree::sim::{Layout, Scene, Sim};
+use macrotree::sim::{Layout, Scene, SceneChecker, Sim, plan_failure, plan_in_cell};
 use macrotree::sweep::{SweepConfig, run_scenario, run_sweep_with};
 use macrotree::world::World;
 use macrotree::{App, Failure, FailureKind, Params};
@@ -579,7 +577,7 @@ fn a_custom_condition_fails_with_its_declared_kind() {
 /// The planner on the real cell (`sim::planning::plan_in_cell`), in `scene` with the arm at home.
 fn planned(scene: &Scene, start: &[f64; 6], goals: &GoalSet, config: &PlannerConfig) -> Failure {
     let sim = Sim::new(scene);
-    let mut checker = SceneChecker::from_sim(&sim, macrotree::sim::collision::DEFAULT_MARGIN).unwrap();
+    let mut checker = SceneChecker::from_sim(&sim, macrotree::sim::DEFAULT_MARGIN).unwrap();
     plan_failure(&plan_in_cell(&mut checker, start, goals, config).expect_err("no motion"))
 }
 

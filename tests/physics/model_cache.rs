@@ -10,9 +10,9 @@ use std::sync::Arc;
 use cli::{s, scratch};
 use macrotree::episode::{EpisodeConfig, EpisodeReport, NoObserver, run_episode};
 use macrotree::scene::SceneSpec;
-use macrotree::sim::cache::{model_key, model_key_stamped, model_path};
-use macrotree::sim::scene::{SCENE_XML, menagerie_dir};
-use macrotree::sim::{ModelOrigin, Scene};
+use macrotree::sim::{
+    ModelOrigin, SCENE_XML, Scene, menagerie_dir, model_key, model_key_stamped, model_path,
+};
 
 fn episode(scene: &Scene) -> EpisodeReport {
     let plan = Arc::new(
@@ -122,11 +122,7 @@ fn a_corrupt_cache_file_is_ignored_and_replaced() {
     let spec = SceneSpec::builtin();
     let (_, origin) = cached(&spec, &dir);
     assert_eq!(origin, ModelOrigin::CompiledAndStored);
-    let key = model_key(
-        &macrotree::sim::mjcf::cell_mjcf(SCENE_XML, &spec),
-        &menagerie_dir(),
-    )
-    .unwrap();
+    let key = model_key(&macrotree::sim::cell_mjcf(SCENE_XML, &spec), &menagerie_dir()).unwrap();
     let path = model_path(&dir, &key);
     let mut bytes = std::fs::read(&path).unwrap();
     let middle = bytes.len() / 2;
@@ -160,7 +156,7 @@ fn a_changed_menagerie_file_changes_the_key() {
     std::os::unix::fs::symlink(real.join("universal_robots_ur5e/LICENSE"), arm.join("LICENSE")).unwrap();
     let xml = std::fs::read_to_string(real.join("universal_robots_ur5e/ur5e.xml")).unwrap();
     std::fs::write(arm.join("ur5e.xml"), &xml).unwrap();
-    let scene = macrotree::sim::mjcf::cell_mjcf(SCENE_XML, &SceneSpec::builtin());
+    let scene = macrotree::sim::cell_mjcf(SCENE_XML, &SceneSpec::builtin());
     let original = model_key(&scene, &real).unwrap();
     assert_eq!(
         model_key(&scene, &dir).unwrap(),

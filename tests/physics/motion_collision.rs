@@ -3,11 +3,10 @@
 
 use std::sync::OnceLock;
 
-use macrotree::motion::plan::{CollisionChecker, GoalSet, PlanFailure, PlannerConfig, edge, plan};
+use macrotree::motion::plan::{CollisionChecker, GoalSet, PlanFailure, PlannerConfig, check_segment, plan};
 use macrotree::motion::{Trajectory, down_pose, fk, ik};
 use macrotree::scene::SceneSpec;
-use macrotree::sim::collision::{DEFAULT_MARGIN, SceneChecker};
-use macrotree::sim::{HOME_Q, Scene, Sim};
+use macrotree::sim::{DEFAULT_MARGIN, HOME_Q, Scene, SceneChecker, Sim};
 use nalgebra::Vector3;
 
 fn cube_bowl() -> &'static Scene {
@@ -166,7 +165,7 @@ fn the_planner_goes_around_the_post_and_every_configuration_on_the_way_is_free()
     assert!(goals.len() >= 4);
     // The direct joint motion to the nearest goal hits the post.
     assert!(
-        edge::check_segment(
+        check_segment(
             &mut c,
             &start,
             &goals.configs[0],
@@ -236,8 +235,8 @@ fn the_check_budget_is_a_hard_deterministic_cap_ending_in_no_path_naming_the_pos
     let again = plan(&mut c, &start, &goals, &config).unwrap_err();
     assert_eq!(again.reason, e.reason);
     // Through the cell's planning entry point it is a typed `no_path` failure.
-    let e = macrotree::sim::planning::plan_in_cell(&mut c, &start, &goals, &config).unwrap_err();
-    let f = macrotree::sim::planning::plan_failure(&e);
+    let e = macrotree::sim::plan_in_cell(&mut c, &start, &goals, &config).unwrap_err();
+    let f = macrotree::sim::plan_failure(&e);
     assert_eq!(f.kind, macrotree::failure::FailureKind::NoPath);
     assert!(f.message.contains("post"), "{}", f.message);
     // With the default budget the same query plans.

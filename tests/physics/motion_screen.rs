@@ -7,8 +7,7 @@
 use macrotree::motion::plan::{CollisionChecker, FastChecks, GoalSet, PlannerConfig, plan};
 use macrotree::motion::{JOINT_LIMITS, down_pose, fk, ik};
 use macrotree::scene::SceneSpec;
-use macrotree::sim::collision::{DEFAULT_MARGIN, SceneChecker};
-use macrotree::sim::{HOME_Q, Scene, Sim};
+use macrotree::sim::{DEFAULT_MARGIN, HOME_Q, Scene, SceneChecker, Sim};
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

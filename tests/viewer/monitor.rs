@@ -456,7 +456,7 @@ fn run_live(
     viewer: LiveViewer,
     breaks: &[BreakSpec],
     goal: Goal,
-) -> std::thread::JoinHandle<(EpisodeReport, Vec<macrotree::viewer::monitor::ForcedRecord>)> {
+) -> std::thread::JoinHandle<(EpisodeReport, Vec<macrotree::viewer::ForcedRecord>)> {
     let breaks = breaks.to_vec();
     std::thread::spawn(move || {
         let mut view = ViewObserver::new(&plan, Some(viewer), None, None);

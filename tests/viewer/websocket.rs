@@ -362,7 +362,7 @@ fn tree_panel_and_capture_replies_travel_as_text_frames() {
     assert_eq!(texts[1]["type"], "status");
     assert_eq!(texts[1]["statuses"], serde_json::json!(["running", "success"]));
     let events = texts[1]["events"].as_array().unwrap();
-    assert_eq!(events.len(), macrotree::viewer::panel::EVENT_HISTORY);
+    assert_eq!(events.len(), macrotree::viewer::EVENT_HISTORY);
     assert_eq!(events.last().unwrap()["event"]["i"], 249);
     // New statuses follow with only the new events.
     v.publish_tree_status_with_attempts(vec!["failure", "halted"], vec![0, 3], vec!["halted".into()]);

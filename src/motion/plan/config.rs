@@ -121,7 +121,7 @@ pub struct PlannerConfig {
     pub limits: JointLimits,
     /// Largest speed of the pinch point along the timed trajectory, m/s (a held block moves
     /// with it): the path speed is capped at every cell boundary of the timing
-    /// ([`CELL`](super::timing::CELL) apart) by this over the pinch's displacement per radian
+    /// (`CELL` apart) by this over the pinch's displacement per radian
     /// of path there. `f64::INFINITY` (the default) leaves the joint limits alone; any other
     /// value must be positive.
     pub tool_speed: f64,

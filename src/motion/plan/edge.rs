@@ -72,7 +72,7 @@ pub fn lerp(a: &[f64; 6], b: &[f64; 6], k: usize, n: usize) -> [f64; 6] {
     q
 }
 
-/// True when every configuration strictly between `a` and `b`, at [`steps`] equal steps of
+/// True when every configuration strictly between `a` and `b`, at `steps` equal steps of
 /// `res`, is free; `a` and `b` themselves are the caller's (checked before). The samples are
 /// visited in bisection order (the middle, then the quarters, …) so a blocked segment is usually
 /// found after few checks; a sample the checker finds free with a reach

@@ -13,34 +13,34 @@
 //!
 //! | module | what |
 //! |---|---|
-//! | [`checker`] | the [`CollisionChecker`] trait, [`Collision`] pairs |
-//! | [`config`] | [`PlannerConfig`], [`JointLimits`], the UR5e's rated speed |
-//! | [`goal`] | [`GoalSet`]: goal configurations from IK branches and symmetric yaws |
-//! | [`edge`] | segments checked at a resolution, in bisection order |
-//! | [`rrt`] | RRT-Connect from a start to a goal set |
-//! | [`shortcut`] | seeded random shortcuts and vertex dropping |
-//! | [`blend`] | corner arcs within a deviation, collision-checked |
-//! | [`timing`] | [`PathTrajectory`]: the smoothed path timed within the joint limits |
-//! | [`reason`] | [`PlanFailure`], [`PlanError`] |
-//! | [`spare`] | [`JointSpare`]: spare clearance by joint range, and how far it reaches |
-//! | [`stats`] | [`PlanStats`] and joint-space distances |
-//! | [`planner`] | [`plan`]: one query, stage by stage |
-//! | [`boxes`] | [`JointBoxes`]: obstacles as boxes in joint space, for tests and benchmarks |
+//! | `checker` | the [`CollisionChecker`] trait, [`Collision`] pairs |
+//! | `config` | [`PlannerConfig`], [`JointLimits`], the UR5e's rated speed |
+//! | `goal` | [`GoalSet`]: goal configurations from IK branches and symmetric yaws |
+//! | `edge` | segments checked at a resolution, in bisection order |
+//! | `rrt` | RRT-Connect from a start to a goal set |
+//! | `shortcut` | seeded random shortcuts and vertex dropping |
+//! | `blend` | corner arcs within a deviation, collision-checked |
+//! | `timing` | [`PathTrajectory`]: the smoothed path timed within the joint limits |
+//! | `reason` | [`PlanFailure`], [`PlanError`] |
+//! | `spare` | [`JointSpare`]: spare clearance by joint range, and how far it reaches |
+//! | `stats` | [`PlanStats`] and joint-space distances |
+//! | `planner` | [`plan`]: one query, stage by stage |
+//! | `boxes` | [`JointBoxes`]: obstacles as boxes in joint space, for tests and benchmarks |
 
-pub mod blend;
-pub mod boxes;
-pub mod checker;
-pub mod config;
-pub mod edge;
-pub mod goal;
-pub mod planner;
-pub mod reason;
+pub(crate) mod blend;
+pub(crate) mod boxes;
+pub(crate) mod checker;
+pub(crate) mod config;
+pub(crate) mod edge;
+pub(crate) mod goal;
+pub(crate) mod planner;
+pub(crate) mod reason;
 mod rng;
-pub mod rrt;
-pub mod shortcut;
-pub mod spare;
-pub mod stats;
-pub mod timing;
+pub(crate) mod rrt;
+pub(crate) mod shortcut;
+pub(crate) mod spare;
+pub(crate) mod stats;
+pub(crate) mod timing;
 
 #[cfg(test)]
 mod tests;
@@ -48,6 +48,7 @@ mod tests;
 pub use boxes::{JointBox, JointBoxes};
 pub use checker::{Collision, CollisionChecker, FastChecks};
 pub use config::{JointLimits, PlannerConfig};
+pub use edge::{Resolution, check_segment};
 pub use goal::GoalSet;
 pub use planner::{PlannedMotion, plan};
 pub use reason::{PlanError, PlanFailure, SearchBudget};

@@ -49,7 +49,7 @@ fn in_bounds(q: &[f64; 6], config: &PlannerConfig) -> bool {
 /// Stages: the start is checked (else [`PlanFailure::StartInCollision`] naming the pairs); goals
 /// outside `config.bounds` or in collision are dropped (none left: [`PlanFailure::NoGoal`] or
 /// [`PlanFailure::GoalInCollision`] naming what blocks them); the straight segment to each free
-/// goal at most [`DIRECT_SLACK`] times as far as the nearest, in the set's order, is tried first; otherwise RRT-Connect searches towards all free goals
+/// goal at most `DIRECT_SLACK` times as far as the nearest, in the set's order, is tried first; otherwise RRT-Connect searches towards all free goals
 /// at once (out of iterations: [`PlanFailure::SearchExhausted`] naming what blocked it most).
 /// The path is then shortcut, its corners blended, and timed within `config.limits`. Every
 /// configuration the arm passes through was checked, at the edge resolution
