@@ -440,11 +440,11 @@ fn distance_at_most(x: &Shape, y: &Shape) -> f64 {
         let (i, sign) = (face / 2, if face % 2 == 0 { -1.0 } else { 1.0 });
         for u in 0..=8 {
             for v in 0..=8 {
-                let mut s = [0.0; 3];
+                let mut s = Vector3::zeros();
                 s[i] = sign * half[i];
                 s[(i + 1) % 3] = half[(i + 1) % 3] * (u as f64 / 4.0 - 1.0);
                 s[(i + 2) % 3] = half[(i + 2) % 3] * (v as f64 / 4.0 - 1.0);
-                let p: [f64; 3] = std::array::from_fn(|k| {
+                let p = Vector3::from_fn(|k, _| {
                     center[k] + axes[0][k] * s[0] + axes[1][k] * s[1] + axes[2][k] * s[2]
                 });
                 let point = Shape::Capsule {

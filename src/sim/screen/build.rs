@@ -60,7 +60,7 @@ impl Screen {
                     Some(GeomShape::Plane) => {
                         let n = gr.column(2).into_owned();
                         Shape::HalfSpace {
-                            normal: [n.x, n.y, n.z],
+                            normal: n,
                             offset: n.dot(&gt),
                         }
                     }

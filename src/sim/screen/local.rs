@@ -46,8 +46,8 @@ impl Local {
             Local::Capsule { a, b, radius } => {
                 let (a, b) = (r * a + t, r * b + t);
                 Shape::Capsule {
-                    a: [a.x, a.y, a.z],
-                    b: [b.x, b.y, b.z],
+                    a,
+                    b,
                     radius: *radius,
                 }
             }
@@ -55,11 +55,11 @@ impl Local {
                 let c = r * center + t;
                 let m = r * axes;
                 Shape::Box {
-                    center: [c.x, c.y, c.z],
+                    center: c,
                     axes: [
-                        [m[(0, 0)], m[(1, 0)], m[(2, 0)]],
-                        [m[(0, 1)], m[(1, 1)], m[(2, 1)]],
-                        [m[(0, 2)], m[(1, 2)], m[(2, 2)]],
+                        m.column(0).into_owned(),
+                        m.column(1).into_owned(),
+                        m.column(2).into_owned(),
                     ],
                     half: *half,
                 }
@@ -114,12 +114,12 @@ pub(super) fn geom_local(m: &MjModel, g: usize) -> Option<GeomShape> {
         MjtGeomBase::mjGEOM_BOX => GeomShape::Solid(Local::Box {
             center: Vector3::zeros(),
             axes: Matrix3::identity(),
-            half: size,
+            half: Vector3::from(size),
         }),
         MjtGeomBase::mjGEOM_MESH | MjtGeomBase::mjGEOM_ELLIPSOID => GeomShape::Solid(Local::Box {
             center: Vector3::new(aabb[0], aabb[1], aabb[2]),
             axes: Matrix3::identity(),
-            half: [aabb[3], aabb[4], aabb[5]],
+            half: Vector3::new(aabb[3], aabb[4], aabb[5]),
         }),
         _ => return None,
     })

@@ -2,7 +2,7 @@
 //! frames, and the scratch that poses them once per set of link frames.
 
 use super::local::Local;
-use super::shapes::{Shape, Sphere};
+use super::shapes::{Shape, Sphere, V3};
 use crate::sim::chain::Frame;
 
 /// A shape in the world with its bounding sphere (`None`: a half-space).
@@ -30,7 +30,7 @@ impl Posing {
     pub(super) fn new(n: usize) -> Self {
         let none = Posed {
             shape: Shape::HalfSpace {
-                normal: [0.0; 3],
+                normal: V3::zeros(),
                 offset: 0.0,
             },
             sphere: None,
@@ -93,7 +93,9 @@ impl MovingShape {
         let Frame { rot, pos } = &frames[self.link];
         let shape = self.local.posed(rot, pos);
         let centre = match &shape {
-            Shape::Capsule { a, b, .. } => [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0, (a[2] + b[2]) / 2.0],
+            Shape::Capsule { a, b, .. } => {
+                V3::new((a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0, (a[2] + b[2]) / 2.0)
+            }
             Shape::Box { center, .. } => *center,
             // Never: a local primitive poses as a capsule or a box.
             Shape::HalfSpace { .. } => {

@@ -105,8 +105,5 @@ pub(super) fn link_sphere<'a>(shapes: impl Iterator<Item = &'a Local> + Clone) -
     let radius = shapes
         .map(|l| (l.centre() - mid).norm() + l.reach())
         .fold(0.0, f64::max);
-    Some(Sphere {
-        centre: [mid.x, mid.y, mid.z],
-        radius,
-    })
+    Some(Sphere { centre: mid, radius })
 }

@@ -18,7 +18,7 @@ fn a_link_sphere_contains_every_shape_of_the_link() {
         Local::Box {
             center: Vector3::new(0.2, -0.1, 0.0),
             axes: Matrix3::identity(),
-            half: [0.02, 0.03, 0.04],
+            half: Vector3::new(0.02, 0.03, 0.04),
         },
     ];
     let Some(Sphere { centre, radius: r }) = link_sphere(shapes.iter()) else {
@@ -46,15 +46,14 @@ fn a_link_capsule_contains_every_shape_of_the_link() {
         Local::Box {
             center: Vector3::new(0.05, -0.04, 0.2),
             axes: Matrix3::new(0.8, -0.6, 0.0, 0.6, 0.8, 0.0, 0.0, 0.0, 1.0),
-            half: [0.02, 0.03, 0.04],
+            half: Vector3::new(0.02, 0.03, 0.04),
         },
     ];
     let Some(Local::Capsule { a, b, radius }) = link_capsule(shapes.iter()) else {
         panic!("a capsule");
     };
-    let (a, b) = ([a.x, a.y, a.z], [b.x, b.y, b.z]);
     // Every shape's extreme points, and the capsule's surface points around its ends.
-    let to_axis = |p: &Vector3<f64>| segment_segment_dist2(&a, &b, &[p.x, p.y, p.z], &[p.x, p.y, p.z]).sqrt();
+    let to_axis = |p: &Vector3<f64>| segment_segment_dist2(&a, &b, p, p).sqrt();
     let mut points: Vec<(Vector3<f64>, f64)> = Vec::new();
     if let Local::Capsule { a, b, radius } = &shapes[0] {
         for k in 0..=20 {
@@ -78,9 +77,13 @@ fn a_link_capsule_contains_every_shape_of_the_link() {
 #[test]
 fn a_sphere_kept_from_a_box_is_not_near_it() {
     let b = Shape::Box {
-        center: [0.5, 0.0, 0.2],
-        axes: [[0.8, 0.6, 0.0], [-0.6, 0.8, 0.0], [0.0, 0.0, 1.0]],
-        half: [0.1, 0.05, 0.2],
+        center: Vector3::new(0.5, 0.0, 0.2),
+        axes: [
+            Vector3::new(0.8, 0.6, 0.0),
+            Vector3::new(-0.6, 0.8, 0.0),
+            Vector3::new(0.0, 0.0, 1.0),
+        ],
+        half: Vector3::new(0.1, 0.05, 0.2),
     };
     let gap = 0.0055;
     let mut apart = 0;
@@ -89,11 +92,11 @@ fn a_sphere_kept_from_a_box_is_not_near_it() {
     for i in 0..20 {
         for j in 0..20 {
             for k in 0..10 {
-                let c = [
+                let c = Vector3::new(
                     0.2 + 0.03 * i as f64,
                     -0.3 + 0.03 * j as f64,
                     0.05 * k as f64 - 0.1,
-                ];
+                );
                 let r = 0.02;
                 let s = Shape::Capsule {
                     a: c,
@@ -110,12 +113,12 @@ fn a_sphere_kept_from_a_box_is_not_near_it() {
     assert!(apart > 1000, "{apart}");
     // Not a box: never apart by this test.
     let h = Shape::HalfSpace {
-        normal: [0.0, 0.0, 1.0],
+        normal: Vector3::new(0.0, 0.0, 1.0),
         offset: 0.0,
     };
     assert!(
         !Sphere {
-            centre: [0.0, 0.0, 5.0],
+            centre: Vector3::new(0.0, 0.0, 5.0),
             radius: 0.1
         }
         .keeps_from_box(&h, gap)

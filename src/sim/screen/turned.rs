@@ -27,14 +27,13 @@ pub(super) struct Places {
 
 /// Where `shape` (world frame, metres) lies about the axis through `o` along the unit `u`.
 fn about_axis(shape: &Shape, o: &Vector3<f64>, u: &Vector3<f64>) -> AxialPlace {
-    let height = |p: &V3| (Vector3::from(*p) - o).dot(u);
+    let height = |p: &V3| (p - o).dot(u);
     let off = |p: &V3| {
-        let d = Vector3::from(*p) - o;
+        let d = p - o;
         (d - u * d.dot(u)).norm()
     };
     // The axis as a segment far longer than the cell, for the distance from the line.
     let (l0, l1) = (o - u * 100.0, o + u * 100.0);
-    let (l0, l1) = ([l0.x, l0.y, l0.z], [l1.x, l1.y, l1.z]);
     match shape {
         Shape::Capsule { a, b, radius } => {
             let (ha, hb) = (height(a), height(b));
@@ -48,9 +47,8 @@ fn about_axis(shape: &Shape, o: &Vector3<f64>, u: &Vector3<f64>) -> AxialPlace {
             let (mut h, mut r) = ([f64::INFINITY, f64::NEG_INFINITY], 0.0f64);
             for k in 0..8 {
                 let s = |i: usize| if k >> i & 1 == 0 { -half[i] } else { half[i] };
-                let c: V3 = std::array::from_fn(|x| {
-                    center[x] + axes[0][x] * s(0) + axes[1][x] * s(1) + axes[2][x] * s(2)
-                });
+                let c =
+                    V3::from_fn(|x, _| center[x] + axes[0][x] * s(0) + axes[1][x] * s(1) + axes[2][x] * s(2));
                 h = [h[0].min(height(&c)), h[1].max(height(&c))];
                 r = r.max(off(&c));
             }

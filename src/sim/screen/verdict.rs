@@ -183,12 +183,9 @@ impl Screen {
     /// without shapes).
     fn world_spheres(&self, frames: &[Frame; 6]) -> [Option<Sphere>; 6] {
         std::array::from_fn(|k| {
-            self.link_spheres[k].map(|s| {
-                let w = frames[k].rot * nalgebra::Vector3::from(s.centre) + frames[k].pos;
-                Sphere {
-                    centre: [w.x, w.y, w.z],
-                    radius: s.radius,
-                }
+            self.link_spheres[k].map(|s| Sphere {
+                centre: frames[k].rot * s.centre + frames[k].pos,
+                radius: s.radius,
             })
         })
     }

@@ -8,7 +8,8 @@
 //! axes). The screen's questions are asked of that one measure: whether two primitives may come
 //! closer than a distance ([`Separation::near`], erring towards "near"), whether they surely do
 //! ([`Separation::within`], erring towards "not"), and a lower bound on their distance
-//! ([`Separation::clearance`]). Plain `[f64; 3]` arithmetic, no allocation.
+//! ([`Separation::clearance`]). Component-wise arithmetic on nalgebra's `Vector3` (the one
+//! vector type of the screen and the arm chain), no allocation.
 
 mod boxes;
 mod segment_box;
@@ -20,21 +21,21 @@ pub(crate) use segment_box::segment_box_dist2;
 pub(crate) use segments::segment_segment_dist2;
 
 /// A point or direction in metres (world or local frame, as documented at each use).
-pub(crate) type V3 = [f64; 3];
+pub(crate) type V3 = nalgebra::Vector3<f64>;
 
 #[inline]
 fn sub(a: &V3, b: &V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+    V3::new(a.x - b.x, a.y - b.y, a.z - b.z)
 }
 
 #[inline]
 fn dot(a: &V3, b: &V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+    a.x * b.x + a.y * b.y + a.z * b.z
 }
 
 #[inline]
 fn axpy(s: f64, a: &V3, b: &V3) -> V3 {
-    [b[0] + s * a[0], b[1] + s * a[1], b[2] + s * a[2]]
+    V3::new(b.x + s * a.x, b.y + s * a.y, b.z + s * a.z)
 }
 
 /// A convex primitive posed in the world.
@@ -82,7 +83,7 @@ impl Shape {
     pub(crate) fn bounding_sphere(&self) -> Option<Sphere> {
         match self {
             Shape::Capsule { a, b, radius } => {
-                let c = [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0, (a[2] + b[2]) / 2.0];
+                let c = V3::new((a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0, (a[2] + b[2]) / 2.0);
                 let h = dot(&sub(b, a), &sub(b, a)).sqrt() / 2.0;
                 Some(Sphere {
                     centre: c,
@@ -199,7 +200,7 @@ impl Separation<'_> {
                 x: (c1, a1, h1),
                 y: (c2, a2, h2),
             } => {
-                let inflated = [h1[0] + gap, h1[1] + gap, h1[2] + gap];
+                let inflated = V3::new(h1[0] + gap, h1[1] + gap, h1[2] + gap);
                 boxes::boxes_overlap(c1, a1, &inflated, c2, a2, h2)
             }
             Separation::Overlapping => true,
@@ -228,7 +229,7 @@ impl Separation<'_> {
     /// A lower bound on the distance, metres (0 when they may touch, and for two half-spaces):
     /// exact but for two boxes, bounded there by the widest gap of their projections on the six
     /// face axes (every separating projection bounds the distance from below).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn clearance(&self) -> f64 {
         let d = match *self {
             Separation::Cores { d2, radii } => d2.sqrt() - radii,

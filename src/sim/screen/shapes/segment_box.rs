@@ -43,8 +43,8 @@ pub(super) fn piece_minimum(a: &V3, d: &V3, half: &V3, m: &V3) -> (f64, f64) {
 pub(crate) fn segment_box_dist2(p: &V3, q: &V3, center: &V3, axes: &[V3; 3], half: &V3) -> f64 {
     let rp = sub(p, center);
     let rq = sub(q, center);
-    let a = [dot(&axes[0], &rp), dot(&axes[1], &rp), dot(&axes[2], &rp)];
-    let b = [dot(&axes[0], &rq), dot(&axes[1], &rq), dot(&axes[2], &rq)];
+    let a = V3::new(dot(&axes[0], &rp), dot(&axes[1], &rp), dot(&axes[2], &rp));
+    let b = V3::new(dot(&axes[0], &rq), dot(&axes[1], &rq), dot(&axes[2], &rq));
     let d = sub(&b, &a);
     // The interior break points, where a coordinate crosses ±h, in order (insertion).
     let mut ts = [0.0f64; 6];
@@ -65,7 +65,7 @@ pub(crate) fn segment_box_dist2(p: &V3, q: &V3, center: &V3, axes: &[V3; 3], hal
             }
         }
     }
-    let at = |t: f64| [a[0] + d[0] * t, a[1] + d[1] * t, a[2] + d[2] * t];
+    let at = |t: f64| V3::new(a[0] + d[0] * t, a[1] + d[1] * t, a[2] + d[2] * t);
     let mut t0 = 0.0;
     for &t1 in ts[..n].iter().chain(&[1.0]) {
         if t1 <= t0 {

@@ -22,7 +22,11 @@ fn beyond(x: &Shape, y: &Shape, d: f64) -> bool {
     surely_beyond(x, y, d)
 }
 
-const I: [V3; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+const I: [V3; 3] = [
+    V3::new(1.0, 0.0, 0.0),
+    V3::new(0.0, 1.0, 0.0),
+    V3::new(0.0, 0.0, 1.0),
+];
 
 fn rot(r: &mut ChaCha8Rng) -> [V3; 3] {
     let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
@@ -34,18 +38,18 @@ fn rot(r: &mut ChaCha8Rng) -> [V3; 3] {
     let m = q.to_rotation_matrix();
     let m = m.matrix();
     [
-        [m[(0, 0)], m[(1, 0)], m[(2, 0)]],
-        [m[(0, 1)], m[(1, 1)], m[(2, 1)]],
-        [m[(0, 2)], m[(1, 2)], m[(2, 2)]],
+        V3::new(m[(0, 0)], m[(1, 0)], m[(2, 0)]),
+        V3::new(m[(0, 1)], m[(1, 1)], m[(2, 1)]),
+        V3::new(m[(0, 2)], m[(1, 2)], m[(2, 2)]),
     ]
 }
 
 fn v(r: &mut ChaCha8Rng, s: f64) -> V3 {
-    [
+    V3::new(
         r.random_range(-s..s),
         r.random_range(-s..s),
         r.random_range(-s..s),
-    ]
+    )
 }
 
 /// Points of a box, dense on its surface.
@@ -55,11 +59,11 @@ fn box_points(c: &V3, axes: &[V3; 3], h: &V3) -> Vec<V3> {
     for i in 0..=n {
         for j in 0..=n {
             for k in 0..=n {
-                let s = [
+                let s = V3::new(
                     -h[0] + 2.0 * h[0] * i as f64 / n as f64,
                     -h[1] + 2.0 * h[1] * j as f64 / n as f64,
                     -h[2] + 2.0 * h[2] * k as f64 / n as f64,
-                ];
+                );
                 let mut p = *c;
                 for a in 0..3 {
                     p = axpy(s[a], &axes[a], &p);
@@ -74,11 +78,11 @@ fn box_points(c: &V3, axes: &[V3; 3], h: &V3) -> Vec<V3> {
 /// A seeded oriented box: axes, half extents 1–20 cm, centre within 10 cm of the origin.
 fn random_box(r: &mut ChaCha8Rng) -> ([V3; 3], V3, V3) {
     let axes = rot(r);
-    let h = [
+    let h = V3::new(
         r.random_range(0.01..0.2),
         r.random_range(0.01..0.2),
         r.random_range(0.01..0.2),
-    ];
+    );
     (axes, h, v(r, 0.1))
 }
 
@@ -95,7 +99,7 @@ fn segment_box_distance_is_exact_against_dense_sampling() {
         for k in 0..=2000 {
             let x = axpy(k as f64 / 2000.0, &sub(&q, &p), &p);
             let rx = sub(&x, &c);
-            let l = [dot(&axes[0], &rx), dot(&axes[1], &rx), dot(&axes[2], &rx)];
+            let l = V3::new(dot(&axes[0], &rx), dot(&axes[1], &rx), dot(&axes[2], &rx));
             sampled = sampled.min(point_box_dist2(&l, &h).sqrt());
         }
         assert!(exact <= sampled + 1e-12, "{exact} > {sampled}");
@@ -107,8 +111,8 @@ fn segment_box_distance_is_exact_against_dense_sampling() {
 /// and both ends: the walk's reference, without its early stop.
 fn every_piece(p: &V3, q: &V3, center: &V3, axes: &[V3; 3], half: &V3) -> f64 {
     let (rp, rq) = (sub(p, center), sub(q, center));
-    let a = [dot(&axes[0], &rp), dot(&axes[1], &rp), dot(&axes[2], &rp)];
-    let b = [dot(&axes[0], &rq), dot(&axes[1], &rq), dot(&axes[2], &rq)];
+    let a = V3::new(dot(&axes[0], &rp), dot(&axes[1], &rp), dot(&axes[2], &rp));
+    let b = V3::new(dot(&axes[0], &rq), dot(&axes[1], &rq), dot(&axes[2], &rq));
     let d = sub(&b, &a);
     let mut ts = vec![0.0, 1.0];
     for i in 0..3 {
@@ -122,7 +126,7 @@ fn every_piece(p: &V3, q: &V3, center: &V3, axes: &[V3; 3], half: &V3) -> f64 {
         }
     }
     ts.sort_by(f64::total_cmp);
-    let at = |t: f64| [a[0] + d[0] * t, a[1] + d[1] * t, a[2] + d[2] * t];
+    let at = |t: f64| V3::new(a[0] + d[0] * t, a[1] + d[1] * t, a[2] + d[2] * t);
     let mut best = point_box_dist2(&a, half).min(point_box_dist2(&b, half));
     for w in ts.windows(2) {
         let (t0, t1) = (w[0], w[1]);
@@ -188,13 +192,13 @@ fn the_quick_capsule_box_bound_never_exceeds_the_clearance() {
     assert!(apart > 200 && said > apart, "{said} {apart}");
     // Other pairs: no quick bound.
     let ball = Shape::Capsule {
-        a: [0.0; 3],
-        b: [0.0; 3],
+        a: V3::repeat(0.0),
+        b: V3::repeat(0.0),
         radius: 0.01,
     };
     let far = Shape::Capsule {
-        a: [5.0, 0.0, 0.0],
-        b: [5.0, 0.0, 0.0],
+        a: V3::new(5.0, 0.0, 0.0),
+        b: V3::new(5.0, 0.0, 0.0),
         radius: 0.01,
     };
     assert!(!beyond(&ball, &far, 0.0));
@@ -226,16 +230,16 @@ fn boxes_that_share_a_point_overlap_and_separated_ones_do_not() {
     let (mut hits, mut misses) = (0, 0);
     for _ in 0..400 {
         let (a1, a2) = (rot(&mut r), rot(&mut r));
-        let h1 = [
+        let h1 = V3::new(
             r.random_range(0.02..0.1),
             r.random_range(0.02..0.1),
             r.random_range(0.02..0.1),
-        ];
-        let h2 = [
+        );
+        let h2 = V3::new(
             r.random_range(0.02..0.1),
             r.random_range(0.02..0.1),
             r.random_range(0.02..0.1),
-        ];
+        );
         let (c1, c2) = (v(&mut r, 0.1), v(&mut r, 0.1));
         // A point of box 2 inside box 1 proves overlap.
         let inside = box_points(&c2, &a2, &h2).iter().any(|p| {
@@ -260,28 +264,28 @@ fn boxes_that_share_a_point_overlap_and_separated_ones_do_not() {
 #[test]
 fn near_inflates_by_the_gap() {
     let cap = Shape::Capsule {
-        a: [0.0, 0.0, 0.1],
-        b: [0.0, 0.0, 0.3],
+        a: V3::new(0.0, 0.0, 0.1),
+        b: V3::new(0.0, 0.0, 0.3),
         radius: 0.05,
     };
     let floor = Shape::HalfSpace {
-        normal: [0.0, 0.0, 1.0],
+        normal: V3::new(0.0, 0.0, 1.0),
         offset: 0.0,
     };
     assert!(!near(&cap, &floor, 0.04));
     assert!(near(&cap, &floor, 0.051));
     let block = Shape::Box {
-        center: [0.2, 0.0, 0.2],
+        center: V3::new(0.2, 0.0, 0.2),
         axes: I,
-        half: [0.05; 3],
+        half: V3::repeat(0.05),
     };
     // Capsule surface at x = 0.05, box face at x = 0.15: 10 cm apart.
     assert!(!near(&cap, &block, 0.099));
     assert!(near(&cap, &block, 0.101));
     let pad = Shape::Box {
-        center: [0.0, 0.0, 0.2],
+        center: V3::new(0.0, 0.0, 0.2),
         axes: I,
-        half: [0.05; 3],
+        half: V3::repeat(0.05),
     };
     assert!(!near(&pad, &block, 0.099));
     assert!(near(&pad, &block, 0.101));
@@ -292,9 +296,9 @@ fn near_inflates_by_the_gap() {
     assert!(within(&cap, &floor, 0.051) && !within(&cap, &floor, 0.049));
     assert!(!within(&pad, &block, 0.101), "two boxes apart: no answer");
     let inside = Shape::Box {
-        center: [0.21, 0.0, 0.2],
+        center: V3::new(0.21, 0.0, 0.2),
         axes: I,
-        half: [0.05; 3],
+        half: V3::repeat(0.05),
     };
     assert!(within(&inside, &block, 0.001) && !within(&inside, &block, 0.0));
 }
@@ -332,11 +336,11 @@ fn clearance_never_exceeds_the_sampled_distance_and_is_exact_where_documented() 
             Shape::Box {
                 center: v(r, 0.15),
                 axes: rot(r),
-                half: [
+                half: V3::new(
                     r.random_range(0.01..0.08),
                     r.random_range(0.01..0.08),
                     r.random_range(0.01..0.08),
-                ],
+                ),
             }
         } else {
             Shape::Capsule {
@@ -372,19 +376,19 @@ fn clearance_never_exceeds_the_sampled_distance_and_is_exact_where_documented() 
     }
     assert!(apart > 60 && tight > 20, "{apart} {tight}");
     let floor = Shape::HalfSpace {
-        normal: [0.0, 0.0, 1.0],
+        normal: V3::new(0.0, 0.0, 1.0),
         offset: 0.0,
     };
     let cube = Shape::Box {
-        center: [0.3, 0.0, 0.07],
+        center: V3::new(0.3, 0.0, 0.07),
         axes: I,
-        half: [0.02; 3],
+        half: V3::repeat(0.02),
     };
     assert!((clearance(&cube, &floor) - 0.05).abs() < 1e-12);
     let far = Shape::Box {
-        center: [0.5, 0.0, 0.07],
+        center: V3::new(0.5, 0.0, 0.07),
         axes: I,
-        half: [0.02; 3],
+        half: V3::repeat(0.02),
     };
     assert!((clearance(&cube, &far) - 0.16).abs() < 1e-12);
     assert_eq!(clearance(&floor, &floor), 0.0);
