@@ -101,7 +101,7 @@ macro_rules! planning_leaf {
                 deserialize_with = "units::opt_plan_time_cap",
                 skip_serializing_if = "Option::is_none"
             )]
-            #[schemars(range(min = units::PLAN_TIME_CAP_RANGE.0, max = units::PLAN_TIME_CAP_RANGE.1))]
+            #[schemars(range(min = units::PLAN_TIME_CAP_RANGE.lo, max = units::PLAN_TIME_CAP_RANGE.hi))]
             pub plan_time_cap: Option<f64>,
         }
 

@@ -10,15 +10,19 @@ use serde::Deserialize;
 use super::color::Color;
 use super::goal::Goal;
 use super::goal_read::{GoalRaw, Rejected, read_goal};
+use super::limits::{
+    BASE_HEIGHT, BLOCK_EDGE, BLOCK_FRICTION, BLOCK_MASS, CLEARANCE, CONTAINER_INNER, OBSTACLE_HEIGHT,
+    OBSTACLE_SIDE, WALL_HEIGHT,
+};
 use super::object_name::is_object_name;
 use super::sample::{Placement, sample_placement};
 use super::types::{ObjectKind, ObjectSpec, Pose, RandomPlacement, Sampler, SceneSpec, Shape};
-use crate::yaml::TablePose;
 use crate::yaml::de::from_value;
 use crate::yaml::diag::{Diagnostic, Issue, Loc, Sources};
 use crate::yaml::suggest::did_you_mean;
 use crate::yaml::units::Angle;
 use crate::yaml::value::{Value, decode_utf8, parse_yaml};
+use crate::yaml::{Bounds, TablePose};
 
 /// The built-in scene `cube_bowl` (the reference tutorial's cell), used when a tree names no
 /// scene. The same text as `scenes/cube_bowl.yaml`.
@@ -29,9 +33,6 @@ pub const MAX_OBJECTS: usize = 16;
 
 /// Keys allowed at the top level of a scene file.
 const TOP_LEVEL_KEYS: &[&str] = &["description", "objects", "goal", "sampler", "spots", "regions"];
-
-/// Highest base of a container or an obstacle above the table (`z:`), metres.
-pub const MAX_Z: f64 = 0.6;
 
 fn d_mass() -> f64 {
     0.05
@@ -54,16 +55,16 @@ fn d_orange() -> Color {
 #[serde(deny_unknown_fields)]
 pub struct BlockRaw {
     /// Edge length, metres (0.02 … 0.07: the 2F-85 opens 0.085 m).
-    #[schemars(range(min = 0.02, max = 0.07))]
+    #[schemars(range(min = BLOCK_EDGE.lo, max = BLOCK_EDGE.hi))]
     size: f64,
     /// Mass, kg (0.005 … 0.5). Default 0.05.
     #[serde(default = "d_mass")]
-    #[schemars(range(min = 0.005, max = 0.5))]
+    #[schemars(range(min = BLOCK_MASS.lo, max = BLOCK_MASS.hi))]
     mass: f64,
     /// Sliding friction coefficient (0.5 … 2: below 0.5 the 2F-85's pads cannot hold a block
     /// through a fast carry). Default 1.0.
     #[serde(default = "d_friction")]
-    #[schemars(range(min = 0.5, max = 2.0))]
+    #[schemars(range(min = BLOCK_FRICTION.lo, max = BLOCK_FRICTION.hi))]
     friction: f64,
     /// Colour name or `[r, g, b, a]`. Default orange.
     #[serde(default = "d_orange")]
@@ -74,11 +75,11 @@ pub struct BlockRaw {
 #[derive(Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ContainerRaw {
-    /// Free space inside the walls `[x, y]`, metres (each 0.06 … 0.40).
+    /// Free space inside the walls `[x, y]`, metres (each 0.06 … 0.4).
     inner: [f64; 2],
     /// Height of the rim above the table, metres (0.02 … 0.12). Default 0.06.
     #[serde(default = "d_wall_height")]
-    #[schemars(range(min = 0.02, max = 0.12))]
+    #[schemars(range(min = WALL_HEIGHT.lo, max = WALL_HEIGHT.hi))]
     wall_height: f64,
     /// Colour name or `[r, g, b, a]`. Default gray.
     #[serde(default = "d_gray")]
@@ -89,7 +90,7 @@ pub struct ContainerRaw {
 #[derive(Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ObstacleRaw {
-    /// Size `[x, y, z]`, metres (x, y: 0.01 … 0.5; z: 0.01 … 1.0, a post or a fixture).
+    /// Size `[x, y, z]`, metres (x, y: 0.01 … 0.5; z: 0.01 … 1, a post or a fixture).
     size: [f64; 3],
     /// Colour name or `[r, g, b, a]`. Default gray.
     #[serde(default = "d_gray")]
@@ -109,6 +110,7 @@ pub struct RandomRaw {
     /// Smallest gap to every other object's footprint (and to the walls of the container a
     /// block is drawn in), metres (0 … 0.5). Default 0.01.
     #[serde(default = "d_clearance")]
+    #[schemars(range(min = CLEARANCE.lo, max = CLEARANCE.hi))]
     clearance: f64,
     /// A block only: draw it on the floor of this container, inside the walls (no `x`/`y`).
     #[serde(rename = "in")]
@@ -152,6 +154,7 @@ pub struct ObjectRaw {
     random: Option<RandomRaw>,
     /// A container or obstacle only: height of its base above the table, metres (0 … 0.6).
     /// Default 0 (standing on the table).
+    #[schemars(range(min = BASE_HEIGHT.lo, max = BASE_HEIGHT.hi))]
     z: Option<f64>,
     /// A block only: what it rests on — a container (on its floor), an obstacle or another
     /// block (on its top). Its height follows; its `pose:` stays in world coordinates.
@@ -495,20 +498,20 @@ fn check_range(
     v: &Value,
     path: &[&str],
     x: f64,
-    lo: f64,
-    hi: f64,
+    bounds: Bounds,
     what: &str,
     issues: &mut Vec<Issue>,
 ) -> bool {
-    if x.is_finite() && (lo..=hi).contains(&x) {
+    if bounds.contains(x) {
         return true;
     }
+    let range = bounds.text();
     issues.push(
         Issue::new(
             v.loc_at(path),
-            format!("{what} must be within {lo} … {hi}, found {x}"),
+            format!("{what} must be within {range}, found {x}"),
         )
-        .label(format!("expected {lo} … {hi}")),
+        .label(format!("expected {range}")),
     );
     false
 }
@@ -544,8 +547,7 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
             body,
             &["block", "size"],
             b.size,
-            0.02,
-            0.07,
+            BLOCK_EDGE,
             "a block's edge (m)",
             issues,
         );
@@ -553,8 +555,7 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
             body,
             &["block", "mass"],
             b.mass,
-            0.005,
-            0.5,
+            BLOCK_MASS,
             "a block's mass (kg)",
             issues,
         );
@@ -562,8 +563,7 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
             body,
             &["block", "friction"],
             b.friction,
-            0.5,
-            2.0,
+            BLOCK_FRICTION,
             "a block's friction",
             issues,
         );
@@ -581,8 +581,7 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
                 body,
                 &["container", "inner"],
                 *x,
-                0.06,
-                0.40,
+                CONTAINER_INNER,
                 &format!("inner size {}", ["x", "y"][i]),
                 issues,
             );
@@ -591,8 +590,7 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
             body,
             &["container", "wall_height"],
             c.wall_height,
-            0.02,
-            0.12,
+            WALL_HEIGHT,
             "a wall height (m)",
             issues,
         );
@@ -606,13 +604,11 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
     } else {
         let o = raw.obstacle.expect("one kind is set");
         for (i, x) in o.size.iter().enumerate() {
-            let hi = if i == 2 { 1.0 } else { 0.5 };
             check_range(
                 body,
                 &["obstacle", "size"],
                 *x,
-                0.01,
-                hi,
+                if i == 2 { OBSTACLE_HEIGHT } else { OBSTACLE_SIDE },
                 &format!("size {}", ["x", "y", "z"][i]),
                 issues,
             );
@@ -649,8 +645,7 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
                 body,
                 &["z"],
                 z,
-                0.0,
-                MAX_Z,
+                BASE_HEIGHT,
                 "the height of a base above the table (m)",
                 issues,
             );
@@ -775,8 +770,7 @@ fn read_object(name: &str, body: &Value, issues: &mut Vec<Issue>) -> Option<Obje
             body,
             &["random", "clearance"],
             r.clearance,
-            0.0,
-            0.5,
+            CLEARANCE,
             "a clearance (m)",
             issues,
         );
@@ -827,5 +821,49 @@ fn check_fixed_poses(scene: &SceneSpec, objects_v: &Value, issues: &mut Vec<Issu
             .object()
             .map_or(objects_v.loc, |n| objects_v.loc_at(&[n, "pose"]));
         issues.push(Issue::new(at, e.to_string()).help(e.hint()));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::SceneFileSchema;
+    use crate::scene::limits::{
+        BASE_HEIGHT, BLOCK_EDGE, BLOCK_FRICTION, BLOCK_MASS, CLEARANCE, CONTAINER_INNER, OBSTACLE_HEIGHT,
+        OBSTACLE_SIDE, WALL_HEIGHT,
+    };
+    use crate::yaml::Bounds;
+
+    /// Every ranged key of a scene file: its schema description states the declared range, and
+    /// a `minimum`/`maximum` in the schema, where there is one, is the declared one.
+    #[test]
+    fn the_scene_schema_states_every_range_as_declared() {
+        let schema = serde_json::to_value(schemars::schema_for!(SceneFileSchema)).expect("schema");
+        let defs = &schema["$defs"];
+        let cases: [(&str, &str, Bounds); 9] = [
+            ("BlockRaw", "size", BLOCK_EDGE),
+            ("BlockRaw", "mass", BLOCK_MASS),
+            ("BlockRaw", "friction", BLOCK_FRICTION),
+            ("ContainerRaw", "inner", CONTAINER_INNER),
+            ("ContainerRaw", "wall_height", WALL_HEIGHT),
+            ("ObstacleRaw", "size", OBSTACLE_SIDE),
+            ("ObstacleRaw", "size", OBSTACLE_HEIGHT),
+            ("ObjectRaw", "z", BASE_HEIGHT),
+            ("RandomRaw", "clearance", CLEARANCE),
+        ];
+        for (def, key, bounds) in cases {
+            let property = &defs[def]["properties"][key];
+            let description = property["description"].as_str().unwrap_or_default();
+            assert!(
+                description.contains(&bounds.text()),
+                "{def}.{key}: the description `{description}` does not state {}",
+                bounds.text()
+            );
+            if let Some(min) = property["minimum"].as_f64() {
+                assert_eq!(min, bounds.lo, "{def}.{key}");
+            }
+            if let Some(max) = property["maximum"].as_f64() {
+                assert_eq!(max, bounds.hi, "{def}.{key}");
+            }
+        }
     }
 }

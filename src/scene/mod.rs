@@ -22,6 +22,7 @@ mod footprint;
 mod goal;
 mod goal_read;
 mod layout_keys;
+pub mod limits;
 mod load;
 mod object_name;
 mod placement_error;

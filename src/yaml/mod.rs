@@ -8,6 +8,7 @@
 //! (`crate::suite`) are all read through it; it depends on nothing else in the crate but the
 //! robot's constants in [`crate::motion`] (for the reach and joint-limit checks).
 
+pub mod bounds;
 pub mod de;
 pub mod diag;
 mod ident;
@@ -17,6 +18,7 @@ mod table_pose;
 pub mod units;
 pub mod value;
 
+pub use bounds::Bounds;
 pub use diag::{Diagnostic, Issue, Loc, MAX_FIELD_CHARS, Sources, cut_text, short_number};
 pub use ident::is_identifier;
 pub use read::read_limited;

@@ -11,6 +11,7 @@ use schemars::{JsonSchema, Schema, SchemaGenerator, json_schema};
 use serde::de::{self, Deserializer, Visitor};
 use serde::{Deserialize, Serialize};
 
+use super::bounds::Bounds;
 use crate::motion::kinematics::TOOL_LENGTH;
 use crate::motion::ur5e::{FOREARM, JOINT_LIMITS, LATERAL_OFFSET, SHOULDER_HEIGHT, UPPER_ARM, WRIST_2_TO_3};
 use crate::motion::{ARM_JOINTS, gripper};
@@ -112,14 +113,14 @@ pub fn time_limit<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
 
 /// Shortest and longest wall-clock cap of one plan a tree may set, seconds (the planner's own
 /// range for `PlannerConfig::time_cap`).
-pub const PLAN_TIME_CAP_RANGE: (f64, f64) = (0.001, 60.0);
+pub const PLAN_TIME_CAP_RANGE: Bounds = Bounds::new(0.001, 60.0);
 
 /// An optional wall-clock cap on one plan, seconds, within [`PLAN_TIME_CAP_RANGE`] (absent =
 /// `None`).
 pub fn opt_plan_time_cap<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
     let x = number(d, "a planning time cap (s)")?;
-    let (lo, hi) = PLAN_TIME_CAP_RANGE;
-    if !(lo..=hi).contains(&x) {
+    if !PLAN_TIME_CAP_RANGE.contains(x) {
+        let Bounds { lo, hi } = PLAN_TIME_CAP_RANGE;
         return Err(de::Error::custom(format!(
             "a planning time cap is wall-clock seconds between {lo} and {hi}, found `{x}`"
         )));
