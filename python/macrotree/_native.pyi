@@ -15,6 +15,9 @@ CTRL_LOW: list[float]
 CTRL_HIGH: list[float]
 RESIDUAL_HIGH: list[float]
 OBJECT_NAMES: list[str]
+VALUES_PER_POSE: int
+MAX_MACRO_STEPS: int
+GRIPPER_COMMAND_RANGE: tuple[float, float]
 
 class MacrotreeError(Exception):
     """Invalid input: the message is located (``file:line:column``) and says what to do."""

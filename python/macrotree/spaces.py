@@ -17,20 +17,27 @@ from typing import Any
 import numpy as np
 from gymnasium import spaces
 
+from macrotree import _native
 from macrotree._native import CTRL_HIGH, CTRL_LOW, JOINT_LIMITS, RESIDUAL_HIGH, STATE_NAMES
 from macrotree._native import MACRO_KEYS as _MACRO_KEYS
 
-#: Largest ``steps`` or ``settle_steps`` of one macro (control periods; 6000 = 60 s at 10 ms).
-#: ``steps = 0`` runs the macro closed loop: until its motion is done and the arm has settled.
-MAX_MACRO_STEPS = 6000
+#: Largest ``steps``, and largest ``settle_steps``, of one macro: reference steps of 10 ms (the
+#: extension's ``MAX_MACRO_STEPS``, 60 s each). ``steps = 0`` runs the macro closed loop: until
+#: its motion is done and the arm has settled.
+MAX_MACRO_STEPS: int = _native.MAX_MACRO_STEPS
 
 #: Half-side of the workspace box for ``position``, metres: every point of the box is within
 #: the 1.5 m a pose target may be from the robot's base (the UR5e reaches about 0.85 m, so far
 #: corners are valid input that fails as unreachable, reported in ``info``).
 POSITION_BOUND = 0.85
 
-#: Range of the gripper command (the 2F-85 actuator's ctrlrange: 0 open … 255 closed).
-GRIPPER_COMMAND_RANGE = (0.0, 255.0)
+#: Range of the gripper command (the 2F-85 actuator's ctrlrange: 0 open … 255 closed; the
+#: extension's ``GRIPPER_COMMAND_RANGE``).
+GRIPPER_COMMAND_RANGE: tuple[float, float] = _native.GRIPPER_COMMAND_RANGE
+
+#: Values of one pose in an observation (x, y, z in metres, then qw, qx, qy, qz): ``pinch``, and
+#: each object's in ``environment_state`` (the extension's ``VALUES_PER_POSE``).
+VALUES_PER_POSE: int = _native.VALUES_PER_POSE
 
 
 def _inside_f32(lo: float, hi: float) -> tuple[np.float32, np.float32]:
@@ -146,7 +153,7 @@ def observation_space(
     :data:`OBSERVATION_KEYS`; ``pinch`` is part of the state)."""
     f32 = np.float32
     state = spaces.Box(-np.inf, np.inf, (len(STATE_NAMES),), f32)
-    environment = spaces.Box(-np.inf, np.inf, (7 * objects,), f32)
+    environment = spaces.Box(-np.inf, np.inf, (VALUES_PER_POSE * objects,), f32)
     h, w = image_size
     if keys == "lerobot":
         lerobot: dict[str, spaces.Space[Any]] = {
@@ -159,7 +166,7 @@ def observation_space(
     fields: dict[str, spaces.Space[Any]] = {
         "agent_pos": state,
         "environment_state": environment,
-        "pinch": spaces.Box(-np.inf, np.inf, (7,), f32),
+        "pinch": spaces.Box(-np.inf, np.inf, (VALUES_PER_POSE,), f32),
     }
     if cameras:
         fields["pixels"] = spaces.Dict(

@@ -14,13 +14,7 @@ pub fn observation<'py>(py: Python<'py>, o: &Observation, pixels: Pixels) -> PyR
     let d = PyDict::new(py);
     d.set_item("agent_pos", o.state().to_vec().into_pyarray(py))?;
     d.set_item("environment_state", o.environment_state().into_pyarray(py))?;
-    let pinch: Vec<f32> = o
-        .pinch_pos
-        .iter()
-        .chain(&o.pinch_quat)
-        .map(|&v| v as f32)
-        .collect();
-    d.set_item("pinch", pinch.into_pyarray(py))?;
+    d.set_item("pinch", o.pinch().to_vec().into_pyarray(py))?;
     if !pixels.is_empty() {
         let images = PyDict::new(py);
         for (name, w, h, rgb) in pixels {

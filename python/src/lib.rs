@@ -42,6 +42,12 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(video::write_mp4, m)?)?;
     m.add_function(wrap_pyfunction!(policy::run_policy_model, m)?)?;
     m.add("OBJECT_NAMES", macrotree::world::vectors::OBJECT_NAMES.to_vec())?;
+    m.add("VALUES_PER_POSE", macrotree::env::ENVIRONMENT_VALUES_PER_OBJECT)?;
+    m.add("MAX_MACRO_STEPS", macrotree::env::MAX_MACRO_STEPS)?;
+    m.add(
+        "GRIPPER_COMMAND_RANGE",
+        (macrotree::motion::OPEN_CTRL, macrotree::motion::CLOSED_CTRL),
+    )?;
     m.add_class::<env::Env>()?;
     m.add_class::<vector::VecEnv>()?;
     Ok(())

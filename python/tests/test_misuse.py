@@ -17,6 +17,7 @@ import pytest
 
 import macrotree
 from macrotree import MacroMode
+from macrotree.spaces import MAX_MACRO_STEPS
 
 
 def scene(data: Path) -> str:
@@ -135,6 +136,8 @@ def macro_env(data: Path) -> macrotree.MacroEnv:
         ({"mode": 1.5}, "whole number"),
         ({"mode": "0"}, "whole number"),
         ({"mode": 0, "steps": [2.7]}, "whole number"),
+        # One past the action space's bound, which is the extension's own limit.
+        ({"mode": 0, "steps": [MAX_MACRO_STEPS + 1]}, f"each at most {MAX_MACRO_STEPS} "),
     ],
 )
 def test_malformed_macro_actions_are_refused(
@@ -188,7 +191,7 @@ env.reset(seed=0)
 vec = macrotree.VectorEnv(sys.argv[1], num_envs=2, **slow)
 vec.reset(seed=0)
 out = {}
-long_wait = {"mode": 0, "steps": [6000]}  # 600 s of simulated time: several seconds of wall time
+long_wait = {"mode": 0, "steps": [6000]}  # 60 s of simulated time: several seconds of wall time
 steps = (("env", lambda: env.step(long_wait)), ("vec", lambda: vec.step([long_wait] * 2)))
 for name, step in steps:
     threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT)).start()

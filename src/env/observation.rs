@@ -163,6 +163,12 @@ impl Observation {
         out
     }
 
+    /// The Python env's `pinch`: the pinch point (metres) and its orientation `[w, x, y, z]`,
+    /// world frame, as `f32` ([`pose_vector`], [`ENVIRONMENT_VALUES_PER_OBJECT`] values).
+    pub fn pinch(&self) -> [f32; ENVIRONMENT_VALUES_PER_OBJECT] {
+        pose_vector(&self.pinch_pos, &self.pinch_quat)
+    }
+
     /// The object called `name`, if the scene has one.
     pub fn object(&self, name: &str) -> Option<&ObjectObservation> {
         self.objects.iter().find(|o| o.name == name)

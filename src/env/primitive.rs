@@ -23,8 +23,14 @@ use crate::motion::{
 /// steps of 2 ms): the unit of [`Duration::Steps`].
 pub const REFERENCE_STEP: f64 = 0.01;
 
-/// Longest duration of one primitive, seconds.
-pub const MAX_DURATION: f64 = 600.0;
+/// Most reference steps a macro's `steps` may take, and its `settle_steps` (each):
+/// [`MAX_DURATION`] in [`REFERENCE_STEP`]s. The Python action space's bound is this one, so
+/// every action the space holds is accepted.
+pub const MAX_MACRO_STEPS: u32 = (MAX_DURATION / REFERENCE_STEP) as u32;
+
+/// Longest duration of one primitive's motion, and of its settling, seconds (the env's default
+/// episode limit).
+pub const MAX_DURATION: f64 = 60.0;
 
 /// Farthest a pose target may be from the robot's base, metres (the UR5e reaches about
 /// 0.85 m plus the gripper).
@@ -163,23 +169,18 @@ impl Primitive {
                 ));
             }
             Duration::Steps { steps, settle }
-                if steps == 0 && settle == 0
-                    || (u64::from(steps) + u64::from(settle)) as f64 * REFERENCE_STEP > MAX_DURATION =>
+                if steps == 0 && settle == 0 || steps > MAX_MACRO_STEPS || settle > MAX_MACRO_STEPS =>
             {
                 return bad(format!(
-                    "{name}: steps {steps} + settle {settle}; expected at least 1 and at most {} reference steps of {REFERENCE_STEP} s",
-                    (MAX_DURATION / REFERENCE_STEP) as u64
+                    "{name}: steps {steps}, settle {settle}; expected at least 1 in all, and each at most {MAX_MACRO_STEPS} reference steps of {REFERENCE_STEP} s"
                 ));
             }
             Duration::Auto | Duration::AutoThen { .. } if matches!(self, Primitive::Wait { .. }) => {
                 return bad("wait: needs a duration (Seconds or Steps), not Auto".to_string());
             }
-            Duration::AutoThen { settle }
-                if settle == 0 || f64::from(settle) * REFERENCE_STEP > MAX_DURATION =>
-            {
+            Duration::AutoThen { settle } if settle == 0 || settle > MAX_MACRO_STEPS => {
                 return bad(format!(
-                    "{name}: settle {settle}; expected at least 1 and at most {} reference steps of {REFERENCE_STEP} s",
-                    (MAX_DURATION / REFERENCE_STEP) as u64
+                    "{name}: settle {settle}; expected at least 1 and at most {MAX_MACRO_STEPS} reference steps of {REFERENCE_STEP} s"
                 ));
             }
             _ => {}
