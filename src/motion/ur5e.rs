@@ -107,5 +107,5 @@ pub const WRIST_1_TO_2: f64 = 0.127;
 /// Measured on the Menagerie models (`tests/physics/motion_collision.rs`: the largest distance of
 /// a collision geom's bounding sphere from each axis, over the stretched arm and random joints,
 /// is 1.08, 1.11, 0.70, 0.31, 0.27, 0.10 m), plus a held block's 6.1 cm half diagonal
-/// (`HELD_BLOCK_REACH`).
+/// ([`HELD_BLOCK_REACH`](super::plan::HELD_BLOCK_REACH)).
 pub const LEVER_ARMS: [f64; 6] = [1.16, 1.19, 0.77, 0.38, 0.34, 0.12];

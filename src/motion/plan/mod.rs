@@ -47,7 +47,7 @@ mod tests;
 
 pub use boxes::{JointBox, JointBoxes};
 pub use checker::{Collision, CollisionChecker, FastChecks};
-pub use config::{JointLimits, PlannerConfig};
+pub use config::{HELD_BLOCK_REACH, JointLimits, PlannerConfig};
 pub use edge::{Resolution, check_segment};
 pub use goal::GoalSet;
 pub use planner::{PlannedMotion, plan};
