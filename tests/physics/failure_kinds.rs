@@ -209,20 +209,32 @@ fn substitutions_that_do_not_fit_the_tree_are_substitution() {
 }
 
 #[test]
-fn an_episode_runs_the_substitutions_its_command_resolved_once() {
-    // The rules resolved by the command are what the episode runs: it does not resolve
-    // `substitutions` again (these would not even fit the tree).
+fn an_episode_reuses_the_resolution_of_its_own_rules_and_resolves_other_rules_again() {
+    // The command resolves its rules once and every episode runs that resolution; an episode
+    // whose rules are not the ones resolved resolves its own (here: rules that do not fit).
     let p = plan("main: {sequence: {children: [{home: {}}, {grasp: {}}]}}");
-    let resolved = resolve(&p, &["main/**/grasp=failure".parse().unwrap()]).unwrap();
-    let config = EpisodeConfig {
-        substitutions: vec!["main/nothing_here=failure".parse().unwrap()],
-        resolved: Some(Arc::new(resolved)),
-        ..tree_goal()
+    let rules: Vec<Substitution> = vec!["main/**/grasp=failure".parse().unwrap()];
+    let resolved = Arc::new(resolve(&p, &rules).unwrap());
+    let run = |substitutions: Vec<Substitution>| {
+        let config = EpisodeConfig {
+            substitutions,
+            resolved: Some(resolved.clone()),
+            ..tree_goal()
+        };
+        let mut cell = Cell::new(scene(), &Layout::default(), CONTROL_PERIOD);
+        run_in_cell(
+            &mut cell,
+            p.clone(),
+            &Factory::builtin(),
+            &config,
+            &mut NoObserver,
+        )
     };
-    let mut cell = Cell::new(scene(), &Layout::default(), CONTROL_PERIOD);
-    let r = run_in_cell(&mut cell, p, &Factory::builtin(), &config, &mut NoObserver);
-    assert_eq!(kind_of(&r), FailureKind::Substituted);
-    assert_eq!(r.failed_node.as_deref(), Some("main/sequence/grasp"));
+    let own = run(rules.clone());
+    assert_eq!(kind_of(&own), FailureKind::Substituted);
+    assert_eq!(own.failed_node.as_deref(), Some("main/sequence/grasp"));
+    let other = run(vec!["main/nothing_here=failure".parse().unwrap()]);
+    assert_eq!(kind_of(&other), FailureKind::Substitution);
 }
 
 #[test]
