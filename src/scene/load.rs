@@ -31,8 +31,10 @@ pub const BUILTIN_CUBE_BOWL: &str = include_str!("../../scenes/cube_bowl.yaml");
 /// Most objects in one scene.
 pub const MAX_OBJECTS: usize = 16;
 
-/// Keys allowed at the top level of a scene file.
-const TOP_LEVEL_KEYS: &[&str] = &["description", "objects", "goal", "sampler", "spots", "regions"];
+/// Keys allowed at the top level of a scene file: the fields of [`SceneFileSchema`].
+fn top_level_keys() -> &'static [&'static str] {
+    crate::yaml::field_names::<SceneFileSchema>()
+}
 
 fn d_mass() -> f64 {
     0.05
@@ -277,7 +279,7 @@ fn is_scene_document(v: &Value) -> bool {
     v.as_map().is_some_and(|entries| {
         entries
             .iter()
-            .any(|(k, _)| k.as_str().is_some_and(|k| TOP_LEVEL_KEYS.contains(&k)))
+            .any(|(k, _)| k.as_str().is_some_and(|k| top_level_keys().contains(&k)))
     })
 }
 
@@ -334,8 +336,8 @@ fn read_scene(v: &Value, name: String, issues: &mut Vec<Issue>) -> Option<SceneS
                 let other = other.unwrap_or("?");
                 issues.push(
                     Issue::new(k.loc, format!("unknown top-level key `{other}` in a scene file"))
-                        .label("expected `description`, `objects`, `goal`, `sampler`, `spots` or `regions`")
-                        .maybe_help(did_you_mean(other, TOP_LEVEL_KEYS.iter().copied())),
+                        .label(format!("expected {}", crate::yaml::de::list(top_level_keys())))
+                        .maybe_help(did_you_mean(other, top_level_keys().iter().copied())),
                 )
             }
         }

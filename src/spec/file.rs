@@ -349,3 +349,29 @@ fn parse_subtree_def(name: &str, loc: Loc, v: &Value, issues: &mut Vec<Issue>) -
     }
     Some(def)
 }
+
+#[cfg(test)]
+mod tests {
+    use std::collections::BTreeSet;
+
+    use super::{SUBTREE_KEYS, TOP_LEVEL_KEYS};
+    use crate::kinds::Registry;
+
+    fn keys(properties: &serde_json::Value) -> BTreeSet<&str> {
+        properties
+            .as_object()
+            .map(|m| m.keys().map(String::as_str).collect())
+            .unwrap_or_default()
+    }
+
+    #[test]
+    fn the_tree_schema_declares_exactly_the_keys_the_reader_takes() {
+        let schema = Registry::builtin().json_schema();
+        assert_eq!(
+            keys(&schema["properties"]),
+            TOP_LEVEL_KEYS.iter().copied().collect()
+        );
+        let subtree = &schema["properties"]["subtrees"]["additionalProperties"]["properties"];
+        assert_eq!(keys(subtree), SUBTREE_KEYS.iter().copied().collect());
+    }
+}

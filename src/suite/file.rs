@@ -209,22 +209,14 @@ fn is_scenario_document(v: &Value) -> bool {
     v.as_map().is_some_and(|entries| {
         entries
             .iter()
-            .any(|(k, _)| k.as_str().is_some_and(|k| KEYS.contains(&k)))
+            .any(|(k, _)| k.as_str().is_some_and(|k| keys().contains(&k)))
     })
 }
 
-const KEYS: &[&str] = &[
-    "description",
-    "tree",
-    "scene",
-    "count",
-    "seed",
-    "fault",
-    "goal",
-    "max_sim_time",
-    "substitute",
-    "expect",
-];
+/// Keys allowed in a scenario file: the fields of [`ScenarioFileRaw`].
+fn keys() -> &'static [&'static str] {
+    crate::yaml::field_names::<ScenarioFileRaw>()
+}
 
 /// `base/rel` with `.` and `a/..` removed lexically (no file system access), so that reproduce
 /// commands read `trees/x.yaml`, not `scenarios/../trees/x.yaml`.
@@ -303,35 +295,22 @@ fn read(path: &Path, v: &Value, issues: &mut Vec<Issue>, custom_kinds: &[&str]) 
     }
     for (k, _) in entries {
         let key = k.as_str().unwrap_or("?");
-        if !KEYS.contains(&key) {
+        if !keys().contains(&key) {
             issues.push(
                 Issue::new(k.loc, format!("unknown key `{key}` in a scenario file"))
-                    .label(format!("expected one of {}", KEYS.join(", ")))
-                    .maybe_help(did_you_mean(key, KEYS.iter().copied())),
+                    .label(format!("expected {}", crate::yaml::de::list(keys())))
+                    .maybe_help(did_you_mean(key, keys().iter().copied())),
             );
         }
     }
     if let Some(e) = v.get("expect").and_then(Value::as_map) {
-        let allowed = [
-            "outcome",
-            "min_success_rate",
-            "failure_kind",
-            "failed_node",
-            "max_sim_time",
-            "max_collisions",
-            "ran",
-            "ran_in_every",
-            "failed",
-            "never_ran",
-            "never_failed",
-            "counts",
-        ];
+        let allowed = crate::yaml::field_names::<Expect>();
         for (k, _) in e {
             let key = k.as_str().unwrap_or("?");
             if !allowed.contains(&key) {
                 issues.push(
                     Issue::new(k.loc, format!("unknown key `{key}` in `expect:`"))
-                        .label(format!("expected one of {}", allowed.join(", ")))
+                        .label(format!("expected {}", crate::yaml::de::list(allowed)))
                         .maybe_help(did_you_mean(key, allowed.iter().copied())),
                 );
             }

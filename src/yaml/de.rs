@@ -226,7 +226,8 @@ fn plain_expected(exp: &str) -> String {
     }
 }
 
-fn list(expected: &[&str]) -> String {
+/// `expected` as a label says it: `` `a` ``, or `` one of `a`, `b` ``, or `nothing`.
+pub fn list(expected: &[&str]) -> String {
     let items: Vec<String> = expected.iter().map(|e| format!("`{e}`")).collect();
     match items.len() {
         0 => "nothing".to_string(),

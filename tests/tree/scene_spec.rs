@@ -142,6 +142,20 @@ fn scene_mistakes_are_located_and_explained() {
     assert!(e.message.contains("no placement found"), "{e}");
 }
 
+/// The keys a scene file takes are the fields of its schema type: an unknown one is located,
+/// lists them all and suggests the nearest.
+#[test]
+fn an_unknown_top_level_key_lists_the_keys_of_the_scene_file_schema() {
+    let d = scene_errors("objects:\n  red: {block: {size: 0.04}, pose: [0.4, 0]}\nregoins: {}\n");
+    let e = find(&d, "unknown top-level key `regoins` in a scene file");
+    assert_eq!((e.line, e.column), (3, 1));
+    assert_eq!(
+        e.label.as_deref(),
+        Some("expected one of `description`, `objects`, `goal`, `sampler`, `spots`, `regions`")
+    );
+    assert_eq!(e.help.as_deref(), Some("did you mean `regions`?"));
+}
+
 /// A pose or spot written in centimetres is reported once, at the number, naming the field (x,
 /// y or yaw) and in metres — not as an angle — and the goals that name the refused object or
 /// spot get no follow-on "unknown" error with a wrong did-you-mean.
