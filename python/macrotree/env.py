@@ -257,8 +257,10 @@ class MacroEnv(gym.Env[Observation, Any]):
         return self._unpack(self._native.step_subtree(name))
 
     def observation(self) -> dict[str, Any]:
-        """The full typed observation of the cell now: joints and velocities, gripper width and
-        command, pinch pose, every object's pose, velocity and grasped flag by name, contacts."""
+        """The full typed observation of the cell now, as the Rust ``env::Observation`` serializes
+        it: joints, velocities and targets, gripper width and command, the last command, pinch
+        and pad positions, every object's kind, half extents, pose, velocities and grasped flag
+        by name, contacts."""
         return dict(self._native.observation())
 
     def object_pose(self, obs: Observation, name: str) -> np.ndarray:

@@ -4,7 +4,7 @@
 use macrotree::env::{Observation, StepResult};
 use numpy::{IntoPyArray, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::PyDict;
 
 /// Camera images to add to an observation under `pixels`, by camera name (H×W×3 bytes).
 pub type Pixels = Vec<(String, u32, u32, Vec<u8>)>;
@@ -27,43 +27,11 @@ pub fn observation<'py>(py: Python<'py>, o: &Observation, pixels: Pixels) -> PyR
     Ok(d)
 }
 
-/// The full typed observation as nested dicts (`objects` keyed by name).
-pub fn full_observation<'py>(
-    py: Python<'py>,
-    o: &Observation,
-    sizes: &[[f64; 3]],
-) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    d.set_item("time", o.time)?;
-    d.set_item("joint_pos", o.joint_pos.to_vec())?;
-    d.set_item("joint_vel", o.joint_vel.to_vec())?;
-    d.set_item("joint_target", o.joint_target.to_vec())?;
-    d.set_item("gripper_joint", o.gripper_joint)?;
-    d.set_item("gripper_width", o.gripper_width)?;
-    d.set_item("gripper_command", o.gripper_command)?;
-    d.set_item("pinch_pos", o.pinch_pos.to_vec())?;
-    d.set_item("pinch_quat", o.pinch_quat.to_vec())?;
-    d.set_item("left_pad", o.left_pad_pos.to_vec())?;
-    d.set_item("right_pad", o.right_pad_pos.to_vec())?;
-    let objects = PyDict::new(py);
-    for (ob, size) in o.objects.iter().zip(sizes) {
-        let x = PyDict::new(py);
-        x.set_item("half_extents", size.to_vec())?;
-        x.set_item("kind", ob.kind)?;
-        x.set_item("pos", ob.pos.to_vec())?;
-        x.set_item("quat", ob.quat.to_vec())?;
-        x.set_item("linvel", ob.linvel.to_vec())?;
-        x.set_item("angvel", ob.angvel.to_vec())?;
-        x.set_item("grasped", ob.grasped)?;
-        objects.set_item(&ob.name, x)?;
-    }
-    d.set_item("objects", objects)?;
-    let contacts = PyList::empty(py);
-    for c in &o.contacts {
-        contacts.append((c.a.as_str(), c.b.as_str()))?;
-    }
-    d.set_item("contacts", contacts)?;
-    Ok(d)
+/// The full typed observation: [`Observation`]'s serde form as Python values (mappings as
+/// dicts, `objects` keyed by name, fixed-size vectors as tuples, lists as lists), so its keys
+/// and layout are the Rust type's.
+pub fn full_observation<'py>(py: Python<'py>, o: &Observation) -> PyResult<Bound<'py, PyAny>> {
+    Ok(pythonize::pythonize(py, o)?)
 }
 
 /// The info of a reset: success so far, the goal predicates, grasped flags.
@@ -101,13 +69,7 @@ fn grasped<'py>(py: Python<'py>, o: &Observation) -> PyResult<Bound<'py, PyDict>
 }
 
 /// A step's result as `{"obs", "reward", "terminated", "truncated", "info"}`.
-pub fn step_result<'py>(
-    py: Python<'py>,
-    r: &StepResult,
-    pixels: Pixels,
-    sizes: &[[f64; 3]],
-) -> PyResult<Bound<'py, PyDict>> {
-    let _ = sizes;
+pub fn step_result<'py>(py: Python<'py>, r: &StepResult, pixels: Pixels) -> PyResult<Bound<'py, PyDict>> {
     let out = PyDict::new(py);
     out.set_item("obs", observation(py, &r.observation, pixels)?)?;
     out.set_item("reward", r.reward)?;

@@ -106,7 +106,7 @@ impl Env {
             .detach(|| e.step_with(&action, &mut signals.poll()))
             .map_err(|e| signals.error(e))?;
         let px = pixels(&env, &self.cameras, self.image)?;
-        Ok(convert::step_result(py, &r, px, &sizes(&env))?.unbind())
+        Ok(convert::step_result(py, &r, px)?.unbind())
     }
 }
 
@@ -124,19 +124,6 @@ pub fn image(py: Python<'_>, img: macrotree::env::Image) -> PyResult<Bound<'_, P
     img.pixels
         .into_pyarray(py)
         .reshape([img.height as usize, img.width as usize, 3])
-}
-
-/// Each object's half extents (x, y, z), metres, scene order.
-pub fn sizes(env: &MacroEnv) -> Vec<[f64; 3]> {
-    env.scene()
-        .spec
-        .objects
-        .iter()
-        .map(|o| {
-            let [hx, hy] = o.shape.footprint_half();
-            [hx, hy, o.shape.height() / 2.0]
-        })
-        .collect()
 }
 
 #[pymethods]
@@ -297,9 +284,9 @@ impl Env {
         self.step(py, Action::Subtree(name))
     }
 
-    fn observation(&self, py: Python<'_>) -> PyResult<Py<PyDict>> {
+    fn observation(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
         let env = self.env()?;
-        Ok(convert::full_observation(py, &env.observe(), &sizes(&env))?.unbind())
+        Ok(convert::full_observation(py, &env.observe())?.unbind())
     }
 
     #[pyo3(signature = (camera, height, width))]

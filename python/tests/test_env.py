@@ -130,6 +130,25 @@ def test_close_on_the_cube_grasps_it(cube_env: macrotree.MacroEnv) -> None:
     assert info["grasped"]["cube"] is True
 
 
+def test_the_full_observation_is_the_rust_observations_serde_form(
+    cube_env: macrotree.MacroEnv,
+) -> None:
+    obs, _ = cube_env.reset(options={"layout": "default"})
+    full = cube_env.observation()
+    # The Rust field names, not renamed ones; the last command is there too.
+    for key in ("joint_pos", "left_pad_pos", "right_pad_pos", "pinch_pos", "last_command"):
+        assert key in full, key
+    assert len(full["last_command"]) == len(macrotree.CTRL_NAMES)
+    # Objects by name, in scene order, each with its kind and bounding box.
+    assert list(full["objects"]) == cube_env.object_names
+    cube = full["objects"]["cube"]
+    assert cube["kind"] == "block"
+    assert np.allclose(cube["pos"], cube_env.object_pose(obs, "cube")[:3], atol=1e-6)
+    half = cube["half_extents"]
+    assert half[0] == half[1] == half[2] > 0.0
+    assert all(set(c) == {"a", "b"} for c in full["contacts"])
+
+
 def test_a_leaf_runs_by_mapping(cube_env: macrotree.MacroEnv) -> None:
     cube_env.reset(options={"layout": "default"})
     _, _, _, _, info = cube_env.step_leaf({"reach": {"target": "cube", "offset": [0, 0, 0.12]}})

@@ -43,7 +43,9 @@ pub struct Observation {
     pub left_pad_pos: [f64; 3],
     /// Centre of the right pads, metres.
     pub right_pad_pos: [f64; 3],
-    /// Every object of the scene, in scene order.
+    /// Every object of the scene, in scene order; serialized as a map from each object's name
+    /// to the object.
+    #[serde(serialize_with = "objects_by_name")]
     pub objects: Vec<ObjectObservation>,
     /// The contacts between distinct parts of the cell (robot–object, object–object; table
     /// contacts left out), each pair once.
@@ -53,10 +55,14 @@ pub struct Observation {
 /// One object of the scene.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ObjectObservation {
-    /// Its name in the scene file.
+    /// Its name in the scene file (serialized as the object's key, see
+    /// [`Observation::objects`]).
+    #[serde(skip)]
     pub name: String,
     /// `block`, `container` or `obstacle`.
     pub kind: &'static str,
+    /// Half extents of its bounding box in its own frame, metres ([`crate::scene::Shape`]).
+    pub half_extents: [f64; 3],
     /// Position (a block's centre; a container's or obstacle's base on the table), metres.
     pub pos: [f64; 3],
     /// Orientation `[w, x, y, z]`.
@@ -79,6 +85,11 @@ pub struct Contact {
     pub b: String,
 }
 
+/// Serializes the objects as a map from name to object, in scene order.
+fn objects_by_name<S: serde::Serializer>(objects: &[ObjectObservation], s: S) -> Result<S::Ok, S::Error> {
+    s.collect_map(objects.iter().map(|o| (&o.name, o)))
+}
+
 impl Observation {
     /// The observation of `cell` now (its world snapshot, refreshed after every control period,
     /// and the simulation's gripper joint).
@@ -94,6 +105,7 @@ impl Observation {
             .map(|(i, o)| ObjectObservation {
                 name: w.name(i).to_string(),
                 kind: w.spec(i).kind().name(),
+                half_extents: w.spec(i).shape.half_extents(),
                 pos: v3(&o.pos),
                 quat: wxyz(&o.quat),
                 linvel: v3(&o.linvel),

@@ -98,6 +98,13 @@ impl Shape {
         }
     }
 
+    /// Half extents of the object's bounding box in its own frame (footprint halves, half the
+    /// height), metres.
+    pub fn half_extents(&self) -> [f64; 3] {
+        let [hx, hy] = self.footprint_half();
+        [hx, hy, self.height() / 2.0]
+    }
+
     /// The footprint at `pose`: a rectangle turned by the pose's yaw.
     pub fn footprint(&self, pose: &Pose) -> super::footprint::Rect {
         super::footprint::Rect {
