@@ -106,7 +106,7 @@ def grasp_distance(full: dict[str, Any], cube: np.ndarray, half: float) -> float
     """The tutorial's gripper-to-cube distance: the nearer pad centre's distance to the cube's
     surface (0 inside), the cube taken as axis-aligned."""
     best = np.inf
-    for pad in (np.asarray(full["left_pad"]), np.asarray(full["right_pad"])):
+    for pad in (np.asarray(full["left_pad_pos"]), np.asarray(full["right_pad_pos"])):
         excess = np.abs(pad - cube) - half
         best = min(best, float(np.linalg.norm(np.maximum(excess, 0.0))))
     return best

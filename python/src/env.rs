@@ -228,7 +228,7 @@ impl Env {
         Ok(self.env()?.config().control_period)
     }
 
-    #[pyo3(signature = (*, seed, layout=None, scenario=None, sweep_seed=None, placement=None))]
+    #[pyo3(signature = (*, seed, layout=None, scenario=None, sweep_seed=None, placement: "dict[str, list[float]] | None" = None) -> "dict[str, Any]")]
     fn reset(
         &self,
         py: Python<'_>,
@@ -259,37 +259,44 @@ impl Env {
         Ok(out.unbind())
     }
 
+    #[pyo3(signature = (action: "dict[str, Any]") -> "dict[str, Any]")]
     fn step_macro(&self, py: Python<'_>, action: Bound<'_, PyDict>) -> PyResult<Py<PyDict>> {
         let p = macro_action::primitive(&action)?;
         self.step(py, Action::Primitive(p))
     }
 
+    #[pyo3(signature = (ctrl: "NDArray[np.float64]") -> "dict[str, Any]")]
     fn step_ctrl(&self, py: Python<'_>, ctrl: PyReadonlyArray1<'_, f64>) -> PyResult<Py<PyDict>> {
         self.step(py, array_action("ctrl", ctrl.as_slice()?)?)
     }
 
+    #[pyo3(signature = (setpoint: "NDArray[np.float64]") -> "dict[str, Any]")]
     fn step_setpoint(&self, py: Python<'_>, setpoint: PyReadonlyArray1<'_, f64>) -> PyResult<Py<PyDict>> {
         self.step(py, array_action("setpoint", setpoint.as_slice()?)?)
     }
 
+    #[pyo3(signature = (residual: "NDArray[np.float64]") -> "dict[str, Any]")]
     fn step_residual(&self, py: Python<'_>, residual: PyReadonlyArray1<'_, f64>) -> PyResult<Py<PyDict>> {
         self.step(py, array_action("residual", residual.as_slice()?)?)
     }
 
+    #[pyo3(signature = (text) -> "dict[str, Any]")]
     fn step_leaf(&self, py: Python<'_>, text: String) -> PyResult<Py<PyDict>> {
         self.step(py, Action::Leaf(text))
     }
 
+    #[pyo3(signature = (name) -> "dict[str, Any]")]
     fn step_subtree(&self, py: Python<'_>, name: String) -> PyResult<Py<PyDict>> {
         self.step(py, Action::Subtree(name))
     }
 
+    #[pyo3(signature = () -> "dict[str, Any]")]
     fn observation(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
         let env = self.env()?;
         Ok(convert::full_observation(py, &env.observe())?.unbind())
     }
 
-    #[pyo3(signature = (camera, height, width))]
+    #[pyo3(signature = (camera, height, width) -> "NDArray[np.uint8]")]
     fn render<'py>(
         &self,
         py: Python<'py>,
@@ -307,6 +314,7 @@ impl Env {
     }
 
     /// The frames filmed since the last call (`rgb_array_list`), each H×W×3 `uint8`.
+    #[pyo3(signature = () -> "list[NDArray[np.uint8]]")]
     fn take_frames<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyArray3<u8>>>> {
         let frames = self.env()?.take_frames();
         frames.into_iter().map(|img| image(py, img)).collect()
@@ -343,7 +351,7 @@ impl Env {
     }
 
     fn gripper_command_for_width(&self, width: f64) -> PyResult<f64> {
-        crate::gripper_command_for_width(width)
+        crate::gripper_command(width)
     }
 }
 

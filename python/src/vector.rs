@@ -144,7 +144,7 @@ impl VecEnv {
         self.names.clone()
     }
 
-    #[pyo3(signature = (*, ids, seeds, layout=None, scenario=None, sweep_seed=None, placement=None))]
+    #[pyo3(signature = (*, ids, seeds, layout=None, scenario=None, sweep_seed=None, placement: "dict[str, list[float]] | None" = None) -> "list[dict[str, Any]]")]
     #[allow(clippy::too_many_arguments)]
     fn reset<'py>(
         &self,
@@ -198,6 +198,7 @@ impl VecEnv {
 
     /// Steps environments `ids` with `actions` in parallel; the batch of their results, in
     /// the order of `ids` (see `batch.rs`).
+    #[pyo3(signature = (ids, actions) -> "dict[str, Any]")]
     fn step<'py>(
         &self,
         py: Python<'py>,
@@ -224,6 +225,7 @@ impl VecEnv {
 
     /// Waits for at least `count` environments to finish; the batch of their results in
     /// finishing order, `env_id` saying whose.
+    #[pyo3(signature = (count) -> "dict[str, Any]")]
     fn recv<'py>(&self, py: Python<'py>, count: usize) -> PyResult<Bound<'py, PyDict>> {
         let mut v = self.vec()?;
         let e: &mut macrotree::env::VecEnv = &mut v;
@@ -234,7 +236,7 @@ impl VecEnv {
         self.batch(py, &v, done)
     }
 
-    #[pyo3(signature = (camera, height, width))]
+    #[pyo3(signature = (camera, height, width) -> "list[NDArray[np.uint8]]")]
     fn render<'py>(
         &self,
         py: Python<'py>,

@@ -13,6 +13,7 @@ use crate::error::value;
 
 /// Writes `frames` (H×W×3 uint8, one size) at `fps` to `path`; returns the number of frames.
 #[pyfunction]
+#[pyo3(signature = (path, frames: "list[NDArray[np.uint8]]", fps))]
 pub fn write_mp4(
     py: Python<'_>,
     path: String,

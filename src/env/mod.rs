@@ -55,7 +55,9 @@ pub use action::Action;
 pub use config::{EnvConfig, MAX_CONTROL_PERIOD};
 pub use leaf::{LEAF_SOURCE_NAME, MAX_LEAF_TEXT, compile_leaf};
 pub use memory::ENV_MEMORY_BYTES;
-pub use observation::{Contact, ENVIRONMENT_VALUES_PER_OBJECT, ObjectObservation, Observation, STATE_NAMES};
+pub use observation::{
+    Contact, ENVIRONMENT_VALUES_PER_OBJECT, ObjectObservation, Observation, STATE_LEN, STATE_NAMES,
+};
 pub use primitive::{Duration, MAX_DURATION, MAX_MACRO_STEPS, MAX_REACH_DISTANCE, Primitive, REFERENCE_STEP};
 #[cfg(feature = "render")]
 pub use render::Image;

@@ -28,6 +28,16 @@ pub struct ResidualLimits {
     pub max_gripper_offset: f64,
 }
 
+impl ResidualLimits {
+    /// The upper bound of each residual value (the lower is its negative): the joint offset
+    /// for each of the six set points (rad), then the gripper offset.
+    pub const fn high(&self) -> [f64; RESIDUAL_LEN] {
+        let mut high = [self.max_joint_offset; RESIDUAL_LEN];
+        high[RESIDUAL_LEN - 1] = self.max_gripper_offset;
+        high
+    }
+}
+
 /// The limits of every residual action: ±0.1 rad per joint (about 8 cm at the pinch for the
 /// shoulder, 1 cm for a wrist), and the gripper's whole range, so a residual can open or close
 /// it.

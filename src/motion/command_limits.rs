@@ -2,7 +2,7 @@
 //! to them — one rule for the environment's `ctrl` action, residual steps and the `policy`
 //! leaf's full commands.
 
-use super::command::CellCommand;
+use super::command::{COMMAND_LEN, CellCommand};
 use super::gripper::{CLOSED_CTRL, OPEN_CTRL};
 use super::ur5e::JOINT_LIMITS;
 
@@ -32,7 +32,33 @@ pub struct ClampedCommand {
     pub clamped: u32,
 }
 
+/// The box a command vector ([`CellCommand::to_vector`]) is held to, value by value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CommandBounds {
+    /// Lowest values: joint limits (rad), −speed (rad/s), −acceleration (rad/s²), open gripper.
+    pub low: [f64; COMMAND_LEN],
+    /// Highest values: joint limits (rad), speed (rad/s), acceleration (rad/s²), closed gripper.
+    pub high: [f64; COMMAND_LEN],
+}
+
 impl CommandLimits {
+    /// The bounds of a command vector under these limits (a `ctrl` action's space): set points
+    /// within [`JOINT_LIMITS`], velocities and accelerations within ± these limits, the gripper
+    /// within 0 … 255.
+    pub const fn bounds(&self) -> CommandBounds {
+        let mut low = [0.0; COMMAND_LEN];
+        let mut high = [0.0; COMMAND_LEN];
+        let mut i = 0;
+        while i < 6 {
+            (low[i], high[i]) = JOINT_LIMITS[i];
+            (low[6 + i], high[6 + i]) = (-self.max_joint_speed, self.max_joint_speed);
+            (low[12 + i], high[12 + i]) = (-self.max_joint_acc, self.max_joint_acc);
+            i += 1;
+        }
+        (low[18], high[18]) = (OPEN_CTRL, CLOSED_CTRL);
+        CommandBounds { low, high }
+    }
+
     /// `command` (finite values) clamped: set points to the joint limits and to within
     /// `max_joint_speed × period` of the arm's set point `from` (radians; `period` in
     /// seconds), so no command asks for a faster motion; velocities and accelerations to these
@@ -61,5 +87,32 @@ impl CommandLimits {
         }
         clamp(&mut command.gripper, OPEN_CTRL, CLOSED_CTRL);
         ClampedCommand { command, clamped }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{CTRL_LIMITS, CellCommand};
+    use crate::motion::{ArmCommand, HOME_Q};
+
+    fn command(value: f64) -> CellCommand {
+        CellCommand {
+            arm: ArmCommand {
+                q: [value; 6],
+                qd: [value; 6],
+                qdd: [value; 6],
+            },
+            gripper: value,
+        }
+    }
+
+    #[test]
+    fn a_command_clamped_from_either_side_lands_on_its_bounds() {
+        let bounds = CTRL_LIMITS.bounds();
+        // A period long enough that the set-point step does not bind: only the bounds do.
+        let high = CTRL_LIMITS.clamp(command(1e6), &HOME_Q, 1e3).command.to_vector();
+        let low = CTRL_LIMITS.clamp(command(-1e6), &HOME_Q, 1e3).command.to_vector();
+        assert_eq!(high, bounds.high);
+        assert_eq!(low, bounds.low);
     }
 }

@@ -27,7 +27,7 @@ pub mod trajectory;
 pub mod ur5e;
 
 pub use command::{ArmCommand, COMMAND_LEN, COMMAND_NAMES, CellCommand};
-pub use command_limits::{CTRL_LIMITS, ClampedCommand, CommandLimits};
+pub use command_limits::{CTRL_LIMITS, ClampedCommand, CommandBounds, CommandLimits};
 pub use gripper::{CLOSED_CTRL, OPEN_CTRL, ctrl_for_width, width_for_ctrl};
 pub use ik::{IkError, down_pose, ik, ik_all, ik_benchmark, ik_down, ik_down_with_pose};
 pub use kinematics::{fk, jacobian};

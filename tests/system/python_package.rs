@@ -135,6 +135,7 @@ fn python_code_is_linted_formatted_and_typed() {
         "python/tests",
         "examples/python",
         "python/lerobot_env_macrotree",
+        "python/generate_stub.py",
     ];
     // One configuration for the package, its tests and the examples.
     let config = ["--config", "python/pyproject.toml"];
@@ -154,6 +155,22 @@ fn python_code_is_linted_formatted_and_typed() {
             .args(["--config-file", "python/pyproject.toml"])
             .args(dirs),
         "mypy --strict",
+    );
+}
+
+/// The committed `_native.pyi` is what `python/generate_stub.py` generates from the extension
+/// (maturin reads the signatures PyO3 records in it; the release build is the one `pip install`
+/// just made).
+#[test]
+fn the_committed_stub_is_what_the_extension_generates() {
+    if skip() {
+        return;
+    }
+    let venv = installed();
+    run(
+        venv.command("python")
+            .args(["python/generate_stub.py", "--check"]),
+        "python/generate_stub.py --check",
     );
 }
 
