@@ -11,6 +11,7 @@ from _typeshed import SupportsGetItem
 from numpy.typing import NDArray
 
 __all__ = [
+    "ACTION_LENGTHS",
     "CTRL_HIGH",
     "CTRL_LOW",
     "CTRL_NAMES",
@@ -20,6 +21,7 @@ __all__ = [
     "MACRO_KEYS",
     "MAX_ENVS",
     "MAX_MACRO_STEPS",
+    "MAX_REACH_DISTANCE",
     "OBJECT_NAMES",
     "RESIDUAL_HIGH",
     "STATE_NAMES",
@@ -32,6 +34,11 @@ __all__ = [
     "run_policy_model",
     "write_mp4",
 ]
+
+ACTION_LENGTHS: Final[list[tuple[str, int]]]
+"""
+The length of each array action mode's action: `ctrl`, `setpoint`, `residual`.
+"""
 
 CTRL_HIGH: Final[list[float]]
 """
@@ -76,6 +83,12 @@ Most environments of one vector environment.
 MAX_MACRO_STEPS: Final[int]
 """
 The longest macro primitive (`steps` + `settle_steps`), in 2 ms physics steps.
+"""
+
+MAX_REACH_DISTANCE: Final[float]
+"""
+The farthest a pose target may be from the robot's base, metres (the UR5e reaches about
+0.85 m plus the gripper; a farther target is refused, a nearer unreachable one fails).
 """
 
 OBJECT_NAMES: Final[list[str]]

@@ -37,9 +37,7 @@ ActionMode = Literal["macro", "ctrl", "setpoint", "residual"]
 #: Every action mode, and the shape of its array actions (``None`` for the macro ``Dict``).
 ACTION_MODES: dict[str, tuple[int, ...] | None] = {
     "macro": None,
-    "ctrl": (19,),
-    "setpoint": (7,),
-    "residual": (7,),
+    **{mode: (length,) for mode, length in _native.ACTION_LENGTHS},
 }
 Observation = dict[str, Any]
 StepReturn = tuple[Observation, SupportsFloat, bool, bool, dict[str, Any]]

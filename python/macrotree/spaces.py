@@ -12,6 +12,7 @@ base tree's six set points (radians) and gripper command for one control period.
 from __future__ import annotations
 
 import enum
+import math
 from typing import Any
 
 import numpy as np
@@ -26,10 +27,6 @@ from macrotree._native import MACRO_KEYS as _MACRO_KEYS
 #: its motion is done and the arm has settled.
 MAX_MACRO_STEPS: int = _native.MAX_MACRO_STEPS
 
-#: Half-side of the workspace box for ``position``, metres: every point of the box is within
-#: the 1.5 m a pose target may be from the robot's base (the UR5e reaches about 0.85 m, so far
-#: corners are valid input that fails as unreachable, reported in ``info``).
-POSITION_BOUND = 0.85
 
 #: Range of the gripper command (the 2F-85 actuator's ctrlrange: 0 open … 255 closed; the
 #: extension's ``GRIPPER_COMMAND_RANGE``).
@@ -49,6 +46,12 @@ def _inside_f32(lo: float, hi: float) -> tuple[np.float32, np.float32]:
         high = np.nextafter(high, np.float32(-np.inf))
     return low, high
 
+
+#: Half-side of the workspace box for ``position``, metres: the largest whose corners are within
+#: the extension's ``MAX_REACH_DISTANCE`` (1.5 m) of the robot's base, rounded down to float32,
+#: so every point of the box is accepted (the UR5e reaches about 0.85 m, so far corners are
+#: valid input that fails as unreachable, reported in ``info``).
+POSITION_BOUND = float(_inside_f32(0.0, _native.MAX_REACH_DISTANCE / math.sqrt(3.0))[1])
 
 #: Each arm joint's target range, radians (the UR5e's: ±2π, the elbow ±π).
 JOINT_BOUNDS = [_inside_f32(lo, hi) for lo, hi in JOINT_LIMITS]

@@ -362,7 +362,9 @@ pub fn array_action(mode: &str, u: &[f64]) -> PyResult<Action> {
         "ctrl" => Ok(Action::Ctrl(
             u.try_into().map_err(|_| wrong(macrotree::motion::COMMAND_LEN))?,
         )),
-        "setpoint" => Ok(Action::Setpoint(u.try_into().map_err(|_| wrong(7))?)),
+        "setpoint" => Ok(Action::Setpoint(
+            u.try_into().map_err(|_| wrong(macrotree::env::SETPOINT_LEN))?,
+        )),
         "residual" => Ok(Action::Residual(
             u.try_into().map_err(|_| wrong(macrotree::env::RESIDUAL_LEN))?,
         )),

@@ -79,6 +79,17 @@ mod _native {
     /// The longest macro primitive (`steps` + `settle_steps`), in 2 ms physics steps.
     #[pymodule_export]
     const MAX_MACRO_STEPS: u32 = macrotree::env::MAX_MACRO_STEPS;
+    /// The length of each array action mode's action: `ctrl`, `setpoint`, `residual`.
+    #[pymodule_export]
+    const ACTION_LENGTHS: [(&str, usize); 3] = [
+        ("ctrl", COMMAND_LEN),
+        ("setpoint", macrotree::env::SETPOINT_LEN),
+        ("residual", macrotree::env::RESIDUAL_LEN),
+    ];
+    /// The farthest a pose target may be from the robot's base, metres (the UR5e reaches about
+    /// 0.85 m plus the gripper; a farther target is refused, a nearer unreachable one fails).
+    #[pymodule_export]
+    const MAX_REACH_DISTANCE: f64 = macrotree::env::MAX_REACH_DISTANCE;
     /// The gripper command's range: open, closed (the 2F-85's 0 … 255).
     #[pymodule_export]
     const GRIPPER_COMMAND_RANGE: (f64, f64) = (OPEN_CTRL, CLOSED_CTRL);

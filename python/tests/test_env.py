@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 import macrotree
-from macrotree import Gripper, MacroMode
+from macrotree import Gripper, MacroMode, _native
+from macrotree.spaces import POSITION_BOUND
 
 
 def macro(mode: MacroMode, **fields: object) -> dict[str, object]:
@@ -147,6 +148,19 @@ def test_the_full_observation_is_the_rust_observations_serde_form(
     half = cube["half_extents"]
     assert half[0] == half[1] == half[2] > 0.0
     assert all(set(c) == {"a", "b"} for c in full["contacts"])
+
+
+def test_the_far_corner_of_the_position_box_is_accepted_and_fails_as_unreachable(
+    cube_env: macrotree.MacroEnv,
+) -> None:
+    obs, _ = cube_env.reset(options={"layout": "default"})
+    corner = np.full(3, POSITION_BOUND, dtype=np.float32)
+    assert float(np.linalg.norm(corner.astype(np.float64))) <= _native.MAX_REACH_DISTANCE
+    _, _, _, _, info = cube_env.step(
+        macro(MacroMode.REACH_POSE, position=corner, quaternion=obs["pinch"][3:], steps=[50])
+    )
+    assert info["status"] == "failure", info
+    assert info["failure_kind"] == "unreachable", info
 
 
 def test_a_leaf_runs_by_mapping(cube_env: macrotree.MacroEnv) -> None:

@@ -8,6 +8,10 @@ use crate::motion::{
     ArmCommand, CLOSED_CTRL, COMMAND_LEN, CTRL_LIMITS, CellCommand, ClampedCommand, JOINT_LIMITS, OPEN_CTRL,
 };
 
+/// Values of a set-point action ([`Action::Setpoint`]): six joint set points and the gripper
+/// command.
+pub const SETPOINT_LEN: usize = 7;
+
 /// One step's action. Every action runs to completion on simulated time, closed loop inside
 /// (the leaf's or primitive's controller acts every control period); the caller decides again
 /// after it.
@@ -35,7 +39,7 @@ pub enum Action {
     Ctrl([f64; COMMAND_LEN]),
     /// Plain set points: six arm joint targets (radians) and the gripper command, with zero
     /// velocity and acceleration — [`Action::Ctrl`] with its velocities and accelerations zero.
-    Setpoint([f64; 7]),
+    Setpoint([f64; SETPOINT_LEN]),
     /// A node of the environment's tree, by its `name:` (a subtree call is named after its
     /// subtree: `pick`), by its node path (`main/sequence[cube to bowl]/…`), or `main` for the
     /// whole tree: it runs until it finishes, ticked exactly as inside the whole tree.

@@ -51,7 +51,7 @@ mod vector;
 use std::sync::Arc;
 
 pub use crate::motion::{CTRL_LIMITS, CommandLimits};
-pub use action::Action;
+pub use action::{Action, SETPOINT_LEN};
 pub use config::{EnvConfig, MAX_CONTROL_PERIOD};
 pub use leaf::{LEAF_SOURCE_NAME, MAX_LEAF_TEXT, compile_leaf};
 pub use memory::ENV_MEMORY_BYTES;
