@@ -179,8 +179,10 @@ fn the_flat_vectors_have_the_datasets_layout() {
     // The pinch orientation is the FK of the commanded joints (tool pointing down at home).
     let q = o.pinch_quat;
     assert!((q.iter().map(|v| v * v).sum::<f64>() - 1.0).abs() < 1e-9);
+    // Serialized, the objects are keyed by name.
     let json = serde_json::to_value(&o).unwrap();
-    assert!(json["objects"][0]["grasped"].is_boolean());
+    assert!(json["objects"]["cube"]["grasped"].is_boolean());
+    assert_eq!(json["objects"]["cube"]["half_extents"][2], cube.half_extents[2]);
 }
 
 #[test]
