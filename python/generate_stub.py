@@ -29,12 +29,10 @@ CONFIG = HERE / "pyproject.toml"
 
 # What PyO3 writes for a module it could not see whole: here, only because of the exception.
 INCOMPLETE = "def __getattr__(name: str) -> Incomplete: ...\n"
+# The class as `python/src/error.rs` makes it (its docstring is the extension's, at run time).
 EXCEPTION = '''class MacrotreeError(Exception):
-    """Invalid input (a tree, scene or leaf mapping that does not check, a number out of range):
-    the message is located (``file:line:column``) and says what to do."""
-
     kind: str
-    """The error's stable kind, e.g. ``invalid_tree``."""
+    """The error's stable kind, e.g. ``invalid_tree`` (set on every instance)."""
 '''
 IMPORTS = "import numpy as np\nfrom numpy.typing import NDArray\nfrom typing import Any\n"
 

@@ -285,8 +285,5 @@ def write_mp4(path: str, frames: list[NDArray[np.uint8]], fps: SupportsIndex) ->
     """
 
 class MacrotreeError(Exception):
-    """Invalid input (a tree, scene or leaf mapping that does not check, a number out of range):
-    the message is located (``file:line:column``) and says what to do."""
-
     kind: str
-    """The error's stable kind, e.g. ``invalid_tree``."""
+    """The error's stable kind, e.g. ``invalid_tree`` (set on every instance)."""
