@@ -1,7 +1,7 @@
 """
 The native core of the `macrotree` package: single and vector environments over the Rust
-library, the spaces' constants, video writing and ONNX policy evaluation. Generated from
-`python/src/lib.rs`; `python/generate_stub.py` writes this stub.
+library, the spaces' constants, video writing and ONNX policy evaluation. Its type stub,
+`macrotree/_native.pyi`, is generated from the built module by `python/generate_stub.py`.
 """
 
 from typing import Any, Final, SupportsFloat, SupportsIndex, final

@@ -17,8 +17,8 @@ mod vector;
 mod video;
 
 /// The native core of the `macrotree` package: single and vector environments over the Rust
-/// library, the spaces' constants, video writing and ONNX policy evaluation. Generated from
-/// `python/src/lib.rs`; `python/generate_stub.py` writes this stub.
+/// library, the spaces' constants, video writing and ONNX policy evaluation. Its type stub,
+/// `macrotree/_native.pyi`, is generated from the built module by `python/generate_stub.py`.
 #[pyo3::pymodule]
 mod _native {
     use pyo3::prelude::*;
