@@ -15,7 +15,7 @@
 //! | 0 | [`failure`] | typed failures: a stable kind, a message, the node, the cause | no |
 //! | 1 | [`yaml`] | located YAML: values with file:line:column, typed reads, diagnostics, units | no |
 //! | 2 | [`scene`] | scene files: named objects, placements, the goal | no |
-//! | 2 | [`error`] | the library's typed [`Error`] | no |
+//! | 2 | `error` | the library's typed [`Error`] | no |
 //! | 3 | [`world`] | typed world snapshot, condition predicates, goal, object queries | no |
 //! | 4 | [`kinds`] | what each node kind *is*: name, category, doc, parameters, schema | no |
 //! | 5 | [`spec`] | tree files → typed, expanded spec (includes, subtrees, object checks) | no |
@@ -151,7 +151,7 @@
 #![warn(missing_docs)]
 
 #[cfg(feature = "sim")]
-pub use app::App;
+pub use app::{App, ProgramInfo};
 pub use error::Error;
 pub use failure::{Failure, FailureKind};
 pub use kinds::{Category, ParamError, Params, Registry};
@@ -159,7 +159,7 @@ pub use kinds::{Category, ParamError, Params, Registry};
 #[cfg(feature = "sim")]
 pub mod actions;
 #[cfg(feature = "sim")]
-pub mod app;
+mod app;
 pub mod cleanup;
 #[cfg(feature = "cli")]
 pub mod cli;
@@ -169,7 +169,7 @@ pub mod dataset;
 pub mod env;
 #[cfg(feature = "sim")]
 pub mod episode;
-pub mod error;
+mod error;
 #[cfg(feature = "sim")]
 pub mod factory;
 pub mod failure;

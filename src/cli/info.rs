@@ -1,5 +1,5 @@
 //! How a program built on the crate ([`crate::App::run_cli`]) presents itself: its name,
-//! description and version ([`crate::app::ProgramInfo`]) in `--help`, usage lines and
+//! description and version ([`crate::ProgramInfo`]) in `--help`, usage lines and
 //! `--version`.
 
 use clap::{CommandFactory, FromArgMatches};
