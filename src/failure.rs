@@ -13,7 +13,7 @@
 //! with [`FailureKind::Custom`].
 //!
 //! ```
-//! use macrotree::failure::{Failure, FailureKind};
+//! use macrotree::{Failure, FailureKind};
 //!
 //! let f = Failure::new(FailureKind::GraspFailed, "grasp failed: fingers stopped at 0.0 mm");
 //! assert_eq!(f.kind.as_str(), "grasp_failed");

@@ -12,7 +12,7 @@
 //! | 0 | [`motion`] | UR5e kinematics, closed-form IK, trajectories, gripper calibration | no |
 //! | 0 | [`cleanup`] | temporary files and staging folders removed on exit, on SIGINT/SIGTERM, or by a later run | no |
 //! | 1 | [`output`] | safe output files (every file the CLI writes) | no |
-//! | 0 | [`failure`] | typed failures: a stable kind, a message, the node, the cause | no |
+//! | 0 | `failure` | typed failures: a stable kind, a message, the node, the cause | no |
 //! | 1 | [`yaml`] | located YAML: values with file:line:column, typed reads, diagnostics, units | no |
 //! | 2 | [`scene`] | scene files: named objects, placements, the goal | no |
 //! | 2 | `error` | the library's typed [`Error`] | no |
@@ -153,7 +153,7 @@
 #[cfg(feature = "sim")]
 pub use app::{App, ProgramInfo};
 pub use error::Error;
-pub use failure::{Failure, FailureKind};
+pub use failure::{Failure, FailureKind, MAX_CUSTOM_KINDS, MAX_CUSTOM_NAME};
 pub use kinds::{Category, ParamError, Params, Registry};
 
 #[cfg(feature = "sim")]
@@ -172,7 +172,7 @@ pub mod episode;
 mod error;
 #[cfg(feature = "sim")]
 pub mod factory;
-pub mod failure;
+mod failure;
 #[cfg(feature = "sim")]
 pub mod faults;
 pub mod kinds;

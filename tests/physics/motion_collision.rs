@@ -237,7 +237,7 @@ fn the_check_budget_is_a_hard_deterministic_cap_ending_in_no_path_naming_the_pos
     // Through the cell's planning entry point it is a typed `no_path` failure.
     let e = macrotree::sim::plan_in_cell(&mut c, &start, &goals, &config).unwrap_err();
     let f = macrotree::sim::plan_failure(&e);
-    assert_eq!(f.kind, macrotree::failure::FailureKind::NoPath);
+    assert_eq!(f.kind, macrotree::FailureKind::NoPath);
     assert!(f.message.contains("post"), "{}", f.message);
     // With the default budget the same query plans.
     assert!(plan(&mut c, &start, &goals, &PlannerConfig::default()).is_ok());

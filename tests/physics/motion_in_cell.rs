@@ -5,9 +5,9 @@
 use std::path::Path;
 use std::sync::Arc;
 
+use macrotree::FailureKind;
 use macrotree::episode::{EpisodeConfig, EpisodeReport, NoObserver, run_episode};
 use macrotree::factory::Factory;
-use macrotree::failure::FailureKind;
 use macrotree::plan::{Loader, Plan};
 use macrotree::scene::SceneSpec;
 use macrotree::sim::Scene;

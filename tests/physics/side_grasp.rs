@@ -8,8 +8,8 @@
 //! parameters.
 
 use macrotree::App;
+use macrotree::FailureKind;
 use macrotree::env::{Action, EnvConfig, MacroEnv, Reset, Status, StepResult};
-use macrotree::failure::FailureKind;
 use macrotree::plan::Loader;
 use macrotree::scene::SceneSpec;
 use macrotree::sim::Scene;

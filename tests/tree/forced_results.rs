@@ -5,7 +5,7 @@
 
 use std::sync::Arc;
 
-use macrotree::failure::FailureKind;
+use macrotree::FailureKind;
 use macrotree::plan::{Loader, Plan};
 use macrotree::runtime::{
     ForceError, ForcedResult, LeafOutcome, TreeRunner, TreeStatus, scripted::ScriptedDriver,
