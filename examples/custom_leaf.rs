@@ -428,11 +428,19 @@ fn main() -> ExitCode {
             println!("{json}");
             eprintln!(
                 "push demo: {} ({} after {:.2} s simulated)",
-                if report.success { "success" } else { "failure" },
-                report.failure_reason.as_deref().unwrap_or("the tree succeeded"),
-                report.sim_time_s
+                if report.outcome.success {
+                    "success"
+                } else {
+                    "failure"
+                },
+                report
+                    .outcome
+                    .failure_reason
+                    .as_deref()
+                    .unwrap_or("the tree succeeded"),
+                report.outcome.sim_time_s
             );
-            if report.success {
+            if report.outcome.success {
                 ExitCode::SUCCESS
             } else {
                 ExitCode::from(1)

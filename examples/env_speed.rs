@@ -155,7 +155,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             &mut NoObserver,
         );
         tree_t.push(t.elapsed().as_secs_f64());
-        assert!(r.success);
+        assert!(r.outcome.success);
     }
     let (l, t) = (median(leaf_t), median(tree_t));
     println!(

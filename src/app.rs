@@ -37,7 +37,7 @@ pub struct ProgramInfo {
 /// let app = App::new(); // the built-in node kinds; add yours with `register_action`
 /// let plan = app.compile_str("main: {sequence: {children: [{home: {}}, {at_home: {}}]}}", "t.yaml")?;
 /// let report = app.run_episode(&plan, &EpisodeConfig { goal: Goal::Tree, ..EpisodeConfig::default() })?;
-/// println!("{}", report.tree_status);
+/// println!("{}", report.outcome.tree_status);
 /// # Ok::<(), macrotree::Error>(())
 /// ```
 #[derive(Clone, Debug)]

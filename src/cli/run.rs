@@ -389,7 +389,7 @@ pub fn run(app: &crate::App, args: RunArgs) -> Result<(), CliError> {
             );
         }
     }
-    if report.success {
+    if report.outcome.success {
         Ok(())
     } else {
         Err(CliError::TaskFailed)
@@ -402,9 +402,9 @@ fn success_message(report: &crate::episode::EpisodeReport, goal: Goal) -> String
     match goal {
         Goal::Tree => "the tree succeeded (goal checked: the tree's own conditions)".to_string(),
         Goal::Bowl => "the tree succeeded and the cube rests in the bowl".to_string(),
-        Goal::Scene if report.goal.is_empty() => "the tree succeeded".to_string(),
+        Goal::Scene if report.outcome.goal.is_empty() => "the tree succeeded".to_string(),
         Goal::Scene => {
-            let holds: Vec<String> = report.goal.iter().map(|g| g.predicate.clone()).collect();
+            let holds: Vec<String> = report.outcome.goal.iter().map(|g| g.predicate.clone()).collect();
             format!(
                 "the tree succeeded and the scene's goal holds: {}",
                 holds.join(", ")
@@ -419,18 +419,18 @@ fn ms(x: f64) -> f64 {
 }
 
 fn finish_report(report: &crate::episode::EpisodeReport, goal: Goal, json: bool) {
-    if report.success {
+    if report.outcome.success {
         tracing::info!(
-            sim_time_s = ms(report.sim_time_s),
-            grasp_attempts = report.grasp_attempts,
+            sim_time_s = ms(report.outcome.sim_time_s),
+            grasp_attempts = report.outcome.grasp_attempts,
             "episode succeeded: {}",
             success_message(report, goal)
         );
     } else {
         tracing::warn!(
-            reason = report.failure_reason.as_deref().unwrap_or(""),
-            node = report.failed_node.as_deref().unwrap_or("-"),
-            sim_time_s = ms(report.sim_time_s),
+            reason = report.outcome.failure_reason.as_deref().unwrap_or(""),
+            node = report.outcome.failed_node.as_deref().unwrap_or("-"),
+            sim_time_s = ms(report.outcome.sim_time_s),
             "episode failed"
         );
     }
@@ -442,24 +442,23 @@ fn finish_report(report: &crate::episode::EpisodeReport, goal: Goal, json: bool)
 
 fn print_summary(r: &crate::episode::EpisodeReport, goal: Goal, json: bool) {
     use super::human::say;
-    let c = &r.checks;
     say!(
         json,
         "{}: tree {}, {:.2} s simulated in {:.3} s wall ({} physics steps), {} grasp attempt(s)",
-        if r.success { "SUCCESS" } else { "FAILURE" },
-        r.tree_status,
-        r.sim_time_s,
+        if r.outcome.success { "SUCCESS" } else { "FAILURE" },
+        r.outcome.tree_status,
+        r.outcome.sim_time_s,
         r.wall_time_s,
-        r.physics_steps,
-        r.grasp_attempts
+        r.outcome.physics_steps,
+        r.outcome.grasp_attempts
     );
-    if let Some(reason) = &r.failure_reason {
+    if let Some(reason) = &r.outcome.failure_reason {
         say!(json, "  reason: {reason}");
     }
-    if let Some(node) = &r.failed_node {
+    if let Some(node) = &r.outcome.failed_node {
         say!(json, "  failed node: {node}");
     }
-    for n in r.nodes.iter().filter(|n| n.counts.overridden > 0) {
+    for n in r.outcome.nodes.iter().filter(|n| n.counts.overridden > 0) {
         say!(
             json,
             "  result forced from the monitor: {} ({}×; its successes and failures count them)",
@@ -479,7 +478,7 @@ fn print_summary(r: &crate::episode::EpisodeReport, goal: Goal, json: bool) {
             }
         );
     }
-    for o in &r.objects {
+    for o in &r.outcome.objects {
         let [x, y, z, yaw] = o.end;
         say!(
             json,
@@ -488,7 +487,7 @@ fn print_summary(r: &crate::episode::EpisodeReport, goal: Goal, json: bool) {
             o.name
         );
     }
-    for g in &r.goal {
+    for g in &r.outcome.goal {
         let matched = g
             .matched_yaw_deg
             .map(|y| format!(" (the block's yaw, at the quarter turn nearest the goal's: {y:.1}°)"))
@@ -501,32 +500,35 @@ fn print_summary(r: &crate::episode::EpisodeReport, goal: Goal, json: bool) {
         );
     }
     say!(json, "  success judged by {}", r.goal_checked);
-    for c in &r.collisions {
+    for c in &r.outcome.collisions {
         say!(json, "  collision at {:.2} s ({}): {}", c.time, c.label(), c.what);
     }
-    // The cube and bowl lines only for a scene that has them (see `World::cube`).
+    // The cube and bowl lines only for a scene that has a cube (see `World::cube`).
+    let Some(legacy) = &r.outcome.cube_bowl else {
+        return;
+    };
     let xyz = |p: [f64; 3]| format!("({:.3}, {:.3}, {:.3}) m", p[0], p[1], p[2]);
-    match (r.cube_final, r.bowl_target) {
-        (Some(cube), Some(bowl)) => say!(json, "  cube final {}, bowl target {}", xyz(cube), xyz(bowl)),
-        (Some(cube), None) => say!(json, "  cube final {}", xyz(cube)),
-        (None, Some(bowl)) => say!(json, "  bowl target {}", xyz(bowl)),
-        (None, None) => {}
-    }
-    if r.cube_final.is_some() {
-        say!(
+    match legacy.bowl_target {
+        Some(bowl) => say!(
             json,
-            "  checks: grasp distance {} m, motion while closed {:.3} m, lift while closed {:.3} m, home error {:.4} rad{}",
-            c.grasp_distance.map_or("-".into(), |d| format!("{d:.4}")),
-            c.cube_motion_while_closed,
-            c.cube_lift_while_closed,
-            c.home_error,
-            if r.bowl_target.is_some() {
-                format!(", in bowl {}", c.in_bowl)
-            } else {
-                String::new()
-            }
-        );
-    } else {
-        say!(json, "  checks: home error {:.4} rad", c.home_error);
+            "  cube final {}, bowl target {}",
+            xyz(legacy.cube_final),
+            xyz(bowl)
+        ),
+        None => say!(json, "  cube final {}", xyz(legacy.cube_final)),
     }
+    let c = &legacy.checks;
+    say!(
+        json,
+        "  checks: grasp distance {} m, motion while closed {:.3} m, lift while closed {:.3} m, home error {:.4} rad{}",
+        c.grasp_distance.map_or("-".into(), |d| format!("{d:.4}")),
+        c.cube_motion_while_closed,
+        c.cube_lift_while_closed,
+        c.home_error,
+        if legacy.bowl_target.is_some() {
+            format!(", in bowl {}", c.in_bowl)
+        } else {
+            String::new()
+        }
+    );
 }

@@ -139,7 +139,7 @@ pub fn sweep(app: &crate::App, args: SweepArgs) -> Result<(), CliError> {
             dataset_error = Some(e);
             return ControlFlow::Break(());
         }
-        if !r.success {
+        if !r.outcome.success {
             failures += 1;
             bar.set_message(format!("{failures} failed"));
         }

@@ -235,7 +235,7 @@ impl DatasetWriter {
     /// whether it was written (with `only_success`, failed episodes are not). Its clips are moved
     /// into the dataset or removed.
     pub fn add(&mut self, result: &ScenarioResult, recording: Recording) -> Result<bool, DatasetError> {
-        let keep = !self.opts.only_success || result.success;
+        let keep = !self.opts.only_success || result.outcome.success;
         if !keep || recording.frames.is_empty() {
             for clip in &recording.clips {
                 let _ = std::fs::remove_file(&clip.path);
@@ -349,7 +349,7 @@ impl DatasetWriter {
             stats,
             scenario: result.index,
             seed: result.seed,
-            success: result.success,
+            success: result.outcome.success,
         });
         self.frames += n;
         Ok(true)

@@ -3,7 +3,9 @@
 //! ([`crate::actions`], [`crate::sim`]).
 
 pub mod collision;
+mod cube_bowl;
 mod driver;
+mod outcome;
 pub mod replay;
 mod report;
 pub mod scenario;
@@ -13,7 +15,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 pub use collision::{Collision, CollisionCounts, CollisionPolicy, HitKind, Hitter};
+pub use cube_bowl::CubeBowlReport;
 pub use driver::{DriverState, LeafCounters, MacroDriver};
+pub use outcome::EpisodeOutcome;
 pub use report::{EpisodeReport, LayoutJson, NodeReport, ObjectReport};
 
 use crate::actions::Cell;
@@ -300,14 +304,14 @@ pub fn run_in_cell(
     );
     report.layout = LayoutJson::of(&placement, &world.scene);
     report.add_scene(&initial, &world, collisions, unstable);
-    report.nodes = NodeReport::of(&runner);
+    report.outcome.nodes = NodeReport::of(&runner);
     report.planning = cell.planning().clone();
-    if !report.success {
-        report.failed_node = runner.last_failed_path();
+    if !report.outcome.success {
+        report.outcome.failed_node = runner.last_failed_path();
     }
     if let Some(f) = collided {
-        report.success = false;
-        report.failed_node = f.node.clone();
+        report.outcome.success = false;
+        report.outcome.failed_node = f.node.clone();
         report.set_failure(f);
     }
     report

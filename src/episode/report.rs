@@ -2,74 +2,36 @@
 
 use serde::Serialize;
 
-use super::{Collision, LeafCounters};
+use super::{Collision, CubeBowlReport, EpisodeOutcome, LeafCounters};
 use super::{EpisodeConfig, Goal};
 use crate::actions::Checks;
 use crate::failure::{Failure, FailureKind};
 use crate::runtime::TreeStatus;
 use crate::scene::{ObjectKind, Placement, SceneSpec};
 use crate::world::World;
-use crate::world::goal::{GoalValue, evaluate};
+use crate::world::goal::evaluate;
 
-/// What happened in one episode. Lengths in metres, times in seconds.
+/// What happened in one episode, as `run --json` prints it: its [`EpisodeOutcome`] and what
+/// only this run has (the wall time, the layout it started from, the failure's chain of causes).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EpisodeReport {
-    /// The episode met its [`Goal`]: by default the tree succeeded and the scene's goal holds;
-    /// with `Goal::Bowl`, the tree succeeded and the scene's cube rests in its bowl; with
-    /// `Goal::Tree`, the tree succeeded.
-    pub success: bool,
-    /// Final status of the tree: "success", "failure", or "running" when the time limit hit.
-    pub tree_status: &'static str,
-    /// Why it failed, if it did: the root node's reason (which names the failing leaf or
-    /// condition, e.g. "all 3 attempts failed; last: …"), the time limit, or a missed goal.
-    pub failure_reason: Option<String>,
-    /// Simulated time of the episode.
-    pub sim_time_s: f64,
+    /// How the episode ended (its fields sit at the top level of the JSON).
+    #[serde(flatten)]
+    pub outcome: EpisodeOutcome,
     /// Wall-clock time of the episode (tree + physics), seconds.
     pub wall_time_s: f64,
-    /// MuJoCo steps taken.
-    pub physics_steps: u64,
-    /// Grasp leaves started on the arm (a grasp answered by a substitution is not counted).
-    pub grasp_attempts: u32,
-    /// Leaves preempted while running.
-    pub halts: u32,
-    /// Final centre [x, y, z] of the scene's cube ([`World::cube`]); absent without one.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub cube_final: Option<[f64; 3]>,
-    /// The bowl target [x, y, z] at the end (the centre of the top of the scene's bowl's floor,
-    /// [`World::bowl_target`]); absent without a bowl.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub bowl_target: Option<[f64; 3]>,
-    /// The reference tutorial's checks (on the scene's cube and bowl).
-    pub checks: Checks,
     /// Where the scene's cube and bowl started.
     pub layout: LayoutJson,
     /// The seed.
     pub seed: u64,
-    /// The scene's name.
-    pub scene: String,
-    /// Every object's initial and final pose, in scene order.
-    pub objects: Vec<ObjectReport>,
-    /// Every goal predicate's value at the end, in the scene's order.
-    pub goal: Vec<GoalValue>,
-    /// Contacts that should not happen (the fingers on a wall, …), in the order first seen.
-    pub collisions: Vec<Collision>,
     /// What success was judged by ([`Goal::checked`]), e.g. `the tree's result only (the scene
     /// declares no goal)`.
     pub goal_checked: String,
-    /// The path of the last leaf (or check) that failed, when the episode failed: the leaf where
-    /// the failure started, not the composite or decorator that passed it up (that is the root).
-    pub failed_node: Option<String>,
-    /// A stable name for the kind of failure (`grasp_lost`, `timeout`, `substituted`, …; see
-    /// [`FailureKind`]), for grouping; `None` on success. Serialized as its name.
-    pub failure_kind: Option<FailureKind>,
     /// The failure itself, when the episode failed: its kind, message (`failure_reason`), the
     /// node it happened at and its chain of causes (not written to the JSON, which has
     /// `failure_reason`, `failure_kind` and `failed_node`).
     #[serde(skip)]
     pub failure: Option<Failure>,
-    /// How often every node ran, in plan order (preorder).
-    pub nodes: Vec<NodeReport>,
     /// Motions checked and planned in this episode, and the wall-clock time it took.
     pub planning: crate::actions::PlanningTally,
 }
@@ -204,28 +166,28 @@ impl EpisodeReport {
             Some(tree_failure.unwrap_or_else(|| Failure::other("the tree failed")))
         };
         Self {
-            success,
-            tree_status,
-            failure_reason: failure.as_ref().map(|f| f.message.clone()),
-            sim_time_s: world.time,
+            outcome: EpisodeOutcome {
+                success,
+                tree_status,
+                failure_reason: failure.as_ref().map(|f| f.message.clone()),
+                sim_time_s: world.time,
+                grasp_attempts: counters.grasp_attempts,
+                halts: counters.halts,
+                physics_steps,
+                cube_bowl: CubeBowlReport::of(world, checks),
+                scene: world.scene.name.clone(),
+                objects: Vec::new(),
+                goal,
+                collisions: Vec::new(),
+                failed_node: None,
+                failure_kind: failure.as_ref().map(|f| f.kind),
+                nodes: Vec::new(),
+            },
             wall_time_s,
-            physics_steps,
-            grasp_attempts: counters.grasp_attempts,
-            halts: counters.halts,
-            cube_final: world.cube().map(|c| world.objects[c].pos.into()),
-            bowl_target: world.bowl_target().map(Into::into),
-            checks,
             layout: LayoutJson::default(),
             seed: config.seed,
-            scene: world.scene.name.clone(),
-            objects: Vec::new(),
             goal_checked: config.goal.checked(&world.scene.goal),
-            goal,
-            collisions: Vec::new(),
-            failed_node: None,
-            failure_kind: failure.as_ref().map(|f| f.kind),
             failure,
-            nodes: Vec::new(),
             planning: Default::default(),
         }
     }
@@ -240,7 +202,7 @@ impl EpisodeReport {
         collisions: Vec<Collision>,
         unstable: Option<Failure>,
     ) {
-        self.objects = (0..end.objects.len())
+        self.outcome.objects = (0..end.objects.len())
             .map(|i| ObjectReport {
                 name: end.name(i).to_string(),
                 kind: end.spec(i).kind(),
@@ -248,17 +210,17 @@ impl EpisodeReport {
                 end: pose(end, i),
             })
             .collect();
-        self.collisions = collisions;
+        self.outcome.collisions = collisions;
         if let Some(why) = unstable {
-            self.success = false;
+            self.outcome.success = false;
             self.set_failure(why);
         }
     }
 
     /// Marks the episode failed by `failure`: its reason and kind.
     pub fn set_failure(&mut self, failure: Failure) {
-        self.failure_reason = Some(failure.message.clone());
-        self.failure_kind = Some(failure.kind);
+        self.outcome.failure_reason = Some(failure.message.clone());
+        self.outcome.failure_kind = Some(failure.kind);
         self.failure = Some(failure);
     }
 }
@@ -311,12 +273,12 @@ mod tests {
             let bowl = judged(w, Goal::Bowl);
             let scene = judged(w, Goal::Scene);
             assert_eq!(
-                bowl.success, scene.success,
+                bowl.outcome.success, scene.outcome.success,
                 "--goal bowl and --goal scene disagree"
             );
-            assert_eq!(bowl.success, expected);
-            assert_eq!(bowl.checks.in_bowl, expected);
-            assert_eq!(scene.goal[0].holds, expected, "{:?}", scene.goal);
+            assert_eq!(bowl.outcome.success, expected);
+            assert_eq!(bowl.outcome.in_bowl(), expected);
+            assert_eq!(scene.outcome.goal[0].holds, expected, "{:?}", scene.outcome.goal);
         }
     }
 
@@ -356,6 +318,44 @@ mod tests {
             "{json}"
         );
         assert_eq!(json["layout"], serde_json::json!({}));
-        assert_eq!(json["checks"]["grasp_distance"], serde_json::Value::Null);
+        assert!(
+            json.get("checks").is_none(),
+            "the tutorial's checks without a cube: {json}"
+        );
+    }
+
+    #[test]
+    fn the_flagship_report_lists_its_cube_and_bowl_fields_between_the_counts_and_the_scene() {
+        let r = judged(&resting(), Goal::Scene);
+        let json = serde_json::to_string(&r.outcome).unwrap();
+        let keys: Vec<&str> = [
+            "success",
+            "tree_status",
+            "failure_reason",
+            "sim_time_s",
+            "grasp_attempts",
+            "halts",
+            "physics_steps",
+            "cube_final",
+            "bowl_target",
+            "checks",
+            "scene",
+            "objects",
+            "goal",
+            "collisions",
+            "failed_node",
+            "failure_kind",
+            "nodes",
+        ]
+        .into_iter()
+        .collect();
+        let at: Vec<usize> = keys
+            .iter()
+            .map(|k| {
+                json.find(&format!("\"{k}\":"))
+                    .unwrap_or_else(|| panic!("no {k}: {json}"))
+            })
+            .collect();
+        assert!(at.windows(2).all(|w| w[0] < w[1]), "{json}");
     }
 }

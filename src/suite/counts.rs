@@ -178,6 +178,7 @@ impl CountExpect {
                     .iter()
                     .map(|r| {
                         let n = r
+                            .outcome
                             .nodes
                             .iter()
                             .filter(|nd| glob_match(&self.node, &nd.path))
@@ -222,6 +223,7 @@ impl CountExpect {
         }
         let (metric, bounds) = self.metric();
         let n: u64 = r
+            .outcome
             .nodes
             .iter()
             .filter(|nd| glob_match(&self.node, &nd.path))

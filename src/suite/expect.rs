@@ -142,8 +142,17 @@ pub fn check(expect: &Expect, results: &[ScenarioResult], summary: &Summary) -> 
             if let Some(kind) = &expect.failure_kind {
                 let other: Vec<String> = results
                     .iter()
-                    .filter(|r| !r.success && r.failure_kind.map(FailureKind::as_str) != Some(kind.as_str()))
-                    .map(|r| format!("#{} {}", r.index, r.failure_kind.unwrap_or(FailureKind::Other)))
+                    .filter(|r| {
+                        !r.outcome.success
+                            && r.outcome.failure_kind.map(FailureKind::as_str) != Some(kind.as_str())
+                    })
+                    .map(|r| {
+                        format!(
+                            "#{} {}",
+                            r.index,
+                            r.outcome.failure_kind.unwrap_or(FailureKind::Other)
+                        )
+                    })
                     .collect();
                 out.push(Checked {
                     expectation: format!("every failure is of kind `{kind}`"),
@@ -158,8 +167,17 @@ pub fn check(expect: &Expect, results: &[ScenarioResult], summary: &Summary) -> 
             if let Some(p) = &expect.failed_node {
                 let other: Vec<String> = results
                     .iter()
-                    .filter(|r| !r.success && !r.failed_node.as_deref().is_some_and(|n| glob_match(p, n)))
-                    .map(|r| format!("#{} at {}", r.index, r.failed_node.as_deref().unwrap_or("-")))
+                    .filter(|r| {
+                        !r.outcome.success
+                            && !r.outcome.failed_node.as_deref().is_some_and(|n| glob_match(p, n))
+                    })
+                    .map(|r| {
+                        format!(
+                            "#{} at {}",
+                            r.index,
+                            r.outcome.failed_node.as_deref().unwrap_or("-")
+                        )
+                    })
                     .collect();
                 out.push(Checked {
                     expectation: format!("every failure ends at `{p}`"),
@@ -174,7 +192,7 @@ pub fn check(expect: &Expect, results: &[ScenarioResult], summary: &Summary) -> 
         }
     }
     if let Some(t) = expect.max_sim_time {
-        let worst = results.iter().map(|r| r.sim_time_s).fold(0.0, f64::max);
+        let worst = results.iter().map(|r| r.outcome.sim_time_s).fold(0.0, f64::max);
         out.push(Checked {
             expectation: format!("sim time ≤ {t} s"),
             ok: worst <= t,
@@ -209,7 +227,8 @@ pub fn check(expect: &Expect, results: &[ScenarioResult], summary: &Summary) -> 
         let missing: Vec<u64> = results
             .iter()
             .filter(|r| {
-                !r.nodes
+                !r.outcome
+                    .nodes
                     .iter()
                     .any(|nd| nd.counts.activations > 0 && glob_match(p, &nd.path))
             })
@@ -268,19 +287,18 @@ pub fn offending_commands(expect: &Expect, results: &[ScenarioResult], config: &
             expect.counts.iter().any(|c| c.broken_by(r))
                 || expect
                     .max_collisions
-                    .is_some_and(|max| !r.collisions.is_empty() && too_many_collisions(max, results))
+                    .is_some_and(|max| !r.outcome.collisions.is_empty() && too_many_collisions(max, results))
                 || match expect.outcome {
-                    Outcome::Success => !r.success,
+                    Outcome::Success => !r.outcome.success,
                     Outcome::Failure => {
-                        r.success
+                        r.outcome.success
                             || expect
                                 .failure_kind
                                 .as_deref()
-                                .is_some_and(|k| r.failure_kind.map(FailureKind::as_str) != Some(k))
-                            || expect
-                                .failed_node
-                                .as_deref()
-                                .is_some_and(|p| !r.failed_node.as_deref().is_some_and(|n| glob_match(p, n)))
+                                .is_some_and(|k| r.outcome.failure_kind.map(FailureKind::as_str) != Some(k))
+                            || expect.failed_node.as_deref().is_some_and(|p| {
+                                !r.outcome.failed_node.as_deref().is_some_and(|n| glob_match(p, n))
+                            })
                     }
                 }
         })
@@ -290,5 +308,9 @@ pub fn offending_commands(expect: &Expect, results: &[ScenarioResult], config: &
 
 /// More than `max` collisions over `results`.
 fn too_many_collisions(max: u64, results: &[ScenarioResult]) -> bool {
-    results.iter().map(|r| r.collisions.len() as u64).sum::<u64>() > max
+    results
+        .iter()
+        .map(|r| r.outcome.collisions.len() as u64)
+        .sum::<u64>()
+        > max
 }

@@ -15,7 +15,7 @@
 //! let plan = Arc::new(app.load_tree("trees/cube_to_bowl.yaml".as_ref()).unwrap());
 //! let config = SweepConfig { scenarios: 100, seed: 1, ..SweepConfig::default() };
 //! let run = run_sweep(&scene, &plan, app.factory(), &config, |r| println!("{}", r.to_jsonl())).unwrap();
-//! println!("{} of {} succeeded", run.results.iter().filter(|r| r.success).count(), run.results.len());
+//! println!("{} of {} succeeded", run.results.iter().filter(|r| r.outcome.success).count(), run.results.len());
 //! ```
 
 mod config;

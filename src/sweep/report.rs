@@ -68,7 +68,7 @@ fn identity(r: &ScenarioResult) -> Vec<(&'static str, String)> {
     vec![
         ("tree", r.tree.clone()),
         ("scene file", format!("{:?}", r.scene_file)),
-        ("scene", r.scene.clone()),
+        ("scene", r.outcome.scene.clone()),
         ("tree digest", r.tree_digest.clone().unwrap_or_default()),
         ("scenario count", r.scenarios.to_string()),
         ("seed", r.sweep_seed.to_string()),

@@ -2,14 +2,10 @@
 
 use serde::Serialize;
 
-use crate::actions::Checks;
-use crate::episode::Collision;
-use crate::episode::{EpisodeConfig, EpisodeReport, Goal, NodeReport, ObjectReport};
-use crate::failure::FailureKind;
+use crate::episode::{EpisodeConfig, EpisodeOutcome, EpisodeReport, Goal};
 use crate::faults::FaultKind;
 use crate::runtime::substitute::Substitution;
 use crate::sweep::{Scenario, ScenarioLayout, SweepConfig};
-use crate::world::goal::GoalValue;
 
 /// One line of the sweep's JSONL: the scenario and its episode's outcome (the fields of
 /// `run --json`, except the wall time, so that a sweep's output is byte-identical for any number
@@ -49,43 +45,10 @@ pub struct ScenarioResult {
     /// `run --cube X,Y,YAW --bowl X,Y` takes it); other scenes list every object in `objects`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub layout: Option<ScenarioLayout>,
-    /// The episode met the sweep's goal (by default: the tree succeeded and the scene's goal
-    /// holds; see [`Goal`]).
-    pub success: bool,
-    /// Final status of the tree.
-    pub tree_status: &'static str,
-    /// Why it failed, if it did.
-    pub failure_reason: Option<String>,
-    /// Simulated time, seconds.
-    pub sim_time_s: f64,
-    /// Grasp leaves started on the arm (a grasp answered by a substitution is not counted).
-    pub grasp_attempts: u32,
-    /// Leaves preempted while running.
-    pub halts: u32,
-    /// MuJoCo steps taken.
-    pub physics_steps: u64,
-    /// Final centre [x, y, z] of the scene's cube, metres; absent without one.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub cube_final: Option<[f64; 3]>,
-    /// Bowl target [x, y, z] at the end, metres; absent without a bowl.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub bowl_target: Option<[f64; 3]>,
-    /// The reference tutorial's checks.
-    pub checks: Checks,
-    /// The scene's name.
-    pub scene: String,
-    /// Every object's initial and final pose, `[x, y, z, yaw°]`.
-    pub objects: Vec<ObjectReport>,
-    /// Every goal predicate's value at the end.
-    pub goal: Vec<GoalValue>,
-    /// Contacts that should not happen, by name.
-    pub collisions: Vec<Collision>,
-    /// The path of the node whose failure ended the episode, if one did.
-    pub failed_node: Option<String>,
-    /// The kind of failure (`timeout`, `grasp_lost`, …; serialized as its name), for grouping.
-    pub failure_kind: Option<FailureKind>,
-    /// How often every node ran, in plan order.
-    pub nodes: Vec<NodeReport>,
+    /// How the episode ended (its fields sit at the top level of the line); its `success` is
+    /// judged by the sweep's goal.
+    #[serde(flatten)]
+    pub outcome: EpisodeOutcome,
     /// The digest of the tree, its includes and the scene the sweep ran
     /// ([`SweepConfig::tree_digest`]); a line that has it also ends with its checksum (`crc32`).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -118,23 +81,7 @@ impl ScenarioResult {
             seed: scenario.seed,
             fault: config.fault,
             layout: scenario.layout,
-            success: r.success,
-            tree_status: r.tree_status,
-            failure_reason: r.failure_reason,
-            sim_time_s: r.sim_time_s,
-            grasp_attempts: r.grasp_attempts,
-            halts: r.halts,
-            physics_steps: r.physics_steps,
-            cube_final: r.cube_final,
-            bowl_target: r.bowl_target,
-            checks: r.checks,
-            scene: r.scene,
-            objects: r.objects,
-            goal: r.goal,
-            collisions: r.collisions,
-            failure_kind: r.failure_kind,
-            failed_node: r.failed_node,
-            nodes: r.nodes,
+            outcome: r.outcome,
             tree_digest: config.tree_digest.clone(),
             wall_time_s: r.wall_time_s,
             planning: r.planning.counts(),
@@ -165,29 +112,7 @@ impl ScenarioResult {
             seed,
             fault: config.fault,
             layout,
-            success: false,
-            tree_status: "failure",
-            failure_kind: Some(reason.kind),
-            failure_reason: Some(reason.message),
-            sim_time_s: 0.0,
-            grasp_attempts: 0,
-            halts: 0,
-            physics_steps: 0,
-            cube_final: None,
-            bowl_target: None,
-            checks: Checks {
-                grasp_distance: None,
-                cube_motion_while_closed: 0.0,
-                cube_lift_while_closed: 0.0,
-                home_error: f64::NAN,
-                in_bowl: false,
-            },
-            scene: String::new(),
-            objects: Vec::new(),
-            goal: Vec::new(),
-            collisions: Vec::new(),
-            failed_node: None,
-            nodes: Vec::new(),
+            outcome: EpisodeOutcome::not_run(reason),
             tree_digest: config.tree_digest.clone(),
             wall_time_s: 0.0,
             planning: Default::default(),

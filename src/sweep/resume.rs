@@ -13,7 +13,7 @@
 //!   shard match;
 //! - its `sweep_seed`, `fault`, episode `seed` and `layout` are those of that scenario of this
 //!   sweep seed ([`SweepConfig::scenario`](super::SweepConfig::scenario)): the seed matches;
-//! - its `success` agrees with its `tree_status` and `checks.in_bowl` under this `--goal`;
+//! - its `success` agrees with its `tree_status` and goal (or `checks.in_bowl`) under this `--goal`;
 //! - its `tree`, `scenarios`, `sweep_goal`, `max_sim_time`, `scene_file`, `substitutions`, `collision_policy` (and `suite`
 //!   for `macrotree test`) are this sweep's;
 //! - it is exactly what this version writes for the result it holds (no unknown or reordered
@@ -30,7 +30,7 @@ use serde_json::Value;
 
 use super::{ScenarioResult, SweepConfig, run_scenario};
 use crate::actions::{CONTROL_PERIOD, Cell, Checks};
-use crate::episode::Goal;
+use crate::episode::{CubeBowlReport, EpisodeOutcome, Goal};
 use crate::faults::FaultKind;
 use crate::plan::Plan;
 use crate::sim::{Layout, Scene};
@@ -256,6 +256,7 @@ fn check_result(
         .scenario(scene, index)
         .map_err(|e| format!("scenario {index} cannot be drawn: {e}"))?;
     let initial: Vec<[f64; 3]> = r
+        .outcome
         .objects
         .iter()
         .map(|o| [o.initial[0], o.initial[1], o.initial[3]])
@@ -271,16 +272,16 @@ fn check_result(
             .iter()
             .zip(&drawn)
             .all(|(a, b)| (a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9);
-    if r.seed != s.seed || r.layout != s.layout || !same_objects || r.scene != scene.spec.name {
+    if r.seed != s.seed || r.layout != s.layout || !same_objects || r.outcome.scene != scene.spec.name {
         return Err("its scene, layout or episode seed is not that of this sweep seed".into());
     }
     let goal_ok = match config.goal {
-        Goal::Scene => r.goal.iter().all(|g| g.holds),
-        Goal::Bowl => r.checks.in_bowl,
+        Goal::Scene => r.outcome.goal.iter().all(|g| g.holds),
+        Goal::Bowl => r.outcome.in_bowl(),
         Goal::Tree => true,
     };
-    let met = r.tree_status == "success" && goal_ok;
-    if r.success != met {
+    let met = r.outcome.tree_status == "success" && goal_ok;
+    if r.outcome.success != met {
         return Err(format!(
             "its success does not follow from --goal {}",
             config.goal.name()
@@ -307,7 +308,6 @@ pub fn parse_line(line: &str) -> Result<ScenarioResult, String> {
     let field = |k: &str| v.get(k).ok_or_else(|| format!("no `{k}`"));
     let u64_of = |k: &str| field(k)?.as_u64().ok_or_else(|| format!("`{k}` is not a count"));
     let u32_of = |k: &str| u32::try_from(u64_of(k)?).map_err(|_| format!("`{k}` is too large"));
-    let checks = field("checks")?;
     let parsed = |k: &str| -> Result<Value, String> { Ok(field(k)?.clone()) };
     let failure_reason = match field("failure_reason")? {
         Value::Null => None,
@@ -388,21 +388,51 @@ pub fn parse_line(line: &str) -> Result<ScenarioResult, String> {
                 bowl: floats(layout.get("bowl"), "layout.bowl")?,
             }),
         },
-        success: field("success")?.as_bool().ok_or("`success` is not a boolean")?,
-        tree_status: ["success", "failure", "running"]
-            .into_iter()
-            .find(|s| *s == status)
-            .ok_or("unknown `tree_status`")?,
-        failure_kind,
-        failure_reason,
-        sim_time_s: float(field("sim_time_s")?, "sim_time_s")?,
-        grasp_attempts: u32_of("grasp_attempts")?,
-        halts: u32_of("halts")?,
-        physics_steps: u64_of("physics_steps")?,
-        cube_final: v
-            .get("cube_final")
-            .map(|x| floats(Some(x), "cube_final"))
-            .transpose()?,
+        outcome: EpisodeOutcome {
+            success: field("success")?.as_bool().ok_or("`success` is not a boolean")?,
+            tree_status: ["success", "failure", "running"]
+                .into_iter()
+                .find(|s| *s == status)
+                .ok_or("unknown `tree_status`")?,
+            failure_kind,
+            failure_reason,
+            sim_time_s: float(field("sim_time_s")?, "sim_time_s")?,
+            grasp_attempts: u32_of("grasp_attempts")?,
+            halts: u32_of("halts")?,
+            physics_steps: u64_of("physics_steps")?,
+            cube_bowl: v.get("cube_final").map(|c| cube_bowl(&v, c)).transpose()?,
+            scene: field("scene")?.as_str().ok_or("`scene` is not text")?.to_string(),
+            objects: serde_json::from_value(parsed("objects")?).map_err(|e| format!("`objects`: {e}"))?,
+            goal: serde_json::from_value(parsed("goal")?).map_err(|e| format!("`goal`: {e}"))?,
+            collisions: serde_json::from_value(parsed("collisions")?)
+                .map_err(|e| format!("`collisions`: {e}"))?,
+            failed_node: serde_json::from_value(parsed("failed_node")?)
+                .map_err(|e| format!("`failed_node`: {e}"))?,
+            nodes: serde_json::from_value(parsed("nodes")?).map_err(|e| format!("`nodes`: {e}"))?,
+        },
+        tree_digest,
+        wall_time_s: 0.0,
+        planning: match v.get("planning") {
+            None => Default::default(),
+            Some(p) => serde_json::from_value(p.clone()).map_err(|e| format!("`planning`: {e}"))?,
+        },
+        planning_wall_s: 0.0,
+    })
+}
+
+/// A number; `null` stands for NaN (which JSON cannot spell).
+fn float(v: &Value, name: &str) -> Result<f64, String> {
+    match v {
+        Value::Null => Ok(f64::NAN),
+        v => v.as_f64().ok_or_else(|| format!("`{name}` is not a number")),
+    }
+}
+
+/// The flagship's legacy section of line `v`, whose `cube_final` is `cube_final`.
+fn cube_bowl(v: &Value, cube_final: &Value) -> Result<CubeBowlReport, String> {
+    let checks = v.get("checks").ok_or("`cube_final` without `checks`")?;
+    Ok(CubeBowlReport {
+        cube_final: floats(Some(cube_final), "cube_final")?,
         bowl_target: v
             .get("bowl_target")
             .map(|x| floats(Some(x), "bowl_target"))
@@ -423,30 +453,7 @@ pub fn parse_line(line: &str) -> Result<ScenarioResult, String> {
                 .and_then(Value::as_bool)
                 .ok_or("`checks.in_bowl` is not a boolean")?,
         },
-        scene: field("scene")?.as_str().ok_or("`scene` is not text")?.to_string(),
-        objects: serde_json::from_value(parsed("objects")?).map_err(|e| format!("`objects`: {e}"))?,
-        goal: serde_json::from_value(parsed("goal")?).map_err(|e| format!("`goal`: {e}"))?,
-        collisions: serde_json::from_value(parsed("collisions")?)
-            .map_err(|e| format!("`collisions`: {e}"))?,
-        failed_node: serde_json::from_value(parsed("failed_node")?)
-            .map_err(|e| format!("`failed_node`: {e}"))?,
-        nodes: serde_json::from_value(parsed("nodes")?).map_err(|e| format!("`nodes`: {e}"))?,
-        tree_digest,
-        wall_time_s: 0.0,
-        planning: match v.get("planning") {
-            None => Default::default(),
-            Some(p) => serde_json::from_value(p.clone()).map_err(|e| format!("`planning`: {e}"))?,
-        },
-        planning_wall_s: 0.0,
     })
-}
-
-/// A number; `null` stands for NaN (which JSON cannot spell).
-fn float(v: &Value, name: &str) -> Result<f64, String> {
-    match v {
-        Value::Null => Ok(f64::NAN),
-        v => v.as_f64().ok_or_else(|| format!("`{name}` is not a number")),
-    }
 }
 
 fn float_at(v: &Value, key: &str) -> Result<f64, String> {

@@ -89,13 +89,13 @@ impl Tally {
     /// Adds one result (any order; the failures listed are the first ones added).
     pub fn add(&mut self, r: &ScenarioResult) {
         self.n += 1;
-        self.successes += u64::from(r.success);
+        self.successes += u64::from(r.outcome.success);
         self.planning.add(r);
-        self.collisions.add(&r.collisions);
-        self.scene_goal_seen |= !r.goal.is_empty();
-        *self.attempts.entry(r.grasp_attempts).or_insert(0) += 1;
-        *self.times.entry(order_key(r.sim_time_s)).or_insert(0) += 1;
-        for node in &r.nodes {
+        self.collisions.add(&r.outcome.collisions);
+        self.scene_goal_seen |= !r.outcome.goal.is_empty();
+        *self.attempts.entry(r.outcome.grasp_attempts).or_insert(0) += 1;
+        *self.times.entry(order_key(r.outcome.sim_time_s)).or_insert(0) += 1;
+        for node in &r.outcome.nodes {
             let i = match self.node_at.get(&node.path) {
                 Some(&i) => i,
                 None => {
@@ -119,13 +119,14 @@ impl Tally {
             t.failures += u64::from(c.failures);
             t.halts += u64::from(c.halts);
         }
-        if r.success {
+        if r.outcome.success {
             return;
         }
         self.failures_total += 1;
         let key = (
-            r.failed_node.clone().unwrap_or_else(|| "-".into()),
-            r.failure_kind
+            r.outcome.failed_node.clone().unwrap_or_else(|| "-".into()),
+            r.outcome
+                .failure_kind
                 .unwrap_or(crate::failure::FailureKind::Other)
                 .to_string(),
         );
@@ -140,11 +141,15 @@ impl Tally {
                 seed: r.seed,
                 cube: r.layout.map(|l| l.cube),
                 bowl: r.layout.map(|l| l.bowl),
-                node: r.failed_node.clone(),
-                kind: r.failure_kind,
-                collisions: r.collisions.iter().map(|c| c.what.clone()).collect(),
-                reason: r.failure_reason.clone().unwrap_or_else(|| "failed".into()),
-                grasp_attempts: r.grasp_attempts,
+                node: r.outcome.failed_node.clone(),
+                kind: r.outcome.failure_kind,
+                collisions: r.outcome.collisions.iter().map(|c| c.what.clone()).collect(),
+                reason: r
+                    .outcome
+                    .failure_reason
+                    .clone()
+                    .unwrap_or_else(|| "failed".into()),
+                grasp_attempts: r.outcome.grasp_attempts,
                 reproduce: r.reproduce(&self.tree, &self.config),
             });
         }

@@ -101,13 +101,13 @@ fn bench_replay_ends_in_the_episodes_exact_final_state() {
         &config,
         &mut macrotree::episode::NoObserver,
     );
-    assert!(r.success);
+    assert!(r.outcome.success);
     assert_eq!(
         v["state_fingerprint"].as_str(),
         Some(fnv1a_hex(&cell.sim().state_fingerprint()).as_str()),
         "{stdout}"
     );
-    assert_eq!(v["physics_steps"].as_u64(), Some(r.physics_steps));
+    assert_eq!(v["physics_steps"].as_u64(), Some(r.outcome.physics_steps));
 }
 
 /// Runs `run TREE --json EXTRA…`; the episode's wall time (seconds, as the report measures it:

@@ -690,9 +690,9 @@ fn a_sweep_tally_stays_bounded_however_many_scenarios_it_sums() {
     for i in 0..200_000u64 {
         let mut r = template.clone();
         r.index = i;
-        r.success = i % 3 != 0;
-        failures += u64::from(!r.success);
-        r.sim_time_s = (i % 500) as f64 * 0.004;
+        r.outcome.success = i % 3 != 0;
+        failures += u64::from(!r.outcome.success);
+        r.outcome.sim_time_s = (i % 500) as f64 * 0.004;
         tally.add(&r);
     }
     let summary = tally.finish(1.0, 1);

@@ -76,9 +76,9 @@ fn rendering_never_changes_the_physics_bits() {
         &config,
         &mut observer,
     );
-    assert!(a.success && b.success);
+    assert!(a.outcome.success && b.outcome.success);
     // Every 8th tick rendered both cameras, and the images changed along the episode.
-    let ticks = b.physics_steps / 2;
+    let ticks = b.outcome.physics_steps / 2;
     assert_eq!(observer.ticks, ticks);
     assert_eq!(observer.sums.len() as u64, 2 * ticks.div_ceil(8));
     let distinct: std::collections::BTreeSet<_> = observer.sums.iter().collect();
@@ -88,7 +88,7 @@ fn rendering_never_changes_the_physics_bits() {
         plain.sim().state_fingerprint(),
         rendered.sim().state_fingerprint()
     );
-    assert_eq!(a.physics_steps, b.physics_steps);
+    assert_eq!(a.outcome.physics_steps, b.outcome.physics_steps);
 }
 
 #[test]

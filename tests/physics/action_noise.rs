@@ -35,7 +35,7 @@ fn noise_moves_the_executed_path_while_the_labels_stay_clean_commands() {
     let (clean_report, clean_frames) = record(&clean);
     let (noisy_report, noisy_frames) = record(&noisy);
     assert!(
-        clean_report.success && noisy_report.success,
+        clean_report.outcome.success && noisy_report.outcome.success,
         "{:?}",
         noisy_report.failure
     );
@@ -82,7 +82,7 @@ fn noisy_demonstrations_of_the_flagship_still_succeed() {
         .filter(|&k| {
             let s = sweep.scenario(scene, k).unwrap();
             let (report, _) = record(&sweep.episode_config(&s));
-            report.success
+            report.outcome.success
         })
         .count();
     assert_eq!(

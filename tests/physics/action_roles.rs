@@ -86,9 +86,12 @@ fn pick(role: ActionRole, fault: Option<FaultKind>) -> (EpisodeReport, bool) {
 #[test]
 fn a_custom_pick_declared_as_a_grasp_is_counted_checked_and_faulted_as_one() {
     let (r, _) = pick(ActionRole::Grasp, None);
-    assert!(r.success, "{:?}", r.failure_reason);
-    assert_eq!(r.grasp_attempts, 1, "counted as a grasp attempt");
+    assert!(r.outcome.success, "{:?}", r.outcome.failure_reason);
+    assert_eq!(r.outcome.grasp_attempts, 1, "counted as a grasp attempt");
     let d = r
+        .outcome
+        .cube_bowl
+        .expect("the scene has a cube")
         .checks
         .grasp_distance
         .expect("the grasp checks were taken when it ended");
@@ -100,9 +103,16 @@ fn a_custom_pick_declared_as_a_grasp_is_counted_checked_and_faulted_as_one() {
 #[test]
 fn a_custom_action_of_no_role_is_neither_counted_nor_faulted() {
     let (r, _) = pick(ActionRole::Other, None);
-    assert!(r.success, "{:?}", r.failure_reason);
-    assert_eq!(r.grasp_attempts, 0);
-    assert_eq!(r.checks.grasp_distance, None);
+    assert!(r.outcome.success, "{:?}", r.outcome.failure_reason);
+    assert_eq!(r.outcome.grasp_attempts, 0);
+    assert_eq!(
+        r.outcome
+            .cube_bowl
+            .expect("the scene has a cube")
+            .checks
+            .grasp_distance,
+        None
+    );
     let (_, fired) = pick(ActionRole::Other, Some(FaultKind::Nudge));
     assert!(!fired, "the nudge fault waits for a grasp that never comes");
 }

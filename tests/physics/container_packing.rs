@@ -68,11 +68,11 @@ goal:
         &format!("  sequence:\n    children:\n      - home: {{}}\n{steps}"),
     );
     assert!(
-        r.success,
+        r.outcome.success,
         "three blocks into the 20 cm bin: {:?} ({:?}) at {:?}",
-        r.failure_reason, r.failure_kind, r.failed_node
+        r.outcome.failure_reason, r.outcome.failure_kind, r.outcome.failed_node
     );
-    assert!(r.collisions.is_empty(), "{:?}", r.collisions);
+    assert!(r.outcome.collisions.is_empty(), "{:?}", r.outcome.collisions);
     let w = cell.world();
     let bin = w.index_of("bin").unwrap();
     for b in ["a", "b", "c"] {

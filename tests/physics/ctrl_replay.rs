@@ -59,7 +59,7 @@ fn an_episodes_commands_replayed_through_ctrl_give_its_physics_bit_for_bit() {
             &config,
             &mut rec,
         );
-        assert!(report.success, "{:?}", report.failure);
+        assert!(report.outcome.success, "{:?}", report.failure);
         assert!(
             rec.commands
                 .iter()
@@ -127,8 +127,8 @@ fn a_dataset_at_its_frame_rate_replays_through_ctrl_to_the_same_outcome() {
             env.step(&Action::Ctrl(action)).unwrap();
         }
         let replayed = goal_holds(&mut env);
-        successes += report.success as u32;
-        same += (replayed == report.success) as u32;
+        successes += report.outcome.success as u32;
+        same += (replayed == report.outcome.success) as u32;
     }
     assert_eq!(successes, scenarios as u32, "every recorded episode succeeded");
     assert_eq!(same, scenarios as u32, "every replay ends as its episode did");

@@ -54,8 +54,11 @@ fn replay(reset: Reset, config: EpisodeConfig) {
         &config,
         &mut rec,
     );
-    assert!(report.success, "{:?}", report.failure);
-    assert_eq!(report.halts, 0, "no leaf was halted, so the replay applies");
+    assert!(report.outcome.success, "{:?}", report.failure);
+    assert_eq!(
+        report.outcome.halts, 0,
+        "no leaf was halted, so the replay applies"
+    );
     let kinds: Vec<&str> = rec.started.iter().map(|s| s.split('"').nth(1).unwrap()).collect();
     assert_eq!(
         kinds,
@@ -83,7 +86,7 @@ fn replay(reset: Reset, config: EpisodeConfig) {
     // run_episode simulates one more control period after the tree has finished.
     let (last_steps, _) = rec.states.last().unwrap();
     assert_eq!(*last_steps, steps + 2);
-    assert_eq!(report.physics_steps, steps + 2);
+    assert_eq!(report.outcome.physics_steps, steps + 2);
     let (_, episode_state) = rec
         .states
         .iter()

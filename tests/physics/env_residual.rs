@@ -41,7 +41,7 @@ fn a_zero_residual_runs_the_scripted_episode_bit_for_bit() {
             &config,
             &mut rec,
         );
-        assert!(report.success, "{:?}", report.failure);
+        assert!(report.outcome.success, "{:?}", report.failure);
 
         let mut env = residual_env();
         env.reset(&Reset::Scenario {

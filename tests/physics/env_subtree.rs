@@ -93,9 +93,9 @@ fn the_whole_tree_as_one_step_is_run_episode_bit_for_bit() {
         &sweep.episode_config(&s),
         &mut states,
     );
-    assert!(report.success);
+    assert!(report.outcome.success);
     assert_eq!(
-        report.physics_steps,
+        report.outcome.physics_steps,
         r.physics_steps + 2,
         "run_episode ticks one period more"
     );

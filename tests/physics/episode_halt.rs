@@ -53,8 +53,8 @@ main:
         &EpisodeConfig::default(),
         &mut trace,
     );
-    assert_eq!(report.tree_status, "success");
-    assert_eq!(report.halts, 1, "exactly one leaf halted");
+    assert_eq!(report.outcome.tree_status, "success");
+    assert_eq!(report.outcome.halts, 1, "exactly one leaf halted");
     let halted: Vec<&Transition> = trace
         .transitions
         .iter()

@@ -51,17 +51,17 @@ fn run_all(layouts: &[Layout]) -> Vec<(EpisodeReport, oracle::Verdict)> {
 fn reference_layouts_pass_the_tutorial_checks() {
     let layouts = Layout::reference_layouts();
     for (layout, (r, verdict)) in layouts.iter().zip(run_all(&layouts)) {
-        let c = &r.checks;
+        let c = &r.outcome.cube_bowl.expect("the tutorial scene has a cube").checks;
         eprintln!(
             "{layout:?}: success {} in {:.2} s sim, grasp {:?} m, motion {:.3} m, lift {:.3} m, home {:.4} rad",
-            r.success,
-            r.sim_time_s,
+            r.outcome.success,
+            r.outcome.sim_time_s,
             c.grasp_distance,
             c.cube_motion_while_closed,
             c.cube_lift_while_closed,
             c.home_error
         );
-        assert!(r.success, "{layout:?}: {:?}", r.failure_reason);
+        assert!(r.outcome.success, "{layout:?}: {:?}", r.outcome.failure_reason);
         let grasp = c.grasp_distance.expect("a grasp happened");
         assert!(grasp <= 0.025, "{layout:?}: grasp distance {grasp} m > 0.025 m");
         assert!(
@@ -82,11 +82,14 @@ fn reference_layouts_pass_the_tutorial_checks() {
         assert!(
             c.in_bowl,
             "{layout:?}: cube not in the bowl at {:?}",
-            r.cube_final
+            r.outcome.cube_bowl.map(|l| l.cube_final)
         );
         assert!(c.pass_reference());
         assert!(verdict.inside(), "{layout:?}: the oracle disagrees: {verdict:?}");
-        assert_eq!(r.grasp_attempts, 1, "{layout:?}: a clean layout needs one grasp");
+        assert_eq!(
+            r.outcome.grasp_attempts, 1,
+            "{layout:?}: a clean layout needs one grasp"
+        );
     }
 }
 
@@ -119,13 +122,13 @@ fn rotated_cubes_across_the_region_end_in_the_bowl() {
     let failures: Vec<String> = layouts
         .iter()
         .zip(&reports)
-        .filter(|(_, (r, v))| !r.success || !v.inside())
-        .map(|(l, (r, v))| format!("{l:?}: {:?}, oracle {v:?}", r.failure_reason))
+        .filter(|(_, (r, v))| !r.outcome.success || !v.inside())
+        .map(|(l, (r, v))| format!("{l:?}: {:?}, oracle {v:?}", r.outcome.failure_reason))
         .collect();
     for (l, (r, v)) in layouts.iter().zip(&reports) {
         eprintln!(
             "{l:?}: {:.2} s sim, {} grasp(s), oracle offset {:?} of ±{:?} m, height error {:.2e} m",
-            r.sim_time_s, r.grasp_attempts, v.offset, v.allowed, v.height_error
+            r.outcome.sim_time_s, r.outcome.grasp_attempts, v.offset, v.allowed, v.height_error
         );
     }
     assert!(failures.is_empty(), "failed layouts:\n{}", failures.join("\n"));
@@ -168,7 +171,7 @@ fn same_tree_layout_and_seed_give_a_bit_identical_episode() {
         &config,
         &mut NoObserver,
     );
-    assert!(ra.success);
+    assert!(ra.outcome.success);
     oracle::assert_no_warning(a.sim(), "episode a");
     oracle::assert_no_warning(b.sim(), "episode b");
     assert_eq!(

@@ -116,15 +116,16 @@ fn run(plan: &Arc<Plan>, layout: Layout, fault: Option<(FaultKind, u64)>) -> Out
     let verdict = oracle::settle_and_judge(cell.sim_mut(), "cube", "bowl");
     eprintln!(
         "{layout:?} {fault:?}: tree {}, in bowl {}, {:.2} s sim, {} grasp(s), cube at ({:.4}, {:.4}, {:.4}) m, yaw {:.2}°{}",
-        report.tree_status,
-        report.checks.in_bowl,
-        report.sim_time_s,
-        report.grasp_attempts,
-        report.cube_final.unwrap()[0],
-        report.cube_final.unwrap()[1],
-        report.cube_final.unwrap()[2],
+        report.outcome.tree_status,
+        report.outcome.in_bowl(),
+        report.outcome.sim_time_s,
+        report.outcome.grasp_attempts,
+        report.outcome.cube_bowl.unwrap().cube_final[0],
+        report.outcome.cube_bowl.unwrap().cube_final[1],
+        report.outcome.cube_bowl.unwrap().cube_final[2],
         cube_yaw.to_degrees(),
         report
+            .outcome
             .failure_reason
             .as_deref()
             .map(|r| format!(", {r}"))
@@ -150,8 +151,12 @@ fn place_on_table_sets_the_cube_down_square_on_the_spot() {
     ] {
         let o = run(&plan, layout, fault);
         let r = &o.report;
-        assert_eq!(r.tree_status, "success", "{layout:?}: {:?}", r.failure_reason);
-        let [x, y, z] = r.cube_final.expect("the scene has a cube");
+        assert_eq!(
+            r.outcome.tree_status, "success",
+            "{layout:?}: {:?}",
+            r.outcome.failure_reason
+        );
+        let [x, y, z] = r.outcome.cube_bowl.expect("the scene has a cube").cube_final;
         let off = (x - 0.32).hypot(y + 0.30);
         eprintln!("  {:.1} mm from the spot", off * 1e3);
         assert!(off <= 0.005, "{layout:?}: cube {:.1} mm from the spot", off * 1e3);
@@ -164,11 +169,11 @@ fn place_on_table_sets_the_cube_down_square_on_the_spot() {
             "{layout:?}: cube yaw {:.1}° from square",
             o.cube_yaw.to_degrees()
         );
-        assert!(!r.checks.in_bowl);
+        assert!(!r.outcome.in_bowl());
         assert!(!o.oracle.inside(), "{layout:?}: {:?}", o.oracle);
         assert!(o.trace.reached("cube_at[on the spot?]", NodeStatus::Success));
         let grasps = if fault.is_some() { 2 } else { 1 };
-        assert_eq!(r.grasp_attempts, grasps, "{layout:?} {fault:?}");
+        assert_eq!(r.outcome.grasp_attempts, grasps, "{layout:?} {fault:?}");
     }
 }
 
@@ -177,9 +182,9 @@ fn recenter_and_grasp_recovers_a_missed_taught_pick() {
     let plan = tree("recenter_and_grasp.yaml");
     // The cube where it was taught: the blind pick works, the recovery never runs.
     let o = run(&plan, Layout::default(), None);
-    assert!(o.report.success, "{:?}", o.report.failure_reason);
+    assert!(o.report.outcome.success, "{:?}", o.report.outcome.failure_reason);
     assert!(o.oracle.inside(), "{:?}", o.oracle);
-    assert_eq!(o.report.grasp_attempts, 1);
+    assert_eq!(o.report.outcome.grasp_attempts, 1);
     assert!(
         !o.trace.touched("sequence[recentre]"),
         "the recovery ran on a clean layout"
@@ -194,8 +199,8 @@ fn recenter_and_grasp_recovers_a_missed_taught_pick() {
     ] {
         let o = run(&plan, layout, None);
         let r = &o.report;
-        assert!(r.success, "{layout:?}: {:?}", r.failure_reason);
-        assert!(r.checks.in_bowl);
+        assert!(r.outcome.success, "{layout:?}: {:?}", r.outcome.failure_reason);
+        assert!(r.outcome.in_bowl());
         assert!(o.oracle.inside(), "{layout:?}: {:?}", o.oracle);
         assert!(
             o.trace.reached("sequence[taught pick]", NodeStatus::Failure),
@@ -212,13 +217,21 @@ fn recenter_and_grasp_recovers_a_missed_taught_pick() {
             !o.trace.touched("reach[down at taught spot]"),
             "{layout:?}: the blind descent ran on a cube off the taught spot"
         );
-        assert!(r.collisions.is_empty(), "{layout:?}: {:?}", r.collisions);
+        assert!(
+            r.outcome.collisions.is_empty(),
+            "{layout:?}: {:?}",
+            r.outcome.collisions
+        );
         assert!(
             o.trace.reached("sequence[recentre]", NodeStatus::Success),
             "{layout:?}: the recovery did not succeed"
         );
         // The squeeze and the real grasp.
-        assert!(r.grasp_attempts >= 2, "{layout:?}: {} grasps", r.grasp_attempts);
+        assert!(
+            r.outcome.grasp_attempts >= 2,
+            "{layout:?}: {} grasps",
+            r.outcome.grasp_attempts
+        );
     }
 
     // The cube moves after it was looked at: the cube is off the taught spot, so the squeeze is
@@ -234,7 +247,7 @@ fn recenter_and_grasp_recovers_a_missed_taught_pick() {
         s.max_off * 1e3,
         end * 1e3
     );
-    assert!(o.report.success, "{:?}", o.report.failure_reason);
+    assert!(o.report.outcome.success, "{:?}", o.report.outcome.failure_reason);
     assert!(
         o.trace
             .reached("cube_at[cube on the taught spot?]", NodeStatus::Failure)
@@ -263,10 +276,14 @@ fn recenter_and_grasp_blind_descent_landed_a_finger_on_a_cube_beside_the_taught_
     // 30 mm along the fingers from the taught spot: the pads' faces (65 mm apart) are 10.5 mm
     // beyond a square cube's faces at the spot, so the blind descent put a finger on this one.
     let o = run(&plan, Layout::new(0.48, -0.18, 0.0, 0.45, 0.08), None);
-    assert!(o.report.success, "{:?}", o.report.failure_reason);
+    assert!(o.report.outcome.success, "{:?}", o.report.outcome.failure_reason);
     assert!(o.oracle.inside(), "{:?}", o.oracle);
     assert!(!o.trace.touched("reach[down at taught spot]"));
-    assert!(o.report.collisions.is_empty(), "{:?}", o.report.collisions);
+    assert!(
+        o.report.outcome.collisions.is_empty(),
+        "{:?}",
+        o.report.outcome.collisions
+    );
 }
 
 #[test]
@@ -281,11 +298,15 @@ fn library_pick_place_puts_the_cube_in_the_bowl() {
         (Layout::default(), Some((FaultKind::Slip, 3))),
     ] {
         let o = run(&plan, layout, fault);
-        assert!(o.report.success, "{layout:?}: {:?}", o.report.failure_reason);
+        assert!(
+            o.report.outcome.success,
+            "{layout:?}: {:?}",
+            o.report.outcome.failure_reason
+        );
         assert!(o.oracle.inside(), "{layout:?}: {:?}", o.oracle);
         assert!(o.trace.reached("subtree[pick_and_place]", NodeStatus::Success));
         let grasps = if fault.is_some() { 2 } else { 1 };
-        assert_eq!(o.report.grasp_attempts, grasps, "{layout:?} {fault:?}");
+        assert_eq!(o.report.outcome.grasp_attempts, grasps, "{layout:?} {fault:?}");
     }
 }
 

@@ -66,10 +66,10 @@ fn tree_goal() -> EpisodeConfig {
 
 /// The report's kind, its typed failure's kind and the JSON's `failure_kind` agree; the kind.
 fn kind_of(r: &EpisodeReport) -> FailureKind {
-    assert!(!r.success);
+    assert!(!r.outcome.success);
     let f = r.failure.as_ref().expect("a failed episode has its failure");
-    assert_eq!(r.failure_kind, Some(f.kind));
-    assert_eq!(r.failure_reason.as_deref(), Some(f.message.as_str()));
+    assert_eq!(r.outcome.failure_kind, Some(f.kind));
+    assert_eq!(r.outcome.failure_reason.as_deref(), Some(f.message.as_str()));
     let json = serde_json::to_value(r).unwrap();
     assert_eq!(json["failure_kind"], f.kind.as_str());
     assert!(json.get("failure").is_none(), "the JSON keeps its fields: {json}");
@@ -232,7 +232,7 @@ fn an_episode_reuses_the_resolution_of_its_own_rules_and_resolves_other_rules_ag
     };
     let own = run(rules.clone());
     assert_eq!(kind_of(&own), FailureKind::Substituted);
-    assert_eq!(own.failed_node.as_deref(), Some("main/sequence/grasp"));
+    assert_eq!(own.outcome.failed_node.as_deref(), Some("main/sequence/grasp"));
     let other = run(vec!["main/nothing_here=failure".parse().unwrap()]);
     assert_eq!(kind_of(&other), FailureKind::Substitution);
 }
@@ -250,7 +250,7 @@ fn the_episode_time_limit_is_time_limit() {
 #[test]
 fn a_tree_that_succeeds_without_the_scene_goal_is_goal_not_met() {
     let r = episode("main: {cube_on_table: {}}", &EpisodeConfig::default(), vec![]);
-    assert_eq!(r.tree_status, "success");
+    assert_eq!(r.outcome.tree_status, "success");
     assert_eq!(kind_of(&r), FailureKind::GoalNotMet);
     let bowl = EpisodeConfig {
         goal: Goal::Bowl,
@@ -308,7 +308,7 @@ fn a_leaf_past_its_own_time_limit_is_timeout() {
     );
     assert_eq!(kind_of(&r), FailureKind::Timeout);
     // The wording is the point here: it says what the leaf was still waiting for.
-    assert!(r.failure_reason.unwrap().contains("arm still moving"));
+    assert!(r.outcome.failure_reason.unwrap().contains("arm still moving"));
 }
 
 /// Pick the cube, then carry it to the bowl (no retry: the carry's failure ends the episode).
@@ -330,7 +330,7 @@ fn a_cube_that_slips_from_the_fingers_is_grasp_lost() {
     };
     let r = episode(PICK_AND_CARRY, &config, vec![]);
     assert_eq!(kind_of(&r), FailureKind::GraspLost);
-    assert_eq!(r.failed_node.as_deref(), Some("main/sequence/carry"));
+    assert_eq!(r.outcome.failed_node.as_deref(), Some("main/sequence/carry"));
 }
 
 /// Once a carry starts, slides the bowl (a mocap body) round a 5 cm circle, one turn in 2 s.
@@ -439,8 +439,8 @@ fn a_layout_the_sweep_cannot_draw_is_layout() {
         0,
         &mut NoObserver,
     );
-    assert!(!r.success);
-    assert_eq!(r.failure_kind, Some(FailureKind::Layout));
+    assert!(!r.outcome.success);
+    assert_eq!(r.outcome.failure_kind, Some(FailureKind::Layout));
 }
 
 #[test]
@@ -465,7 +465,7 @@ fn an_episode_that_panics_is_panicked_and_the_sweep_carries_on() {
             )
         },
         |r, _| {
-            kinds.push(r.failure_kind);
+            kinds.push(r.outcome.failure_kind);
             ControlFlow::Continue(())
         },
     )
@@ -540,7 +540,7 @@ fn a_custom_action_fails_with_the_kind_it_declares() {
     let r = stuck_episode(FailureKind::Custom("jammed"));
     assert_eq!(kind_of(&r), FailureKind::Custom("jammed"));
     assert_eq!(
-        r.failure_reason.as_deref(),
+        r.outcome.failure_reason.as_deref(),
         Some("stuck: the block will not move")
     );
 }
@@ -550,7 +550,8 @@ fn a_custom_kind_the_action_does_not_declare_is_reported_as_other() {
     let r = stuck_episode(FailureKind::Custom("wedged"));
     assert_eq!(kind_of(&r), FailureKind::Other);
     assert!(
-        r.failure_reason
+        r.outcome
+            .failure_reason
             .unwrap()
             .contains("undeclared failure kind `wedged`")
     );
@@ -692,16 +693,16 @@ fn a_resumed_sweep_reads_the_kind_back_from_the_file_custom_kinds_included() {
     };
     let mut cell = Cell::new(scene(), &Layout::default(), CONTROL_PERIOD);
     let r = run_scenario(&mut cell, &plan, app.factory(), &config, 0, &mut NoObserver);
-    assert_eq!(r.failure_kind, Some(FailureKind::Custom("jammed")));
+    assert_eq!(r.outcome.failure_kind, Some(FailureKind::Custom("jammed")));
     let line = serde_json::to_string(&r).unwrap();
     let back = macrotree::sweep::resume::parse_line(&line).unwrap();
-    assert_eq!(back.failure_kind, Some(FailureKind::Custom("jammed")));
+    assert_eq!(back.outcome.failure_kind, Some(FailureKind::Custom("jammed")));
     assert_eq!(serde_json::to_string(&back).unwrap(), line);
     // The kind is read, not derived from the reason: a reason that reads like another kind
     // keeps the kind written beside it; a kind that is no name is refused.
     let relabelled = line.replace("stuck: the block will not move", "grasp lost during transfer");
     let back = macrotree::sweep::resume::parse_line(&relabelled).unwrap();
-    assert_eq!(back.failure_kind, Some(FailureKind::Custom("jammed")));
+    assert_eq!(back.outcome.failure_kind, Some(FailureKind::Custom("jammed")));
     let bad = line.replace("\"failure_kind\":\"jammed\"", "\"failure_kind\":\"Jammed!\"");
     assert_ne!(bad, line);
     let e = macrotree::sweep::resume::parse_line(&bad).unwrap_err();

@@ -24,7 +24,11 @@ fn ten_seeded_nudges_all_succeed() {
     };
     let run = sweep_flagship(&config);
     for r in &run.results {
-        assert!(r.success, "#{} {:?}: {:?}", r.index, r.layout, r.failure_reason);
+        assert!(
+            r.outcome.success,
+            "#{} {:?}: {:?}",
+            r.index, r.layout, r.outcome.failure_reason
+        );
     }
 }
 
@@ -75,9 +79,13 @@ fn a_nudge_really_moves_the_cube_as_the_gripper_closes() {
             "seed {seed}: {}; moved {:.1} mm; {} grasp(s)",
             event.detail,
             moved.max * 1e3,
-            report.grasp_attempts
+            report.outcome.grasp_attempts
         );
-        assert!(report.success, "seed {seed}: {:?}", report.failure_reason);
+        assert!(
+            report.outcome.success,
+            "seed {seed}: {:?}",
+            report.outcome.failure_reason
+        );
         oracle::assert_no_warning(cell.sim(), &format!("seed {seed}"));
         oracle::assert_in(cell.sim_mut(), "cube", "bowl", &format!("seed {seed}"));
         assert!(
@@ -122,7 +130,7 @@ fn every_fault_fires_exactly_once_in_an_episode() {
         let event = event.unwrap_or_else(|| panic!("{kind} never fired"));
         eprintln!(
             "{kind}: {} at {:.2} s; success {}",
-            event.detail, event.time, report.success
+            event.detail, event.time, report.outcome.success
         );
         assert_eq!(event.kind, kind);
         // Every firing is logged, and there is exactly one: one `fault KIND:` line, at the
@@ -133,7 +141,11 @@ fn every_fault_fires_exactly_once_in_an_episode() {
             .collect();
         assert_eq!(fired.len(), 1, "{kind}: {fired:#?}");
         assert!(fired[0].contains(&event.detail), "{kind}: {}", fired[0]);
-        assert!(report.success, "{kind}: {:?}", report.failure_reason);
+        assert!(
+            report.outcome.success,
+            "{kind}: {:?}",
+            report.outcome.failure_reason
+        );
         oracle::assert_in(cell.sim_mut(), "cube", "bowl", kind.name());
     }
 }

@@ -108,7 +108,7 @@ fn a_bump_really_knocks_the_cube_and_the_tree_picks_it_up_where_it_lies() {
             "bump #{index}: {}; moved {:.1} mm; {:?}",
             event.detail,
             moved * 1e3,
-            report.failure_reason
+            report.outcome.failure_reason
         );
         assert!(
             (0.02..0.08).contains(&moved),
@@ -118,7 +118,11 @@ fn a_bump_really_knocks_the_cube_and_the_tree_picks_it_up_where_it_lies() {
             cube1.z < 0.03,
             "bump #{index}: the cube left the table: {cube1:?}"
         );
-        assert!(report.success, "bump #{index}: {:?}", report.failure_reason);
+        assert!(
+            report.outcome.success,
+            "bump #{index}: {:?}",
+            report.outcome.failure_reason
+        );
         oracle::assert_in(cell.sim_mut(), "cube", "bowl", &format!("bump #{index}"));
     }
 }
@@ -144,7 +148,11 @@ fn a_late_bowl_really_moves_the_bowl_and_the_cube_lands_where_it_now_is() {
             (end - bowl1).norm() < 1e-9,
             "late_bowl #{index}: the bowl moved again"
         );
-        assert!(report.success, "late_bowl #{index}: {:?}", report.failure_reason);
+        assert!(
+            report.outcome.success,
+            "late_bowl #{index}: {:?}",
+            report.outcome.failure_reason
+        );
         // In the bowl where it is now (the oracle reads the bowl's floor geom in MuJoCo).
         oracle::assert_in(cell.sim_mut(), "cube", "bowl", &format!("late_bowl #{index}"));
     }
@@ -160,16 +168,16 @@ fn batch(kind: FaultKind) {
     };
     let run = sweep_flagship(&config);
     assert_eq!(run.results.len(), 20);
-    let ok = run.results.iter().filter(|r| r.success).count();
+    let ok = run.results.iter().filter(|r| r.outcome.success).count();
     eprintln!("{kind}: {ok}/20 recovered");
     for r in &run.results {
         // A MuJoCo warning would be a failure with its reason (the episode stops on it).
         assert!(
-            r.success,
+            r.outcome.success,
             "{kind} #{} {:?}: {:?}",
-            r.index, r.layout, r.failure_reason
+            r.index, r.layout, r.outcome.failure_reason
         );
-        assert!(r.checks.in_bowl, "{kind} #{}", r.index);
+        assert!(r.outcome.in_bowl(), "{kind} #{}", r.index);
     }
 }
 

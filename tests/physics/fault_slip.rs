@@ -58,8 +58,8 @@ fn a_slip_drops_the_cube_and_the_tree_picks_it_up_where_it_fell() {
             &mut trace,
         )
     });
-    assert!(report.success, "{:?}", report.failure_reason);
-    assert_eq!(report.grasp_attempts, 2);
+    assert!(report.outcome.success, "{:?}", report.outcome.failure_reason);
+    assert_eq!(report.outcome.grasp_attempts, 2);
     oracle::assert_no_warning(cell.sim(), "slip episode");
     // The slip fired once, and said so once.
     let fired = lines.iter().filter(|l| l.contains("fault slip: ")).count();
@@ -148,18 +148,27 @@ fn ten_seeded_slips_all_recover_with_a_second_grasp() {
     for r in &run.results {
         eprintln!(
             "#{}: success {} after {} grasp(s)",
-            r.index, r.success, r.grasp_attempts
+            r.index, r.outcome.success, r.outcome.grasp_attempts
         );
     }
     for r in &run.results {
-        assert!(r.success, "#{} {:?}: {:?}", r.index, r.layout, r.failure_reason);
         assert!(
-            r.grasp_attempts >= 2,
+            r.outcome.success,
+            "#{} {:?}: {:?}",
+            r.index, r.layout, r.outcome.failure_reason
+        );
+        assert!(
+            r.outcome.grasp_attempts >= 2,
             "#{}: the slip did not take the cube ({} grasp)",
             r.index,
-            r.grasp_attempts
+            r.outcome.grasp_attempts
         );
-        assert!(r.grasp_attempts <= 3, "#{}: {} grasps", r.index, r.grasp_attempts);
+        assert!(
+            r.outcome.grasp_attempts <= 3,
+            "#{}: {} grasps",
+            r.index,
+            r.outcome.grasp_attempts
+        );
     }
 }
 
@@ -193,5 +202,5 @@ fn a_slip_is_deterministic_and_fires_once() {
     assert_eq!(a, b, "same seed, same episode, bit for bit");
     let c = run(4);
     assert_ne!(a.1.time, c.1.time, "another seed, another moment");
-    assert_eq!(a.0.grasp_attempts, 2, "it fires once: one re-grasp");
+    assert_eq!(a.0.outcome.grasp_attempts, 2, "it fires once: one re-grasp");
 }

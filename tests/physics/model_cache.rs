@@ -58,9 +58,9 @@ fn a_cached_model_runs_the_episode_bit_for_bit_like_a_compiled_one() {
     assert_eq!(origin, ModelOrigin::Cache, "the second load is a hit");
     let a = episode(&fresh);
     let b = episode(&from_cache);
-    assert!(a.success, "{:?}", a.failure_reason);
+    assert!(a.outcome.success, "{:?}", a.outcome.failure_reason);
     assert_eq!(outcome(&a), outcome(&b));
-    assert_eq!(a.physics_steps, b.physics_steps);
+    assert_eq!(a.outcome.physics_steps, b.outcome.physics_steps);
 }
 
 #[test]
@@ -83,7 +83,7 @@ fn a_scene_built_while_another_of_its_model_lives_shares_the_model() {
         "another model is never shared"
     );
     assert!(!std::sync::Arc::ptr_eq(&first.model, &third.model));
-    assert!(episode(&second).success);
+    assert!(episode(&second).outcome.success);
     drop((first, second));
     let (_, origin) = cached(&spec, &dir);
     assert_eq!(origin, ModelOrigin::Cache, "a dropped model is read again");
@@ -130,7 +130,7 @@ fn a_corrupt_cache_file_is_ignored_and_replaced() {
     std::fs::write(&path, &bytes).unwrap();
     let (scene, origin) = cached(&spec, &dir);
     assert_eq!(origin, ModelOrigin::CompiledAndStored, "a flipped bit is caught");
-    assert!(episode(&scene).success);
+    assert!(episode(&scene).outcome.success);
     // While it lives, a scene of the same model would share it instead of reading the file.
     drop(scene);
     std::fs::write(&path, &bytes[..1000]).unwrap();

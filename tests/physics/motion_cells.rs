@@ -74,19 +74,24 @@ fn a_held_block_is_carried_past_a_wall_taller_than_the_lift_without_touching_it(
     // block and the fingers through it, so the carry plans around (over) it.
     let scene = wall_between(0.30);
     let r = run(&scene, flagship());
-    assert!(r.success, "{:?} {:?}", r.failure_reason, r.collisions);
+    assert!(
+        r.outcome.success,
+        "{:?} {:?}",
+        r.outcome.failure_reason, r.outcome.collisions
+    );
     assert!(r.planning.plans >= 1, "{:?}", r.planning);
     assert_eq!(r.planning.plan_failures, 0, "{:?}", r.planning);
     let bad: Vec<_> = r
+        .outcome
         .collisions
         .iter()
         .filter(|c| matches!(c.who, Hitter::HeldBlock | Hitter::Fingers))
         .collect();
     assert!(bad.is_empty(), "{bad:?}");
     assert!(
-        !r.collisions.iter().any(|c| c.object == "wall"),
+        !r.outcome.collisions.iter().any(|c| c.object == "wall"),
         "{:?}",
-        r.collisions
+        r.outcome.collisions
     );
 }
 
@@ -114,13 +119,16 @@ fn a_carry_with_a_small_check_budget_ends_in_no_path_naming_the_fixture() {
     let cell = scene(&std::fs::read_to_string(Path::new(ROOT).join("scenes/go_around.yaml")).unwrap());
     let r = run(&cell, carry_around(", max_checks: 40"));
     assert_eq!(
-        r.failure_kind,
+        r.outcome.failure_kind,
         Some(FailureKind::NoPath),
         "{:?}",
-        r.failure_reason
+        r.outcome.failure_reason
     );
-    assert_eq!(r.failed_node.as_deref(), Some("main/sequence/carry[around]"));
-    let why = r.failure_reason.unwrap_or_default();
+    assert_eq!(
+        r.outcome.failed_node.as_deref(),
+        Some("main/sequence/carry[around]")
+    );
+    let why = r.outcome.failure_reason.unwrap_or_default();
     assert!(why.contains("fixture"), "{why}");
     // The refusal ends with what to change: the leaf's own budget, with its value.
     assert!(
@@ -128,9 +136,9 @@ fn a_carry_with_a_small_check_budget_ends_in_no_path_naming_the_fixture() {
         "{why}"
     );
     assert_eq!(r.planning.plan_failures, 1, "{:?}", r.planning);
-    assert!(r.collisions.is_empty(), "{:?}", r.collisions);
+    assert!(r.outcome.collisions.is_empty(), "{:?}", r.outcome.collisions);
     let r = run(&cell, carry_around(""));
-    assert!(r.success, "{:?}", r.failure_reason);
+    assert!(r.outcome.success, "{:?}", r.outcome.failure_reason);
     assert_eq!(r.planning.plan_failures, 0, "{:?}", r.planning);
 }
 
@@ -139,7 +147,7 @@ fn a_low_wall_needs_no_plan_and_a_tall_one_does() {
     // The contrast that makes the test above mean something: a 5 cm wall is cleared by the
     // carry's own 15 cm lift, the 30 cm one is not.
     let low = run(&wall_between(0.05), flagship());
-    assert!(low.success, "{:?}", low.failure_reason);
+    assert!(low.outcome.success, "{:?}", low.outcome.failure_reason);
     assert_eq!(low.planning.plans, 0, "{:?}", low.planning);
 }
 
@@ -180,15 +188,18 @@ objects:
 fn no_path_through_a_tree_when_the_check_budget_runs_out_names_the_fixture() {
     let (cell, plan) = swing_tree(", max_checks: 40");
     let r = run(&cell, plan);
-    assert!(!r.success);
+    assert!(!r.outcome.success);
     assert_eq!(
-        r.failure_kind,
+        r.outcome.failure_kind,
         Some(FailureKind::NoPath),
         "{:?}",
-        r.failure_reason
+        r.outcome.failure_reason
     );
-    assert_eq!(r.failed_node.as_deref(), Some("main/sequence/move_joints[swing]"));
-    let why = r.failure_reason.unwrap_or_default();
+    assert_eq!(
+        r.outcome.failed_node.as_deref(),
+        Some("main/sequence/move_joints[swing]")
+    );
+    let why = r.outcome.failure_reason.unwrap_or_default();
     assert!(why.contains("fixture"), "{why}");
     // The refusal ends with what to change: the leaf's own budget, with its value.
     assert!(
@@ -197,16 +208,16 @@ fn no_path_through_a_tree_when_the_check_budget_runs_out_names_the_fixture() {
     );
     assert_eq!(r.planning.plan_failures, 1, "{:?}", r.planning);
     // Failed before swinging: nothing was hit.
-    assert!(r.collisions.is_empty(), "{:?}", r.collisions);
+    assert!(r.outcome.collisions.is_empty(), "{:?}", r.outcome.collisions);
 }
 
 #[test]
 fn the_same_swing_with_the_default_budget_goes_around_the_fixture() {
     let (cell, plan) = swing_tree("");
     let r = run(&cell, plan);
-    assert!(r.success, "{:?}", r.failure_reason);
+    assert!(r.outcome.success, "{:?}", r.outcome.failure_reason);
     assert!(r.planning.plans >= 1, "{:?}", r.planning);
-    assert!(r.collisions.is_empty(), "{:?}", r.collisions);
+    assert!(r.outcome.collisions.is_empty(), "{:?}", r.outcome.collisions);
 }
 
 /// The go-around cell with the arm on one side of the fixture, then a `reach` named `across`
@@ -226,22 +237,25 @@ fn a_reach_with_a_small_check_budget_ends_in_no_path_naming_the_fixture() {
     let (cell, plan) = reach_across_tree(", max_checks: 40");
     let r = run(&cell, plan);
     assert_eq!(
-        r.failure_kind,
+        r.outcome.failure_kind,
         Some(FailureKind::NoPath),
         "{:?}",
-        r.failure_reason
+        r.outcome.failure_reason
     );
-    assert_eq!(r.failed_node.as_deref(), Some("main/sequence/reach[across]"));
-    let why = r.failure_reason.unwrap_or_default();
+    assert_eq!(
+        r.outcome.failed_node.as_deref(),
+        Some("main/sequence/reach[across]")
+    );
+    let why = r.outcome.failure_reason.unwrap_or_default();
     assert!(why.contains("fixture"), "{why}");
     assert!(r.planning.plan_failures >= 1, "{:?}", r.planning);
-    assert!(r.collisions.is_empty(), "{:?}", r.collisions);
+    assert!(r.outcome.collisions.is_empty(), "{:?}", r.outcome.collisions);
     // The same reach with the planner's own budget goes around.
     let (cell, plan) = reach_across_tree("");
     let r = run(&cell, plan);
-    assert!(r.success, "{:?}", r.failure_reason);
+    assert!(r.outcome.success, "{:?}", r.outcome.failure_reason);
     assert!(r.planning.plans >= 1, "{:?}", r.planning);
-    assert!(r.collisions.is_empty(), "{:?}", r.collisions);
+    assert!(r.outcome.collisions.is_empty(), "{:?}", r.outcome.collisions);
 }
 
 #[test]
@@ -300,19 +314,19 @@ fn goal_in_collision_through_a_tree_names_the_fixture_and_the_node() {
     ));
     let r = run(&cell, plan);
     assert_eq!(
-        r.failure_kind,
+        r.outcome.failure_kind,
         Some(FailureKind::GoalInCollision),
         "{:?}",
-        r.failure_reason
+        r.outcome.failure_reason
     );
     assert_eq!(
-        r.failed_node.as_deref(),
+        r.outcome.failed_node.as_deref(),
         Some("main/sequence/move_joints[into fixture]")
     );
-    let why = r.failure_reason.unwrap_or_default();
+    let why = r.outcome.failure_reason.unwrap_or_default();
     assert!(why.contains("fixture"), "{why}");
     assert!(why.contains("; help: the joint angles themselves put"), "{why}");
-    assert!(r.collisions.is_empty(), "{:?}", r.collisions);
+    assert!(r.outcome.collisions.is_empty(), "{:?}", r.outcome.collisions);
 }
 
 #[test]
@@ -322,11 +336,14 @@ fn unreachable_through_a_tree_names_the_node_and_why() {
         tree("main:\n  sequence:\n    children:\n      - reach: {name: too far, target: [0.95, 0.0, 0.2]}\n");
     let r = run(&cell, plan);
     assert_eq!(
-        r.failure_kind,
+        r.outcome.failure_kind,
         Some(FailureKind::Unreachable),
         "{:?}",
-        r.failure_reason
+        r.outcome.failure_reason
     );
-    assert_eq!(r.failed_node.as_deref(), Some("main/sequence/reach[too far]"));
-    assert!(r.failure_reason.unwrap_or_default().contains("beyond"));
+    assert_eq!(
+        r.outcome.failed_node.as_deref(),
+        Some("main/sequence/reach[too far]")
+    );
+    assert!(r.outcome.failure_reason.unwrap_or_default().contains("beyond"));
 }

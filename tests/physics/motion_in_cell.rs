@@ -57,7 +57,7 @@ fn run(scene: &Scene, plan: Arc<Plan>) -> EpisodeReport {
 }
 
 fn hit_the_post(r: &EpisodeReport) -> bool {
-    r.collisions.iter().any(|c| c.what.contains("post"))
+    r.outcome.collisions.iter().any(|c| c.what.contains("post"))
 }
 
 #[test]
@@ -65,15 +65,15 @@ fn home_plans_a_detour_around_a_tall_post_beside_its_direct_swing() {
     // The post stands where the arm swings back home from the bowl: the gripper would clip it.
     let scene = cell_with_post([0.45, -0.18], [0.45, 0.17], [0.28, 0.485]);
     let r = run(&scene, flagship());
-    assert!(r.success, "{:?}", r.failure_reason);
+    assert!(r.outcome.success, "{:?}", r.outcome.failure_reason);
     assert!(r.planning.plans >= 1, "{:?}", r.planning);
     assert_eq!(r.planning.plan_failures, 0);
-    assert!(!hit_the_post(&r), "{:?}", r.collisions);
+    assert!(!hit_the_post(&r), "{:?}", r.outcome.collisions);
     // The same episode again: the same plans, the same physics.
     let again = run(&scene, flagship());
     assert_eq!(again.planning.counts(), r.planning.counts());
-    assert_eq!(again.objects, r.objects);
-    assert_eq!(again.physics_steps, r.physics_steps);
+    assert_eq!(again.outcome.objects, r.outcome.objects);
+    assert_eq!(again.outcome.physics_steps, r.outcome.physics_steps);
 }
 
 #[test]
@@ -83,9 +83,9 @@ fn a_held_block_is_carried_to_an_arm_pose_whose_set_down_clears_the_post() {
     // without the planner hit the post).
     let scene = cell_with_post([0.45, -0.2], [0.45, 0.2], [0.35, 0.0]);
     let r = run(&scene, flagship());
-    assert!(r.success, "{:?}", r.failure_reason);
+    assert!(r.outcome.success, "{:?}", r.outcome.failure_reason);
     assert!(r.planning.plans >= 1, "{:?}", r.planning);
-    assert!(!hit_the_post(&r), "{:?}", r.collisions);
+    assert!(!hit_the_post(&r), "{:?}", r.outcome.collisions);
     assert_eq!(r.planning.straight_contacts, 0, "{:?}", r.planning);
 }
 
@@ -94,7 +94,7 @@ fn a_free_cell_runs_without_the_planner() {
     // The flagship cell: every motion is checked and none needs planning.
     let scene = Scene::load().expect("scene");
     let r = run(&scene, flagship());
-    assert!(r.success);
+    assert!(r.outcome.success);
     assert_eq!(r.planning.plans, 0, "{:?}", r.planning);
     assert!(r.planning.motions_checked >= 6, "{:?}", r.planning);
 }
@@ -125,19 +125,19 @@ fn goal_in_collision_through_a_tree_names_the_table() {
         0.0,
     ];
     let r = run(&scene, move_joints(into_table));
-    assert!(!r.success);
+    assert!(!r.outcome.success);
     assert_eq!(
-        r.failure_kind,
+        r.outcome.failure_kind,
         Some(FailureKind::GoalInCollision),
         "{:?}",
-        r.failure_reason
+        r.outcome.failure_reason
     );
-    let why = r.failure_reason.unwrap_or_default();
+    let why = r.outcome.failure_reason.unwrap_or_default();
     assert!(why.contains("table"), "{why}");
     assert_eq!(r.planning.plans, 1);
     assert_eq!(r.planning.plan_failures, 1);
     // Failed before moving: the arm never reached the table.
-    assert!(r.collisions.is_empty(), "{:?}", r.collisions);
+    assert!(r.outcome.collisions.is_empty(), "{:?}", r.outcome.collisions);
 }
 
 #[test]
@@ -151,10 +151,10 @@ fn unreachable_through_a_tree_says_why() {
     );
     let r = run(&scene, plan);
     assert_eq!(
-        r.failure_kind,
+        r.outcome.failure_kind,
         Some(FailureKind::Unreachable),
         "{:?}",
-        r.failure_reason
+        r.outcome.failure_reason
     );
-    assert!(r.failure_reason.unwrap_or_default().contains("beyond"));
+    assert!(r.outcome.failure_reason.unwrap_or_default().contains("beyond"));
 }

@@ -48,11 +48,11 @@ fn run_scenario(
 }
 
 fn assert_done(r: &EpisodeReport, what: &str) {
-    assert!(r.success, "{what}: {:?}", r.failure_reason);
+    assert!(r.outcome.success, "{what}: {:?}", r.outcome.failure_reason);
     assert!(
-        !r.goal.is_empty() && r.goal.iter().all(|g| g.holds),
+        !r.outcome.goal.is_empty() && r.outcome.goal.iter().all(|g| g.holds),
         "{what}: {:?}",
-        r.goal
+        r.outcome.goal
     );
 }
 
@@ -64,8 +64,9 @@ fn sort_by_color_puts_every_block_in_the_bin_of_its_colour() {
         // Independently of the predicate code: each block's final centre lies inside the walls
         // (12 cm inner, so within 6 cm in x and y) of the bin of its colour, on its floor.
         for colour in ["red", "green", "blue"] {
-            let block = r.objects.iter().find(|o| o.name == colour).unwrap();
+            let block = r.outcome.objects.iter().find(|o| o.name == colour).unwrap();
             let bin = r
+                .outcome
                 .objects
                 .iter()
                 .find(|o| o.name == format!("{colour}_bin"))
@@ -78,7 +79,11 @@ fn sort_by_color_puts_every_block_in_the_bin_of_its_colour() {
                 block.end[2]
             );
         }
-        assert!(r.sim_time_s < 3.0 * 6.0, "{} s for three blocks", r.sim_time_s);
+        assert!(
+            r.outcome.sim_time_s < 3.0 * 6.0,
+            "{} s for three blocks",
+            r.outcome.sim_time_s
+        );
         // The oracle: MuJoCo contact with the bin's floor, height, footprint, at rest.
         for colour in ["red", "green", "blue"] {
             let bin = format!("{colour}_bin");
@@ -91,7 +96,7 @@ fn sort_by_color_puts_every_block_in_the_bin_of_its_colour() {
 fn stack_three_builds_the_tower() {
     let (r, _) = run_scenario("trees/stack_three.yaml", 0, 3, None);
     assert_done(&r, "stack");
-    let z = |n: &str| r.objects.iter().find(|o| o.name == n).unwrap().end;
+    let z = |n: &str| r.outcome.objects.iter().find(|o| o.name == n).unwrap().end;
     let (red, green, blue) = (z("red"), z("green"), z("blue"));
     // 44 mm blocks: centres at 22, 66, 110 mm, each within half a block of the one below.
     for (top, below, height) in [(red, green, 0.110), (green, blue, 0.066)] {
@@ -105,8 +110,8 @@ fn stack_three_builds_the_tower() {
 fn clear_table_puts_every_block_in_the_bin() {
     let (r, mut cell) = run_scenario("trees/clear_table.yaml", 0, 0, None);
     assert_done(&r, "clear");
-    let bin = r.objects.iter().find(|o| o.name == "bin").unwrap().end;
-    for o in r.objects.iter().filter(|o| o.name != "bin") {
+    let bin = r.outcome.objects.iter().find(|o| o.name == "bin").unwrap().end;
+    for o in r.outcome.objects.iter().filter(|o| o.name != "bin") {
         assert!(
             (o.end[0] - bin[0]).abs() < 0.14 && (o.end[1] - bin[1]).abs() < 0.14,
             "{}",
@@ -136,9 +141,9 @@ fn a_slip_hits_the_carried_block_and_the_task_still_finishes() {
         );
     }
     assert!(
-        r.grasp_attempts >= 4,
+        r.outcome.grasp_attempts >= 4,
         "one block was grasped twice: {}",
-        r.grasp_attempts
+        r.outcome.grasp_attempts
     );
 }
 
@@ -167,10 +172,10 @@ fn a_tree_that_succeeds_without_doing_the_job_is_caught() {
         &EpisodeConfig::default(),
         &mut NoObserver,
     );
-    assert_eq!(r.tree_status, "success");
-    assert!(!r.success);
-    assert_eq!(r.failure_kind, Some(macrotree::FailureKind::GoalNotMet));
-    let reason = r.failure_reason.unwrap();
+    assert_eq!(r.outcome.tree_status, "success");
+    assert!(!r.outcome.success);
+    assert_eq!(r.outcome.failure_kind, Some(macrotree::FailureKind::GoalNotMet));
+    let reason = r.outcome.failure_reason.unwrap();
     assert!(
         reason.contains("the scene's goal does not hold: not red in red_bin"),
         "{reason}"
@@ -196,13 +201,13 @@ fn a_carry_that_would_lower_the_fingers_onto_the_bowl_names_it() {
         &EpisodeConfig::default(),
         &mut NoObserver,
     );
-    assert_eq!(r.failure_kind, Some(macrotree::FailureKind::Blocked));
-    let reason = r.failure_reason.unwrap_or_default();
+    assert_eq!(r.outcome.failure_kind, Some(macrotree::FailureKind::Blocked));
+    let reason = r.outcome.failure_reason.unwrap_or_default();
     assert!(
         reason.contains("no clear way down") && reason.contains("would hit bowl"),
         "{reason}"
     );
-    assert_eq!(r.failed_node.as_deref(), Some("main/sequence/carry"));
+    assert_eq!(r.outcome.failed_node.as_deref(), Some("main/sequence/carry"));
 }
 
 /// MuJoCo resets a simulation whose state blows up and carries on; the episode must not.

@@ -116,9 +116,9 @@ fn run(yaml: &str) -> (EpisodeReport, Trace, Cell) {
 /// scene's goal, which most of these trees do not pursue).
 fn assert_tree_succeeded(r: &EpisodeReport) {
     assert_eq!(
-        r.tree_status, "success",
+        r.outcome.tree_status, "success",
         "{:?} at {:?}",
-        r.failure_reason, r.failed_node
+        r.outcome.failure_reason, r.outcome.failed_node
     );
 }
 
@@ -225,7 +225,11 @@ main:
         y2 = cy + 0.05
     );
     let (r, trace, mut cell) = run(&yaml);
-    assert!(r.success, "{:?} at {:?}", r.failure_reason, r.failed_node);
+    assert!(
+        r.outcome.success,
+        "{:?} at {:?}",
+        r.outcome.failure_reason, r.outcome.failed_node
+    );
     // Every named condition was evaluated (once, in sequence) to the answer the tree expects.
     let names = [
         "home0",
@@ -312,7 +316,7 @@ fn race_decides_by_the_first_finisher_and_halts_the_arm_where_it_is() {
     );
     let (r, trace, _) = run(&yaml);
     assert_tree_succeeded(&r);
-    assert_eq!(r.halts, 1);
+    assert_eq!(r.outcome.halts, 1);
     let halted = trace.first("race/move_joints", NodeStatus::Halted);
     assert!(
         (0.18..0.23).contains(&halted.sim_time),
@@ -343,9 +347,9 @@ fn race_decides_by_the_first_finisher_and_halts_the_arm_where_it_is() {
     let (r, trace, _) = run(yaml);
     assert_tree_succeeded(&r);
     assert!(
-        r.sim_time_s < 1.0,
+        r.outcome.sim_time_s < 1.0,
         "the race ended with the home, at {} s",
-        r.sim_time_s
+        r.outcome.sim_time_s
     );
     assert!(trace.of("race/wait").iter().any(|t| t.to == NodeStatus::Halted));
 }

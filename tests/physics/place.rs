@@ -90,9 +90,9 @@ fn yaw_error_deg(w: &World, i: usize, want_deg: f64) -> f64 {
 
 fn assert_success(r: &EpisodeReport, what: &str) {
     assert!(
-        r.success,
+        r.outcome.success,
         "{what}: {:?} ({:?}) at {:?}",
-        r.failure_reason, r.failure_kind, r.failed_node
+        r.outcome.failure_reason, r.outcome.failure_kind, r.outcome.failed_node
     );
 }
 
@@ -256,17 +256,17 @@ fn place_is_refused_when_the_opened_fingers_would_hit_a_neighbour_in_every_quart
     let across = Vector2::new(-closing.y, closing.x);
     let (r, _) = place_beside("refused", &[closing, across]);
     assert_eq!(
-        r.failure_kind,
+        r.outcome.failure_kind,
         Some(FailureKind::Blocked),
         "{:?}",
-        r.failure_reason
+        r.outcome.failure_reason
     );
-    let reason = r.failure_reason.unwrap_or_default();
+    let reason = r.outcome.failure_reason.unwrap_or_default();
     assert!(
         reason.contains("no clear way down") && reason.contains("would hit n"),
         "{reason}"
     );
-    assert_eq!(r.failed_node.as_deref(), Some("main/sequence/place"));
+    assert_eq!(r.outcome.failed_node.as_deref(), Some("main/sequence/place"));
 }
 
 #[test]
@@ -343,7 +343,7 @@ fn a_deep_bin_could_not_take_a_second_block_held_diagonally() {
     }
     let (r, cell) = run("deep_bin_square", &objects, &sequence(&steps));
     assert_success(&r, "two blocks into a deep 0.20 m bin");
-    assert!(r.collisions.is_empty(), "{:?}", r.collisions);
+    assert!(r.outcome.collisions.is_empty(), "{:?}", r.outcome.collisions);
     let w = cell.world();
     let bin = index(w, "bin");
     for b in ["a", "b"] {
@@ -373,20 +373,23 @@ fn carry_into_a_full_container_fails_before_moving() {
     );
     let (r, cell) = run("bin_full", &objects, &sequence(&steps));
     assert_eq!(
-        r.failure_kind,
+        r.outcome.failure_kind,
         Some(FailureKind::ContainerFull),
         "{:?}",
-        r.failure_reason
+        r.outcome.failure_reason
     );
-    let reason = r.failure_reason.clone().unwrap_or_default();
+    let reason = r.outcome.failure_reason.clone().unwrap_or_default();
     assert!(
         reason.contains("bin cannot take b") && reason.contains("it holds a"),
         "{reason}"
     );
     assert!(
-        r.failed_node.as_deref().is_some_and(|n| n.contains("carry")),
+        r.outcome
+            .failed_node
+            .as_deref()
+            .is_some_and(|n| n.contains("carry")),
         "{:?}",
-        r.failed_node
+        r.outcome.failed_node
     );
     let w = cell.world();
     let b = w.objects[index(w, "b")].pos;

@@ -41,26 +41,33 @@ fn a_policy_leaf_drives_the_arm_to_its_models_set_points_until_its_condition_hol
         let r = run(&format!(
             "main: {{sequence: {{children: [{{{AWAY}}}, {{policy: {{model: {model}{extra}, until: {{at_home: {{}}}}, timeout: 3}}}}]}}}}"
         ));
-        assert!(r.success, "{model}: {:?}", r.failure_reason);
+        assert!(r.outcome.success, "{model}: {:?}", r.outcome.failure_reason);
         // 0.37 rad at most 3 rad/s after a 0.38 s move: home within half a second more.
-        assert!(r.sim_time_s < 1.2, "{model}: {} s", r.sim_time_s);
+        assert!(r.outcome.sim_time_s < 1.2, "{model}: {} s", r.outcome.sim_time_s);
     }
 }
 
 #[test]
 fn a_non_finite_action_fails_the_leaf_as_policy_output_invalid() {
     let r = run("main: {policy: {model: nan.onnx, timeout: 2}}");
-    assert!(!r.success);
-    assert_eq!(r.failure_kind, Some(FailureKind::Custom("policy_output_invalid")));
-    assert!(
-        r.failure_reason.as_deref().unwrap_or("").contains("finite"),
-        "{:?}",
-        r.failure_reason
+    assert!(!r.outcome.success);
+    assert_eq!(
+        r.outcome.failure_kind,
+        Some(FailureKind::Custom("policy_output_invalid"))
     );
     assert!(
-        r.sim_time_s < 0.1,
+        r.outcome
+            .failure_reason
+            .as_deref()
+            .unwrap_or("")
+            .contains("finite"),
+        "{:?}",
+        r.outcome.failure_reason
+    );
+    assert!(
+        r.outcome.sim_time_s < 0.1,
         "fails on its first call, not at its timeout: {} s",
-        r.sim_time_s
+        r.outcome.sim_time_s
     );
 }
 
@@ -68,25 +75,25 @@ fn a_non_finite_action_fails_the_leaf_as_policy_output_invalid() {
 fn a_policy_without_its_condition_times_out_and_a_fallback_takes_over() {
     let r = run("main: {policy: {model: still_relative.onnx, until: {at_home: {}}, timeout: 0.4}}");
     // The arm starts at home, so `at_home` holds at once: the relative zero action never moves it.
-    assert!(r.success, "{:?}", r.failure_reason);
+    assert!(r.outcome.success, "{:?}", r.outcome.failure_reason);
     let r = run(&format!(
         "main: {{sequence: {{children: [{{{AWAY}}}, {{policy: {{model: still_relative.onnx, until: {{at_home: {{}}}}, timeout: 0.4}}}}]}}}}"
     ));
     assert_eq!(
-        r.failure_kind,
+        r.outcome.failure_kind,
         Some(FailureKind::Timeout),
         "{:?}",
-        r.failure_reason
+        r.outcome.failure_reason
     );
     let r = run(&format!(
         "main: {{sequence: {{children: [{{{AWAY}}}, {{fallback: {{children: [{{policy: {{model: still_relative.onnx, until: {{at_home: {{}}}}, timeout: 0.4}}}}, {{home: {{}}}}]}}}}]}}}}"
     ));
     assert!(
-        r.success,
+        r.outcome.success,
         "the scripted fallback brings the arm home: {:?}",
-        r.failure_reason
+        r.outcome.failure_reason
     );
-    assert_eq!(r.halts, 0);
+    assert_eq!(r.outcome.halts, 0);
 }
 
 #[test]
@@ -113,10 +120,10 @@ fn a_full_command_is_held_over_the_models_period_with_its_velocity_feedforward()
         &mut rec,
     );
     assert_eq!(
-        report.failure_kind,
+        report.outcome.failure_kind,
         Some(FailureKind::Timeout),
         "{:?}",
-        report.failure_reason
+        report.outcome.failure_reason
     );
     let pan: Vec<(f64, f64)> = rec.commanded.clone();
     assert!(pan.len() > 200, "{} control periods", pan.len());
@@ -161,7 +168,7 @@ impl macrotree::episode::EpisodeObserver for PanJoint {
 
 /// The model calls in a `timeout` failure's reason ("… after N model calls").
 fn calls(r: &EpisodeReport) -> u32 {
-    let reason = r.failure_reason.as_deref().unwrap_or("");
+    let reason = r.outcome.failure_reason.as_deref().unwrap_or("");
     let n = reason
         .split("after ")
         .last()
@@ -183,7 +190,12 @@ fn a_chunk_runs_its_steps_before_the_model_runs_again() {
     assert!((5..=6).contains(&whole), "{whole}");
     assert!((20..=21).contains(&single), "{single}");
     let r = run(&tree(", n_action_steps: 5"));
-    assert!(r.failure_reason.unwrap_or_default().contains("chunk of 4"));
+    assert!(
+        r.outcome
+            .failure_reason
+            .unwrap_or_default()
+            .contains("chunk of 4")
+    );
 }
 
 #[test]
@@ -193,12 +205,12 @@ fn the_same_tree_and_model_give_the_same_episode() {
     );
     let a = run(&yaml);
     let b = run(&yaml);
-    assert!(a.success);
-    assert_eq!(a.sim_time_s.to_bits(), b.sim_time_s.to_bits());
-    assert_eq!(a.physics_steps, b.physics_steps);
+    assert!(a.outcome.success);
+    assert_eq!(a.outcome.sim_time_s.to_bits(), b.outcome.sim_time_s.to_bits());
+    assert_eq!(a.outcome.physics_steps, b.outcome.physics_steps);
     assert_eq!(
-        serde_json::to_string(&a.objects).unwrap(),
-        serde_json::to_string(&b.objects).unwrap()
+        serde_json::to_string(&a.outcome.objects).unwrap(),
+        serde_json::to_string(&b.outcome.objects).unwrap()
     );
 }
 
@@ -276,7 +288,11 @@ fn a_policy_tree_records_a_dataset_whose_actions_replay_to_the_same_outcome() {
             &sweep.episode_config(&s),
             &mut rec,
         );
-        assert!(report.success, "scenario {index}: {:?}", report.failure_reason);
+        assert!(
+            report.outcome.success,
+            "scenario {index}: {:?}",
+            report.outcome.failure_reason
+        );
         let frames = rec.finish().unwrap().frames;
         let learned = frames.iter().filter(|f| f.active_kind == "policy").count();
         assert!(

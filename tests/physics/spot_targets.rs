@@ -65,11 +65,15 @@ fn run(name: &str, main: &str) -> (EpisodeReport, Cell) {
 
 fn assert_success(r: &EpisodeReport, what: &str) {
     assert!(
-        r.success,
+        r.outcome.success,
         "{what}: {:?} ({:?}) at {:?}",
-        r.failure_reason, r.failure_kind, r.failed_node
+        r.outcome.failure_reason, r.outcome.failure_kind, r.outcome.failed_node
     );
-    assert!(r.collisions.is_empty(), "{what}: collisions {:?}", r.collisions);
+    assert!(
+        r.outcome.collisions.is_empty(),
+        "{what}: collisions {:?}",
+        r.outcome.collisions
+    );
 }
 
 /// Yaw error of object `i` modulo a quarter turn, degrees.

@@ -66,7 +66,7 @@ fn a_fixed_seeded_batch_of_30_all_succeeds() {
     assert_eq!(summary.scenarios, 30);
     assert_eq!(summary.success_rate, 1.0);
     for r in &results {
-        assert!(r.checks.in_bowl && r.grasp_attempts >= 1, "{r:?}");
+        assert!(r.outcome.in_bowl() && r.outcome.grasp_attempts >= 1, "{r:?}");
     }
 }
 

@@ -241,6 +241,7 @@ fn cube_at_checks_the_yaw_of_a_placement() {
             &config,
             &mut NoObserver,
         )
+        .outcome
         .success
     };
     assert!(check("deg(30)", 30.0), "a cube turned 30° is at 30°");

@@ -262,7 +262,7 @@ fn record_clear_table(path: &Path) -> EpisodeReport {
         &EpisodeConfig::default(),
         &mut view,
     );
-    assert!(report.success, "{:?}", report.failure_reason);
+    assert!(report.outcome.success, "{:?}", report.outcome.failure_reason);
     let (_, rec) = view.finish();
     rec.unwrap().write(path).unwrap();
     report
@@ -385,7 +385,10 @@ fn replay_markers_and_transition_steps_seek_to_failures_retries_and_trace_lines(
         &config,
         &mut view,
     );
-    assert!(report.success && report.grasp_attempts == 2, "{report:?}");
+    assert!(
+        report.outcome.success && report.outcome.grasp_attempts == 2,
+        "{report:?}"
+    );
     view.finish().1.unwrap().write(&html).unwrap();
     let browser = Chromium::open(&format!("file://{}#t=0&paused", html.display()), WIDTH, HEIGHT);
     let mut dt = browser.devtools();
@@ -514,7 +517,7 @@ fn breakpoints_pause_a_live_episode_which_then_ends_exactly_as_without_them() {
         &EpisodeConfig::default(),
         &mut NoObserver,
     );
-    assert!(reference.success);
+    assert!(reference.outcome.success);
     let first_reach = plan
         .nodes
         .iter()
@@ -623,15 +626,23 @@ fn a_failure_forced_from_the_page_runs_the_fallbacks_next_child_and_is_reported(
     screenshot(&mut dt, "monitor_forced.png");
     dt.eval("document.querySelector('#mon-resume').click()");
     let (report, forced) = episode.join().unwrap();
-    assert!(report.success, "{report:?}");
+    assert!(report.outcome.success, "{report:?}");
     assert!(
-        report.sim_time_s < 5.0,
+        report.outcome.sim_time_s < 5.0,
         "the wait did not run its 5 s: {}",
-        report.sim_time_s
+        report.outcome.sim_time_s
     );
     assert_eq!(forced.len(), 1);
     assert_eq!(forced[0].path, wait);
-    let counts = |path: &str| report.nodes.iter().find(|n| n.path == path).unwrap().counts;
+    let counts = |path: &str| {
+        report
+            .outcome
+            .nodes
+            .iter()
+            .find(|n| n.path == path)
+            .unwrap()
+            .counts
+    };
     assert_eq!(counts(&wait).overridden, 1);
     assert_eq!(counts(&wait).failures, 1);
     assert_eq!(counts(&home).successes, 1);
@@ -735,6 +746,6 @@ fn a_paused_episode_waits_for_a_command_and_resumes_on_one() {
         }
     }
     let (report, _) = episode.join().unwrap();
-    assert!(report.success);
+    assert!(report.outcome.success);
     assert!(started.elapsed() >= Duration::from_millis(800));
 }

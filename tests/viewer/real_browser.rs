@@ -567,13 +567,13 @@ fn flagship_episode(
     };
     let wall = started.elapsed().as_secs_f64();
     let after = thread_sched();
-    assert!(report.success, "the flagship episode failed: {report:?}");
+    assert!(report.outcome.success, "the flagship episode failed: {report:?}");
     let times = Times {
         wall,
         cpu: after.0 - cpu,
         queued: after.1 - queued,
     };
-    (times, report.physics_steps, live)
+    (times, report.outcome.physics_steps, live)
 }
 
 /// What one episode cost the simulation thread, seconds.

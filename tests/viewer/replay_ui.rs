@@ -68,7 +68,10 @@ fn record(path: &std::path::Path) {
         &config,
         &mut view,
     );
-    assert!(report.success && report.grasp_attempts == 2, "{report:?}");
+    assert!(
+        report.outcome.success && report.outcome.grasp_attempts == 2,
+        "{report:?}"
+    );
     let (_, rec) = view.finish();
     rec.unwrap().write(path).unwrap();
 }
