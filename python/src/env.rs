@@ -144,9 +144,6 @@ impl Env {
         render_camera: Option<String>,
         noise: Option<String>,
     ) -> PyResult<Self> {
-        // Checked before anything is built: the observation space holds images of this size.
-        macrotree::render::check_image_size(image_size.0, image_size.1)
-            .map_err(pyo3::exceptions::PyValueError::new_err)?;
         let settings = Settings {
             scene: scene.as_deref(),
             tree: tree.as_deref(),
@@ -154,6 +151,7 @@ impl Env {
             max_sim_time,
             fault: fault.as_deref(),
             noise: noise.as_deref(),
+            image_size,
         };
         let parts = py.detach(|| setup::build(&settings))?;
         let task = parts.scene.spec.name.clone();

@@ -28,10 +28,14 @@ pub struct Settings<'a> {
     pub fault: Option<&'a str>,
     /// `JOINT_SIGMA[,GRIPPER_SIGMA]`, as `sweep --noise` reads it.
     pub noise: Option<&'a str>,
+    /// Camera images' `(width, height)`, pixels (the observation space holds images of this
+    /// size, so it is checked before anything is built).
+    pub image_size: (u32, u32),
 }
 
 /// Loads the scene (a file, or the tree's `scene:`) and the tree (checked against that scene).
 pub fn build(s: &Settings<'_>) -> PyResult<Parts> {
+    macrotree::render::check_image_size(s.image_size.0, s.image_size.1).map_err(value)?;
     let app = App::new();
     let (spec, tree) = match (s.scene, s.tree) {
         (Some(scene), Some(tree)) => {

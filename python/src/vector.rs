@@ -105,9 +105,6 @@ impl VecEnv {
         image_size: (u32, u32),
         noise: Option<String>,
     ) -> PyResult<Self> {
-        // Checked before anything is built: the observation space holds images of this size.
-        macrotree::render::check_image_size(image_size.0, image_size.1)
-            .map_err(pyo3::exceptions::PyValueError::new_err)?;
         let settings = Settings {
             scene: scene.as_deref(),
             tree: tree.as_deref(),
@@ -115,6 +112,7 @@ impl VecEnv {
             max_sim_time,
             fault: fault.as_deref(),
             noise: noise.as_deref(),
+            image_size,
         };
         let parts = py.detach(|| setup::build(&settings))?;
         let names = parts.scene.spec.objects.iter().map(|o| o.name.clone()).collect();

@@ -68,24 +68,10 @@ impl ScenarioResult {
     /// The result of `scenario` of the sweep `config` from its episode report.
     pub fn new(scenario: &Scenario, config: &SweepConfig, r: EpisodeReport) -> Self {
         Self {
-            suite: config.suite.clone(),
-            tree: config.tree.clone(),
-            scene_file: config.scene_file.clone(),
-            scenarios: config.scenarios,
-            sweep_goal: config.goal,
-            max_sim_time: config.max_sim_time,
-            substitutions: config.substitutions.clone(),
-            collision_policy: config.collisions,
-            index: scenario.index,
-            sweep_seed: config.seed,
-            seed: scenario.seed,
-            fault: config.fault,
-            layout: scenario.layout,
-            outcome: r.outcome,
-            tree_digest: config.tree_digest.clone(),
             wall_time_s: r.wall_time_s,
             planning: r.planning.counts(),
             planning_wall_s: r.planning.planning_wall_s,
+            ..Self::of(config, scenario.index, scenario.seed, scenario.layout, r.outcome)
         }
     }
 
@@ -97,6 +83,18 @@ impl ScenarioResult {
         seed: u64,
         layout: Option<ScenarioLayout>,
         reason: crate::failure::Failure,
+    ) -> Self {
+        Self::of(config, index, seed, layout, EpisodeOutcome::not_run(reason))
+    }
+
+    /// Scenario `index` of the sweep `config` (episode seed `seed`, drawn `layout`) that ended
+    /// with `outcome`, with no wall-clock time or planning counted.
+    fn of(
+        config: &SweepConfig,
+        index: u64,
+        seed: u64,
+        layout: Option<ScenarioLayout>,
+        outcome: EpisodeOutcome,
     ) -> Self {
         Self {
             suite: config.suite.clone(),
@@ -112,7 +110,7 @@ impl ScenarioResult {
             seed,
             fault: config.fault,
             layout,
-            outcome: EpisodeOutcome::not_run(reason),
+            outcome,
             tree_digest: config.tree_digest.clone(),
             wall_time_s: 0.0,
             planning: Default::default(),
