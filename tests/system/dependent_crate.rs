@@ -132,10 +132,14 @@ fn a_dependent_crate_builds_and_runs_with_only_the_documented_setup() {
              [dependencies]\nmacrotree = {{ path = {ROOT:?} }}\nserde = {{ version = \"1\", features = [\"derive\"] }}\n\
              schemars = \"1\"\nserde_json = \"1\"\n\n\
              # Only so that this test shares the artifacts of macrotree's own test build (not\n\
-             # needed by users): its dev-dependencies, for the same features of the shared\n\
-             # dependencies, and its release profile.\n\
-             jsonschema = {{ version = \"=0.61.2\", default-features = false }}\npng = \"=0.18.1\"\n\n\
-             [profile.release]\ndebug = \"line-tables-only\"\n\n[workspace]\n"
+             # needed by users): the workspace's dev-dependencies and the crates whose features\n\
+             # the Python extension's dependencies add, for the same features of the shared\n\
+             # dependencies; its feature resolver and release profile.\n\
+             jsonschema = {{ version = \"=0.61.2\", default-features = false }}\npng = \"=0.18.1\"\n\
+             matrixmultiply = {{ version = \"=0.3.11\", features = [\"cgemm\"] }}\n\
+             num-complex = \"=0.4.6\"\nnum-integer = \"=0.1.47\"\n\
+             portable-atomic = {{ version = \"=1.15.0\", features = [\"require-cas\"] }}\n\n\
+             [profile.release]\ndebug = \"line-tables-only\"\n\n[workspace]\nresolver = \"1\"\n"
         ),
     )
     .unwrap();
