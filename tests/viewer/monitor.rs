@@ -504,6 +504,14 @@ fn physics_of(report: &EpisodeReport) -> serde_json::Value {
     v
 }
 
+/// The simulated time, in seconds, at which the monitor's state says the episode is paused
+/// ("… at 0.248 s").
+fn paused_time(state: &serde_json::Value) -> f64 {
+    let text = state["state"].as_str().unwrap();
+    let tail = text.rsplit(" at ").next().unwrap();
+    tail.trim_end_matches(" s").parse().unwrap()
+}
+
 #[test]
 fn breakpoints_pause_a_live_episode_which_then_ends_exactly_as_without_them() {
     if !browser_available() {
@@ -541,6 +549,20 @@ fn breakpoints_pause_a_live_episode_which_then_ends_exactly_as_without_them() {
     // The declared breakpoint holds the episode before the first reach starts.
     let s = wait_paused(&mut dt, &first_reach);
     assert!(s["state"].as_str().unwrap().contains("before"), "{s}");
+    // The clock shows "t = –" until the page has drawn its first scene frame, and that frame
+    // may come after the pause is shown: the clock is read once it shows the paused instant
+    // (to its two decimals).
+    let paused_at = paused_time(&s);
+    let clock = dt.wait_until(MONITOR, Duration::from_secs(30), |v| {
+        serde_json::from_str::<serde_json::Value>(v.as_str().unwrap_or("null")).is_ok_and(|x| {
+            x["clock"]
+                .as_str()
+                .and_then(|c| c.strip_prefix("t = ")?.strip_suffix(" s")?.parse::<f64>().ok())
+                .is_some_and(|t| (t - paused_at).abs() <= 0.0051)
+        })
+    });
+    let s: serde_json::Value = serde_json::from_str(clock.as_str().unwrap()).unwrap();
+    assert!(s["state"].as_str().unwrap().contains("before"), "{s}");
     // Simulated time stands still while paused.
     std::thread::sleep(Duration::from_millis(1500));
     let again = eval_json(&mut dt, MONITOR);
@@ -568,14 +590,9 @@ fn breakpoints_pause_a_live_episode_which_then_ends_exactly_as_without_them() {
             .is_ok_and(|x| x["state"].as_str().is_some_and(|t| t.contains("after a step")))
     });
     let stepped: serde_json::Value = serde_json::from_str(stepped.as_str().unwrap()).unwrap();
-    let at = |state: &serde_json::Value| -> f64 {
-        let text = state["state"].as_str().unwrap();
-        let tail = text.rsplit(" at ").next().unwrap();
-        tail.trim_end_matches(" s").parse().unwrap()
-    };
     let period = macrotree::actions::CONTROL_PERIOD;
     assert!(
-        (at(&stepped) - at(&s) - period).abs() < 1e-9,
+        (paused_time(&stepped) - paused_time(&s) - period).abs() < 1e-9,
         "one control period later: {s} → {stepped}"
     );
     dt.eval("document.querySelector('#mon-resume').click()");
