@@ -36,9 +36,10 @@
 //! | 13 | `suite` | scenario suites (`macrotree test`): files, expectations, JUnit | yes |
 //! | 14 | `cli` | the command line | yes |
 //!
-//! Layers 8 and up need the cargo feature `sim` (on by default); without it (`cargo build -p macrotree
-//! --no-default-features`) the library loads, validates and compiles trees and scenes, gives the
-//! JSON Schema and the diagrams, and ticks trees on scripted leaves — and links no MuJoCo.
+//! Layers 8 and up need the cargo feature `sim` (on by default); without it (`cargo build -p
+//! macrotree --no-default-features`) the library loads, validates and compiles trees and scenes,
+//! gives the JSON Schema and the diagrams, and ticks trees on scripted leaves — and links no
+//! MuJoCo.
 //!
 //! Units everywhere: metres, radians, seconds, unless a name says otherwise.
 //!

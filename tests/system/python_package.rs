@@ -7,8 +7,9 @@
 //! The virtual environment lives in `target/python-test/venv` and is rebuilt when
 //! `python/requirements-test.txt` changes; maturin builds the extension in the workspace's
 //! `target/` (cargo holds no lock on it while tests run) with the features of `cargo test` (the
-//! workspace manifest says how), so only pyo3 and the extension crate itself are compiled here. Python is `python3`, or `MACROTREE_PYTHON`. `MACROTREE_SKIP_PYTHON_TESTS=1` skips these tests (never
-//! under `CI`).
+//! workspace manifest says how), so only pyo3 and the extension crate itself are compiled here.
+//! Python is `python3`, or `MACROTREE_PYTHON`. `MACROTREE_SKIP_PYTHON_TESTS=1` skips these tests
+//! (never under `CI`).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -487,10 +487,31 @@ const MONITOR: &str = "JSON.stringify({\
   events: Array.from(document.querySelectorAll('#events li')).map(l => l.textContent),\
 })";
 
+/// The simulated time, in seconds, at which the monitor's state says the episode is paused
+/// ("… at 0.248 s").
+fn paused_time(state: &serde_json::Value) -> Option<f64> {
+    let text = state["state"].as_str()?;
+    text.rsplit(" at ").next()?.strip_suffix(" s")?.parse().ok()
+}
+
+/// The page's clock, in seconds ("t = 0.25 s"); `None` ("t = –") before its first scene frame.
+fn clock_time(state: &serde_json::Value) -> Option<f64> {
+    let text = state["clock"].as_str()?;
+    text.strip_prefix("t = ")?.strip_suffix(" s")?.parse().ok()
+}
+
+/// The monitor's state once the page shows the episode paused at node `at`, its clock at the
+/// paused instant (to its two decimals: the scene frame of that instant may come after the
+/// pause is shown).
 fn wait_paused(dt: &mut Devtools, at: &str) -> serde_json::Value {
     let v = dt.wait_until(MONITOR, Duration::from_secs(120), |v| {
-        serde_json::from_str::<serde_json::Value>(v.as_str().unwrap_or("null"))
-            .is_ok_and(|s| s["state"].as_str().is_some_and(|t| t.starts_with("paused")) && s["here"][0] == at)
+        serde_json::from_str::<serde_json::Value>(v.as_str().unwrap_or("null")).is_ok_and(|s| {
+            s["state"].as_str().is_some_and(|t| t.starts_with("paused"))
+                && s["here"][0] == at
+                && paused_time(&s)
+                    .zip(clock_time(&s))
+                    .is_some_and(|(p, c)| (c - p).abs() <= 0.0051)
+        })
     });
     serde_json::from_str(v.as_str().unwrap()).unwrap()
 }
@@ -502,14 +523,6 @@ fn physics_of(report: &EpisodeReport) -> serde_json::Value {
     map.remove("wall_time_s");
     map.remove("planning");
     v
-}
-
-/// The simulated time, in seconds, at which the monitor's state says the episode is paused
-/// ("… at 0.248 s").
-fn paused_time(state: &serde_json::Value) -> f64 {
-    let text = state["state"].as_str().unwrap();
-    let tail = text.rsplit(" at ").next().unwrap();
-    tail.trim_end_matches(" s").parse().unwrap()
 }
 
 #[test]
@@ -549,20 +562,6 @@ fn breakpoints_pause_a_live_episode_which_then_ends_exactly_as_without_them() {
     // The declared breakpoint holds the episode before the first reach starts.
     let s = wait_paused(&mut dt, &first_reach);
     assert!(s["state"].as_str().unwrap().contains("before"), "{s}");
-    // The clock shows "t = –" until the page has drawn its first scene frame, and that frame
-    // may come after the pause is shown: the clock is read once it shows the paused instant
-    // (to its two decimals).
-    let paused_at = paused_time(&s);
-    let clock = dt.wait_until(MONITOR, Duration::from_secs(30), |v| {
-        serde_json::from_str::<serde_json::Value>(v.as_str().unwrap_or("null")).is_ok_and(|x| {
-            x["clock"]
-                .as_str()
-                .and_then(|c| c.strip_prefix("t = ")?.strip_suffix(" s")?.parse::<f64>().ok())
-                .is_some_and(|t| (t - paused_at).abs() <= 0.0051)
-        })
-    });
-    let s: serde_json::Value = serde_json::from_str(clock.as_str().unwrap()).unwrap();
-    assert!(s["state"].as_str().unwrap().contains("before"), "{s}");
     // Simulated time stands still while paused.
     std::thread::sleep(Duration::from_millis(1500));
     let again = eval_json(&mut dt, MONITOR);
@@ -592,7 +591,7 @@ fn breakpoints_pause_a_live_episode_which_then_ends_exactly_as_without_them() {
     let stepped: serde_json::Value = serde_json::from_str(stepped.as_str().unwrap()).unwrap();
     let period = macrotree::actions::CONTROL_PERIOD;
     assert!(
-        (paused_time(&stepped) - paused_time(&s) - period).abs() < 1e-9,
+        (paused_time(&stepped).unwrap() - paused_time(&s).unwrap() - period).abs() < 1e-9,
         "one control period later: {s} → {stepped}"
     );
     dt.eval("document.querySelector('#mon-resume').click()");
