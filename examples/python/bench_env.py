@@ -7,7 +7,9 @@
 3. Vector environments, envpool-style: N single environments in a Python loop, Gymnasium's
    ``SyncVectorEnv`` and ``AsyncVectorEnv``, and ``macrotree.VectorEnv``, in ``ctrl`` steps per
    second; ``vector_vs_single`` is the median ratio of alternating rounds of the native vector env
-   and one environment.
+   and one environment, ``processes_vs_single`` that of N processes stepping one environment each
+   (the machine's ceiling in that run) and ``vector_vs_processes`` the share of it reached.
+4. The same ratio for macro steps (a 0.5 s wait each).
 
     python examples/python/bench_env.py [--repeat 5] [--envs 2] [--json]
 """
@@ -16,10 +18,12 @@ from __future__ import annotations
 
 import argparse
 import json
+import multiprocessing
 import statistics
 import sys
 import time
 from collections.abc import Callable
+from multiprocessing.connection import Connection
 from typing import Any
 
 import gymnasium as gym
@@ -151,13 +155,16 @@ def vector(n: int, repeat: int) -> dict[str, float]:
         out[name] = steps_per_second(step, n, repeat)
         envs.close()
 
-    # The native vector env against one environment in alternating rounds: the ratio of each
-    # round, so a machine whose speed drifts still compares like with like.
+    # The native vector env against one environment, and against n processes stepping one
+    # environment each (what the machine's cores give at best, without a GIL or a hand-off), in
+    # alternating rounds: the ratios of each round, so a machine whose speed drifts still
+    # compares like with like.
     native = macrotree.VectorEnv(scene(), num_envs=n, action_mode="setpoint", threads=n)
     native.reset(seed=0)
     rounds = 4 * repeat + 1
     chunk = len(batch) // rounds
-    singles, vectors, ratios = [], [], []
+    free = [FreeProcess(batch[:, i]) for i in range(n)]
+    singles, vectors, ratios, ceilings, shares = [], [], [], [], []
     for r in range(rounds):
         ks = range(r * chunk, (r + 1) * chunk)
         start = time.perf_counter()
@@ -168,14 +175,95 @@ def vector(n: int, repeat: int) -> dict[str, float]:
         for k in ks:
             native.step(batch[k])
         vector = n * chunk / (time.perf_counter() - start)
+        start = time.perf_counter()
+        for p in free:
+            p.start(ks.start, ks.stop)
+        for p in free:
+            p.wait()
+        apart = n * chunk / (time.perf_counter() - start)
+        singles.append(single)
+        vectors.append(vector)
+        ratios.append(vector / single)
+        ceilings.append(apart / single)
+        shares.append(vector / apart)
+    native.close()
+    for p in free:
+        p.close()
+    out["macrotree_vector_env"] = statistics.median(vectors)
+    out["single_env_paired"] = statistics.median(singles)
+    out["vector_vs_single"] = statistics.median(ratios)
+    out["processes_vs_single"] = statistics.median(ceilings)
+    out["vector_vs_processes"] = statistics.median(shares)
+    return out
+
+
+def _free_worker(conn: Connection, actions: np.ndarray) -> None:
+    """A process stepping its own environment through ``actions[start:stop]`` on request."""
+    env = macrotree.MacroEnv(scene(), action_mode="setpoint")
+    env.reset(seed=0)
+    conn.send("ready")
+    while (job := conn.recv()) is not None:
+        start, stop = job
+        for k in range(start, stop):
+            env.step(actions[k])
+        conn.send("done")
+    env.close()
+
+
+class FreeProcess:
+    """One environment in a process of its own, stepped on request (the machine's ceiling)."""
+
+    def __init__(self, actions: np.ndarray) -> None:
+        context = multiprocessing.get_context("spawn")
+        self._conn, theirs = context.Pipe()
+        self._process = context.Process(target=_free_worker, args=(theirs, actions), daemon=True)
+        self._process.start()
+        if self._conn.recv() != "ready":
+            raise RuntimeError("the free process did not start")
+
+    def start(self, first: int, stop: int) -> None:
+        self._conn.send((first, stop))
+
+    def wait(self) -> None:
+        if self._conn.recv() != "done":
+            raise RuntimeError("the free process did not finish its steps")
+
+    def close(self) -> None:
+        self._conn.send(None)
+        self._process.join(timeout=30)
+
+
+#: A macro action of a 0.5 s wait (50 reference steps of 10 ms; mode 0 is the reference's wait).
+WAIT_MACRO: dict[str, Any] = {"mode": 0, "steps": [50]}
+
+
+def vector_macro(n: int, repeat: int) -> dict[str, float]:
+    """Macro steps (:data:`WAIT_MACRO`): ``macrotree.VectorEnv`` against one environment in
+    alternating rounds of 10 steps; ``vector_vs_single`` is the median ratio of the rounds."""
+    one = macrotree.MacroEnv(scene())
+    one.reset(seed=0)
+    native = macrotree.VectorEnv(scene(), num_envs=n, threads=n)
+    native.reset(seed=0)
+    actions = [WAIT_MACRO] * n
+    singles, vectors, ratios = [], [], []
+    for _ in range(2 * repeat - 1):
+        start = time.perf_counter()
+        for _ in range(10):
+            one.step(WAIT_MACRO)
+        single = 10 / (time.perf_counter() - start)
+        start = time.perf_counter()
+        for _ in range(10):
+            native.step(actions)
+        vector = n * 10 / (time.perf_counter() - start)
         singles.append(single)
         vectors.append(vector)
         ratios.append(vector / single)
     native.close()
-    out["macrotree_vector_env"] = statistics.median(vectors)
-    out["single_env_paired"] = statistics.median(singles)
-    out["vector_vs_single"] = statistics.median(ratios)
-    return out
+    return {
+        "single_env": statistics.median(singles),
+        "macrotree_vector_env": statistics.median(vectors),
+        "vector_vs_single": statistics.median(ratios),
+    }
 
 
 def main() -> int:
@@ -188,6 +276,7 @@ def main() -> int:
         "flagship_leaf_by_leaf": flagship(args.repeat),
         "ctrl": ctrl(args.repeat),
         f"vector_{args.envs}_envs": vector(args.envs, args.repeat),
+        f"vector_{args.envs}_envs_macro": vector_macro(args.envs, args.repeat),
     }
     if args.json:
         print(json.dumps(results))

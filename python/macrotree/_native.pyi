@@ -250,13 +250,19 @@ class VecEnv:
         placement: dict[str, list[float]] | None = None,
     ) -> list[dict[str, Any]]: ...
     def send(
-        self, /, ids: SupportsGetItem[int, SupportsIndex], actions: SupportsGetItem[int, Any]
+        self,
+        /,
+        ids: SupportsGetItem[int, SupportsIndex],
+        actions: list[Any] | tuple[str, NDArray[np.float64]],
     ) -> None:
         """
         Starts `actions` on environments `ids` and returns at once.
         """
     def step(
-        self, /, ids: SupportsGetItem[int, SupportsIndex], actions: SupportsGetItem[int, Any]
+        self,
+        /,
+        ids: SupportsGetItem[int, SupportsIndex],
+        actions: list[Any] | tuple[str, NDArray[np.float64]],
     ) -> dict[str, Any]:
         """
         Steps environments `ids` with `actions` in parallel; the batch of their results, in

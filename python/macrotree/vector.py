@@ -212,6 +212,9 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         self._last_obs: dict[str, Any] | None = None
         self._last_shared = False
         self._seen = np.zeros(self.num_envs, dtype=bool)
+        self._all_seen = False
+        # The ids of every sub-environment, in order.
+        self._every = list(range(self.num_envs))
 
     def _draw(self, i: int, seed: int | None) -> int:
         """Sub-environment *i*'s placement seed, drawn exactly as :meth:`MacroEnv.reset` draws
@@ -259,8 +262,9 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         """Steps every sub-environment with its action, in parallel. Under ``SAME_STEP`` a
         sub-environment that ended is reset in the same step; its last observation and info are in
         ``info["final_obs"]`` and ``info["final_info"]``."""
-        ids = list(range(self.num_envs))
-        return self._finish(self._native.step(ids, self._native_actions(actions, self.num_envs)))
+        return self._finish(
+            self._native.step(self._every, self._native_actions(actions, self.num_envs))
+        )
 
     def send(self, actions: Any, env_ids: Sequence[int] | np.ndarray | None = None) -> None:
         """Starts the actions of ``env_ids`` (default: all) on the worker threads and returns at
@@ -363,7 +367,9 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         info["env_id"] = np.asarray(ids, dtype=np.int64)
         return obs, rew, term, trunc, info
 
-    def _native_actions(self, actions: Any, n: int) -> list[Any]:
+    def _native_actions(self, actions: Any, n: int) -> list[Any] | tuple[str, np.ndarray]:
+        """The extension's form of a batch of ``n`` actions: ``(mode, (n, width) array)`` in an
+        array mode (one hand-over for the batch), else a list of single actions."""
         shape = ACTION_MODES[self.action_mode]
         if shape is not None:
             array = real_array(actions, f"{self.action_mode} actions")
@@ -372,7 +378,7 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
                     f"{self.action_mode} actions must have shape ({n}, {shape[0]}), "
                     f"got {array.shape}"
                 )
-            return [(self.action_mode, row) for row in array]
+            return (self.action_mode, array)
         if isinstance(actions, dict):
             return [
                 macro_to_native({k: np.asarray(v)[i] for k, v in actions.items()}) for i in range(n)
@@ -401,15 +407,17 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
     def _remember(self, ids: list[int], batch: dict[str, Any]) -> None:
         """Keeps the batched observations ``batch`` of ``ids`` as their last ones: by reference
         when they are every sub-environment's (a step), else written into a private copy."""
-        if ids == list(range(self.num_envs)):
+        if ids == self._every:
             self._last_obs, self._last_shared = batch, True
-        else:
-            if self._last_obs is None:
-                self._last_obs = {k: _zeros_like(v, self.num_envs) for k, v in batch.items()}
-            elif self._last_shared:
-                self._last_obs = _copy(self._last_obs)
-            self._last_shared = False
-            _put_rows(self._last_obs, ids, batch)
+            if not self._all_seen:
+                self._seen[:] = self._all_seen = True
+            return
+        if self._last_obs is None:
+            self._last_obs = {k: _zeros_like(v, self.num_envs) for k, v in batch.items()}
+        elif self._last_shared:
+            self._last_obs = _copy(self._last_obs)
+        self._last_shared = False
+        _put_rows(self._last_obs, ids, batch)
         self._seen[ids] = True
 
     def _finish(
@@ -417,14 +425,16 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
     ) -> tuple[dict[str, Any], np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         """A batch of step results (built by the extension) as Gymnasium returns it; under
         ``SAME_STEP`` the sub-environments that ended are reset and their rows replaced."""
-        ids = [int(i) for i in batch["env_id"]]
+        ids: list[int] = batch["env_id"]
         observations = with_keys(batch["obs"], self.observation_keys)
-        rewards = np.asarray(batch["reward"], dtype=np.float64)
-        terminated = np.asarray(batch["terminated"], dtype=bool)
-        truncated = np.asarray(batch["truncated"], dtype=bool)
+        # The extension gives these as float64 and bool arrays.
+        rewards: np.ndarray = batch["reward"]
+        terminated: np.ndarray = batch["terminated"]
+        truncated: np.ndarray = batch["truncated"]
         info: dict[str, Any] = batch["info"]
-        ended = [int(k) for k in np.flatnonzero(terminated | truncated)]
-        if self.autoreset_mode == AutoresetMode.SAME_STEP and ended:
+        done = terminated | truncated
+        if self.autoreset_mode == AutoresetMode.SAME_STEP and done.any():
+            ended = [int(k) for k in np.flatnonzero(done)]
             # Gymnasium 1.x: ``final_obs`` an object array, ``final_info`` the ended
             # sub-environments' infos batched like any info (``final_info["is_success"]`` and its
             # mask ``final_info["_is_success"]``), each with its ``_key`` mask.

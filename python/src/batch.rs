@@ -2,30 +2,101 @@
 //! `(n, …)` arrays, rewards and flags as `(n,)` arrays, and the info in Gymnasium 1.x's vector
 //! layout (each key an array over sub-environments with a `_key` mask; nested dicts batched the
 //! same way). The Python side then only handles the sub-environments that ended.
+//!
+//! This runs on the calling thread while the worker threads wait for the next batch, so it is
+//! kept lean: the fixed keys are interned Python strings, every array is made in one piece, and
+//! the masks of a batch are one read-only all-true array (every sub-environment of a batch gives
+//! every key).
 
 use macrotree::env::StepResult;
-use numpy::{IntoPyArray, PyArray1, PyArrayMethods};
+use numpy::{Element, IxDyn, PyArray, PyArray1, PyArrayMethods};
+use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 
 use crate::convert::{Pixels, tree_status};
 
-/// One column of an info: its values for every sub-environment and its `_key` mask (all set:
-/// every sub-environment of a batch gives every key).
-fn column<'py>(info: &Bound<'py, PyDict>, key: &str, values: Bound<'py, PyAny>, n: usize) -> PyResult<()> {
-    info.set_item(key, values)?;
-    info.set_item(format!("_{key}"), vec![true; n].into_pyarray(info.py()))
+/// An info key and its mask's key (`_key`), interned.
+macro_rules! key {
+    ($py:expr, $k:literal) => {
+        (intern!($py, $k), intern!($py, concat!("_", $k)))
+    };
 }
 
-/// An object array of Python values.
+/// A batched info under construction: its dict and the batch's one mask.
+struct Columns<'py> {
+    dict: Bound<'py, PyDict>,
+    /// The `(n,)` all-true read-only mask every key of the batch shares.
+    mask: Bound<'py, PyAny>,
+}
+
+impl<'py> Columns<'py> {
+    fn new(py: Python<'py>, mask: &Bound<'py, PyAny>) -> Self {
+        Self {
+            dict: PyDict::new(py),
+            mask: mask.clone(),
+        }
+    }
+
+    /// Sets a fixed key (`key!`) and its mask.
+    fn put(
+        &self,
+        (key, mask): (&Bound<'py, PyString>, &Bound<'py, PyString>),
+        values: Bound<'py, PyAny>,
+    ) -> PyResult<()> {
+        self.dict.set_item(key, values)?;
+        self.dict.set_item(mask, &self.mask)
+    }
+
+    /// Sets a key named at run time (a goal predicate, an object) and its mask.
+    fn put_named(&self, key: &str, values: Bound<'py, PyAny>) -> PyResult<()> {
+        self.dict.set_item(key, values)?;
+        self.dict.set_item(format!("_{key}"), &self.mask)
+    }
+}
+
+/// A `(n,)` array of `values`.
+fn array<'py, T: Element>(py: Python<'py>, values: impl Iterator<Item = T>) -> Bound<'py, PyAny> {
+    PyArray1::from_iter(py, values).into_any()
+}
+
+/// An `(n,)` object array of Python values.
 fn objects<'py>(py: Python<'py>, values: Vec<Py<PyAny>>) -> Bound<'py, PyAny> {
     PyArray1::from_vec(py, values).into_any()
 }
 
-/// `(n, width)` float32 array of `n` rows.
-fn rows<'py>(py: Python<'py>, flat: Vec<f32>, n: usize) -> PyResult<Bound<'py, PyAny>> {
-    let width = flat.len().checked_div(n).unwrap_or(0);
-    Ok(flat.into_pyarray(py).reshape([n, width])?.into_any())
+/// An array of `shape` holding `flat` (row-major; as long as the shape's product), made in one
+/// piece.
+fn matrix<'py, T: Element + Copy>(
+    py: Python<'py>,
+    shape: &[usize],
+    flat: &[T],
+) -> PyResult<Bound<'py, PyAny>> {
+    let out = PyArray::<T, IxDyn>::zeros(py, shape, false);
+    // SAFETY: the array was just made here and no other reference to it exists yet.
+    let dst = unsafe { out.as_slice_mut() }?;
+    if dst.len() != flat.len() {
+        return Err(crate::error::value(format!(
+            "a batch column of shape {shape:?} got {} values",
+            flat.len()
+        )));
+    }
+    dst.copy_from_slice(flat);
+    Ok(out.into_any())
+}
+
+/// The `(n, width)` float32 array whose row `k` is `row(results[k])`.
+fn rows<'py, R: AsRef<[f32]>>(
+    py: Python<'py>,
+    results: &[StepResult],
+    row: impl Fn(&StepResult) -> R,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mut flat = Vec::new();
+    for r in results {
+        flat.extend_from_slice(row(r).as_ref());
+    }
+    let width = flat.len().checked_div(results.len()).unwrap_or(0);
+    matrix(py, &[results.len(), width], &flat)
 }
 
 /// The batch `{"obs", "reward", "terminated", "truncated", "info"}` of `results` (one per
@@ -37,169 +108,116 @@ pub fn batch<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let n = results.len();
     let obs = PyDict::new(py);
-    let flat = |f: &dyn Fn(&StepResult) -> Vec<f32>| results.iter().flat_map(f).collect::<Vec<f32>>();
     obs.set_item(
-        "agent_pos",
-        rows(py, flat(&|r| r.observation.state().to_vec()), n)?,
+        intern!(py, "agent_pos"),
+        rows(py, results, |r| r.observation.state())?,
     )?;
     obs.set_item(
-        "environment_state",
-        rows(py, flat(&|r| r.observation.environment_state()), n)?,
+        intern!(py, "environment_state"),
+        rows(py, results, |r| r.observation.environment_state())?,
     )?;
     obs.set_item(
-        "pinch",
-        rows(
-            py,
-            flat(&|r| {
-                let o = &r.observation;
-                o.pinch_pos
-                    .iter()
-                    .chain(&o.pinch_quat)
-                    .map(|&v| v as f32)
-                    .collect()
-            }),
-            n,
-        )?,
+        intern!(py, "pinch"),
+        rows(py, results, |r| r.observation.pinch())?,
     )?;
     if pixels.first().is_some_and(|p| !p.is_empty()) {
         let images = PyDict::new(py);
         for c in 0..pixels[0].len() {
             let (name, w, h, _) = &pixels[0][c];
-            let (w, h) = (*w as usize, *h as usize);
-            let mut all = Vec::with_capacity(n * w * h * 3);
+            let mut all = Vec::with_capacity(n * *w as usize * *h as usize * 3);
             for p in &pixels {
                 all.extend_from_slice(&p[c].3);
             }
-            images.set_item(name, all.into_pyarray(py).reshape([n, h, w, 3])?)?;
+            images.set_item(name, matrix(py, &[n, *h as usize, *w as usize, 3], &all)?)?;
         }
-        obs.set_item("pixels", images)?;
+        obs.set_item(intern!(py, "pixels"), images)?;
     }
     let out = PyDict::new(py);
-    out.set_item("obs", obs)?;
+    out.set_item(intern!(py, "obs"), obs)?;
+    out.set_item(intern!(py, "reward"), array(py, results.iter().map(|r| r.reward)))?;
     out.set_item(
-        "reward",
-        results
-            .iter()
-            .map(|r| r.reward)
-            .collect::<Vec<f64>>()
-            .into_pyarray(py),
+        intern!(py, "terminated"),
+        array(py, results.iter().map(|r| r.terminated)),
     )?;
     out.set_item(
-        "terminated",
-        results
-            .iter()
-            .map(|r| r.terminated)
-            .collect::<Vec<bool>>()
-            .into_pyarray(py),
+        intern!(py, "truncated"),
+        array(py, results.iter().map(|r| r.truncated)),
     )?;
-    out.set_item(
-        "truncated",
-        results
-            .iter()
-            .map(|r| r.truncated)
-            .collect::<Vec<bool>>()
-            .into_pyarray(py),
-    )?;
-    out.set_item("info", info(py, results)?)?;
+    out.set_item(intern!(py, "info"), info(py, results)?)?;
     Ok(out)
 }
 
 fn info<'py>(py: Python<'py>, results: &[StepResult]) -> PyResult<Bound<'py, PyDict>> {
     let n = results.len();
-    let info = PyDict::new(py);
-    let bools = |f: &dyn Fn(&StepResult) -> bool| {
-        results
-            .iter()
-            .map(f)
-            .collect::<Vec<bool>>()
-            .into_pyarray(py)
-            .into_any()
-    };
-    let floats = |f: &dyn Fn(&StepResult) -> f64| {
-        results
-            .iter()
-            .map(f)
-            .collect::<Vec<f64>>()
-            .into_pyarray(py)
-            .into_any()
-    };
-    let ints = |f: &dyn Fn(&StepResult) -> i64| {
-        results
-            .iter()
-            .map(f)
-            .collect::<Vec<i64>>()
-            .into_pyarray(py)
-            .into_any()
-    };
-    let strings = |f: &dyn Fn(&StepResult) -> Option<String>| {
+    let mask = PyArray1::from_vec(py, vec![true; n]).into_any();
+    mask.getattr(intern!(py, "flags"))?
+        .setattr(intern!(py, "writeable"), false)?;
+    let info = Columns::new(py, &mask);
+    let bools = |f: &dyn Fn(&StepResult) -> bool| array(py, results.iter().map(f));
+    let floats = |f: &dyn Fn(&StepResult) -> f64| array(py, results.iter().map(f));
+    let ints = |f: &dyn Fn(&StepResult) -> i64| array(py, results.iter().map(f));
+    let strings = |f: &dyn Fn(&StepResult) -> Option<&str>| {
         let v = results
             .iter()
             .map(|r| match f(r) {
-                Some(s) => PyString::new(py, &s).into_any().unbind(),
+                Some(s) => PyString::new(py, s).into_any().unbind(),
                 None => py.None(),
             })
             .collect();
         objects(py, v)
     };
-    column(
-        &info,
-        "is_success",
+    info.put(
+        key!(py, "is_success"),
         bools(&|r| !r.goal.is_empty() && r.goal.iter().all(|g| g.holds)),
-        n,
     )?;
-    let goal = PyDict::new(py);
+    let goal = Columns::new(py, &mask);
     if let Some(first) = results.first() {
         for (k, g) in first.goal.iter().enumerate() {
-            column(
-                &goal,
-                &g.predicate,
-                bools(&|r| r.goal.get(k).is_some_and(|x| x.holds)),
-                n,
-            )?;
+            goal.put_named(&g.predicate, bools(&|r| r.goal.get(k).is_some_and(|x| x.holds)))?;
         }
     }
-    column(&info, "goal", goal.into_any(), n)?;
-    let grasped = PyDict::new(py);
+    info.put(key!(py, "goal"), goal.dict.into_any())?;
+    let grasped = Columns::new(py, &mask);
     if let Some(first) = results.first() {
         for (k, o) in first.observation.objects.iter().enumerate() {
-            column(
-                &grasped,
+            grasped.put_named(
                 &o.name,
                 bools(&|r| r.observation.objects.get(k).is_some_and(|x| x.grasped)),
-                n,
             )?;
         }
     }
-    column(&info, "grasped", grasped.into_any(), n)?;
-    column(&info, "episode_sim_time", floats(&|r| r.observation.time), n)?;
-    column(
-        &info,
-        "status",
-        strings(&|r| Some(if r.success() { "success" } else { "failure" }.to_string())),
-        n,
+    info.put(key!(py, "grasped"), grasped.dict.into_any())?;
+    info.put(key!(py, "episode_sim_time"), floats(&|r| r.observation.time))?;
+    let status = |r: &StepResult| {
+        if r.success() {
+            intern!(py, "success")
+        } else {
+            intern!(py, "failure")
+        }
+        .clone()
+        .into_any()
+        .unbind()
+    };
+    info.put(
+        key!(py, "status"),
+        objects(py, results.iter().map(status).collect()),
     )?;
-    column(
-        &info,
-        "failure_kind",
-        strings(&|r| r.failure.as_ref().map(|f| f.kind.as_str().to_string())),
-        n,
+    info.put(
+        key!(py, "failure_kind"),
+        strings(&|r| r.failure.as_ref().map(|f| f.kind.as_str())),
     )?;
-    column(
-        &info,
-        "failure_message",
-        strings(&|r| r.failure.as_ref().map(|f| f.message.clone())),
-        n,
+    info.put(
+        key!(py, "failure_message"),
+        strings(&|r| r.failure.as_ref().map(|f| f.message.as_str())),
     )?;
-    column(
-        &info,
-        "failure_node",
-        strings(&|r| r.failure.as_ref().and_then(|f| f.node.clone())),
-        n,
+    info.put(
+        key!(py, "failure_node"),
+        strings(&|r| r.failure.as_ref().and_then(|f| f.node.as_deref())),
     )?;
-    column(&info, "sim_time", floats(&|r| r.sim_time), n)?;
-    column(&info, "physics_steps", ints(&|r| r.physics_steps as i64), n)?;
-    column(&info, "ctrl_clamped", ints(&|r| i64::from(r.ctrl_clamped)), n)?;
-    let lists = |f: &dyn Fn(&StepResult) -> Vec<String>| -> PyResult<Bound<'py, PyAny>> {
+    info.put(key!(py, "sim_time"), floats(&|r| r.sim_time))?;
+    info.put(key!(py, "physics_steps"), ints(&|r| r.physics_steps as i64))?;
+    info.put(key!(py, "ctrl_clamped"), ints(&|r| i64::from(r.ctrl_clamped)))?;
+    let lists = |f: &dyn Fn(&StepResult) -> Vec<&str>| -> PyResult<Bound<'py, PyAny>> {
         let v = results
             .iter()
             .map(|r| Ok(PyList::new(py, f(r))?.into_any().unbind()))
@@ -207,42 +225,33 @@ fn info<'py>(py: Python<'py>, results: &[StepResult]) -> PyResult<Bound<'py, PyD
         Ok(objects(py, v))
     };
     if results.first().is_some_and(|r| r.base.is_some()) {
-        let width = macrotree::motion::COMMAND_LEN;
+        const WIDTH: usize = macrotree::motion::COMMAND_LEN;
         let flat: Vec<f64> = results
             .iter()
-            .flat_map(|r| {
-                r.base
-                    .as_ref()
-                    .map_or([f64::NAN; macrotree::motion::COMMAND_LEN], |b| b.command)
-            })
+            .flat_map(|r| r.base.as_ref().map_or([f64::NAN; WIDTH], |b| b.command))
             .collect();
-        column(
-            &info,
-            "base_action",
-            flat.into_pyarray(py).reshape([n, width])?.into_any(),
-            n,
-        )?;
-        column(
-            &info,
-            "base_status",
-            strings(&|r| r.base.as_ref().map(|b| tree_status(b.status).to_string())),
-            n,
+        let base = matrix(py, &[n, WIDTH], &flat)?;
+        info.put(key!(py, "base_action"), base)?;
+        info.put(
+            key!(py, "base_status"),
+            strings(&|r| r.base.as_ref().map(|b| tree_status(b.status))),
         )?;
     }
-    column(&info, "goal_steps", ints(&|r| r.goal_ticks as i64), n)?;
-    column(
-        &info,
-        "collisions",
-        lists(&|r| r.collisions.iter().map(|c| c.what.clone()).collect())?,
-        n,
+    info.put(key!(py, "goal_steps"), ints(&|r| r.goal_ticks as i64))?;
+    info.put(
+        key!(py, "collisions"),
+        lists(&|r| r.collisions.iter().map(|c| c.what.as_str()).collect())?,
     )?;
-    column(&info, "faults", lists(&|r| r.faults_fired.clone())?, n)?;
+    info.put(
+        key!(py, "faults"),
+        lists(&|r| r.faults_fired.iter().map(String::as_str).collect())?,
+    )?;
     if results.iter().any(|r| !r.rewards.is_empty()) {
         let v = results
             .iter()
-            .map(|r| r.rewards.clone().into_pyarray(py).into_any().unbind())
+            .map(|r| PyArray1::from_slice(py, &r.rewards).into_any().unbind())
             .collect();
-        column(&info, "rewards", objects(py, v), n)?;
+        info.put(key!(py, "rewards"), objects(py, v))?;
     }
-    Ok(info)
+    Ok(info.dict)
 }

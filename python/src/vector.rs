@@ -4,7 +4,7 @@
 use macrotree::env::{Action, Reset};
 use std::sync::Mutex;
 
-use numpy::{PyArray3, PyReadonlyArray1};
+use numpy::{PyArray3, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
@@ -49,6 +49,27 @@ fn action_of(a: &Bound<'_, PyAny>) -> PyResult<Action> {
             crate::env::array_action(&mode, array.as_slice()?)
         }
     }
+}
+
+/// A batch of actions from Python: `(mode, values)` with `mode` `"ctrl"`, `"setpoint"` or
+/// `"residual"` and `values` a float64 array of one row per environment (one borrow for the
+/// batch), or a list of single actions ([`action_of`]).
+fn actions_of(actions: &Bound<'_, PyAny>) -> PyResult<Vec<Action>> {
+    if let Ok((mode, values)) = actions.extract::<(String, PyReadonlyArray2<'_, f64>)>() {
+        let values = values.as_array();
+        return values
+            .rows()
+            .into_iter()
+            .map(|row| match row.as_slice() {
+                Some(u) => crate::env::array_action(&mode, u),
+                None => crate::env::array_action(&mode, &row.to_vec()),
+            })
+            .collect();
+    }
+    let list = actions.cast::<PyList>().map_err(|_| {
+        value("actions are a list of actions or (mode, float64 array of one row per environment)")
+    })?;
+    list.iter().map(|a| action_of(&a)).collect()
 }
 
 type Guard<'a> = std::sync::MutexGuard<'a, macrotree::env::VecEnv>;
@@ -196,14 +217,14 @@ impl VecEnv {
 
     /// Steps environments `ids` with `actions` in parallel; the batch of their results, in
     /// the order of `ids` (see `batch.rs`).
-    #[pyo3(signature = (ids, actions) -> "dict[str, Any]")]
+    #[pyo3(signature = (ids, actions: "list[Any] | tuple[str, NDArray[np.float64]]") -> "dict[str, Any]")]
     fn step<'py>(
         &self,
         py: Python<'py>,
         ids: Vec<usize>,
-        actions: Vec<Bound<'py, PyAny>>,
+        actions: Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let actions = actions.iter().map(action_of).collect::<PyResult<Vec<_>>>()?;
+        let actions = actions_of(&actions)?;
         let mut v = self.vec()?;
         let e: &mut macrotree::env::VecEnv = &mut v;
         let signals = crate::error::SignalPoll::default();
@@ -214,8 +235,9 @@ impl VecEnv {
     }
 
     /// Starts `actions` on environments `ids` and returns at once.
-    fn send<'py>(&self, py: Python<'py>, ids: Vec<usize>, actions: Vec<Bound<'py, PyAny>>) -> PyResult<()> {
-        let actions = actions.iter().map(action_of).collect::<PyResult<Vec<_>>>()?;
+    #[pyo3(signature = (ids, actions: "list[Any] | tuple[str, NDArray[np.float64]]"))]
+    fn send<'py>(&self, py: Python<'py>, ids: Vec<usize>, actions: Bound<'py, PyAny>) -> PyResult<()> {
+        let actions = actions_of(&actions)?;
         let mut v = self.vec()?;
         let e: &mut macrotree::env::VecEnv = &mut v;
         py.detach(|| e.send(&ids, &actions)).map_err(to_py)

@@ -164,3 +164,20 @@ def test_step_subtree_runs_the_whole_tree_on_each_sub_env(data: Path) -> None:
     with pytest.raises(macrotree.MacrotreeError, match="pik"):
         vec.step_subtree("pik")
     vec.close()
+
+
+def test_a_steps_info_masks_are_set_for_every_sub_env_and_read_only(data: Path) -> None:
+    vec = macrotree.VectorEnv(scene(data), num_envs=2, action_mode="setpoint")
+    vec.reset(seed=0)
+    hold = np.concatenate([np.asarray(_native.HOME), [0.0]])
+    _, _, _, _, info = vec.step(np.stack([hold, hold]))
+    masks = {k: v for k, v in info.items() if k.startswith("_")}
+    assert {"_is_success", "_goal", "_grasped", "_status", "_sim_time"} <= set(masks)
+    for key, mask in masks.items():
+        assert mask.dtype == bool and mask.shape == (2,) and mask.all(), key
+        # The masks of one batch may be one array: a write would reach every key, so none is
+        # allowed.
+        assert not mask.flags.writeable, key
+    with pytest.raises(ValueError, match="read-only"):
+        info["_is_success"][0] = False
+    vec.close()
