@@ -22,7 +22,7 @@ import multiprocessing
 import statistics
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from multiprocessing.connection import Connection
 from typing import Any
 
@@ -31,6 +31,7 @@ import numpy as np
 
 import macrotree
 from macrotree._library import data_dir
+from macrotree.env import ActionMode
 
 #: The action leaves the flagship tree (``trees/cube_to_bowl.yaml``) starts, in order, when its
 #: first attempt succeeds (``tests/physics/env_replay.rs`` checks these give ``run_episode``'s
@@ -163,7 +164,7 @@ def vector(n: int, repeat: int) -> dict[str, float]:
     native.reset(seed=0)
     rounds = 4 * repeat + 1
     chunk = len(batch) // rounds
-    free = [FreeProcess(batch[:, i]) for i in range(n)]
+    free = [FreeProcess("setpoint", batch[:, i]) for i in range(n)]
     singles, vectors, ratios, ceilings, shares = [], [], [], [], []
     for r in range(rounds):
         ks = range(r * chunk, (r + 1) * chunk)
@@ -197,9 +198,9 @@ def vector(n: int, repeat: int) -> dict[str, float]:
     return out
 
 
-def _free_worker(conn: Connection, actions: np.ndarray) -> None:
+def _free_worker(conn: Connection, mode: ActionMode, actions: Sequence[Any] | np.ndarray) -> None:
     """A process stepping its own environment through ``actions[start:stop]`` on request."""
-    env = macrotree.MacroEnv(scene(), action_mode="setpoint")
+    env = macrotree.MacroEnv(scene(), action_mode=mode)
     env.reset(seed=0)
     conn.send("ready")
     while (job := conn.recv()) is not None:
@@ -213,10 +214,12 @@ def _free_worker(conn: Connection, actions: np.ndarray) -> None:
 class FreeProcess:
     """One environment in a process of its own, stepped on request (the machine's ceiling)."""
 
-    def __init__(self, actions: np.ndarray) -> None:
+    def __init__(self, mode: ActionMode, actions: Sequence[Any] | np.ndarray) -> None:
         context = multiprocessing.get_context("spawn")
         self._conn, theirs = context.Pipe()
-        self._process = context.Process(target=_free_worker, args=(theirs, actions), daemon=True)
+        self._process = context.Process(
+            target=_free_worker, args=(theirs, mode, actions), daemon=True
+        )
         self._process.start()
         if self._conn.recv() != "ready":
             raise RuntimeError("the free process did not start")
@@ -238,15 +241,18 @@ WAIT_MACRO: dict[str, Any] = {"mode": 0, "steps": [50]}
 
 
 def vector_macro(n: int, repeat: int) -> dict[str, float]:
-    """Macro steps (:data:`WAIT_MACRO`): ``macrotree.VectorEnv`` against one environment in
-    alternating rounds of 10 steps; ``vector_vs_single`` is the median ratio of the rounds."""
+    """Macro steps (:data:`WAIT_MACRO`): ``macrotree.VectorEnv`` against one environment and
+    against n free processes, in alternating rounds of 10 steps; medians of the rounds' ratios."""
     one = macrotree.MacroEnv(scene())
-    one.reset(seed=0)
     native = macrotree.VectorEnv(scene(), num_envs=n, threads=n)
+    rounds = 2 * repeat - 1
+    free = [FreeProcess("macro", [WAIT_MACRO] * 10 * rounds) for _ in range(n)]
+    # 10 rounds of 10 waits of 0.5 s stay within the default 120 s episode.
+    one.reset(seed=0)
     native.reset(seed=0)
     actions = [WAIT_MACRO] * n
-    singles, vectors, ratios = [], [], []
-    for _ in range(2 * repeat - 1):
+    singles, vectors, ratios, ceilings, shares = [], [], [], [], []
+    for r in range(rounds):
         start = time.perf_counter()
         for _ in range(10):
             one.step(WAIT_MACRO)
@@ -255,14 +261,26 @@ def vector_macro(n: int, repeat: int) -> dict[str, float]:
         for _ in range(10):
             native.step(actions)
         vector = n * 10 / (time.perf_counter() - start)
+        start = time.perf_counter()
+        for p in free:
+            p.start(10 * r, 10 * (r + 1))
+        for p in free:
+            p.wait()
+        apart = n * 10 / (time.perf_counter() - start)
         singles.append(single)
         vectors.append(vector)
         ratios.append(vector / single)
+        ceilings.append(apart / single)
+        shares.append(vector / apart)
     native.close()
+    for p in free:
+        p.close()
     return {
         "single_env": statistics.median(singles),
         "macrotree_vector_env": statistics.median(vectors),
         "vector_vs_single": statistics.median(ratios),
+        "processes_vs_single": statistics.median(ceilings),
+        "vector_vs_processes": statistics.median(shares),
     }
 
 
