@@ -48,6 +48,9 @@ FLAGSHIP_LEAVES: list[dict[str, Any]] = [
 ]
 
 CTRL_STEPS = 2000
+#: Steps of each environment in one paired round (about 15 ms each at 10 ms control periods on
+#: this machine; rounds much shorter are dominated by waking the free processes).
+ROUND_STEPS = 100
 
 
 def scene() -> str:
@@ -163,7 +166,8 @@ def vector(n: int, repeat: int) -> dict[str, float]:
     native = macrotree.VectorEnv(scene(), num_envs=n, action_mode="setpoint", threads=n)
     native.reset(seed=0)
     rounds = 4 * repeat + 1
-    chunk = len(batch) // rounds
+    chunk = ROUND_STEPS
+    batch = np.stack([np.stack([wave(k, home)] * n) for k in range(rounds * chunk)])
     free = [FreeProcess("setpoint", batch[:, i]) for i in range(n)]
     singles, vectors, ratios, ceilings, shares = [], [], [], [], []
     for r in range(rounds):
