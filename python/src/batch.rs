@@ -56,8 +56,10 @@ impl<'py> Columns<'py> {
 }
 
 /// A `(n,)` array of `values`.
-fn array<'py, T: Element>(py: Python<'py>, values: impl Iterator<Item = T>) -> Bound<'py, PyAny> {
-    PyArray1::from_iter(py, values).into_any()
+fn array<'py, T: Element + Copy>(py: Python<'py>, values: impl Iterator<Item = T>) -> Bound<'py, PyAny> {
+    // Copied into an array numpy owns: one Python object, where handing over the `Vec` would
+    // make two (the array and a container that owns the `Vec`).
+    PyArray1::from_slice(py, &values.collect::<Vec<T>>()).into_any()
 }
 
 /// An `(n,)` object array of Python values.
