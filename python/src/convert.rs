@@ -2,7 +2,8 @@
 //! `{"obs", "reward", "terminated", "truncated", "info"}` with Python bools and floats.
 
 use macrotree::env::{Observation, StepResult};
-use numpy::{IntoPyArray, PyArray3, PyArrayMethods};
+use numpy::{IntoPyArray, PyArray1, PyArray3, PyArrayMethods};
+use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -12,9 +13,12 @@ pub type Pixels = Vec<(String, u32, u32, Vec<u8>)>;
 /// The Gymnasium observation: `agent_pos`, `environment_state`, `pinch` (float32), and `pixels`.
 pub fn observation<'py>(py: Python<'py>, o: &Observation, pixels: Pixels) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    d.set_item("agent_pos", o.state().to_vec().into_pyarray(py))?;
-    d.set_item("environment_state", o.environment_state().into_pyarray(py))?;
-    d.set_item("pinch", o.pinch().to_vec().into_pyarray(py))?;
+    d.set_item(intern!(py, "agent_pos"), PyArray1::from_slice(py, &o.state()))?;
+    d.set_item(
+        intern!(py, "environment_state"),
+        PyArray1::from_slice(py, &o.environment_state()),
+    )?;
+    d.set_item(intern!(py, "pinch"), PyArray1::from_slice(py, &o.pinch()))?;
     if !pixels.is_empty() {
         let images = PyDict::new(py);
         for (name, w, h, rgb) in pixels {
@@ -22,7 +26,7 @@ pub fn observation<'py>(py: Python<'py>, o: &Observation, pixels: Pixels) -> PyR
             let array: Bound<'py, PyArray3<u8>> = array;
             images.set_item(name, array)?;
         }
-        d.set_item("pixels", images)?;
+        d.set_item(intern!(py, "pixels"), images)?;
     }
     Ok(d)
 }
@@ -42,10 +46,10 @@ pub fn reset_info<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let info = PyDict::new(py);
     let success = !goal.is_empty() && goal.iter().all(|g| g.holds);
-    info.set_item("is_success", success)?;
-    info.set_item("goal", goal_dict(py, goal)?)?;
-    info.set_item("grasped", grasped(py, o)?)?;
-    info.set_item("episode_sim_time", o.time)?;
+    info.set_item(intern!(py, "is_success"), success)?;
+    info.set_item(intern!(py, "goal"), goal_dict(py, goal)?)?;
+    info.set_item(intern!(py, "grasped"), grasped(py, o)?)?;
+    info.set_item(intern!(py, "episode_sim_time"), o.time)?;
     Ok(info)
 }
 
@@ -71,31 +75,37 @@ fn grasped<'py>(py: Python<'py>, o: &Observation) -> PyResult<Bound<'py, PyDict>
 /// A step's result as `{"obs", "reward", "terminated", "truncated", "info"}`.
 pub fn step_result<'py>(py: Python<'py>, r: &StepResult, pixels: Pixels) -> PyResult<Bound<'py, PyDict>> {
     let out = PyDict::new(py);
-    out.set_item("obs", observation(py, &r.observation, pixels)?)?;
-    out.set_item("reward", r.reward)?;
-    out.set_item("terminated", r.terminated)?;
-    out.set_item("truncated", r.truncated)?;
+    out.set_item(intern!(py, "obs"), observation(py, &r.observation, pixels)?)?;
+    out.set_item(intern!(py, "reward"), r.reward)?;
+    out.set_item(intern!(py, "terminated"), r.terminated)?;
+    out.set_item(intern!(py, "truncated"), r.truncated)?;
     let info = reset_info(py, &r.observation, &r.goal)?;
-    info.set_item("status", if r.success() { "success" } else { "failure" })?;
+    info.set_item(
+        intern!(py, "status"),
+        if r.success() { "success" } else { "failure" },
+    )?;
     let f = r.failure.as_ref();
-    info.set_item("failure_kind", f.map(|f| f.kind.as_str()))?;
-    info.set_item("failure_message", f.map(|f| f.message.as_str()))?;
-    info.set_item("failure_node", f.and_then(|f| f.node.as_deref()))?;
-    info.set_item("sim_time", r.sim_time)?;
-    info.set_item("physics_steps", r.physics_steps)?;
-    info.set_item("ctrl_clamped", r.ctrl_clamped)?;
+    info.set_item(intern!(py, "failure_kind"), f.map(|f| f.kind.as_str()))?;
+    info.set_item(intern!(py, "failure_message"), f.map(|f| f.message.as_str()))?;
+    info.set_item(intern!(py, "failure_node"), f.and_then(|f| f.node.as_deref()))?;
+    info.set_item(intern!(py, "sim_time"), r.sim_time)?;
+    info.set_item(intern!(py, "physics_steps"), r.physics_steps)?;
+    info.set_item(intern!(py, "ctrl_clamped"), r.ctrl_clamped)?;
     if let Some(base) = &r.base {
-        info.set_item("base_action", base.command.to_vec().into_pyarray(py))?;
-        info.set_item("base_status", tree_status(base.status))?;
+        info.set_item(
+            intern!(py, "base_action"),
+            PyArray1::from_slice(py, &base.command),
+        )?;
+        info.set_item(intern!(py, "base_status"), tree_status(base.status))?;
     }
-    info.set_item("goal_steps", r.goal_ticks)?;
+    info.set_item(intern!(py, "goal_steps"), r.goal_ticks)?;
     let collisions: Vec<&str> = r.collisions.iter().map(|c| c.what.as_str()).collect();
-    info.set_item("collisions", collisions)?;
-    info.set_item("faults", r.faults_fired.clone())?;
+    info.set_item(intern!(py, "collisions"), collisions)?;
+    info.set_item(intern!(py, "faults"), r.faults_fired.clone())?;
     if !r.rewards.is_empty() {
-        info.set_item("rewards", r.rewards.clone().into_pyarray(py))?;
+        info.set_item(intern!(py, "rewards"), PyArray1::from_slice(py, &r.rewards))?;
     }
-    out.set_item("info", info)?;
+    out.set_item(intern!(py, "info"), info)?;
     Ok(out)
 }
 
