@@ -262,34 +262,7 @@ impl Registry {
             "title": "macrotree behavior tree file",
             "description": "A behavior tree in YAML for the UR5e + Robotiq gripper. See docs/tree_format.md. Units: m, s, m/s, rad (or deg(..)).",
             "type": "object",
-            "properties": {
-                "description": {"description": "What the tree does, one line (the task string of reports and datasets).",
-                                "type": "string"},
-                "scene": {"description": "The scene file the tree runs on by default, relative to this file (`--scene` overrides it). Without it: the built-in cube_bowl scene.",
-                          "type": "string"},
-                "include": {"description": "Files with subtrees to load, relative to this file.",
-                            "anyOf": [{"type": "string"}, {"type": "array", "items": {"type": "string"}}]},
-                "subtrees": {
-                    "description": "Reusable subtrees by name.",
-                    "type": "object",
-                    "propertyNames": {"pattern": "^[A-Za-z_][A-Za-z0-9_]*$"},
-                    "additionalProperties": {
-                        "type": "object",
-                        "properties": {
-                            "description": {"type": "string"},
-                            "params": {"description": "Parameter names with default values (`~` = required).",
-                                       "type": "object", "propertyNames": {"pattern": "^[A-Za-z_][A-Za-z0-9_]*$"}},
-                            "root": {"$ref": "#/$defs/NodeTemplate"}
-                        },
-                        "required": ["root"],
-                        "additionalProperties": false
-                    }
-                },
-                "main": {"$ref": "#/$defs/Node"},
-                "breakpoints": {"description": "Where a live monitor (`run --view`) pauses, as `--break` does: node path globs, each optionally ending in `@before` (the default) or `@after`.",
-                                "type": "array",
-                                "items": {"type": "string", "minLength": 1}}
-            },
+            "properties": super::tree_file::properties(super::tree_file::TREE_FILE_KEYS),
             "additionalProperties": false,
             "$defs": Value::Object(defs),
         })

@@ -28,6 +28,7 @@ mod policy;
 mod registry;
 mod role;
 mod targets;
+mod tree_file;
 
 pub use approach::Approach;
 pub use catalog::{NodeDoc, ParamDoc};
@@ -48,3 +49,4 @@ pub use policy::{MAX_ACTION_STEPS, MAX_POLICY_PERIOD, POLICY_OUTPUT_INVALID, Pol
 pub use registry::{Category, FileCheck, NodeType, Registry};
 pub use role::ActionRole;
 pub use targets::{PathKind, Target, Yaw};
+pub use tree_file::{FileKey, SUBTREE_KEY_NAMES, SUBTREE_KEYS, TREE_FILE_KEY_NAMES, TREE_FILE_KEYS};

@@ -1,25 +1,28 @@
 //! The top level of a tree file: `include:`, `subtrees:` and `main:`.
 
+use crate::yaml::de::list;
 use crate::yaml::diag::{Issue, Loc};
 use crate::yaml::is_identifier;
 use crate::yaml::suggest::did_you_mean;
 use crate::yaml::value::{Value, ValueKind};
 
-/// Keys allowed at the top level of a tree file.
-pub const TOP_LEVEL_KEYS: &[&str] = &[
-    "description",
-    "scene",
-    "include",
-    "subtrees",
-    "main",
-    "breakpoints",
-];
+/// Keys allowed at the top level of a tree file (declared with their schema in `kinds`).
+pub use crate::kinds::TREE_FILE_KEY_NAMES as TOP_LEVEL_KEYS;
 /// Most `breakpoints:` entries of a tree file.
 pub const MAX_BREAKPOINTS: usize = 64;
 /// Most characters of one `breakpoints:` entry.
 pub const MAX_BREAKPOINT_CHARS: usize = 512;
-/// Keys allowed in a subtree definition.
-pub const SUBTREE_KEYS: &[&str] = &["params", "root", "description"];
+/// Keys allowed in a subtree definition (declared with their schema in `kinds`).
+pub use crate::kinds::SUBTREE_KEY_NAMES as SUBTREE_KEYS;
+
+/// `keys` as `` `a:`, `b:` and `c:` ``.
+fn keys_colon(keys: &[&str]) -> String {
+    let shown: Vec<String> = keys.iter().map(|k| format!("`{k}:`")).collect();
+    match shown.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+        _ => shown.concat(),
+    }
+}
 
 /// One `include:` entry.
 #[derive(Clone, Debug)]
@@ -134,9 +137,9 @@ pub fn parse_tree_file(v: &Value, issues: &mut Vec<Issue>) -> Option<TreeFile> {
             Some("breakpoints") => parse_breakpoints(val, &mut out.breakpoints, issues),
             Some(other) => issues.push(
                 Issue::new(k.loc, format!("unknown top-level key `{other}`"))
-                    .label("expected `description`, `scene`, `include`, `subtrees`, `main` or `breakpoints`")
+                    .label(format!("expected {}", list(&TOP_LEVEL_KEYS)))
                     .maybe_help(did_you_mean(other, TOP_LEVEL_KEYS.iter().copied()))
-                    .help_or("remove it; a tree file has only `description:`, `scene:`, `include:`, `subtrees:`, `main:` and `breakpoints:`"),
+                    .help_or(format!("remove it; a tree file has only {}", keys_colon(&TOP_LEVEL_KEYS))),
             ),
             None => issues.push(
                 Issue::new(
@@ -332,9 +335,12 @@ fn parse_subtree_def(name: &str, loc: Loc, v: &Value, issues: &mut Vec<Issue>) -
             }
             Some(other) => issues.push(
                 Issue::new(k.loc, format!("unknown key `{other}` in subtree `{name}`"))
-                    .label("expected `params`, `root` or `description`")
+                    .label(format!("expected {}", list(&SUBTREE_KEYS)))
                     .maybe_help(did_you_mean(other, SUBTREE_KEYS.iter().copied()))
-                    .help_or("a subtree has `params:` (optional), `root:` and `description:` (optional)"),
+                    .help_or(format!(
+                        "a subtree has {}; only `root:` is required",
+                        keys_colon(&SUBTREE_KEYS)
+                    )),
             ),
             None => issues.push(Issue::new(k.loc, "keys must be names").label("expected `params` or `root`")),
         }
@@ -373,5 +379,23 @@ mod tests {
         );
         let subtree = &schema["properties"]["subtrees"]["additionalProperties"]["properties"];
         assert_eq!(keys(subtree), SUBTREE_KEYS.iter().copied().collect());
+    }
+
+    #[test]
+    fn the_reader_takes_every_declared_key_and_names_them_all_for_an_unknown_one() {
+        let text = "description: d\nscene: s.yaml\ninclude: [lib.yaml]\nbreakpoints: [main]\n\
+                    subtrees:\n  t:\n    description: d\n    params: {x: 1}\n    root: {wait: {seconds: $x}}\n\
+                    main: {t: {}}\n";
+        let v = crate::yaml::value::parse_yaml(text, 0).unwrap();
+        let mut issues = Vec::new();
+        assert!(super::parse_tree_file(&v, &mut issues).is_some());
+        assert!(issues.is_empty(), "{issues:?}");
+        let v = crate::yaml::value::parse_yaml("mian: {wait: {}}\nsubtrees: {t: {rot: {wait: {}}}}\n", 0)
+            .unwrap();
+        super::parse_tree_file(&v, &mut issues);
+        let shown = format!("{issues:?}");
+        for key in TOP_LEVEL_KEYS.iter().chain(&SUBTREE_KEYS) {
+            assert!(shown.contains(&format!("`{key}`")), "{key}: {shown}");
+        }
     }
 }
