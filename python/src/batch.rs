@@ -4,12 +4,13 @@
 //! same way). The Python side then only handles the sub-environments that ended.
 //!
 //! This runs on the calling thread while the worker threads wait for the next batch, so it is
-//! kept lean: the fixed keys are interned Python strings, every array is made in one piece, and
-//! the masks of a batch are one read-only all-true array (every sub-environment of a batch gives
+//! kept lean: the fixed keys are interned Python strings, every array but the images is copied
+//! into memory numpy owns (one Python object each; the images' buffers are handed over), and the
+//! masks of a batch are one read-only all-true array (every sub-environment of a batch gives
 //! every key).
 
 use macrotree::env::StepResult;
-use numpy::{Element, IxDyn, PyArray, PyArray1, PyArrayMethods};
+use numpy::{Element, IntoPyArray, IxDyn, PyArray, PyArray1, PyArrayMethods};
 use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
@@ -130,7 +131,9 @@ pub fn batch<'py>(
             for p in &pixels {
                 all.extend_from_slice(&p[c].3);
             }
-            images.set_item(name, matrix(py, &[n, *h as usize, *w as usize, 3], &all)?)?;
+            // Images are large: the `Vec` is handed over, not copied.
+            let image = all.into_pyarray(py).reshape([n, *h as usize, *w as usize, 3])?;
+            images.set_item(name, image)?;
         }
         obs.set_item(intern!(py, "pixels"), images)?;
     }
@@ -151,7 +154,7 @@ pub fn batch<'py>(
 
 fn info<'py>(py: Python<'py>, results: &[StepResult]) -> PyResult<Bound<'py, PyDict>> {
     let n = results.len();
-    let mask = PyArray1::from_vec(py, vec![true; n]).into_any();
+    let mask = array(py, std::iter::repeat_n(true, n));
     mask.getattr(intern!(py, "flags"))?
         .setattr(intern!(py, "writeable"), false)?;
     let info = Columns::new(py, &mask);

@@ -181,3 +181,21 @@ def test_a_steps_info_masks_are_set_for_every_sub_env_and_read_only(data: Path) 
     with pytest.raises(ValueError, match="read-only"):
         info["_is_success"][0] = False
     vec.close()
+
+
+def test_a_steps_camera_images_are_each_sub_envs_own(data: Path) -> None:
+    cameras = ["front", "wrist"]
+    vec = macrotree.VectorEnv(scene(data), num_envs=2, cameras=cameras, image_size=(32, 48))
+    vec.reset(seed=[1, 2])
+    wait = {"mode": int(MacroMode.WAIT), "steps": [5]}
+    obs, *_ = vec.step([wait, wait])
+    assert obs in vec.observation_space
+    single = macrotree.MacroEnv(scene(data), cameras=cameras, image_size=(32, 48))
+    single.reset(seed=2)
+    one, *_ = single.step(wait)
+    for camera in cameras:
+        images = obs["pixels"][camera]
+        assert images.shape == (2, 32, 48, 3) and images.dtype == np.uint8
+        assert np.array_equal(images[1], one["pixels"][camera]), camera
+        assert not np.array_equal(images[0], images[1]), "two layouts, two images"
+    vec.close()
