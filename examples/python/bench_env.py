@@ -169,37 +169,63 @@ def vector(n: int, repeat: int) -> dict[str, float]:
     chunk = ROUND_STEPS
     batch = np.stack([np.stack([wave(k, home)] * n) for k in range(rounds * chunk)])
     free = [FreeProcess("setpoint", batch[:, i]) for i in range(n)]
+    out.update(
+        paired_rounds(
+            n,
+            rounds,
+            chunk,
+            single=lambda k: one.step(batch[k][0]),
+            vector=lambda k: native.step(batch[k]),
+            free=free,
+        )
+    )
+    native.close()
+    for p in free:
+        p.close()
+    return out
+
+
+def paired_rounds(
+    n: int,
+    rounds: int,
+    steps: int,
+    single: Callable[[int], object],
+    vector: Callable[[int], object],
+    free: Sequence[FreeProcess],
+) -> dict[str, float]:
+    """Alternating rounds of ``steps`` steps (step indices ``r * steps`` on): one environment
+    (``single(k)``), the n-environment vector env (``vector(k)``, n steps each) and the n free
+    processes; the medians of the rates and of each round's ratios, so a machine whose speed
+    drifts still compares like with like."""
     singles, vectors, ratios, ceilings, shares = [], [], [], [], []
     for r in range(rounds):
-        ks = range(r * chunk, (r + 1) * chunk)
+        ks = range(r * steps, (r + 1) * steps)
         start = time.perf_counter()
         for k in ks:
-            one.step(batch[k][0])
-        single = chunk / (time.perf_counter() - start)
+            single(k)
+        one = steps / (time.perf_counter() - start)
         start = time.perf_counter()
         for k in ks:
-            native.step(batch[k])
-        vector = n * chunk / (time.perf_counter() - start)
+            vector(k)
+        together = n * steps / (time.perf_counter() - start)
         start = time.perf_counter()
         for p in free:
             p.start(ks.start, ks.stop)
         for p in free:
             p.wait()
-        apart = n * chunk / (time.perf_counter() - start)
-        singles.append(single)
-        vectors.append(vector)
-        ratios.append(vector / single)
-        ceilings.append(apart / single)
-        shares.append(vector / apart)
-    native.close()
-    for p in free:
-        p.close()
-    out["macrotree_vector_env"] = statistics.median(vectors)
-    out["single_env_paired"] = statistics.median(singles)
-    out["vector_vs_single"] = statistics.median(ratios)
-    out["processes_vs_single"] = statistics.median(ceilings)
-    out["vector_vs_processes"] = statistics.median(shares)
-    return out
+        apart = n * steps / (time.perf_counter() - start)
+        singles.append(one)
+        vectors.append(together)
+        ratios.append(together / one)
+        ceilings.append(apart / one)
+        shares.append(together / apart)
+    return {
+        "single_env_paired": statistics.median(singles),
+        "macrotree_vector_env": statistics.median(vectors),
+        "vector_vs_single": statistics.median(ratios),
+        "processes_vs_single": statistics.median(ceilings),
+        "vector_vs_processes": statistics.median(shares),
+    }
 
 
 def _free_worker(conn: Connection, mode: ActionMode, actions: Sequence[Any] | np.ndarray) -> None:
@@ -255,37 +281,18 @@ def vector_macro(n: int, repeat: int) -> dict[str, float]:
     one.reset(seed=0)
     native.reset(seed=0)
     actions = [WAIT_MACRO] * n
-    singles, vectors, ratios, ceilings, shares = [], [], [], [], []
-    for r in range(rounds):
-        start = time.perf_counter()
-        for _ in range(10):
-            one.step(WAIT_MACRO)
-        single = 10 / (time.perf_counter() - start)
-        start = time.perf_counter()
-        for _ in range(10):
-            native.step(actions)
-        vector = n * 10 / (time.perf_counter() - start)
-        start = time.perf_counter()
-        for p in free:
-            p.start(10 * r, 10 * (r + 1))
-        for p in free:
-            p.wait()
-        apart = n * 10 / (time.perf_counter() - start)
-        singles.append(single)
-        vectors.append(vector)
-        ratios.append(vector / single)
-        ceilings.append(apart / single)
-        shares.append(vector / apart)
+    out = paired_rounds(
+        n,
+        rounds,
+        10,
+        single=lambda _: one.step(WAIT_MACRO),
+        vector=lambda _: native.step(actions),
+        free=free,
+    )
     native.close()
     for p in free:
         p.close()
-    return {
-        "single_env": statistics.median(singles),
-        "macrotree_vector_env": statistics.median(vectors),
-        "vector_vs_single": statistics.median(ratios),
-        "processes_vs_single": statistics.median(ceilings),
-        "vector_vs_processes": statistics.median(shares),
-    }
+    return out
 
 
 def main() -> int:

@@ -212,7 +212,6 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         self._last_obs: dict[str, Any] | None = None
         self._last_shared = False
         self._seen = np.zeros(self.num_envs, dtype=bool)
-        self._all_seen = False
         # The ids of every sub-environment, in order.
         self._every = list(range(self.num_envs))
 
@@ -409,8 +408,7 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         when they are every sub-environment's (a step), else written into a private copy."""
         if ids == self._every:
             self._last_obs, self._last_shared = batch, True
-            if not self._all_seen:
-                self._seen[:] = self._all_seen = True
+            self._seen[:] = True
             return
         if self._last_obs is None:
             self._last_obs = {k: _zeros_like(v, self.num_envs) for k, v in batch.items()}

@@ -5,12 +5,12 @@
 //!
 //! This runs on the calling thread while the worker threads wait for the next batch, so it is
 //! kept lean: the fixed keys are interned Python strings, every array but the images is copied
-//! into memory numpy owns (one Python object each; the images' buffers are handed over), and the
+//! into memory numpy owns (the images' buffers are handed over), and the
 //! masks of a batch are one read-only all-true array (every sub-environment of a batch gives
 //! every key).
 
 use macrotree::env::StepResult;
-use numpy::{Element, IntoPyArray, IxDyn, PyArray, PyArray1, PyArrayMethods};
+use numpy::{Element, IntoPyArray, PyArray1, PyArrayMethods};
 use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
@@ -68,24 +68,13 @@ fn objects<'py>(py: Python<'py>, values: Vec<Py<PyAny>>) -> Bound<'py, PyAny> {
     PyArray1::from_vec(py, values).into_any()
 }
 
-/// An array of `shape` holding `flat` (row-major; as long as the shape's product), made in one
-/// piece.
+/// The `(rows, width)` array holding `flat` (row-major).
 fn matrix<'py, T: Element + Copy>(
     py: Python<'py>,
-    shape: &[usize],
+    [rows, width]: [usize; 2],
     flat: &[T],
 ) -> PyResult<Bound<'py, PyAny>> {
-    let out = PyArray::<T, IxDyn>::zeros(py, shape, false);
-    // SAFETY: the array was just made here and no other reference to it exists yet.
-    let dst = unsafe { out.as_slice_mut() }?;
-    if dst.len() != flat.len() {
-        return Err(crate::error::value(format!(
-            "a batch column of shape {shape:?} got {} values",
-            flat.len()
-        )));
-    }
-    dst.copy_from_slice(flat);
-    Ok(out.into_any())
+    Ok(PyArray1::from_slice(py, flat).reshape([rows, width])?.into_any())
 }
 
 /// The `(n, width)` float32 array whose row `k` is `row(results[k])`.
@@ -99,7 +88,7 @@ fn rows<'py, R: AsRef<[f32]>>(
         flat.extend_from_slice(row(r).as_ref());
     }
     let width = flat.len().checked_div(results.len()).unwrap_or(0);
-    matrix(py, &[results.len(), width], &flat)
+    matrix(py, [results.len(), width], &flat)
 }
 
 /// The batch `{"obs", "reward", "terminated", "truncated", "info"}` of `results` (one per
@@ -235,7 +224,7 @@ fn info<'py>(py: Python<'py>, results: &[StepResult]) -> PyResult<Bound<'py, PyD
             .iter()
             .flat_map(|r| r.base.as_ref().map_or([f64::NAN; WIDTH], |b| b.command))
             .collect();
-        let base = matrix(py, &[n, WIDTH], &flat)?;
+        let base = matrix(py, [n, WIDTH], &flat)?;
         info.put(key!(py, "base_action"), base)?;
         info.put(
             key!(py, "base_status"),

@@ -146,7 +146,7 @@ pub fn parse_tree_file(v: &Value, issues: &mut Vec<Issue>) -> Option<TreeFile> {
                     k.loc,
                     format!("top-level keys must be names, found {}", k.describe()),
                 )
-                .label("expected `include`, `subtrees` or `main`"),
+                .label(format!("expected {}", list(&TOP_LEVEL_KEYS))),
             ),
         }
     }
@@ -342,7 +342,9 @@ fn parse_subtree_def(name: &str, loc: Loc, v: &Value, issues: &mut Vec<Issue>) -
                         keys_colon(&SUBTREE_KEYS)
                     )),
             ),
-            None => issues.push(Issue::new(k.loc, "keys must be names").label("expected `params` or `root`")),
+            None => issues.push(
+                Issue::new(k.loc, "keys must be names").label(format!("expected {}", list(&SUBTREE_KEYS))),
+            ),
         }
     }
     if !has_root {

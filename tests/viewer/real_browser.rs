@@ -134,12 +134,7 @@ fn live_page_renders_the_scene_and_the_tree_panel() {
     }
     viewer.publish_poses(sim.data(), sim.time());
     let moved = decode_png(&viewer.capture_image(Duration::from_secs(60)).unwrap());
-    let diff = moved
-        .rgb
-        .iter()
-        .zip(&img.rgb)
-        .filter(|(a, b)| a.abs_diff(**b) > 30)
-        .count();
+    let diff = differing_bytes(&moved, &img);
     assert!(
         diff > 500,
         "the robot did not move in the page: {diff} bytes differ"
@@ -189,6 +184,15 @@ fn record_episode(dir: &Path, seconds: f64) -> PathBuf {
     let path = dir.join("replay.html");
     rec.write(&path).unwrap();
     path
+}
+
+/// How many colour bytes of two screenshots of one size differ by more than 30 (of 255).
+fn differing_bytes(a: &Image, b: &Image) -> usize {
+    a.rgb
+        .iter()
+        .zip(&b.rgb)
+        .filter(|(x, y)| x.abs_diff(**y) > 30)
+        .count()
 }
 
 /// The replay bar as JSON: the clock label (`t / duration s`) and whether it plays.
@@ -248,12 +252,7 @@ fn recorded_replay_plays_offline_and_animates() {
     let cl = classify(&late);
     eprintln!("replay late {cl:?}");
     assert_scene_visible(cl, "replay at its end");
-    let diff = early
-        .rgb
-        .iter()
-        .zip(&late.rgb)
-        .filter(|(a, b)| a.abs_diff(**b) > 30)
-        .count();
+    let diff = differing_bytes(&early, &late);
     assert!(diff > 1000, "the replay did not animate: {diff} bytes differ");
     drop(browser);
     let _ = std::fs::remove_dir_all(&dir);
