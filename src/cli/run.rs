@@ -314,7 +314,7 @@ pub fn run(app: &crate::App, args: RunArgs) -> Result<(), CliError> {
     };
     if args.record.is_some() {
         // Fail before simulating if the bundle the replay inlines is missing.
-        crate::viewer::page::load_bundle().map_err(|path| {
+        crate::viewer::load_bundle().map_err(|path| {
             CliError::Input(format!(
                 "error: {}",
                 crate::viewer::ViewerError::BundleMissing { path }

@@ -12,17 +12,19 @@
 
 mod guard;
 mod http;
-pub mod limits;
-pub(crate) mod monitor;
-pub(crate) mod observer;
-pub mod page;
-pub(crate) mod panel;
-pub mod proto;
-pub(crate) mod record;
-pub mod scene;
+mod limits;
+mod monitor;
+mod observer;
+mod page;
+mod panel;
+mod proto;
+mod record;
+mod scene;
 mod server;
 mod slots;
-pub(crate) mod tree;
+#[cfg(test)]
+mod tests;
+mod tree;
 
 use std::net::{IpAddr, Ipv4Addr, SocketAddr, TcpListener};
 use std::path::PathBuf;
@@ -37,6 +39,7 @@ use tungstenite::Bytes;
 pub use limits::ServerLimits;
 pub use monitor::{BreakSpec, BreakWhen, ForcedRecord, Monitor, MonitorCommand};
 pub use observer::{PUBLISH_HZ, ViewObserver, tree_view};
+pub use page::{BUNDLE_ENV, bundle_help, bundle_path, load_bundle};
 pub use panel::{EVENT_HISTORY, TreeNodeView};
 pub use record::Recorder;
 pub use scene::SceneLayout;

@@ -7,10 +7,6 @@
 use rmpv::Value;
 use tungstenite::Bytes;
 
-/// msgpack-lite ext code of a `Uint8Array` (little-endian raw bytes).
-pub const EXT_UINT8: i8 = 0x12;
-/// msgpack-lite ext code of an `Int32Array`.
-pub const EXT_INT32: i8 = 0x15;
 /// msgpack-lite ext code of a `Uint32Array`.
 pub const EXT_UINT32: i8 = 0x16;
 /// msgpack-lite ext code of a `Float32Array`.
@@ -247,20 +243,4 @@ pub fn mat_mul(a: &Mat4, b: &Mat4) -> Mat4 {
 pub fn color_hex(rgb: [f32; 3]) -> u32 {
     let c = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u32;
     (c(rgb[0]) << 16) | (c(rgb[1]) << 8) | c(rgb[2])
-}
-
-/// Reads `(type, path)` from an encoded command (for the scene tree and tests).
-pub fn peek_type_path(value: &Value) -> (Option<&str>, Option<&str>) {
-    let mut ty = None;
-    let mut path = None;
-    if let Value::Map(fields) = value {
-        for (k, v) in fields {
-            match k.as_str() {
-                Some("type") => ty = v.as_str(),
-                Some("path") => path = v.as_str(),
-                _ => {}
-            }
-        }
-    }
-    (ty, path)
 }

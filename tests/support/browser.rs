@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use macrotree::viewer::page;
+use macrotree::viewer::{bundle_help, load_bundle};
 use tungstenite::{Message, WebSocket};
 
 pub const CHROMIUM: &str = "/usr/bin/chromium";
@@ -26,8 +26,8 @@ pub fn browser_check(chromium: &Path, skip: bool) -> Result<bool, String> {
             "{} is missing: install it (apt-get install chromium)",
             chromium.display()
         )
-    } else if let Err(p) = page::load_bundle() {
-        page::bundle_help(&p)
+    } else if let Err(p) = load_bundle() {
+        bundle_help(&p)
     } else {
         return Ok(true);
     };

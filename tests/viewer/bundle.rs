@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::process::Command;
 
 use macrotree::sim::Scene;
-use macrotree::viewer::{LiveViewer, Recorder, ViewerError, ViewerOptions, page};
+use macrotree::viewer::{BUNDLE_ENV, LiveViewer, Recorder, ViewerError, ViewerOptions, bundle_path};
 
 /// The child's marker: set only in the process [`a_missing_bundle_says_to_run_tools_bootstrap`] starts.
 const CHILD: &str = "MACROTREE_TEST_MISSING_BUNDLE_CHILD";
@@ -18,7 +18,7 @@ fn a_missing_bundle_says_to_run_tools_bootstrap() {
     let out = Command::new(std::env::current_exe().expect("the test binary"))
         .args(["--exact", "bundle::missing_bundle_checked_in_a_child_process"])
         .args(["--ignored", "--nocapture", "--test-threads", "1"])
-        .env(page::BUNDLE_ENV, &missing)
+        .env(BUNDLE_ENV, &missing)
         .env(CHILD, "1")
         .output()
         .expect("starts the test binary");
@@ -38,8 +38,8 @@ fn missing_bundle_checked_in_a_child_process() {
         eprintln!("skipped: run only as a child of a_missing_bundle_says_to_run_tools_bootstrap");
         return;
     }
-    let missing = PathBuf::from(std::env::var_os(page::BUNDLE_ENV).expect("set by the parent"));
-    assert_eq!(page::bundle_path(), missing);
+    let missing = PathBuf::from(std::env::var_os(BUNDLE_ENV).expect("set by the parent"));
+    assert_eq!(bundle_path(), missing);
     let scene = Scene::load().unwrap();
     let opts = ViewerOptions {
         port: 0,

@@ -1,4 +1,4 @@
-//! The viewer: encoding, the websocket hub, the replay page and a real headless Chromium.
+//! The viewer: the websocket hub, the replay page and a real headless Chromium.
 //!
 //! One test binary (`cargo test --release --test viewer`); one file per subject.
 
@@ -7,7 +7,6 @@ mod support;
 
 mod bundle;
 mod cli_view;
-mod encoding;
 mod monitor;
 mod real_browser;
 mod replay_ui;

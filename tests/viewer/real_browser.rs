@@ -18,7 +18,7 @@ use browser::*;
 use macrotree::episode::{EpisodeConfig, NoObserver, run_episode};
 use macrotree::plan::Plan;
 use macrotree::sim::{HOME_Q, Scene, Sim};
-use macrotree::viewer::{LiveViewer, Recorder, TreeNodeView, ViewObserver, ViewerOptions, page};
+use macrotree::viewer::{LiveViewer, Recorder, TreeNodeView, ViewObserver, ViewerOptions, load_bundle};
 use mujoco_rs::prelude::*;
 
 fn demo_tree() -> Vec<TreeNodeView> {
@@ -512,7 +512,7 @@ fn hostile_names_show_as_text_in_the_live_page_and_the_replay() {
 #[test]
 fn a_default_length_episode_replay_stays_under_15_mb() {
     // Sizes only (no browser): 30 s of a moving arm at 30 fps.
-    if page::load_bundle().is_err() {
+    if load_bundle().is_err() {
         assert!(std::env::var_os("CI").is_none(), "bundle missing in CI");
         return;
     }

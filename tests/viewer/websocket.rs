@@ -6,8 +6,9 @@ use std::net::{SocketAddr, TcpStream};
 use std::time::{Duration, Instant};
 
 use macrotree::sim::{HOME_Q, Scene, Sim};
-use macrotree::viewer::proto;
-use macrotree::viewer::{LiveViewer, ServerLimits, TreeNodeView, ViewerError, ViewerOptions, page};
+use macrotree::viewer::{
+    LiveViewer, ServerLimits, TreeNodeView, ViewerError, ViewerOptions, bundle_help, load_bundle,
+};
 use tungstenite::{Message, WebSocket};
 
 type Client = WebSocket<TcpStream>;
@@ -30,7 +31,7 @@ fn start_with(scene: &Scene, limits: ServerLimits) -> Option<LiveViewer> {
     match LiveViewer::start(&scene.model, &opts) {
         Ok(v) => Some(v),
         Err(ViewerError::BundleMissing { path }) if std::env::var_os("CI").is_none() => {
-            eprintln!("SKIPPED: {}", page::bundle_help(&path));
+            eprintln!("SKIPPED: {}", bundle_help(&path));
             None
         }
         Err(e) => panic!("{e}"),
@@ -57,8 +58,24 @@ fn page_request(addr: SocketAddr) -> tungstenite::handshake::client::Request {
 /// A decoded server message.
 #[derive(Debug)]
 enum Msg {
-    Cmd { ty: String, path: String, raw: Vec<u8> },
+    Cmd(Cmd),
     Text(serde_json::Value),
+}
+
+/// A decoded MeshCat command.
+#[derive(Debug)]
+struct Cmd {
+    /// `type`, e.g. `set_transform`.
+    ty: String,
+    /// `path` (empty when the command has none).
+    path: String,
+    /// `matrix` of a `set_transform`: 16 column-major numbers.
+    matrix: Option<Vec<f64>>,
+}
+
+/// A string field of a msgpack map.
+fn field<'a>(map: &'a [(rmpv::Value, rmpv::Value)], key: &str) -> Option<&'a rmpv::Value> {
+    map.iter().find(|(k, _)| k.as_str() == Some(key)).map(|(_, v)| v)
 }
 
 fn recv(ws: &mut Client) -> Msg {
@@ -66,12 +83,16 @@ fn recv(ws: &mut Client) -> Msg {
         match ws.read().expect("message") {
             Message::Binary(b) => {
                 let value = rmpv::decode::read_value(&mut &b[..]).unwrap();
-                let (ty, path) = proto::peek_type_path(&value);
-                return Msg::Cmd {
-                    ty: ty.unwrap().to_owned(),
-                    path: path.unwrap_or("").to_owned(),
-                    raw: b.to_vec(),
-                };
+                let map = value.as_map().expect("a command is a msgpack map");
+                let text = |key| field(map, key).and_then(rmpv::Value::as_str).map(str::to_owned);
+                let matrix = field(map, "matrix")
+                    .and_then(rmpv::Value::as_array)
+                    .map(|a| a.iter().map(|v| v.as_f64().expect("float64 entries")).collect());
+                return Msg::Cmd(Cmd {
+                    ty: text("type").expect("a command has a type"),
+                    path: text("path").unwrap_or_default(),
+                    matrix,
+                });
             }
             Message::Text(t) => return Msg::Text(serde_json::from_str(t.as_str()).unwrap()),
             _ => {}
@@ -80,22 +101,34 @@ fn recv(ws: &mut Client) -> Msg {
 }
 
 /// Reads binary commands (skipping text frames) until `n` were read.
-fn recv_cmds(ws: &mut Client, n: usize) -> Vec<(String, String, Vec<u8>)> {
+fn recv_cmds(ws: &mut Client, n: usize) -> Vec<Cmd> {
     let mut out = Vec::new();
     while out.len() < n {
-        if let Msg::Cmd { ty, path, raw, .. } = recv(ws) {
-            out.push((ty, path, raw));
+        if let Msg::Cmd(cmd) = recv(ws) {
+            out.push(cmd);
         }
     }
     out
 }
 
-fn expected_transform(path: &str, data_xpos: [f64; 3], xmat: [f64; 9]) -> Vec<u8> {
-    proto::encode(&proto::set_transform(
-        path,
-        &proto::mat_from_pos_xmat(data_xpos, xmat),
-    ))
-    .to_vec()
+/// The `set_transform` a body at `xpos` with MuJoCo's row-major `xmat` must get: three.js's
+/// column-major 4×4 matrix.
+fn expected_transform(path: &str, xpos: [f64; 3], xmat: [f64; 9]) -> Cmd {
+    let x = xmat;
+    let matrix = vec![
+        x[0], x[3], x[6], 0.0, x[1], x[4], x[7], 0.0, x[2], x[5], x[8], 0.0, xpos[0], xpos[1], xpos[2], 1.0,
+    ];
+    Cmd {
+        ty: "set_transform".into(),
+        path: path.into(),
+        matrix: Some(matrix),
+    }
+}
+
+impl PartialEq for Cmd {
+    fn eq(&self, other: &Self) -> bool {
+        (&self.ty, &self.path, &self.matrix) == (&other.ty, &other.path, &other.matrix)
+    }
 }
 
 /// Moves the arm so that every step changes the poses.
@@ -129,7 +162,7 @@ fn late_joiner_gets_the_latest_snapshot_then_live_frames() {
 
     let mut a = connect(v.local_addr());
     let snapshot = recv_cmds(&mut a, expected);
-    let count = |ty: &str, path: &str| snapshot.iter().filter(|(t, p, _)| t == ty && p == path).count();
+    let count = |ty: &str, path: &str| snapshot.iter().filter(|c| c.ty == ty && c.path == path).count();
     for g in &layout.geoms {
         assert_eq!(count("set_object", &g.path), 1, "{}", g.path);
     }
@@ -154,7 +187,7 @@ fn late_joiner_gets_the_latest_snapshot_then_live_frames() {
         d.xpos()[shoulder],
         d.xmat()[shoulder],
     );
-    assert!(snapshot.iter().any(|(_, _, raw)| raw == &latest));
+    assert!(snapshot.contains(&latest));
     assert!(v.wait_for_clients(1, Duration::from_secs(5)));
 
     // Live frames follow, only for bodies that moved; a second browser gets them too.
@@ -173,9 +206,9 @@ fn late_joiner_gets_the_latest_snapshot_then_live_frames() {
     );
     for ws in [&mut a, &mut b] {
         let frame = recv_cmds(ws, 1);
-        assert_eq!(frame[0].0, "set_transform");
+        assert_eq!(frame[0].ty, "set_transform");
         let mut seen = frame;
-        while !seen.iter().any(|(_, _, raw)| raw == &next) {
+        while !seen.contains(&next) {
             seen.extend(recv_cmds(ws, 1));
             assert!(
                 seen.len() <= drawn.len(),
@@ -184,7 +217,7 @@ fn late_joiner_gets_the_latest_snapshot_then_live_frames() {
         }
         assert!(
             seen.iter()
-                .all(|(t, p, _)| t == "set_transform" && p != "/mujoco/world")
+                .all(|c| c.ty == "set_transform" && c.path != "/mujoco/world")
         );
     }
 
@@ -255,11 +288,11 @@ fn a_stalled_reader_gets_coalesced_poses_and_never_blocks_the_sim() {
     let mut shoulder_msgs = 0u64;
     let mut total = 0usize;
     loop {
-        let (_, path, raw) = recv_cmds(&mut ws, 1).remove(0);
+        let cmd = recv_cmds(&mut ws, 1).remove(0);
         total += 1;
-        if path == layout.body_paths[shoulder] {
+        if cmd.path == layout.body_paths[shoulder] {
             shoulder_msgs += 1;
-            if raw == last {
+            if cmd == last {
                 break;
             }
         }
@@ -322,10 +355,10 @@ fn http_serves_the_page_the_bundle_and_a_download() {
     assert!(page.contains("macrotree.live()") && page.contains("/main.min.js"));
     let (head, body) = http_get(addr, "/main.min.js");
     assert!(head.starts_with("HTTP/1.1 200") && head.contains("javascript"));
-    assert_eq!(body, page::load_bundle().unwrap().to_vec());
+    assert_eq!(body, load_bundle().unwrap().to_vec());
     let (head, body) = http_get(addr, "/viewer.js");
     assert!(head.starts_with("HTTP/1.1 200"));
-    assert_eq!(body, page::PAGE_JS.as_bytes());
+    assert_eq!(body, include_bytes!("../../assets/viewer/viewer.js"));
     let (head, _) = http_get(addr, "/nope");
     assert!(head.starts_with("HTTP/1.1 404"));
     let (head, body) = http_get(addr, "/download");
@@ -380,7 +413,7 @@ fn tree_panel_and_capture_replies_travel_as_text_frames() {
     // capture_image goes to one client, whose text reply is decoded.
     let answer = std::thread::spawn(move || {
         loop {
-            if let Msg::Cmd { ty, .. } = recv(&mut ws)
+            if let Msg::Cmd(Cmd { ty, .. }) = recv(&mut ws)
                 && ty == "capture_image"
             {
                 let reply = r#"{"type":"img","data":"data:image/png;base64,AAEC"}"#;
@@ -530,7 +563,7 @@ fn a_client_sending_a_large_message_is_dropped_and_the_server_stays_healthy() {
     let scene = Scene::load().unwrap();
     let Some(v) = start(&scene) else { return };
     let addr = v.local_addr();
-    let limit = macrotree::viewer::limits::MAX_CLIENT_MESSAGE;
+    let limit = ServerLimits::DEFAULT.max_client_message;
     let mut ws = connect(addr);
     assert!(v.wait_for_clients(1, Duration::from_secs(5)));
     // The client reads the scene first: its thread polls input between writes.
@@ -633,10 +666,10 @@ fn a_capture_answer_may_exceed_the_message_limit() {
         let b64 = base64::engine::general_purpose::STANDARD.encode(&png);
         format!(r#"{{"type":"img","data":"data:image/png;base64,{b64}"}}"#)
     };
-    assert!(answer.len() > 10 * macrotree::viewer::limits::MAX_CLIENT_MESSAGE);
+    assert!(answer.len() > 10 * ServerLimits::DEFAULT.max_client_message);
     let replier = std::thread::spawn(move || {
         loop {
-            if let Msg::Cmd { ty, .. } = recv(&mut ws)
+            if let Msg::Cmd(Cmd { ty, .. }) = recv(&mut ws)
                 && ty == "capture_image"
             {
                 ws.send(Message::text(answer)).unwrap();
@@ -833,7 +866,7 @@ fn measure_how_long_a_stalled_reader_is_held() {
     eprintln!(
         "a reader that stalled after 4 messages was dropped after {:?} (limit {:?}, still connected: {})",
         stalled.elapsed(),
-        macrotree::viewer::limits::MAX_CLIENT_LAG,
+        ServerLimits::DEFAULT.max_client_lag,
         v.client_count()
     );
 }

@@ -1,9 +1,9 @@
 //! Unit tests of the viewer's encoding and scene logic (no sockets, no browser).
 
-use macrotree::sim::{Scene, Sim};
-use macrotree::viewer::proto::{self, EXT_FLOAT32, EXT_UINT32};
-use macrotree::viewer::scene::{self, GeomView, SceneLayout, Shape};
-use macrotree::viewer::{Recorder, SceneTree, initial_tree, page};
+use super::proto::{self, EXT_FLOAT32, EXT_UINT32};
+use super::scene::{self, GeomView, SceneLayout, Shape};
+use super::{Recorder, SceneTree, initial_tree, page};
+use crate::sim::{Scene, Sim};
 use mujoco_rs::prelude::*;
 use rmpv::Value;
 
@@ -417,7 +417,7 @@ fn recorder_subsamples_moving_bodies_into_one_animation() {
     let scene = Scene::load().unwrap();
     let mut sim = Sim::new(&scene);
     let mut rec = Recorder::new(&scene.model);
-    let mut q = macrotree::sim::HOME_Q;
+    let mut q = crate::sim::HOME_Q;
     q[0] += 0.6;
     sim.set_arm_ctrl(&q);
     rec.frame(sim.data(), sim.time());
