@@ -43,6 +43,7 @@ pub fn register(path: &Path, dir: bool) -> Registered {
 }
 
 /// Removes every registered path (the signal handler's clean-up before the process exits).
+#[cfg(feature = "cli")]
 pub fn remove_all() {
     let taken = match LIVE.lock() {
         Ok(mut live) => live.take().unwrap_or_default(),

@@ -10,7 +10,7 @@
 //! | layer | module | what it holds | MuJoCo? |
 //! |---|---|---|---|
 //! | 0 | [`motion`] | UR5e kinematics, closed-form IK, trajectories, gripper calibration | no |
-//! | 0 | [`cleanup`] | temporary files and staging folders removed on exit, on SIGINT/SIGTERM, or by a later run | no |
+//! | 0 | `cleanup` | temporary files and staging folders removed on exit, on SIGINT/SIGTERM, or by a later run | no |
 //! | 1 | [`output`] | safe output files (every file the CLI writes) | no |
 //! | 0 | `failure` | typed failures: a stable kind, a message, the node, the cause | no |
 //! | 1 | [`yaml`] | located YAML: values with file:line:column, typed reads, diagnostics, units | no |
@@ -161,7 +161,7 @@ pub use kinds::{Category, ParamError, Params, Registry};
 pub mod actions;
 #[cfg(feature = "sim")]
 mod app;
-pub mod cleanup;
+mod cleanup;
 #[cfg(feature = "cli")]
 pub mod cli;
 #[cfg(feature = "sim")]
