@@ -7,8 +7,9 @@
 //! package's target folder, the same compiler, `Cargo.lock`, dependency features and release
 //! profile, so that every dependency of macrotree is reused. macrotree itself is compiled once
 //! more as a dependency (cargo's hash of a path dependency includes its place relative to the
-//! workspace root): 1.5 to 3 min on 2 busy cores after macrotree's sources change, 2.6 s when
-//! they have not. Nothing is downloaded (`--offline`).
+//! workspace root), unoptimised as a user's debug build compiles a path dependency: 35 s on 2
+//! cores after macrotree's sources change (132 s at the release profile's opt-level 3), 2.6 s
+//! when they have not. Nothing is downloaded (`--offline`).
 
 use crate::support::cli;
 
@@ -134,12 +135,13 @@ fn a_dependent_crate_builds_and_runs_with_only_the_documented_setup() {
              # Only so that this test shares the artifacts of macrotree's own test build (not\n\
              # needed by users): the workspace's dev-dependencies and the crates whose features\n\
              # the Python extension's dependencies add, for the same features of the shared\n\
-             # dependencies; its feature resolver and release profile.\n\
+             # dependencies; its feature resolver and release profile. macrotree itself\n\
+             # unoptimised, as in a debug build (it is compiled again either way).\n\
              jsonschema = {{ version = \"=0.61.2\", default-features = false }}\npng = \"=0.18.1\"\n\
              matrixmultiply = {{ version = \"=0.3.11\", features = [\"cgemm\"] }}\n\
              num-complex = \"=0.4.6\"\nnum-integer = \"=0.1.47\"\n\
              portable-atomic = {{ version = \"=1.15.0\", features = [\"require-cas\"] }}\n\n\
-             [profile.release]\ndebug = \"line-tables-only\"\n\n[workspace]\nresolver = \"1\"\n"
+             [profile.release]\ndebug = \"line-tables-only\"\n\n[profile.release.package.macrotree]\nopt-level = 0\ndebug = false\n\n[workspace]\nresolver = \"1\"\n"
         ),
     )
     .unwrap();
