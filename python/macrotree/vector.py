@@ -430,9 +430,9 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         terminated: np.ndarray = batch["terminated"]
         truncated: np.ndarray = batch["truncated"]
         info: dict[str, Any] = batch["info"]
-        done = terminated | truncated
-        if self.autoreset_mode == AutoresetMode.SAME_STEP and done.any():
-            ended = [int(k) for k in np.flatnonzero(done)]
+        # ``ended``: whether any sub-environment terminated or was truncated (from the extension).
+        if batch["ended"] and self.autoreset_mode == AutoresetMode.SAME_STEP:
+            ended = [int(k) for k in np.flatnonzero(terminated | truncated)]
             # Gymnasium 1.x: ``final_obs`` an object array, ``final_info`` the ended
             # sub-environments' infos batched like any info (``final_info["is_success"]`` and its
             # mask ``final_info["_is_success"]``), each with its ``_key`` mask.

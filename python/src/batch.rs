@@ -91,7 +91,7 @@ fn rows<'py, R: AsRef<[f32]>>(
     matrix(py, [results.len(), width], &flat)
 }
 
-/// The batch `{"obs", "reward", "terminated", "truncated", "info"}` of `results` (one per
+/// The batch `{"obs", "reward", "terminated", "truncated", "info", "ended"}` of `results` (one per
 /// sub-environment stepped, in order) with their camera images `pixels`.
 pub fn batch<'py>(
     py: Python<'py>,
@@ -138,6 +138,11 @@ pub fn batch<'py>(
         array(py, results.iter().map(|r| r.truncated)),
     )?;
     out.set_item(intern!(py, "info"), info(py, results)?)?;
+    // Whether any sub-environment ended, so that the common step needs no array reduction.
+    out.set_item(
+        intern!(py, "ended"),
+        results.iter().any(|r| r.terminated || r.truncated),
+    )?;
     Ok(out)
 }
 
