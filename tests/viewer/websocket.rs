@@ -63,7 +63,7 @@ enum Msg {
 }
 
 /// A decoded MeshCat command.
-#[derive(Debug)]
+#[derive(Debug, PartialEq)]
 struct Cmd {
     /// `type`, e.g. `set_transform`.
     ty: String,
@@ -73,7 +73,7 @@ struct Cmd {
     matrix: Option<Vec<f64>>,
 }
 
-/// A string field of a msgpack map.
+/// A field of a msgpack map.
 fn field<'a>(map: &'a [(rmpv::Value, rmpv::Value)], key: &str) -> Option<&'a rmpv::Value> {
     map.iter().find(|(k, _)| k.as_str() == Some(key)).map(|(_, v)| v)
 }
@@ -122,12 +122,6 @@ fn expected_transform(path: &str, xpos: [f64; 3], xmat: [f64; 9]) -> Cmd {
         ty: "set_transform".into(),
         path: path.into(),
         matrix: Some(matrix),
-    }
-}
-
-impl PartialEq for Cmd {
-    fn eq(&self, other: &Self) -> bool {
-        (&self.ty, &self.path, &self.matrix) == (&other.ty, &other.path, &other.matrix)
     }
 }
 
