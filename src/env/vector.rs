@@ -26,8 +26,10 @@ use crate::sim::Scene;
 pub const MAX_ENVS: usize = 1024;
 
 /// How long a worker with nothing to do, or a caller waiting for results, polls before it
-/// sleeps.
-pub const SPIN_WAIT: Duration = Duration::from_micros(200);
+/// sleeps: long enough to span a policy loop's Python between two batches with room to spare (a
+/// `ctrl` step is about 100 µs; docs/python.md has the settings measured). The price: an idle
+/// worker burns up to this much CPU after each step.
+pub const SPIN_WAIT: Duration = Duration::from_micros(500);
 
 /// How often a waiting caller asks its interrupt poll (Ctrl-C) whether to stop.
 pub const INTERRUPT_POLL: Duration = Duration::from_millis(20);
