@@ -315,3 +315,55 @@ fn a_policy_tree_records_a_dataset_whose_actions_replay_to_the_same_outcome() {
         );
     }
 }
+
+/// The shipped learned tree with `closing_chunk.onnx` in place of its model: the policy closes
+/// the gripper at home and never holds the cube, so the scripted pick takes over. It must open
+/// the gripper before it descends, or the closed fingers stop on the cube in every attempt.
+#[test]
+fn the_learned_trees_scripted_pick_opens_a_gripper_the_policy_closed() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = crate::support::cli::scratch("learned-tree-closing-policy").join("trees");
+    for sub in ["lib", "policies"] {
+        std::fs::create_dir_all(dir.join(sub)).unwrap();
+    }
+    for file in ["learned_cube_to_bowl.yaml", "lib/learned_pick.yaml"] {
+        std::fs::copy(root.join("trees").join(file), dir.join(file)).unwrap();
+    }
+    std::fs::copy(
+        root.join(FOLDER).join("closing_chunk.onnx"),
+        dir.join("policies/cube_pick.onnx"),
+    )
+    .unwrap();
+    let path = dir.join("learned_cube_to_bowl.yaml");
+    let app = App::new();
+    let plan = app
+        .compile_str(&std::fs::read_to_string(&path).unwrap(), path.to_str().unwrap())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let report = app.run_episode(&plan, &EpisodeConfig::default()).unwrap();
+    assert!(report.outcome.success, "{:?}", report.outcome.failure_reason);
+    let node = |tail: &str| {
+        report
+            .outcome
+            .nodes
+            .iter()
+            .find(|n| n.path.ends_with(tail))
+            .unwrap_or_else(|| panic!("no node {tail}"))
+    };
+    let policy = node("policy[approach and grasp]");
+    assert_eq!(
+        (policy.counts.activations, policy.counts.failures),
+        (1, 1),
+        "the policy ran once and gave up"
+    );
+    let fallback = node("subtree[scripted_pick]");
+    assert_eq!(
+        (fallback.counts.activations, fallback.counts.successes),
+        (1, 1),
+        "the scripted pick held the cube at its first try"
+    );
+    assert!(
+        report.outcome.collisions.is_empty(),
+        "{:?}",
+        report.outcome.collisions
+    );
+}
