@@ -1,24 +1,10 @@
 //! The live server's limits: connections, sizes and waits. Every one is bounded; the defaults
-//! are the constants below, and [`ServerLimits`] lets a caller (or a test) choose others.
+//! are [`ServerLimits::DEFAULT`], and a caller (or a test) may choose others.
 
 use std::time::Duration;
 
-/// Default of [`ServerLimits::max_connections`].
-const MAX_CONNECTIONS: usize = 64;
-/// Default of [`ServerLimits::request_deadline`].
-const REQUEST_DEADLINE: Duration = Duration::from_secs(10);
 /// Largest request head (request line and headers), bytes.
 pub(super) const MAX_REQUEST_HEAD: usize = 16 * 1024;
-/// Default of [`ServerLimits::response_deadline`].
-const RESPONSE_DEADLINE: Duration = Duration::from_secs(60);
-/// Default of [`ServerLimits::max_client_lag`].
-const MAX_CLIENT_LAG: Duration = Duration::from_secs(30);
-/// Default of [`ServerLimits::ping_interval`].
-const PING_INTERVAL: Duration = Duration::from_secs(1);
-/// Default of [`ServerLimits::max_client_message`].
-const MAX_CLIENT_MESSAGE: usize = 4 * 1024;
-/// Default of [`ServerLimits::max_capture_reply`].
-const MAX_CAPTURE_REPLY: usize = 32 << 20;
 
 /// The limits of one live server. Durations are wall time; sizes are bytes. The defaults are
 /// [`ServerLimits::DEFAULT`].
@@ -49,15 +35,15 @@ pub struct ServerLimits {
 }
 
 impl ServerLimits {
-    /// The documented defaults (the constants of this module).
+    /// The defaults documented on each field.
     pub const DEFAULT: Self = Self {
-        max_connections: MAX_CONNECTIONS,
-        request_deadline: REQUEST_DEADLINE,
-        response_deadline: RESPONSE_DEADLINE,
-        max_client_lag: MAX_CLIENT_LAG,
-        ping_interval: PING_INTERVAL,
-        max_client_message: MAX_CLIENT_MESSAGE,
-        max_capture_reply: MAX_CAPTURE_REPLY,
+        max_connections: 64,
+        request_deadline: Duration::from_secs(10),
+        response_deadline: Duration::from_secs(60),
+        max_client_lag: Duration::from_secs(30),
+        ping_interval: Duration::from_secs(1),
+        max_client_message: 4 * 1024,
+        max_capture_reply: 32 << 20,
     };
 }
 
