@@ -183,11 +183,13 @@ class Env:
         sweep_seed: SupportsIndex | None = None,
         placement: dict[str, list[float]] | None = None,
     ) -> dict[str, Any]: ...
-    def step_ctrl(self, /, ctrl: NDArray[np.float64]) -> dict[str, Any]: ...
+    def step_array(self, /, mode: str, values: Any) -> dict[str, Any]:
+        """
+        One control period of an array mode: `mode` `"ctrl"` (19 values), `"setpoint"` (7) or
+        `"residual"` (7), `values` any array of that many real numbers (see `real.rs`).
+        """
     def step_leaf(self, /, text: str) -> dict[str, Any]: ...
     def step_macro(self, /, action: dict[str, Any]) -> dict[str, Any]: ...
-    def step_residual(self, /, residual: NDArray[np.float64]) -> dict[str, Any]: ...
-    def step_setpoint(self, /, setpoint: NDArray[np.float64]) -> dict[str, Any]: ...
     def step_subtree(self, /, name: str) -> dict[str, Any]: ...
     def take_frames(self, /) -> list[NDArray[np.uint8]]:
         """
@@ -250,19 +252,13 @@ class VecEnv:
         placement: dict[str, list[float]] | None = None,
     ) -> list[dict[str, Any]]: ...
     def send(
-        self,
-        /,
-        ids: SupportsGetItem[int, SupportsIndex],
-        actions: list[Any] | tuple[str, NDArray[np.float64]],
+        self, /, ids: SupportsGetItem[int, SupportsIndex], actions: list[Any] | tuple[str, Any]
     ) -> None:
         """
         Starts `actions` on environments `ids` and returns at once.
         """
     def step(
-        self,
-        /,
-        ids: SupportsGetItem[int, SupportsIndex],
-        actions: list[Any] | tuple[str, NDArray[np.float64]],
+        self, /, ids: SupportsGetItem[int, SupportsIndex], actions: list[Any] | tuple[str, Any]
     ) -> dict[str, Any]:
         """
         Steps environments `ids` with `actions` in parallel; the batch of their results, in

@@ -26,7 +26,6 @@ from macrotree.spaces import (
     macro_action_space,
     macro_to_native,
     observation_space,
-    real_array,
     residual_action_space,
     setpoint_action_space,
     with_keys,
@@ -204,18 +203,9 @@ class MacroEnv(gym.Env[Observation, Any]):
         if self.action_mode == "macro":
             result = self._native.step_macro(macro_to_native(action))
         else:
-            values = real_array(action, f"a {self.action_mode} action").reshape(-1)
-            shape = ACTION_MODES[self.action_mode]
-            if values.shape != shape:
-                raise ValueError(
-                    f"a {self.action_mode} action has {shape} values, got shape {values.shape}"
-                )
-            if self.action_mode == "ctrl":
-                result = self._native.step_ctrl(values)
-            elif self.action_mode == "setpoint":
-                result = self._native.step_setpoint(values)
-            else:
-                result = self._native.step_residual(values)
+            # The extension reads any real array of the mode's length and says what is wrong
+            # with any other.
+            result = self._native.step_array(self.action_mode, action)
         return self._unpack(result)
 
     def render(self) -> Any:

@@ -37,7 +37,6 @@ from macrotree.env import (
 from macrotree.spaces import (
     macro_to_native,
     observation_space,
-    real_array,
     with_keys,
 )
 
@@ -366,18 +365,12 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         info["env_id"] = np.asarray(ids, dtype=np.int64)
         return obs, rew, term, trunc, info
 
-    def _native_actions(self, actions: Any, n: int) -> list[Any] | tuple[str, np.ndarray]:
-        """The extension's form of a batch of ``n`` actions: ``(mode, (n, width) array)`` in an
-        array mode (one hand-over for the batch), else a list of single actions."""
-        shape = ACTION_MODES[self.action_mode]
-        if shape is not None:
-            array = real_array(actions, f"{self.action_mode} actions")
-            if array.shape != (n, *shape):
-                raise ValueError(
-                    f"{self.action_mode} actions must have shape ({n}, {shape[0]}), "
-                    f"got {array.shape}"
-                )
-            return (self.action_mode, array)
+    def _native_actions(self, actions: Any, n: int) -> list[Any] | tuple[str, Any]:
+        """The extension's form of a batch of ``n`` actions: ``(mode, values)`` in an array mode
+        (the extension reads any real array of shape ``(n, width)`` in place and says what is
+        wrong with any other), else a list of single actions."""
+        if ACTION_MODES[self.action_mode] is not None:
+            return (self.action_mode, actions)
         if isinstance(actions, dict):
             return [
                 macro_to_native({k: np.asarray(v)[i] for k, v in actions.items()}) for i in range(n)

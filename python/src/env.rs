@@ -4,7 +4,7 @@ use macrotree::env::{Action, MacroEnv, Reset};
 use macrotree::scene::{Placement, Pose};
 use std::sync::{Mutex, MutexGuard};
 
-use numpy::{IntoPyArray, PyArray3, PyArrayMethods, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -263,19 +263,20 @@ impl Env {
         self.step(py, Action::Primitive(p))
     }
 
-    #[pyo3(signature = (ctrl: "NDArray[np.float64]") -> "dict[str, Any]")]
-    fn step_ctrl(&self, py: Python<'_>, ctrl: PyReadonlyArray1<'_, f64>) -> PyResult<Py<PyDict>> {
-        self.step(py, array_action("ctrl", ctrl.as_slice()?)?)
-    }
-
-    #[pyo3(signature = (setpoint: "NDArray[np.float64]") -> "dict[str, Any]")]
-    fn step_setpoint(&self, py: Python<'_>, setpoint: PyReadonlyArray1<'_, f64>) -> PyResult<Py<PyDict>> {
-        self.step(py, array_action("setpoint", setpoint.as_slice()?)?)
-    }
-
-    #[pyo3(signature = (residual: "NDArray[np.float64]") -> "dict[str, Any]")]
-    fn step_residual(&self, py: Python<'_>, residual: PyReadonlyArray1<'_, f64>) -> PyResult<Py<PyDict>> {
-        self.step(py, array_action("residual", residual.as_slice()?)?)
+    /// One control period of an array mode: `mode` `"ctrl"` (19 values), `"setpoint"` (7) or
+    /// `"residual"` (7), `values` any array of that many real numbers (see `real.rs`).
+    #[pyo3(signature = (mode, values: "Any") -> "dict[str, Any]")]
+    fn step_array(&self, py: Python<'_>, mode: &str, values: Bound<'_, PyAny>) -> PyResult<Py<PyDict>> {
+        let n = action_len(mode)?;
+        let what = format!("a {mode} action");
+        let reals = crate::real::reals(&values, &what)?;
+        if reals.values.len() != n {
+            return Err(value(format!(
+                "{what} has {n} values, got shape {}",
+                reals.shape_text()
+            )));
+        }
+        self.step(py, array_action(mode, &reals.values)?)
     }
 
     #[pyo3(signature = (text) -> "dict[str, Any]")]
@@ -353,21 +354,33 @@ impl Env {
     }
 }
 
-/// The action of an array mode: `"ctrl"` (19 values), `"setpoint"` (7) or `"residual"` (7).
+/// The length of each array action mode's action: `ctrl`, `setpoint`, `residual`.
+pub const ACTION_LENGTHS: [(&str, usize); 3] = [
+    ("ctrl", macrotree::motion::COMMAND_LEN),
+    ("setpoint", macrotree::env::SETPOINT_LEN),
+    ("residual", macrotree::env::RESIDUAL_LEN),
+];
+
+/// The number of values of an array mode's action ([`ACTION_LENGTHS`]).
+pub fn action_len(mode: &str) -> PyResult<usize> {
+    ACTION_LENGTHS
+        .iter()
+        .find(|(m, _)| *m == mode)
+        .map(|&(_, n)| n)
+        .ok_or_else(|| {
+            value(format!(
+                "unknown action mode `{mode}`; expected ctrl, setpoint or residual"
+            ))
+        })
+}
+
+/// The action of an array mode from its values `u` ([`ACTION_LENGTHS`] of them).
 pub fn array_action(mode: &str, u: &[f64]) -> PyResult<Action> {
-    let wrong = |n: usize| value(format!("a {mode} action has {n} values, got {}", u.len()));
+    let n = action_len(mode)?;
+    let wrong = || value(format!("a {mode} action has {n} values, got {}", u.len()));
     match mode {
-        "ctrl" => Ok(Action::Ctrl(
-            u.try_into().map_err(|_| wrong(macrotree::motion::COMMAND_LEN))?,
-        )),
-        "setpoint" => Ok(Action::Setpoint(
-            u.try_into().map_err(|_| wrong(macrotree::env::SETPOINT_LEN))?,
-        )),
-        "residual" => Ok(Action::Residual(
-            u.try_into().map_err(|_| wrong(macrotree::env::RESIDUAL_LEN))?,
-        )),
-        other => Err(value(format!(
-            "unknown action mode `{other}`; expected ctrl, setpoint or residual"
-        ))),
+        "ctrl" => Ok(Action::Ctrl(u.try_into().map_err(|_| wrong())?)),
+        "setpoint" => Ok(Action::Setpoint(u.try_into().map_err(|_| wrong())?)),
+        _ => Ok(Action::Residual(u.try_into().map_err(|_| wrong())?)),
     }
 }

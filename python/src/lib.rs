@@ -12,6 +12,7 @@ mod env;
 mod error;
 mod macro_action;
 mod policy;
+mod real;
 mod setup;
 mod vector;
 mod video;
@@ -81,11 +82,7 @@ mod _native {
     const MAX_MACRO_STEPS: u32 = macrotree::env::MAX_MACRO_STEPS;
     /// The length of each array action mode's action: `ctrl`, `setpoint`, `residual`.
     #[pymodule_export]
-    const ACTION_LENGTHS: [(&str, usize); 3] = [
-        ("ctrl", COMMAND_LEN),
-        ("setpoint", macrotree::env::SETPOINT_LEN),
-        ("residual", macrotree::env::RESIDUAL_LEN),
-    ];
+    const ACTION_LENGTHS: [(&str, usize); 3] = crate::env::ACTION_LENGTHS;
     /// The farthest a pose target may be from the robot's base, metres (the UR5e reaches about
     /// 0.85 m plus the gripper; a farther target is refused, a nearer unreachable one fails).
     #[pymodule_export]

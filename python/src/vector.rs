@@ -4,13 +4,14 @@
 use macrotree::env::{Action, Reset};
 use std::sync::Mutex;
 
-use numpy::{PyArray3, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::PyArray3;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use crate::env::{first_camera, image, pixels, reset_of};
+use crate::env::{action_len, array_action, first_camera, image, pixels, reset_of};
 use crate::error::{to_py, value};
 use crate::macro_action;
+use crate::real::reals;
 use crate::setup::{self, Settings};
 use crate::{batch, convert};
 
@@ -23,14 +24,14 @@ pub struct VecEnv {
     image: (u32, u32),
 }
 
-/// An action from Python: a macro dict; `(mode, values)` with `mode` `"ctrl"` (19 float64
-/// values), `"setpoint"` (7) or `"residual"` (7); or `("leaf", text)` (a leaf as YAML or JSON
+/// An action from Python: a macro dict; `(mode, values)` with `mode` `"ctrl"` (19 real
+/// numbers), `"setpoint"` (7) or `"residual"` (7); or `("leaf", text)` (a leaf as YAML or JSON
 /// text) or `("subtree", name)`.
 fn action_of(a: &Bound<'_, PyAny>) -> PyResult<Action> {
     if let Ok(d) = a.cast::<PyDict>() {
         return Ok(Action::Primitive(macro_action::primitive(d)?));
     }
-    let shape = "an action is a macro dict, (mode, float64 values) with mode ctrl, setpoint or residual, \
+    let shape = "an action is a macro dict, (mode, values) with mode ctrl, setpoint or residual, \
                  (\"leaf\", text) or (\"subtree\", name)";
     let (mode, payload): (String, Bound<'_, PyAny>) = a.extract().map_err(|_| value(shape))?;
     match mode.as_str() {
@@ -45,30 +46,43 @@ fn action_of(a: &Bound<'_, PyAny>) -> PyResult<Action> {
             })
         }
         _ => {
-            let array: PyReadonlyArray1<'_, f64> = payload.extract().map_err(|_| value(shape))?;
-            crate::env::array_action(&mode, array.as_slice()?)
+            let n = action_len(&mode)?;
+            let reals = reals(&payload, &format!("a {mode} action"))?;
+            if reals.values.len() != n {
+                return Err(value(format!(
+                    "a {mode} action has {n} values, got shape {}",
+                    reals.shape_text()
+                )));
+            }
+            array_action(&mode, &reals.values)
         }
     }
 }
 
-/// A batch of actions from Python: `(mode, values)` with `mode` `"ctrl"`, `"setpoint"` or
-/// `"residual"` and `values` a float64 array of one row per environment (one borrow for the
-/// batch), or a list of single actions ([`action_of`]).
-fn actions_of(actions: &Bound<'_, PyAny>) -> PyResult<Vec<Action>> {
-    if let Ok((mode, values)) = actions.extract::<(String, PyReadonlyArray2<'_, f64>)>() {
-        let values = values.as_array();
-        return values
-            .rows()
-            .into_iter()
-            .map(|row| match row.as_slice() {
-                Some(u) => crate::env::array_action(&mode, u),
-                None => crate::env::array_action(&mode, &row.to_vec()),
-            })
+/// A batch of `count` actions from Python: `(mode, values)` with `mode` `"ctrl"`, `"setpoint"`
+/// or `"residual"` and `values` an array of real numbers of shape `(count, width)` (any dtype
+/// and strides: see `real.rs`), or a list of single actions ([`action_of`]).
+fn actions_of(actions: &Bound<'_, PyAny>, count: usize) -> PyResult<Vec<Action>> {
+    if let Ok((mode, values)) = actions.extract::<(String, Bound<'_, PyAny>)>()
+        && !values.is_instance_of::<pyo3::types::PyString>()
+    {
+        let width = action_len(&mode)?;
+        let reals = reals(&values, &format!("{mode} actions"))?;
+        if reals.shape != [count, width] {
+            return Err(value(format!(
+                "{mode} actions must have shape ({count}, {width}), got {}",
+                reals.shape_text()
+            )));
+        }
+        return reals
+            .values
+            .chunks_exact(width)
+            .map(|row| array_action(&mode, row))
             .collect();
     }
-    let list = actions.cast::<PyList>().map_err(|_| {
-        value("actions are a list of actions or (mode, float64 array of one row per environment)")
-    })?;
+    let list = actions
+        .cast::<PyList>()
+        .map_err(|_| value("actions are a list of actions or (mode, array of one row per environment)"))?;
     list.iter().map(|a| action_of(&a)).collect()
 }
 
@@ -217,14 +231,14 @@ impl VecEnv {
 
     /// Steps environments `ids` with `actions` in parallel; the batch of their results, in
     /// the order of `ids` (see `batch.rs`).
-    #[pyo3(signature = (ids, actions: "list[Any] | tuple[str, NDArray[np.float64]]") -> "dict[str, Any]")]
+    #[pyo3(signature = (ids, actions: "list[Any] | tuple[str, Any]") -> "dict[str, Any]")]
     fn step<'py>(
         &self,
         py: Python<'py>,
         ids: Vec<usize>,
         actions: Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let actions = actions_of(&actions)?;
+        let actions = actions_of(&actions, ids.len())?;
         let mut v = self.vec()?;
         let e: &mut macrotree::env::VecEnv = &mut v;
         let signals = crate::error::SignalPoll::default();
@@ -235,9 +249,9 @@ impl VecEnv {
     }
 
     /// Starts `actions` on environments `ids` and returns at once.
-    #[pyo3(signature = (ids, actions: "list[Any] | tuple[str, NDArray[np.float64]]"))]
+    #[pyo3(signature = (ids, actions: "list[Any] | tuple[str, Any]"))]
     fn send<'py>(&self, py: Python<'py>, ids: Vec<usize>, actions: Bound<'py, PyAny>) -> PyResult<()> {
-        let actions = actions_of(&actions)?;
+        let actions = actions_of(&actions, ids.len())?;
         let mut v = self.vec()?;
         let e: &mut macrotree::env::VecEnv = &mut v;
         py.detach(|| e.send(&ids, &actions)).map_err(to_py)

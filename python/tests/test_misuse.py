@@ -110,6 +110,41 @@ def test_strided_actions_are_taken_and_complex_ones_refused(data: Path) -> None:
     env.close()
 
 
+def test_actions_of_any_real_dtype_act_as_their_float64_values(data: Path) -> None:
+    env = macrotree.MacroEnv(scene(data), action_mode="setpoint")
+    target = np.concatenate([env.home + 0.01, [0.0]]).astype(np.float32)
+    forms: list[Any] = [
+        target.astype(np.float64),
+        target,  # float32, read in place
+        target.astype(">f8"),  # float64 in the other byte order
+        [float(v) for v in target],
+    ]
+    results = []
+    for form in forms:
+        env.reset(seed=0)
+        obs, *_ = env.step(form)
+        results.append(obs["agent_pos"])
+    for other in results[1:]:
+        assert np.array_equal(other, results[0])
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match=r"a setpoint action has 7 values, got shape \(2, 7\)"):
+        env.step(np.stack([target, target]))
+    vec = macrotree.VectorEnv(scene(data), num_envs=2, action_mode="setpoint")
+    vec.reset(seed=0)
+    batch = np.stack([target, target])
+    out32, *_ = vec.step(batch)
+    vec.reset(seed=0)
+    out64, *_ = vec.step(batch.astype(np.float64))
+    assert np.array_equal(out32["agent_pos"], out64["agent_pos"])
+    assert np.array_equal(out64["agent_pos"][0], results[0])
+    with pytest.raises(ValueError, match=r"must have shape \(2, 7\), got \(3, 7\)"):
+        vec.step(np.stack([target] * 3))
+    with pytest.raises(TypeError, match="real numbers, got <U1"):
+        vec.step(np.full((2, 7), "0"))
+    vec.close()
+    env.close()
+
+
 @pytest.mark.parametrize(("period", "shown"), [(1e-300, "1.000e-300"), (0.003, "0.003")])
 def test_a_control_period_off_the_physics_steps_is_refused_with_the_rule(
     data: Path, period: float, shown: str
