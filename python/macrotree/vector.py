@@ -206,11 +206,11 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self._pending: set[int] = set()
         self._rngs: list[np.random.Generator | None] = [None] * self.num_envs
-        # The last observation of every sub-environment, batched (rows of those never reset are
-        # meaningless until ``_seen``).
+        # The last observation of every sub-environment, batched (rows of those in ``_unseen``,
+        # never reset, are meaningless).
         self._last_obs: dict[str, Any] | None = None
         self._last_shared = False
-        self._seen = np.zeros(self.num_envs, dtype=bool)
+        self._unseen = set(range(self.num_envs))
         # The ids of every sub-environment, in order.
         self._every = list(range(self.num_envs))
 
@@ -390,9 +390,10 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
             infos[i] = dict(r["info"])
         fresh = _stack([with_keys(r["obs"], self.observation_keys) for r in results])
         self._remember(ids, fresh)
-        missing = [int(i) for i in np.flatnonzero(~self._seen)]
-        if missing:
-            raise ValueError(f"environments {missing} were never reset; reset them all first")
+        if self._unseen:
+            raise ValueError(
+                f"environments {sorted(self._unseen)} were never reset; reset them all first"
+            )
         assert self._last_obs is not None
         return _copy(self._last_obs), _batch_infos(infos)
 
@@ -401,7 +402,7 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
         when they are every sub-environment's (a step), else written into a private copy."""
         if ids == self._every:
             self._last_obs, self._last_shared = batch, True
-            self._seen[:] = True
+            self._unseen.clear()
             return
         if self._last_obs is None:
             self._last_obs = {k: _zeros_like(v, self.num_envs) for k, v in batch.items()}
@@ -409,7 +410,7 @@ class VectorEnv(GymVectorEnv[dict[str, Any], Any, Any]):
             self._last_obs = _copy(self._last_obs)
         self._last_shared = False
         _put_rows(self._last_obs, ids, batch)
-        self._seen[ids] = True
+        self._unseen.difference_update(ids)
 
     def _finish(
         self, batch: dict[str, Any]

@@ -5,9 +5,9 @@
 //!
 //! This runs on the calling thread while the worker threads wait for the next batch, so it is
 //! kept lean: the fixed keys are interned Python strings, every array but the images is copied
-//! into memory numpy owns (the images' buffers are handed over), and the
-//! masks of a batch are one read-only all-true array (every sub-environment of a batch gives
-//! every key).
+//! into memory numpy owns (the images' buffers are handed over), and the masks of a batch are
+//! one read-only all-true array (every sub-environment of a batch gives every key), made once
+//! per vector environment for its full batches ([`full_mask`]).
 
 use macrotree::env::StepResult;
 use numpy::{Element, IntoPyArray, PyArray1, PyArrayMethods};
@@ -91,12 +91,22 @@ fn rows<'py, R: AsRef<[f32]>>(
     matrix(py, [results.len(), width], &flat)
 }
 
+/// The read-only all-true `(n,)` mask every key of a batch of `n` shares.
+pub fn full_mask(py: Python<'_>, n: usize) -> PyResult<Bound<'_, PyAny>> {
+    let mask = array(py, std::iter::repeat_n(true, n));
+    mask.getattr(intern!(py, "flags"))?
+        .setattr(intern!(py, "writeable"), false)?;
+    Ok(mask)
+}
+
 /// The batch `{"obs", "reward", "terminated", "truncated", "info", "ended"}` of `results` (one per
-/// sub-environment stepped, in order) with their camera images `pixels`.
+/// sub-environment stepped, in order) with their camera images `pixels`; `mask` is
+/// [`full_mask`] of `results.len()`.
 pub fn batch<'py>(
     py: Python<'py>,
     results: &[StepResult],
     pixels: Vec<Pixels>,
+    mask: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let n = results.len();
     let obs = PyDict::new(py);
@@ -137,7 +147,7 @@ pub fn batch<'py>(
         intern!(py, "truncated"),
         array(py, results.iter().map(|r| r.truncated)),
     )?;
-    out.set_item(intern!(py, "info"), info(py, results)?)?;
+    out.set_item(intern!(py, "info"), info(py, results, mask)?)?;
     // Whether any sub-environment ended, so that the common step needs no array reduction.
     out.set_item(
         intern!(py, "ended"),
@@ -146,12 +156,13 @@ pub fn batch<'py>(
     Ok(out)
 }
 
-fn info<'py>(py: Python<'py>, results: &[StepResult]) -> PyResult<Bound<'py, PyDict>> {
+fn info<'py>(
+    py: Python<'py>,
+    results: &[StepResult],
+    mask: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyDict>> {
     let n = results.len();
-    let mask = array(py, std::iter::repeat_n(true, n));
-    mask.getattr(intern!(py, "flags"))?
-        .setattr(intern!(py, "writeable"), false)?;
-    let info = Columns::new(py, &mask);
+    let info = Columns::new(py, mask);
     let bools = |f: &dyn Fn(&StepResult) -> bool| array(py, results.iter().map(f));
     let floats = |f: &dyn Fn(&StepResult) -> f64| array(py, results.iter().map(f));
     let ints = |f: &dyn Fn(&StepResult) -> i64| array(py, results.iter().map(f));
@@ -169,14 +180,14 @@ fn info<'py>(py: Python<'py>, results: &[StepResult]) -> PyResult<Bound<'py, PyD
         key!(py, "is_success"),
         bools(&|r| !r.goal.is_empty() && r.goal.iter().all(|g| g.holds)),
     )?;
-    let goal = Columns::new(py, &mask);
+    let goal = Columns::new(py, mask);
     if let Some(first) = results.first() {
         for (k, g) in first.goal.iter().enumerate() {
             goal.put_named(&g.predicate, bools(&|r| r.goal.get(k).is_some_and(|x| x.holds)))?;
         }
     }
     info.put(key!(py, "goal"), goal.dict.into_any())?;
-    let grasped = Columns::new(py, &mask);
+    let grasped = Columns::new(py, mask);
     if let Some(first) = results.first() {
         for (k, o) in first.observation.objects.iter().enumerate() {
             grasped.put_named(

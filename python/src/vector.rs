@@ -22,6 +22,8 @@ pub struct VecEnv {
     names: Vec<String>,
     cameras: Vec<String>,
     image: (u32, u32),
+    /// The mask of a batch of every environment (`batch::full_mask`), made once.
+    full_mask: Py<PyAny>,
 }
 
 /// An action from Python: a macro dict; `(mode, values)` with `mode` `"ctrl"` (19 real
@@ -116,7 +118,14 @@ impl VecEnv {
             images.push(px);
             ids.push(i);
         }
-        let out = batch::batch(py, &results, images)?;
+        let built;
+        let mask = if results.len() == v.num_envs() {
+            self.full_mask.bind(py)
+        } else {
+            built = batch::full_mask(py, results.len())?;
+            &built
+        };
+        let out = batch::batch(py, &results, images, mask)?;
         out.set_item("env_id", ids)?;
         Ok(out)
     }
@@ -169,6 +178,7 @@ impl VecEnv {
             names,
             cameras,
             image: image_size,
+            full_mask: batch::full_mask(py, num_envs)?.unbind(),
         })
     }
 
