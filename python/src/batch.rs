@@ -10,12 +10,14 @@
 //! per vector environment for its full batches ([`full_mask`]).
 
 use macrotree::env::StepResult;
-use numpy::{Element, IntoPyArray, PyArray1, PyArrayMethods};
+use numpy::ndarray::ArrayView2;
+use numpy::{Element, IntoPyArray, PyArray1, PyArray2, PyArrayMethods};
 use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 
 use crate::convert::{Pixels, tree_status};
+use crate::error::value;
 
 /// An info key and its mask's key (`_key`), interned.
 macro_rules! key {
@@ -68,13 +70,15 @@ fn objects<'py>(py: Python<'py>, values: Vec<Py<PyAny>>) -> Bound<'py, PyAny> {
     PyArray1::from_vec(py, values).into_any()
 }
 
-/// The `(rows, width)` array holding `flat` (row-major).
+/// The `(rows, width)` array holding `flat` (row-major), copied into one array numpy owns.
 fn matrix<'py, T: Element + Copy>(
     py: Python<'py>,
     [rows, width]: [usize; 2],
     flat: &[T],
 ) -> PyResult<Bound<'py, PyAny>> {
-    Ok(PyArray1::from_slice(py, flat).reshape([rows, width])?.into_any())
+    let view = ArrayView2::from_shape([rows, width], flat)
+        .map_err(|e| value(format!("a batch of {rows} rows of {width}: {e}")))?;
+    Ok(PyArray2::from_array(py, &view).into_any())
 }
 
 /// The `(n, width)` float32 array whose row `k` is `row(results[k])`.
