@@ -267,16 +267,7 @@ impl Env {
     /// `"residual"` (7), `values` any array of that many real numbers (see `real.rs`).
     #[pyo3(signature = (mode, values: "Any") -> "dict[str, Any]")]
     fn step_array(&self, py: Python<'_>, mode: &str, values: Bound<'_, PyAny>) -> PyResult<Py<PyDict>> {
-        let n = action_len(mode)?;
-        let what = format!("a {mode} action");
-        let reals = crate::real::reals(&values, &what)?;
-        if reals.values.len() != n {
-            return Err(value(format!(
-                "{what} has {n} values, got shape {}",
-                reals.shape_text()
-            )));
-        }
-        self.step(py, array_action(mode, &reals.values)?)
+        self.step(py, array_action_of(mode, &values)?)
     }
 
     #[pyo3(signature = (text) -> "dict[str, Any]")]
@@ -372,6 +363,24 @@ pub fn action_len(mode: &str) -> PyResult<usize> {
                 "unknown action mode `{mode}`; expected ctrl, setpoint or residual"
             ))
         })
+}
+
+/// The action of an array mode from Python: `values` any array of real numbers holding the
+/// mode's [`ACTION_LENGTHS`] values, in any shape (see `real.rs`).
+pub fn array_action_of(mode: &str, values: &Bound<'_, PyAny>) -> PyResult<Action> {
+    let n = action_len(mode)?;
+    let what = format!("a {mode} action");
+    let values = crate::real::reals(values, &what, |shape| {
+        if shape.count() == n {
+            Ok(())
+        } else {
+            Err(value(format!(
+                "{what} has {n} values, got shape {}",
+                shape.text()
+            )))
+        }
+    })?;
+    array_action(mode, &values)
 }
 
 /// The action of an array mode from its values `u` ([`ACTION_LENGTHS`] of them).

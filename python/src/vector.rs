@@ -8,7 +8,7 @@ use numpy::PyArray3;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use crate::env::{action_len, array_action, first_camera, image, pixels, reset_of};
+use crate::env::{action_len, array_action, array_action_of, first_camera, image, pixels, reset_of};
 use crate::error::{to_py, value};
 use crate::macro_action;
 use crate::real::reals;
@@ -47,17 +47,7 @@ fn action_of(a: &Bound<'_, PyAny>) -> PyResult<Action> {
                 Action::Subtree(text)
             })
         }
-        _ => {
-            let n = action_len(&mode)?;
-            let reals = reals(&payload, &format!("a {mode} action"))?;
-            if reals.values.len() != n {
-                return Err(value(format!(
-                    "a {mode} action has {n} values, got shape {}",
-                    reals.shape_text()
-                )));
-            }
-            array_action(&mode, &reals.values)
-        }
+        _ => array_action_of(&mode, &payload),
     }
 }
 
@@ -69,15 +59,17 @@ fn actions_of(actions: &Bound<'_, PyAny>, count: usize) -> PyResult<Vec<Action>>
         && !values.is_instance_of::<pyo3::types::PyString>()
     {
         let width = action_len(&mode)?;
-        let reals = reals(&values, &format!("{mode} actions"))?;
-        if reals.shape != [count, width] {
-            return Err(value(format!(
-                "{mode} actions must have shape ({count}, {width}), got {}",
-                reals.shape_text()
-            )));
-        }
-        return reals
-            .values
+        let values = reals(&values, &format!("{mode} actions"), |shape| {
+            if shape.0 == [count, width] {
+                Ok(())
+            } else {
+                Err(value(format!(
+                    "{mode} actions must have shape ({count}, {width}), got {}",
+                    shape.text()
+                )))
+            }
+        })?;
+        return values
             .chunks_exact(width)
             .map(|row| array_action(&mode, row))
             .collect();
