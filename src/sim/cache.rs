@@ -15,8 +15,12 @@
 //! digest is remembered next to the models with each file's size, times, inode and device
 //! ([`model_key_stamped`]); a file whose metadata changed is read again.
 //!
-//! The cache is bounded: it keeps at most [`MAX_MODELS`] models (each scene variant is one, about
-//! 43 MB) and at most [`MAX_BYTES`] of them; writing a new one removes the least recently used
+//! A model derived from a cached one (the cell's collision model, compiled from the cell's model:
+//! `super::collision_model`) is cached beside it under a key of its own ([`derived_key`]): the
+//! key of the model it derives from, what it is, and the source of the code that derives it.
+//!
+//! The cache is bounded: it keeps at most [`MAX_MODELS`] models (each scene variant is two: its
+//! model, about 43 MB, and its collision model, under 1 MB) and at most [`MAX_BYTES`] of them; writing a new one removes the least recently used
 //! beyond that (a model's modification time is set on each use). Temporary files left by a
 //! process that stopped while writing one (any way, `kill -9` included) are removed by the next
 //! write (see [`crate::cleanup`]).
@@ -43,8 +47,9 @@ const HEADER_LEN: usize = 16 + 20 + 8 + 4;
 /// an old model.
 const COMPOSER_SOURCES: [&str; 2] = [include_str!("scene.rs"), include_str!("mjcf.rs")];
 
-/// Most models the cache keeps (least recently used out).
-pub const MAX_MODELS: usize = 16;
+/// Most models the cache keeps (least recently used out): 16 scene variants, each a model and
+/// its collision model.
+pub const MAX_MODELS: usize = 32;
 /// Most bytes of models the cache keeps (least recently used out): 1 GiB.
 pub const MAX_BYTES: u64 = 1 << 30;
 
@@ -141,13 +146,29 @@ fn file_times(_: &std::fs::Metadata) -> String {
     format!("{:?}", std::time::SystemTime::now())
 }
 
+/// Hashes one length-prefixed field (so that no two lists of fields hash alike).
+fn field(h: &mut Sha1, bytes: &[u8]) {
+    h.update((bytes.len() as u64).to_le_bytes());
+    h.update(bytes);
+}
+
+/// The key (40 hex digits) of a model derived from the model cached under `base`: `what` names
+/// the derived model and `sources` are the code that derives it, so that a change to either is
+/// never served an old model.
+pub fn derived_key(base: &str, what: &str, sources: &[&str]) -> String {
+    let mut h = Sha1::new();
+    field(&mut h, b"macrotree derived model v1");
+    field(&mut h, base.as_bytes());
+    field(&mut h, what.as_bytes());
+    for src in sources {
+        field(&mut h, src.as_bytes());
+    }
+    hex(&h.finalize())
+}
+
 /// The key of `scene_mjcf` with the Menagerie files whose digest is `menagerie`.
 fn key_from(scene_mjcf: &str, menagerie: &[u8]) -> String {
     let mut h = Sha1::new();
-    let field = |h: &mut Sha1, bytes: &[u8]| {
-        h.update((bytes.len() as u64).to_le_bytes());
-        h.update(bytes);
-    };
     field(&mut h, b"macrotree compiled model v1");
     field(&mut h, env!("CARGO_PKG_VERSION").as_bytes());
     field(&mut h, mujoco_rs::mujoco_version().as_bytes());
@@ -175,10 +196,6 @@ fn model_files(menagerie: &Path) -> std::io::Result<Vec<(&'static str, PathBuf)>
 /// SHA-1 over the relative path and bytes of every file of the Menagerie model folders.
 fn menagerie_digest(menagerie: &Path) -> std::io::Result<Vec<u8>> {
     let mut h = Sha1::new();
-    let field = |h: &mut Sha1, bytes: &[u8]| {
-        h.update((bytes.len() as u64).to_le_bytes());
-        h.update(bytes);
-    };
     for (model, rel) in model_files(menagerie)? {
         let bytes = std::fs::read(menagerie.join(model).join(&rel))?;
         field(&mut h, model.as_bytes());

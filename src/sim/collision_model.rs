@@ -14,6 +14,9 @@
 //! A checker on this model reports the same pairs as on the whole model, at distances equal to
 //! rounding (the hull is recentred, so the geom's pose is written in another frame); tested in
 //! `collision_tests.rs`.
+//!
+//! Compiling it takes about 21 M instructions (a fifth of a warm `macrotree run`'s start), so it
+//! is kept in the model cache beside the model it derives from (`super::cache::derived_key`).
 
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
@@ -30,6 +33,18 @@ use super::error::SimError;
 /// body a mass and inertia MuJoCo's compiler accepts; nothing collides with it).
 const STAND_IN_RADIUS: f64 = 0.01;
 
+/// The code that derives the collision model from the cell's model, hashed into its cache key.
+const SOURCES: [&str; 2] = [include_str!("collision_model.rs"), include_str!("cell_spec.rs")];
+
+/// Where a collision model is cached: the model cache's folder and the key of the cell's model
+/// it derives from.
+pub(crate) struct CacheSlot {
+    /// The model cache's folder.
+    pub dir: PathBuf,
+    /// The cache key of the cell's model.
+    pub key: String,
+}
+
 /// What a collision model is compiled from, and the model once compiled (lazily: a process that
 /// never plans never compiles it).
 pub(crate) struct CollisionModel {
@@ -37,35 +52,56 @@ pub(crate) struct CollisionModel {
     xml: String,
     ur5e: PathBuf,
     gripper: PathBuf,
+    /// Where it is cached, if the cell's model is.
+    cache: Option<CacheSlot>,
     compiled: OnceLock<Result<Arc<MjModel>, String>>,
 }
 
 impl CollisionModel {
     /// The collision model of the cell `xml` with the UR5e in `ur5e` and the 2F-85 in `gripper`,
-    /// compiled on first use.
-    pub(crate) fn new(xml: &str, ur5e: &Path, gripper: &Path) -> Self {
+    /// read from `cache` or compiled on first use.
+    pub(crate) fn new(xml: &str, ur5e: &Path, gripper: &Path, cache: Option<CacheSlot>) -> Self {
         Self {
             xml: xml.to_string(),
             ur5e: ur5e.to_path_buf(),
             gripper: gripper.to_path_buf(),
+            cache,
             compiled: OnceLock::new(),
         }
     }
 
-    /// The compiled model, shared; compiled by the first caller from the cell's compiled
-    /// `whole` model (its meshes' convex hulls).
+    /// The model, shared; read from the cache or compiled by the first caller from the cell's
+    /// compiled `whole` model (its meshes' convex hulls), then cached.
     ///
     /// # Errors
     /// The compile failed ([`SimError::Scene`], the same every call).
     pub(crate) fn get(&self, whole: &MjModel) -> Result<Arc<MjModel>, SimError> {
         self.compiled
             .get_or_init(|| {
-                compile_collision_model(&self.xml, &self.ur5e, &self.gripper, whole)
+                self.load_or_compile(whole)
                     .map(Arc::new)
                     .map_err(|e| e.to_string())
             })
             .clone()
             .map_err(SimError::Scene)
+    }
+
+    fn load_or_compile(&self, whole: &MjModel) -> Result<MjModel, SimError> {
+        let compile = || compile_collision_model(&self.xml, &self.ur5e, &self.gripper, whole);
+        let Some(slot) = &self.cache else {
+            return compile();
+        };
+        let key = super::cache::derived_key(&slot.key, "collision model", &SOURCES);
+        if let Some(model) = super::cache::load(&slot.dir, &key) {
+            tracing::debug!(%key, "model cache: collision model hit");
+            return Ok(model);
+        }
+        let model = compile()?;
+        match super::cache::store(&slot.dir, &key, &model) {
+            Ok(path) => tracing::debug!(path = %path.display(), "model cache: collision model stored"),
+            Err(e) => tracing::debug!(error = %e, "model cache: collision model not stored"),
+        }
+        Ok(model)
     }
 }
 

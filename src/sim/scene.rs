@@ -13,7 +13,7 @@ use std::sync::Arc;
 use mujoco_rs::prelude::*;
 
 use super::cell_spec::{cell_spec, spec_err};
-use super::collision_model::CollisionModel;
+use super::collision_model::{CacheSlot, CollisionModel};
 use super::error::SimError;
 use super::layout::Layout;
 use crate::scene::{OBJECT_PREFIX, ObjectKind, Placement, Pose, SceneSpec, sample_placement};
@@ -165,14 +165,15 @@ impl Scene {
         // Before the compile: a scene whose placement cannot be drawn is refused, typed.
         let placement = default_placement(spec)?;
         let xml = super::mjcf::cell_mjcf(SCENE_XML, spec);
-        let (model, origin) = match cache {
+        let (model, origin, slot) = match cache {
             Some(dir) => cached_model(&xml, &ur5e, &gripper, menagerie, dir)?,
             None => (
                 Arc::new(compile_model(&xml, &ur5e, &gripper)?),
                 ModelOrigin::Compiled,
+                None,
             ),
         };
-        let collision_model = CollisionModel::new(&xml, &ur5e, &gripper);
+        let collision_model = CollisionModel::new(&xml, &ur5e, &gripper, slot);
         Ok((Self::from_model(model, spec, placement, collision_model)?, origin))
     }
 
@@ -270,7 +271,8 @@ fn remember_model(key: &str, model: &Arc<MjModel>) {
 }
 
 /// The compiled model of `xml` with the Menagerie models, from the cache in `dir` when it holds
-/// this exact model, else compiled and stored there. A cache that cannot be read or written only
+/// this exact model, else compiled and stored there, with where its collision model is cached
+/// (`None` when the model's files cannot be hashed). A cache that cannot be read or written only
 /// costs the compile (logged at debug level).
 fn cached_model(
     xml: &str,
@@ -278,7 +280,7 @@ fn cached_model(
     gripper: &Path,
     menagerie: &Path,
     dir: &Path,
-) -> Result<(Arc<MjModel>, ModelOrigin), SimError> {
+) -> Result<(Arc<MjModel>, ModelOrigin, Option<CacheSlot>), SimError> {
     let key = match super::cache::model_key_stamped(xml, menagerie, dir) {
         Ok(key) => key,
         Err(e) => {
@@ -286,20 +288,27 @@ fn cached_model(
             return Ok((
                 Arc::new(compile_model(xml, ur5e, gripper)?),
                 ModelOrigin::CompiledNotStored,
+                None,
             ));
         }
     };
     // Scenes share a model only through the same cache folder (tests keep theirs apart).
     let live_key = format!("{}\n{key}", dir.display());
+    let slot = || {
+        Some(CacheSlot {
+            dir: dir.to_path_buf(),
+            key: key.clone(),
+        })
+    };
     if let Some(model) = live_model(&live_key) {
         tracing::debug!(%key, "model cache: shared with a live scene");
-        return Ok((model, ModelOrigin::Shared));
+        return Ok((model, ModelOrigin::Shared, slot()));
     }
     if let Some(model) = super::cache::load(dir, &key) {
         tracing::debug!(%key, "model cache: hit");
         let model = Arc::new(model);
         remember_model(&live_key, &model);
-        return Ok((model, ModelOrigin::Cache));
+        return Ok((model, ModelOrigin::Cache, slot()));
     }
     let model = Arc::new(compile_model(xml, ur5e, gripper)?);
     remember_model(&live_key, &model);
@@ -313,7 +322,7 @@ fn cached_model(
             ModelOrigin::CompiledNotStored
         }
     };
-    Ok((model, origin))
+    Ok((model, origin, slot()))
 }
 
 /// Parses the cell `xml`, attaches the UR5e (`ur5e/`) and the 2F-85 at its attachment site

@@ -144,6 +144,55 @@ fn a_corrupt_cache_file_is_ignored_and_replaced() {
     assert_eq!(origin, ModelOrigin::Cache);
 }
 
+/// The `.mjb` files of `dir`, smallest first.
+fn mjb_files(dir: &Path) -> Vec<std::path::PathBuf> {
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "mjb"))
+        .collect();
+    files.sort_by_key(|p| std::fs::metadata(p).unwrap().len());
+    files
+}
+
+/// `model` in MuJoCo's binary format.
+fn mjb(model: &mujoco_rs::prelude::MjModel) -> Vec<u8> {
+    let mut bytes = vec![0u8; model.size()];
+    model.save_to_buffer(&mut bytes).unwrap();
+    bytes
+}
+
+#[test]
+fn the_collision_model_is_cached_beside_its_model_and_read_back_the_same() {
+    let dir = scratch("model-cache-collision");
+    let spec = SceneSpec::builtin();
+    let (uncached, _) = Scene::build_with_cache(&spec, &menagerie_dir(), None).unwrap();
+    let compiled = mjb(&uncached.collision_model().unwrap());
+    let (first, _) = cached(&spec, &dir);
+    assert_eq!(mjb_files(&dir).len(), 1, "compiled when first needed, not before");
+    assert_eq!(mjb(&first.collision_model().unwrap()), compiled);
+    let files = mjb_files(&dir);
+    assert_eq!(files.len(), 2, "the model and its collision model");
+    drop(first);
+    let (second, origin) = cached(&spec, &dir);
+    assert_eq!(origin, ModelOrigin::Cache);
+    assert_eq!(mjb(&second.collision_model().unwrap()), compiled);
+    drop(second);
+    // A flipped bit in the collision model's file: compiled again and the file replaced.
+    let mut bytes = std::fs::read(&files[0]).unwrap();
+    let middle = bytes.len() / 2;
+    bytes[middle] ^= 0x40;
+    std::fs::write(&files[0], &bytes).unwrap();
+    let (third, _) = cached(&spec, &dir);
+    assert_eq!(mjb(&third.collision_model().unwrap()), compiled);
+    assert_ne!(
+        std::fs::read(&files[0]).unwrap(),
+        bytes,
+        "the corrupt file is replaced"
+    );
+    assert!(episode(&third).outcome.success);
+}
+
 #[cfg(unix)]
 #[test]
 fn a_changed_menagerie_file_changes_the_key() {
@@ -217,10 +266,14 @@ fn the_command_line_uses_the_cache_and_can_turn_it_off() {
     };
     let first = run(s(&dir));
     assert!(first.status.success());
-    assert!(String::from_utf8_lossy(&first.stderr).contains("model cache: stored"));
+    let log = String::from_utf8_lossy(&first.stderr);
+    assert!(log.contains("model cache: stored"), "{log}");
+    assert!(log.contains("model cache: collision model stored"), "{log}");
     let second = run(s(&dir));
     assert!(second.status.success());
-    assert!(String::from_utf8_lossy(&second.stderr).contains("model cache: hit"));
+    let log = String::from_utf8_lossy(&second.stderr);
+    assert!(log.contains("model cache: hit"), "{log}");
+    assert!(log.contains("model cache: collision model hit"), "{log}");
     let off = run("off");
     assert!(off.status.success());
     assert!(!String::from_utf8_lossy(&off.stderr).contains("model cache"));
