@@ -20,8 +20,9 @@
 //! key of the model it derives from, what it is, and the source of the code that derives it.
 //!
 //! The cache is bounded: it keeps at most [`MAX_MODELS`] models (each scene variant is two: its
-//! model, about 43 MB, and its collision model, under 1 MB) and at most [`MAX_BYTES`] of them; writing a new one removes the least recently used
-//! beyond that (a model's modification time is set on each use). Temporary files left by a
+//! model, about 43 MB, and its collision model, under 1 MB) and at most [`MAX_BYTES`] of them;
+//! writing a new one removes the least recently used beyond that (a model's modification time is
+//! set on each use). Temporary files left by a
 //! process that stopped while writing one (any way, `kill -9` included) are removed by the next
 //! write (see [`crate::cleanup`]).
 //!
